@@ -1,0 +1,72 @@
+"""Parsing user dates and building local clock ranges, with clear errors."""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import pandas as pd
+
+from .errors import HybridtrackError
+
+__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range"]
+
+
+def parse_date(text) -> dt.date:
+    """Parse ``YYYY-MM-DD`` (or pass a date through), refusing dates that do not exist."""
+    if isinstance(text, dt.datetime):
+        return text.date()
+    if isinstance(text, dt.date):
+        return text
+    try:
+        return dt.date.fromisoformat(str(text).strip())
+    except ValueError:
+        raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD") from None
+
+
+def parse_clock(text: str) -> dt.time:
+    """Parse a local clock time ``HH:MM`` (or ``HH:MM:SS``); ``24:00`` means the day's end."""
+    value = str(text).strip()
+    if value in ("24:00", "24:00:00"):
+        return dt.time.max
+    try:
+        return dt.time.fromisoformat(value)
+    except ValueError:
+        raise HybridtrackError(f"clock time {text!r} is not HH:MM") from None
+
+
+def parse_freq(text: str) -> pd.Timedelta:
+    """Parse a positive step such as ``1min``, ``10s`` or ``1h``."""
+    try:
+        step = pd.Timedelta(str(text))
+    except ValueError:
+        raise HybridtrackError(f"step {text!r} is not a duration such as '1min' or '10s'") from None
+    if step <= pd.Timedelta(0):
+        raise HybridtrackError(f"step {text!r} must be positive")
+    return step
+
+
+def _localise(day: dt.date, clock: dt.time, tz: str) -> pd.Timestamp:
+    stamp = pd.Timestamp(dt.datetime.combine(day, clock))
+    # a clock time skipped or repeated by a DST change maps to the first valid instant
+    return stamp.tz_localize(tz, nonexistent="shift_forward", ambiguous=True)
+
+
+def local_range(start_date, tz: str, *, end_date=None, start: str = "00:00", end: str | None = None,
+                freq: str = "1min") -> pd.DatetimeIndex:
+    """Stamps on the local clock of `tz` from `start` on `start_date` up to `end` on `end_date`.
+
+    With no `end`, the range runs to the end of `end_date` (exclusive of the next midnight);
+    `end_date` defaults to `start_date`. Steps are equal in absolute time, so a DST change
+    shows as a jump of the local clock, never as a repeated or missing stamp.
+    """
+    first_day = parse_date(start_date)
+    last_day = parse_date(end_date) if end_date is not None else first_day
+    step = parse_freq(freq)
+    t0 = _localise(first_day, parse_clock(start), tz)
+    if end is None:
+        t1 = _localise(last_day + dt.timedelta(days=1), dt.time(0), tz) - pd.Timedelta(1, "ns")
+    else:
+        t1 = _localise(last_day, parse_clock(end), tz)
+    if t1 < t0:
+        raise HybridtrackError(f"the range ends ({t1}) before it starts ({t0})")
+    return pd.date_range(t0, t1, freq=step)
