@@ -1,0 +1,300 @@
+"""Where each collector must point: pure functions over arrays (``domain.md`` §3).
+
+Frame: x east, y north, z up; the sun's unit vector from altitude α and azimuth γ (from
+north) is ``s = (cos α sin γ, cos α cos γ, sin α)``. Every angle is in degrees. Tracking
+angles are NaN while the sun is below the horizon (altitude < 0).
+
+Single-axis collectors (trough, Fresnel row) share one convention, the literature's: the
+angle is measured in the plane across the axis from the horizon at azimuth
+``axis_azimuth + 90°`` (east for a north-south axis) through the zenith (90°, the stow
+position) to the opposite horizon (180°).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .errors import HybridtrackError
+
+__all__ = [
+    "Collector",
+    "KINDS",
+    "sun_vector",
+    "trough_angle",
+    "tracking_rate",
+    "fresnel_angle",
+    "fresnel_end_loss",
+    "heliostat_normal",
+    "normal_angles",
+    "jack_heights",
+    "THREE_POINT_SUPPORT",
+    "AXIS_AZIMUTH",
+]
+
+#: Named horizontal axes: the angle's 0° faces east for "ns" and north for "ew"
+#: (``domain.md``: an east-west axis tracks north-south "with y in place of x").
+AXIS_AZIMUTH = {"ns": 0.0, "ew": 270.0}
+
+#: The published three-jack layout under a heliostat mirror, (x, y) in metres.
+THREE_POINT_SUPPORT = np.array([[0.0, 1.0], [-0.707, -0.707], [0.707, -0.707]])
+
+
+def _like(template, values: np.ndarray, name: str | None = None):
+    """Return `values` as a Series on the template's index when the template is a Series."""
+    if isinstance(template, pd.Series):
+        return pd.Series(values, index=template.index, name=name)
+    return values
+
+
+def sun_vector(altitude, azimuth) -> np.ndarray:
+    """Unit vectors towards the sun, shape ``(..., 3)`` in (east, north, up)."""
+    a = np.radians(np.asarray(altitude, float))
+    g = np.radians(np.asarray(azimuth, float))
+    return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
+
+
+def _cross_axis_angle(altitude, azimuth, axis_azimuth: float) -> np.ndarray:
+    """Angle of the sun's projection on the plane across a horizontal axis (0-180°)."""
+    s = sun_vector(altitude, azimuth)
+    b = np.radians(axis_azimuth)
+    across = s[..., 0] * np.cos(b) - s[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
+    angle = np.degrees(np.arctan2(s[..., 2], across))
+    return np.where(np.asarray(altitude, float) >= 0.0, angle, np.nan)
+
+
+def trough_angle(altitude, azimuth, axis_azimuth: float | str = 0.0):
+    """Rotation angle of a parabolic trough on a horizontal axis.
+
+    Parameters
+    ----------
+    altitude, azimuth : array_like or pandas.Series
+        Sun altitude and azimuth (from north), degrees.
+    axis_azimuth : float or {"ns", "ew"}
+        Azimuth of the axis, degrees from north; 0 is a north-south axis tracking east-west.
+
+    Returns
+    -------
+    ndarray or pandas.Series
+        ρ in 0-180°: 0 faces the horizon at ``axis_azimuth + 90°`` (east for a north-south
+        axis), 90 the zenith (stow), 180 the opposite horizon. NaN while the sun is down.
+        For a north-south axis ρ = atan2(tan α, sin γ), i.e. 90° + pvlib's
+        ``tracking.singleaxis`` tracker_theta with axis_azimuth 180 and no backtracking.
+    """
+    if isinstance(axis_azimuth, str):
+        if axis_azimuth not in AXIS_AZIMUTH:
+            raise HybridtrackError(f"unknown axis {axis_azimuth!r}; use 'ns', 'ew' or degrees")
+        axis_azimuth = AXIS_AZIMUTH[axis_azimuth]
+    return _like(altitude, _cross_axis_angle(altitude, azimuth, float(axis_azimuth)), "trough_angle")
+
+
+def tracking_rate(angle: pd.Series) -> pd.Series:
+    """Rate of change of a tracking angle, degrees per minute.
+
+    Central differences on the series' own time index (one-sided at the ends), so any
+    regular or irregular sampling works; use a fine step where the peak rate matters.
+    """
+    if not isinstance(angle, pd.Series) or not isinstance(angle.index, pd.DatetimeIndex):
+        raise HybridtrackError("tracking_rate needs a Series on a DatetimeIndex")
+    if len(angle) < 2:
+        raise HybridtrackError("tracking_rate needs at least two samples")
+    minutes = np.asarray((angle.index - angle.index[0]) / pd.Timedelta(minutes=1), float)
+    return pd.Series(np.gradient(angle.to_numpy(float), minutes), index=angle.index, name="rate")
+
+
+def fresnel_angle(altitude, azimuth, d: float, h: float, axis_azimuth: float = 0.0):
+    """Tracking angle of a linear Fresnel mirror row.
+
+    The mirror normal bisects the directions to the sun and to the receiver, in the plane
+    across the row's axis.
+
+    Parameters
+    ----------
+    altitude, azimuth : array_like or pandas.Series
+        Sun position, degrees.
+    d : float
+        Signed lateral distance of the row from the receiver line, metres, positive for a
+        row on the ``axis_azimuth + 90°`` side (east of the receiver for a north-south field).
+    h : float
+        Height of the receiver above the row's pivot, metres (> 0).
+    axis_azimuth : float
+        Azimuth of the row axis, degrees from north.
+
+    Returns
+    -------
+    ndarray or pandas.Series
+        Angle of the mirror normal in the trough convention (90° = mirror horizontal, facing
+        the zenith; below 90° tilted towards the ``axis_azimuth + 90°`` side). NaN at night.
+    """
+    if not h > 0:
+        raise HybridtrackError(f"receiver height h must be positive, got {h!r} m")
+    sun = _cross_axis_angle(altitude, azimuth, axis_azimuth)
+    receiver = np.degrees(np.arctan2(h, -float(d)))
+    return _like(altitude, 0.5 * (sun + receiver), "fresnel_angle")
+
+
+def fresnel_end_loss(altitude, azimuth, d: float, h: float):
+    """End loss of a north-south Fresnel row: how far the reflected light runs past the receiver end.
+
+    ``L_end = f cos α cos γ_s / sqrt(cos²α sin²γ_s + sin²α)`` with ``f = sqrt(d² + h²)`` and
+    γ_s the azimuth from south (east negative); at solar noon it reduces to ``f cot α``.
+
+    Parameters
+    ----------
+    altitude, azimuth : array_like or pandas.Series
+        Sun position, degrees (azimuth from north).
+    d, h : float
+        Row's lateral distance from the receiver line and the receiver's height, metres.
+
+    Returns
+    -------
+    ndarray or pandas.Series
+        Metres; positive means the light is lost past the north end, negative the south end.
+        NaN while the sun is down.
+    """
+    a = np.radians(np.asarray(altitude, float))
+    gs = np.radians(np.asarray(azimuth, float) - 180.0)
+    f = np.hypot(float(d), float(h))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        loss = f * np.cos(a) * np.cos(gs) / np.sqrt((np.cos(a) * np.sin(gs)) ** 2 + np.sin(a) ** 2)
+    return _like(altitude, np.where(a > 0.0, loss, np.nan), "end_loss")
+
+
+def heliostat_normal(altitude, azimuth, aim) -> np.ndarray:
+    """Unit mirror normals of a heliostat reflecting the sun onto an aim point.
+
+    Law of reflection: ``n = (s + r) / |s + r|`` with ``r`` the unit vector from the mirror
+    centre to the aim point.
+
+    Parameters
+    ----------
+    altitude, azimuth : array_like
+        Sun position, degrees.
+    aim : array_like, shape (3,)
+        Aim point relative to the mirror centre, (east, north, up) metres.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Unit normals in (east, north, up); rows of NaN while the sun is down.
+    """
+    target = np.asarray(aim, float)
+    if target.shape != (3,) or not np.all(np.isfinite(target)) or not np.linalg.norm(target) > 0:
+        raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
+    s = np.atleast_2d(sun_vector(altitude, azimuth))
+    bisector = s + target / np.linalg.norm(target)
+    n = bisector / np.linalg.norm(bisector, axis=1, keepdims=True)
+    n[np.atleast_1d(np.asarray(altitude, float)) < 0.0] = np.nan
+    return n
+
+
+def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth (from north, 0-360) and elevation of unit normals ``(N, 3)``, degrees."""
+    n = np.atleast_2d(np.asarray(normals, float))
+    azimuth = np.degrees(np.arctan2(n[:, 0], n[:, 1])) % 360.0
+    elevation = np.degrees(np.arcsin(np.clip(n[:, 2], -1.0, 1.0)))
+    return azimuth, elevation
+
+
+def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
+    """Heights of the jacks of a multi-point support that set a mirror to each normal.
+
+    The mirror plane passes through the centre (height 0), so a jack at horizontal position
+    ``(x_i, y_i)`` stands at ``z_i = -(n_x x_i + n_y y_i) / n_z``.
+
+    Parameters
+    ----------
+    normals : array_like, shape (N, 3)
+        Unit mirror normals in (east, north, up), with n_z > 0.
+    supports : array_like, shape (K, 2)
+        Horizontal jack positions (east, north), metres; the published three-jack layout by
+        default.
+
+    Returns
+    -------
+    ndarray, shape (N, K)
+        Jack heights in metres relative to the mirror centre.
+    """
+    n = np.atleast_2d(np.asarray(normals, float))
+    xy = np.asarray(supports, float)
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise HybridtrackError(f"supports must be (x, y) pairs, got shape {xy.shape}")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return -(n[:, :1] * xy[:, 0] + n[:, 1:2] * xy[:, 1]) / n[:, 2:3]
+
+
+#: The collector kinds the project serves.
+KINDS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
+
+
+@dataclass(frozen=True)
+class Collector:
+    """A collector's kind and geometry: everything needed to turn a sun position into targets.
+
+    Parameters
+    ----------
+    kind : {"trough-ns", "trough-ew", "fresnel", "heliostat"}
+        Parabolic trough on a north-south or east-west horizontal axis, a linear Fresnel
+        mirror row, or a two-axis heliostat.
+    axis_azimuth : float, optional
+        Trough or Fresnel axis azimuth in degrees from north; by default the kind's own
+        (0 for "trough-ns" and "fresnel", 270 for "trough-ew", see `AXIS_AZIMUTH`).
+    row_distance, receiver_height : float
+        Fresnel row: signed lateral distance from the receiver line and receiver height (m).
+    aim : tuple of float
+        Heliostat aim point relative to the mirror centre, (east, north, up) metres; the
+        published tower case by default.
+    """
+
+    kind: str = "trough-ns"
+    axis_azimuth: float | None = None
+    row_distance: float = 5.0
+    receiver_height: float = 10.0
+    aim: tuple[float, float, float] = (0.0, 20.0, 100.0)
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise HybridtrackError(f"unknown collector {self.kind!r}; choose from {', '.join(KINDS)}")
+        if self.kind == "fresnel" and not self.receiver_height > 0:
+            raise HybridtrackError(f"receiver height must be positive, got {self.receiver_height!r} m")
+        if self.kind == "heliostat":
+            heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
+
+    @property
+    def single_axis(self) -> bool:
+        """True for troughs and Fresnel rows, whose target is one angle."""
+        return self.kind != "heliostat"
+
+    @property
+    def axis(self) -> float:
+        """The axis azimuth in effect, degrees from north."""
+        if self.axis_azimuth is not None:
+            return float(self.axis_azimuth)
+        return AXIS_AZIMUTH["ew"] if self.kind == "trough-ew" else AXIS_AZIMUTH["ns"]
+
+    def angles(self, altitude: pd.Series, azimuth: pd.Series) -> pd.DataFrame:
+        """Target angles for a sun path, as a frame on the path's index.
+
+        Single-axis kinds give ``angle`` (degrees, trough convention) and ``rate`` (°/min);
+        a Fresnel row adds ``end_loss`` (m, north-south rows); a heliostat gives
+        ``normal_azimuth``, ``normal_elevation`` and the three ``jack_1..3`` heights (m) of the
+        published support.
+        """
+        out = pd.DataFrame(index=altitude.index)
+        if self.kind == "heliostat":
+            normals = heliostat_normal(altitude.to_numpy(float), azimuth.to_numpy(float), self.aim)
+            out["normal_azimuth"], out["normal_elevation"] = normal_angles(normals)
+            for i, column in enumerate(jack_heights(normals).T, start=1):
+                out[f"jack_{i}"] = column
+            return out
+        if self.kind == "fresnel":
+            out["angle"] = fresnel_angle(altitude, azimuth, self.row_distance, self.receiver_height, self.axis)
+        else:
+            out["angle"] = trough_angle(altitude, azimuth, self.axis)
+        if len(out) > 1:
+            out["rate"] = tracking_rate(out["angle"])
+        if self.kind == "fresnel" and self.axis % 180.0 == 0.0:
+            out["end_loss"] = fresnel_end_loss(altitude, azimuth, self.row_distance, self.receiver_height)
+        return out

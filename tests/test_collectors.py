@@ -1,0 +1,166 @@
+"""Collector geometry against pvlib, the published figures and the law of reflection."""
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from hybridtrack import HybridtrackError
+from hybridtrack.collectors import (
+    THREE_POINT_SUPPORT, Collector, fresnel_angle, fresnel_end_loss, heliostat_normal, jack_heights,
+    normal_angles, sun_vector, tracking_rate, trough_angle,
+)
+from hybridtrack.sun import altitude_azimuth, cooper_declination, solar_position
+from hybridtrack.times import local_range
+
+KUNMING_LATITUDE = 25 + 1 / 60
+DISTANCES = np.arange(2.5, 25.01, 2.5)
+END_LOSS_NOON = [4.810, 5.217, 5.833, 6.600, 7.470, 8.413, 9.406, 10.435, 11.490, 12.565]
+END_LOSS_0700 = [1.135, 1.232, 1.376, 1.558, 1.763, 1.985, 2.219, 2.462, 2.711, 2.965]
+
+
+def sun_on(date, site="nanjing", freq="1min", **window):
+    return solar_position(local_range(date, "Asia/Shanghai", freq=freq, **window), site)
+
+
+@pytest.mark.parametrize("date", ["2013-03-20", "2013-06-21", "2013-12-22"])
+def test_trough_angle_is_90_plus_pvlib_singleaxis(date):
+    sun = sun_on(date)
+    rho = trough_angle(sun.altitude, sun.azimuth)
+    pv = pvlib.tracking.singleaxis(90 - sun.altitude, sun.azimuth, axis_azimuth=180, backtrack=False, max_angle=90)
+    up = sun.altitude > 0
+    np.testing.assert_allclose(rho[up], 90 + pv.tracker_theta[up], atol=1e-9)
+    assert rho[~up].isna().all()
+    assert rho[up].between(0, 180).all()
+
+
+def test_trough_angle_matches_the_published_formula():
+    alt, az = np.array([20.0, 45.0, 70.0]), np.array([100.0, 230.0, 170.0])
+    gamma_s = np.radians(az - 180)  # from south
+    published = np.degrees(np.arctan(np.sin(0 - gamma_s) / np.tan(np.radians(alt))))  # from zenith, east +
+    np.testing.assert_allclose(trough_angle(alt, az), 90 - published, atol=1e-12)
+
+
+def test_east_west_axis_tracks_north_south_with_y_for_x():
+    alt, az = np.array([30.0, 60.0]), np.array([150.0, 200.0])
+    s = sun_vector(alt, az)
+    np.testing.assert_allclose(trough_angle(alt, az, "ew"), np.degrees(np.arctan2(s[:, 2], s[:, 1])))
+    # an axis at azimuth 180 is the north-south axis turned round: the angle mirrors
+    np.testing.assert_allclose(trough_angle(alt, az, 180.0), 180 - trough_angle(alt, az, 0.0))
+
+
+def peak_rate(date, start, end):
+    sun = sun_on(date, freq="5s", start=start, end=end)
+    return tracking_rate(trough_angle(sun.altitude, sun.azimuth)).max()
+
+
+def test_nanjing_trough_rates_at_the_solstices():
+    assert peak_rate("2013-12-22", "11:30", "12:40") == pytest.approx(0.398, abs=0.003)
+    assert peak_rate("2013-06-21", "11:30", "12:40") == pytest.approx(0.232, abs=0.003)
+
+
+def test_winter_solstice_noon_rate_is_the_years_largest():
+    # the rate peaks at solar noon each day; sample every day's noon window at 30 s
+    noons = pd.date_range("2013-01-01 11:50", "2013-12-31 11:50", freq="D", tz="Asia/Shanghai")
+    times = pd.DatetimeIndex(np.concatenate([pd.date_range(t, periods=61, freq="30s") for t in noons]))
+    sun = solar_position(times, "nanjing")
+    angle = trough_angle(sun.altitude, sun.azimuth).to_numpy().reshape(len(noons), 61)
+    daily_peak = pd.Series((np.diff(angle, axis=1) * 2).max(axis=1), index=noons.date)  # °/min
+    assert str(daily_peak.idxmax()) == "2013-12-22"
+    assert daily_peak.max() == pytest.approx(0.398, abs=0.003)
+
+
+def test_end_loss_table_for_kunming_equinox():
+    for hour_angle, row in ((0.0, END_LOSS_NOON), (-75.0, END_LOSS_0700)):
+        alt, az = altitude_azimuth(0.0, hour_angle, KUNMING_LATITUDE)
+        losses = [float(fresnel_end_loss(alt, az, d, 10.0)) for d in DISTANCES]
+        np.testing.assert_allclose(losses, row, atol=0.002)
+
+
+def test_end_loss_at_noon_is_f_cot_alpha_and_signs_the_end():
+    alt, az = altitude_azimuth(0.0, 0.0, KUNMING_LATITUDE)
+    assert float(fresnel_end_loss(alt, az, 5, 10)) == pytest.approx(np.hypot(5, 10) / np.tan(np.radians(alt)))
+    # southern hemisphere: the sun is north at noon, the loss moves to the south end
+    alt_s, az_s = altitude_azimuth(0.0, 0.0, -30.0)
+    assert float(fresnel_end_loss(alt_s, az_s, 5, 10)) < 0
+    assert np.isnan(fresnel_end_loss(-5.0, 90.0, 5, 10))
+
+
+def test_december_loses_about_21_6_m_more_than_june():
+    def noon_loss(day_of_year):
+        alt, az = altitude_azimuth(cooper_declination(day_of_year), 0.0, KUNMING_LATITUDE)
+        return float(fresnel_end_loss(alt, az, 0.0, 20.0))  # f = 20 m
+
+    assert noon_loss(344) - noon_loss(162) == pytest.approx(21.6, abs=0.05)  # 10 Dec, 11 Jun
+
+
+def test_fresnel_normal_bisects_sun_and_receiver():
+    alt, az = np.array([25.0, 50.0, 80.0]), np.array([110.0, 180.0, 250.0])
+    for d in (-7.5, 0.0, 7.5):
+        angle = np.radians(fresnel_angle(alt, az, d, 10.0))
+        normal = np.stack([np.cos(angle), np.sin(angle)], axis=1)  # (across, up)
+        s = sun_vector(alt, az)
+        sun = s[:, [0, 2]] / np.linalg.norm(s[:, [0, 2]], axis=1, keepdims=True)
+        receiver = np.array([-d, 10.0]) / np.hypot(d, 10.0)
+        np.testing.assert_allclose(np.sum(normal * sun, 1), normal @ receiver, atol=1e-12)
+    # rows east and west of the receiver turn differently; a row under it is half the trough
+    assert not np.allclose(fresnel_angle(alt, az, 7.5, 10), fresnel_angle(alt, az, -7.5, 10))
+    np.testing.assert_allclose(fresnel_angle(alt, az, 0, 10), 0.5 * (trough_angle(alt, az) + 90))
+
+
+def test_heliostat_reflects_the_sun_onto_the_aim_point():
+    aim = np.array([0.0, 20.0, 100.0])
+    sun = sun_on("2018-06-21", "delingha", "10min")
+    up = sun[sun.altitude > 0]
+    n = heliostat_normal(up.altitude, up.azimuth, aim)
+    s = sun_vector(up.altitude, up.azimuth)
+    reflected = 2 * np.sum(n * s, axis=1, keepdims=True) * n - s
+    np.testing.assert_allclose(reflected, np.tile(aim / np.linalg.norm(aim), (len(up), 1)), atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0)
+    azimuth, elevation = normal_angles(n)
+    assert (elevation > 0).all() and ((azimuth >= 0) & (azimuth < 360)).all()
+
+
+def test_jacks_rear_pair_equal_at_noon_and_mirror_morning_and_evening():
+    aim = (0.0, 20.0, 100.0)
+    hours = np.array([-60.0, -30.0, 0.0, 30.0, 60.0])
+    alt, az = altitude_azimuth(23.44, hours, 37.352317)
+    z = jack_heights(heliostat_normal(alt, az, aim), THREE_POINT_SUPPORT)
+    noon = z[2]
+    assert noon[1] == pytest.approx(noon[2], abs=1e-12)
+    for morning, evening in ((0, 4), (1, 3)):
+        assert z[morning][0] == pytest.approx(z[evening][0], abs=1e-12)
+        assert z[morning][1] == pytest.approx(z[evening][2], abs=1e-12)
+        assert z[morning][2] == pytest.approx(z[evening][1], abs=1e-12)
+    # each jack head lies in the mirror plane through the centre
+    n = heliostat_normal(alt, az, aim)
+    points = np.concatenate([np.broadcast_to(THREE_POINT_SUPPORT, (5, 3, 2)), z[..., None]], axis=2)
+    np.testing.assert_allclose(np.einsum("nkj,nj->nk", points, n), 0.0, atol=1e-12)
+
+
+def test_published_jack_table_needs_an_unnormalised_receiver_vector():
+    """domain.md §3: the printed table adds (0, 20, 100) un-normalised; we keep the true law."""
+    alt, az = altitude_azimuth(23.44, -45.0, 37.352317)
+    ours = heliostat_normal(alt, az, (0, 20, 100))
+    s = sun_vector(alt, az)[0]
+    swamped = s + np.array([0, 20, 100.0])
+    swamped /= np.linalg.norm(swamped)
+    assert np.degrees(np.arccos(np.clip(ours[0] @ swamped, -1, 1))) > 10  # not a rounding matter
+
+
+def test_collector_spec_gives_targets_for_each_kind():
+    sun = sun_on("2021-06-21", "lanzhou", "10min")
+    assert list(Collector("trough-ns").angles(sun.altitude, sun.azimuth)) == ["angle", "rate"]
+    assert list(Collector("fresnel").angles(sun.altitude, sun.azimuth)) == ["angle", "rate", "end_loss"]
+    assert list(Collector("heliostat").angles(sun.altitude, sun.azimuth)) == [
+        "normal_azimuth", "normal_elevation", "jack_1", "jack_2", "jack_3"]
+    ew = Collector("trough-ew").angles(sun.altitude, sun.azimuth)["angle"]
+    np.testing.assert_allclose(ew, trough_angle(sun.altitude, sun.azimuth, "ew"))
+
+
+@pytest.mark.parametrize("kwargs, message", [({"kind": "dish"}, "unknown collector 'dish'"),
+                                             ({"kind": "fresnel", "receiver_height": 0}, "receiver height"),
+                                             ({"kind": "heliostat", "aim": (0, 0, 0)}, "aim point")])
+def test_bad_collector_geometry_is_refused(kwargs, message):
+    with pytest.raises(HybridtrackError, match=message):
+        Collector(**kwargs)
