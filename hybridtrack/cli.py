@@ -1,0 +1,175 @@
+"""The ``hybridtrack`` command line.
+
+Every command has ``--help``. A mistake a user can make (bad file, column, site, date or
+parameter) prints one line, ``hybridtrack: error: ...``, and exits with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+
+import numpy as np
+import pandas as pd
+
+from . import __version__, sites
+from .errors import HybridtrackError
+
+EXIT_USAGE = 2
+
+_COMMANDS: dict[str, tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = {}
+_HELP: dict[str, str] = {}
+
+
+def command(name: str, help: str, arguments: Callable[[argparse.ArgumentParser], None]):
+    """Register the decorated function as sub-command `name`; `arguments` adds its flags."""
+
+    def register(run):
+        _COMMANDS[name] = (arguments, run)
+        _HELP[name] = help
+        return run
+
+    return register
+
+
+def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None = None) -> None:
+    """``--site NAME`` or ``--lat --lon --tz [--altitude]``."""
+    group = parser.add_argument_group("site", f"a built-in site ({', '.join(sites.names())}) or coordinates")
+    group.add_argument("--site", default=None, help=f"built-in site name{f' (default {default})' if default else ''}")
+    group.add_argument("--lat", type=float, help="latitude, degrees north")
+    group.add_argument("--lon", type=float, help="longitude, degrees east")
+    group.add_argument("--tz", help="IANA time zone of the local clock, e.g. Asia/Shanghai")
+    group.add_argument("--altitude", type=float, default=0.0, help="metres above sea level (with --lat/--lon)")
+    parser.set_defaults(_default_site=default)
+
+
+def site_from_arguments(args: argparse.Namespace) -> sites.Site:
+    """The site the user named, or the one given by coordinates."""
+    coordinates = (args.lat, args.lon, args.tz)
+    if args.site is not None:
+        if any(value is not None for value in coordinates):
+            raise HybridtrackError("give either --site or --lat/--lon/--tz, not both")
+        return sites.get(args.site)
+    if all(value is not None for value in coordinates):
+        return sites.custom(args.lat, args.lon, args.tz, args.altitude)
+    if any(value is not None for value in coordinates):
+        raise HybridtrackError("--lat, --lon and --tz go together; one of them is missing")
+    if args._default_site:
+        return sites.get(args._default_site)
+    raise HybridtrackError("no site: give --site NAME or --lat LAT --lon LON --tz TZ")
+
+
+def add_collector_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--collector`` and the geometry flags of each kind."""
+    from .collectors import KINDS
+
+    group = parser.add_argument_group("collector")
+    group.add_argument("--collector", choices=KINDS, default="trough-ns", help="collector kind (default trough-ns)")
+    group.add_argument("--axis-azimuth", type=float, help="trough/Fresnel axis azimuth, degrees from north")
+    group.add_argument("--row-distance", type=float, default=5.0,
+                       help="Fresnel: signed row distance from the receiver line, m, east positive (default 5)")
+    group.add_argument("--receiver-height", type=float, default=10.0, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--aim", type=float, nargs=3, default=(0.0, 20.0, 100.0), metavar=("E", "N", "U"),
+                       help="heliostat: aim point from the mirror centre, m (default 0 20 100)")
+
+
+def collector_from_arguments(args: argparse.Namespace):
+    """The `Collector` the flags describe."""
+    from .collectors import Collector
+
+    return Collector(args.collector, args.axis_azimuth, args.row_distance, args.receiver_height, tuple(args.aim))
+
+
+# --- sun ------------------------------------------------------------------------------------
+
+
+def _sun_arguments(parser: argparse.ArgumentParser) -> None:
+    add_site_arguments(parser, default="nanjing")
+    parser.add_argument("--date", required=True, help="local date, YYYY-MM-DD")
+    parser.add_argument("--start", default="05:00", help="local start time HH:MM (default 05:00)")
+    parser.add_argument("--end", default="20:00", help="local end time HH:MM (default 20:00)")
+    parser.add_argument("--freq", default="10min", help="step, e.g. 1min, 10s (default 10min)")
+    parser.add_argument("--model", choices=("spa", "plc"), default="spa", help="sun model (default spa)")
+    parser.add_argument("--declination", choices=("wang-liu", "cooper"), default="wang-liu",
+                        help="PLC model: declination series (default wang-liu)")
+    parser.add_argument("--eot", choices=("wang-liu", "lamm"), default="wang-liu",
+                        help="PLC model: equation of time (default wang-liu)")
+    add_collector_arguments(parser)
+    parser.add_argument("--csv", metavar="OUT", help="write the table as CSV instead of printing it")
+    parser.add_argument("--plot", metavar="PNG", help="also draw the sun path and targets")
+
+
+@command("sun", "sun position and collector target angles over a day", _sun_arguments)
+def _sun(args: argparse.Namespace) -> int:
+    from .collectors import Collector
+    from .sun import solar_position
+    from .times import local_range
+
+    site = site_from_arguments(args)
+    collector: Collector = collector_from_arguments(args)
+    times = local_range(args.date, site.tz, start=args.start, end=args.end, freq=args.freq)
+    position = solar_position(times, site, args.model, declination=args.declination, equation_of_time=args.eot)
+    angles = collector.angles(position["altitude"], position["azimuth"])
+    table = pd.concat([position[["altitude", "apparent_altitude", "azimuth", "declination",
+                                 "hour_angle", "equation_of_time"]], angles], axis=1)
+    if args.csv:
+        table.to_csv(args.csv, float_format="%.6f", index_label="time")
+        print(f"wrote {len(table)} rows to {args.csv}")
+    else:
+        shown = table.copy()
+        shown.index = shown.index.strftime("%Y-%m-%d %H:%M:%S")
+        print(shown.round(3).to_string(na_rep="-"))
+    up = position["altitude"] > 0
+    print(f"\n{site.name} ({site.latitude:.4f}°, {site.longitude:.4f}°) {args.date}, "
+          f"model {args.model}, collector {collector.kind}")
+    if up.any():
+        peak = position["altitude"].idxmax()
+        print(f"  sun up in range {up.index[up.to_numpy()][0]:%H:%M}-{up.index[up.to_numpy()][-1]:%H:%M}; "
+              f"highest {position['altitude'].max():.3f}° at {peak:%H:%M:%S}")
+        if "rate" in angles:
+            print(f"  fastest target rate {np.nanmax(np.abs(angles['rate'])):.3f} °/min")
+    else:
+        print("  the sun stays below the horizon in this range")
+    if args.plot:
+        from .report import plot_sun_path, save_figure
+
+        title = f"{site.name} {args.date}: {collector.kind} ({args.model})"
+        print(f"  plot: {save_figure(plot_sun_path(position, angles, title=title), args.plot)}")
+    return 0
+
+
+# --- entry point ----------------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser with every registered command."""
+    parser = argparse.ArgumentParser(
+        prog="hybridtrack",
+        description="Weather-aware hybrid sun tracking for concentrating solar collectors.",
+    )
+    parser.add_argument("--version", action="version", version=f"hybridtrack {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name, (add_arguments, run) in _COMMANDS.items():
+        child = sub.add_parser(name, help=_HELP[name], description=_HELP[name])
+        add_arguments(child)
+        child.set_defaults(_run=run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args._run(args)
+    except HybridtrackError as exc:
+        print(f"hybridtrack: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except OSError as exc:
+        name = f" {exc.filename}" if exc.filename else ""
+        print(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

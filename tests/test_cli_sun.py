@@ -1,0 +1,50 @@
+import pandas as pd
+import pytest
+
+from hybridtrack.cli import main
+
+
+def test_sun_prints_a_table_and_summary(capsys):
+    assert main(["sun", "--site", "nanjing", "--date", "2013-12-22", "--freq", "1h"]) == 0
+    out = capsys.readouterr().out
+    assert "2013-12-22 12:00:00" in out and "highest 35.099" in out and "fastest target rate" in out
+
+
+def test_sun_writes_csv_and_plot(tmp_path):
+    csv, png = tmp_path / "sun.csv", tmp_path / "sun.png"
+    assert main(["sun", "--site", "lanzhou", "--date", "2021-06-21", "--model", "plc", "--collector", "heliostat",
+                 "--csv", str(csv), "--plot", str(png), "--freq", "30min"]) == 0
+    table = pd.read_csv(csv, index_col="time")
+    assert {"altitude", "normal_elevation", "jack_3"} <= set(table.columns)
+    assert len(table) == 31 and png.stat().st_size > 10_000
+
+
+def test_sun_at_coordinates_with_fresnel_geometry(capsys):
+    args = ["sun", "--lat", "-33.9", "--lon", "18.4", "--tz", "Africa/Johannesburg", "--date", "2024-12-21",
+            "--collector", "fresnel", "--row-distance", "-5", "--receiver-height", "8"]
+    assert main(args) == 0
+    assert "end_loss" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--site", "mars", "--date", "2013-06-21"], "unknown site 'mars'"),
+    (["--date", "2013-02-30"], "date '2013-02-30' does not exist"),
+    (["--lat", "95", "--lon", "0", "--tz", "UTC", "--date", "2013-06-21"], "latitude 95.0 is outside"),
+    (["--lat", "30", "--date", "2013-06-21"], "--lat, --lon and --tz go together"),
+    (["--date", "2013-06-21", "--freq", "fast"], "step 'fast' is not a duration"),
+    (["--date", "2013-06-21", "--start", "25:00"], "clock time '25:00' is not HH:MM"),
+])
+def test_sun_bad_input_is_one_line_and_status_2(capsys, args, message):
+    assert main(["sun", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and err.startswith("hybridtrack: error: ")
+
+
+def test_every_command_has_help(capsys):
+    from hybridtrack.cli import _COMMANDS
+
+    for name in _COMMANDS:
+        with pytest.raises(SystemExit) as stop:
+            main([name, "--help"])
+        assert stop.value.code == 0
+        assert "usage: hybridtrack" in capsys.readouterr().out
