@@ -1,0 +1,171 @@
+"""`FuzzyWeatherClassifier`: photocurrent and its variation in, sky score and label out."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .config import FuzzyConfig
+from .engine import CompiledSystem, evaluate_fast, evaluate_skfuzzy
+
+__all__ = ["FuzzyWeatherClassifier", "Explanation", "UNKNOWN", "ENGINES"]
+
+#: The label given when no rule fires or an input is missing.
+UNKNOWN = "unknown"
+ENGINES = ("fast", "skfuzzy", "skfuzzy-scalar")
+
+
+@dataclass(frozen=True)
+class Explanation:
+    """One reading taken apart: normalised inputs, memberships, rule firings, score, label."""
+
+    intensity: float
+    variation: float
+    normalised: tuple[float, float]
+    memberships: dict[str, dict[str, float]]
+    rules: list[dict]
+    score: float
+    weather: str
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict: ``{"score", "weather", "rules", ...}`` (NaN score as None)."""
+        return {
+            "intensity": self.intensity,
+            "variation": self.variation,
+            "normalised": list(self.normalised),
+            "score": None if np.isnan(self.score) else self.score,
+            "weather": self.weather,
+            "memberships": self.memberships,
+            "rules": self.rules,
+        }
+
+    def __str__(self) -> str:
+        lines = [f"score {self.score:.3f} -> {self.weather}" if not np.isnan(self.score)
+                 else f"score undefined (no rule fires) -> {self.weather}"]
+        for var, terms in self.memberships.items():
+            lines.append(f"  {var}: " + ", ".join(f"{t} {m:.3f}" for t, m in terms.items()))
+        lines += [f"  rule {r['rule']}: {r['text']}  fires {r['firing']:.3f}" for r in self.rules]
+        return "\n".join(lines)
+
+
+class FuzzyWeatherClassifier:
+    """Mamdani classifier of the sky from a sun sensor's light (``domain.md`` §4).
+
+    Parameters
+    ----------
+    config : FuzzyConfig, optional
+        The system; the published one by default.
+
+    Examples
+    --------
+    >>> clf = FuzzyWeatherClassifier()
+    >>> clf.classify(246.0, 27.0)
+    'sunny'
+    """
+
+    def __init__(self, config: FuzzyConfig | None = None):
+        self.config = config if config is not None else FuzzyConfig.default()
+        self._system = CompiledSystem(self.config)
+
+    # -- inputs ------------------------------------------------------------------------------
+
+    def normalise(self, intensity, variation) -> np.ndarray:
+        """Raw readings (mA) onto the input universes, clipped: ``10 (P - Pmin)/(Pmax - Pmin)``."""
+        columns = []
+        for var, values in zip(self.config.inputs, (intensity, variation)):
+            lo, hi = var.raw_range
+            u0, u1 = var.universe
+            columns.append(np.clip(u0 + (u1 - u0) * (np.asarray(values, float) - lo) / (hi - lo), u0, u1))
+        return np.stack(np.broadcast_arrays(*columns), axis=-1)
+
+    def _prepare(self, intensity, variation, raw: bool) -> tuple[np.ndarray, tuple]:
+        try:
+            a, b = np.broadcast_arrays(np.asarray(intensity, dtype=float), np.asarray(variation, dtype=float))
+        except (TypeError, ValueError) as exc:
+            raise HybridtrackError(f"intensity and variation must be numbers of matching shape: {exc}") from None
+        if raw:
+            x = self.normalise(a, b)
+        else:
+            x = np.stack([np.clip(a, *self.config.inputs[0].universe), np.clip(b, *self.config.inputs[1].universe)],
+                         axis=-1)
+        return x.reshape(-1, 2), a.shape
+
+    @staticmethod
+    def _wrap(values: np.ndarray, shape: tuple, template, name: str):
+        out = values.reshape(shape)
+        if isinstance(template, pd.Series):
+            return pd.Series(out, index=template.index, name=name)
+        if shape == ():
+            return out.item()
+        return out
+
+    # -- outputs -----------------------------------------------------------------------------
+
+    def score(self, intensity, variation, *, raw: bool = True, engine: str = "fast"):
+        """Crisp weather score(s) in the output universe (0-30); NaN where no rule fires.
+
+        Parameters
+        ----------
+        intensity, variation : float, array_like or pandas.Series
+            Sensor photocurrent and its variation: raw mA when `raw`, else normalised 0-10.
+        raw : bool
+            Whether the inputs are raw readings to normalise with the config's ranges.
+        engine : {"fast", "skfuzzy", "skfuzzy-scalar"}
+            ``fast``: vectorised numpy; ``skfuzzy``: scikit-fuzzy's control API with array
+            inputs (the reference); ``skfuzzy-scalar``: scikit-fuzzy one reading at a time.
+
+        Returns
+        -------
+        float, ndarray or pandas.Series
+            Shaped like the inputs; a Series keeps its index.
+        """
+        x, shape = self._prepare(intensity, variation, raw)
+        if engine == "fast":
+            scores, _ = evaluate_fast(self._system, x)
+        elif engine in ("skfuzzy", "skfuzzy-scalar"):
+            scores = evaluate_skfuzzy(self.config, x, one_at_a_time=engine == "skfuzzy-scalar")
+        else:
+            raise HybridtrackError(f"unknown engine {engine!r}; choose from {', '.join(ENGINES)}")
+        template = intensity if isinstance(intensity, pd.Series) else variation
+        return self._wrap(scores, shape, template, "sky_score")
+
+    def label(self, scores):
+        """Weather label of each score by the config's bands; ``unknown`` for NaN."""
+        values = np.asarray(scores, float)
+        names = np.array([band[0] for band in self.config.bands] + [UNKNOWN], dtype=object)
+        edges = np.array([band[2] for band in self.config.bands[:-1]])
+        index = np.searchsorted(edges, values, side="right")
+        index = np.where(np.isnan(values), len(names) - 1, index)
+        if values.ndim == 0:
+            return str(names[int(index)])
+        labels = names[index]
+        if isinstance(scores, pd.Series):
+            return pd.Series(labels, index=scores.index, name="sky")
+        return labels
+
+    def classify(self, intensity, variation, *, raw: bool = True, engine: str = "fast"):
+        """Weather label(s): ``sunny``, ``cloudy``, ``overcast`` (the bands'), or ``unknown``."""
+        return self.label(self.score(intensity, variation, raw=raw, engine=engine))
+
+    def firing(self, intensity, variation, *, raw: bool = True) -> np.ndarray:
+        """Firing strength of every rule, shape (N, rules)."""
+        x, _ = self._prepare(intensity, variation, raw)
+        return self._system.firing(x)
+
+    def explain(self, intensity: float, variation: float, *, raw: bool = True) -> Explanation:
+        """Take one reading apart: memberships, each rule's firing, score and label."""
+        x, _ = self._prepare(intensity, variation, raw)
+        x = x[:1]
+        score_value, firing = evaluate_fast(self._system, x)
+        mu = self._system.memberships(x)
+        memberships = {var.name: {t: float(m) for t, m in zip(var.term_names, mu[i][0])}
+                       for i, var in enumerate(self.config.inputs)}
+        names = self.config.input_names
+        rules = [{"rule": n, "text": rule.describe(names), "when": rule.conditions, "then": rule.then,
+                  "firing": float(firing[0, n - 1])} for n, rule in enumerate(self.config.rules, start=1)]
+        score_value = float(score_value[0])
+        return Explanation(float(intensity), float(variation), (float(x[0, 0]), float(x[0, 1])),
+                           memberships, rules, score_value, self.label(score_value))

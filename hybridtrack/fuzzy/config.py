@@ -1,0 +1,498 @@
+"""The fuzzy classifier's configuration: inputs, terms, output, rules and label bands.
+
+Parameters follow scikit-fuzzy's argument order (``gaussmf``: mean, sigma; ``gauss2mf``:
+mean1, sigma1, mean2, sigma2; ``trimf``: a, b, c; ``trapmf``: a, b, c, d). MATLAB's ``.fis``
+order differs for the Gaussians; `hybridtrack.fuzzy.fis` converts.
+
+The default is the published system (``domain.md`` §4): intensity 30-300 mA and variation
+0-180 mA, each normalised onto 0-10; Gaussian terms; a triangular output on 0-30; four rules.
+The sigmas are a documented choice, since the publication gives only the shapes. Intensity
+terms use σ = 1.5: a term is down to 0.004 five units from its peak ("nothing left").
+Variation terms use σ = 2.5, the narrowest width at which the published reading
+(200.1 mA, 84.6 mA) is cloudy through the cloudy rule firing (0.106 against the sunny rule's
+0.048) rather than through a near-empty tie. All four published readings then land in their
+classes at least 1.1 score units inside the band.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from ..errors import HybridtrackError
+
+try:  # Python 3.11+
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["Term", "Variable", "Rule", "FuzzyConfig", "SHAPES", "LABELS"]
+
+#: Membership shapes and their parameter counts.
+SHAPES = {"gaussmf": 2, "gauss2mf": 4, "trimf": 3, "trapmf": 4}
+
+#: The weather labels the controller understands, in score order.
+LABELS = ("overcast", "cloudy", "sunny")
+
+
+@dataclass(frozen=True)
+class Term:
+    """A linguistic term: a name and a membership function on its variable's universe."""
+
+    name: str
+    shape: str
+    params: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "params", tuple(float(p) for p in self.params))
+
+    @property
+    def centre(self) -> float:
+        """Where the term peaks (the middle of its plateau for gauss2mf and trapmf)."""
+        p = self.params
+        if self.shape == "gaussmf":
+            return p[0]
+        if self.shape == "trimf":
+            return p[1]
+        return 0.5 * (p[0] + p[2]) if self.shape == "gauss2mf" else 0.5 * (p[1] + p[2])
+
+    def check(self, where: str) -> None:
+        """Raise `HybridtrackError` if the shape or its parameters are invalid."""
+        if self.shape not in SHAPES:
+            raise HybridtrackError(f"{where}: unknown membership type {self.shape!r}; choose from {', '.join(SHAPES)}")
+        if len(self.params) != SHAPES[self.shape]:
+            raise HybridtrackError(
+                f"{where}: {self.shape} takes {SHAPES[self.shape]} parameters, got {len(self.params)}"
+            )
+        if not all(math.isfinite(p) for p in self.params):
+            raise HybridtrackError(f"{where}: parameters must be finite numbers, got {list(self.params)}")
+        p = self.params
+        if self.shape == "gaussmf" and not p[1] > 0:
+            raise HybridtrackError(f"{where}: gaussmf sigma must be positive, got {p[1]}")
+        if self.shape == "gauss2mf":
+            if not (p[1] > 0 and p[3] > 0):
+                raise HybridtrackError(f"{where}: gauss2mf sigmas must be positive, got {p[1]} and {p[3]}")
+            if p[0] > p[2]:
+                raise HybridtrackError(f"{where}: gauss2mf means are inverted ({p[0]} > {p[2]})")
+        if self.shape in ("trimf", "trapmf"):
+            if any(a > b for a, b in zip(p, p[1:])):
+                raise HybridtrackError(f"{where}: {self.shape} parameters must be in order, got {list(p)}")
+            if p[0] == p[-1]:
+                raise HybridtrackError(f"{where}: {self.shape} has zero width, got {list(p)}")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """An input or output variable: its universe, its terms and (inputs) the raw range.
+
+    Parameters
+    ----------
+    name : str
+        ``intensity`` and ``variation`` for the inputs, ``weather`` for the output.
+    universe : tuple of float
+        The normalised universe, (0, 10) for inputs and (0, 30) for the output.
+    terms : tuple of Term
+    raw_range : tuple of float, optional
+        Inputs only: the raw reading mapped linearly onto the universe (clipped), in `unit`.
+    unit : str
+        Unit of the raw reading, e.g. ``"mA"``.
+    """
+
+    name: str
+    universe: tuple[float, float]
+    terms: tuple[Term, ...]
+    raw_range: tuple[float, float] | None = None
+    unit: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "universe", tuple(float(v) for v in self.universe))
+        object.__setattr__(self, "terms", tuple(self.terms))
+        if self.raw_range is not None:
+            object.__setattr__(self, "raw_range", tuple(float(v) for v in self.raw_range))
+
+    def term(self, name: str) -> Term:
+        """The term called `name`."""
+        for term in self.terms:
+            if term.name == name:
+                return term
+        raise HybridtrackError(f"variable {self.name!r} has no term {name!r}; it has {', '.join(self.term_names)}")
+
+    @property
+    def term_names(self) -> tuple[str, ...]:
+        """The names of the terms, in order."""
+        return tuple(term.name for term in self.terms)
+
+    def check(self, where: str) -> None:
+        """Raise `HybridtrackError` if the variable is not usable."""
+        lo, hi = self.universe
+        if len(self.universe) != 2 or not lo < hi:
+            raise HybridtrackError(f"{where}: universe must be [low, high] with low < high, got {list(self.universe)}")
+        if self.raw_range is not None and (len(self.raw_range) != 2 or not self.raw_range[0] < self.raw_range[1]):
+            raise HybridtrackError(f"{where}: raw_range must be [min, max] with min < max, got {list(self.raw_range)}")
+        if not self.terms:
+            raise HybridtrackError(f"{where}: no terms")
+        if len(set(self.term_names)) != len(self.terms):
+            raise HybridtrackError(f"{where}: duplicate term names in {list(self.term_names)}")
+        for term in self.terms:
+            term.check(f"{where}.terms.{term.name}")
+
+
+@dataclass(frozen=True)
+class Rule:
+    """IF every named input is its term THEN the output is `then` (AND = min).
+
+    Parameters
+    ----------
+    when : mapping of str to str
+        Input name to term name; an input left out does not matter to the rule.
+    then : str
+        Output term name.
+    """
+
+    when: Mapping[str, str]
+    then: str
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "when", tuple(sorted(dict(self.when).items())))
+
+    @property
+    def conditions(self) -> dict[str, str]:
+        """The rule's conditions as a dict, input name to term name."""
+        return dict(self.when)
+
+    def describe(self, inputs: tuple[str, ...]) -> str:
+        """``intensity is strong AND variation is small -> sunny``."""
+        parts = [f"{name} is {self.conditions[name]}" for name in inputs if name in self.conditions]
+        return f"{' AND '.join(parts)} -> {self.then}"
+
+
+def _default_inputs() -> tuple[Variable, Variable]:
+    intensity = Variable(
+        "intensity", (0.0, 10.0),
+        (Term("weak", "gaussmf", (0.0, 1.5)), Term("medium", "gaussmf", (5.0, 1.5)),
+         Term("strong", "gaussmf", (10.0, 1.5))),
+        raw_range=(30.0, 300.0), unit="mA",
+    )
+    variation = Variable(
+        "variation", (0.0, 10.0),
+        (Term("small", "gaussmf", (0.0, 2.5)), Term("large", "gaussmf", (10.0, 2.5))),
+        raw_range=(0.0, 180.0), unit="mA",
+    )
+    return intensity, variation
+
+
+def _default_output() -> Variable:
+    return Variable(
+        "weather", (0.0, 30.0),
+        (Term("overcast", "trimf", (0.0, 5.0, 10.0)), Term("cloudy", "trimf", (10.0, 15.0, 20.0)),
+         Term("sunny", "trimf", (20.0, 25.0, 30.0))),
+    )
+
+
+PUBLISHED_RULES = (
+    Rule({"intensity": "strong", "variation": "small"}, "sunny"),
+    Rule({"intensity": "strong", "variation": "large"}, "cloudy"),
+    Rule({"intensity": "medium", "variation": "large"}, "cloudy"),
+    Rule({"intensity": "weak", "variation": "small"}, "overcast"),
+)
+
+#: The published table completed with its two unruled cells (``data/fuzzy-complete.toml``). A
+#: choice, not a correction: it turns the published overcast reading (143.4, 45.0) cloudy.
+COMPLETE_RULES = PUBLISHED_RULES + (
+    Rule({"intensity": "medium", "variation": "small"}, "cloudy"),
+    Rule({"intensity": "weak", "variation": "large"}, "overcast"),
+)
+
+
+@dataclass(frozen=True)
+class FuzzyConfig:
+    """A complete Mamdani weather classifier: two inputs, one output, rules and bands.
+
+    Parameters
+    ----------
+    inputs : tuple of Variable
+        ``intensity`` then ``variation``, each with a `raw_range`.
+    output : Variable
+        ``weather`` on 0-30.
+    rules : tuple of Rule
+    bands : tuple of (label, low, high)
+        The score band of each weather label, covering the output universe in order; a score
+        belongs to the band with ``low <= score < high`` (the last band includes its top).
+    resolution : tuple of int
+        Samples across (input universes, output universe); both engines evaluate the system
+        on these samples, as scikit-fuzzy does.
+    name : str
+    """
+
+    inputs: tuple[Variable, ...] = field(default_factory=_default_inputs)
+    output: Variable = field(default_factory=_default_output)
+    rules: tuple[Rule, ...] = PUBLISHED_RULES
+    bands: tuple[tuple[str, float, float], ...] = (("overcast", 0.0, 10.0), ("cloudy", 10.0, 20.0),
+                                                   ("sunny", 20.0, 30.0))
+    resolution: tuple[int, int] = (1001, 3001)
+    name: str = "published"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "inputs", tuple(self.inputs))
+        object.__setattr__(self, "rules", tuple(self.rules))
+        object.__setattr__(self, "bands", tuple((str(n), float(lo), float(hi)) for n, lo, hi in self.bands))
+        object.__setattr__(self, "resolution", tuple(int(r) for r in self.resolution))
+        self.validate()
+
+    # -- construction ------------------------------------------------------------------------
+
+    @classmethod
+    def default(cls) -> FuzzyConfig:
+        """The published system (``domain.md`` §4)."""
+        return cls()
+
+    @classmethod
+    def complete(cls) -> FuzzyConfig:
+        """The published system with its two unruled cells filled (six rules)."""
+        return cls(rules=COMPLETE_RULES, name="complete")
+
+    def replace(self, **changes) -> FuzzyConfig:
+        """A copy with some fields changed (validated)."""
+        return replace(self, **changes)
+
+    def with_params(self, variable: str, term: str, params) -> FuzzyConfig:
+        """A copy with one term's parameters changed."""
+        def swap(var: Variable) -> Variable:
+            if var.name != variable:
+                return var
+            var.term(term)
+            return replace(var, terms=tuple(replace(t, params=tuple(params)) if t.name == term else t
+                                            for t in var.terms))
+
+        return replace(self, inputs=tuple(swap(v) for v in self.inputs), output=swap(self.output))
+
+    # -- validation --------------------------------------------------------------------------
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """Names of the inputs, in order."""
+        return tuple(v.name for v in self.inputs)
+
+    def variable(self, name: str) -> Variable:
+        """The input or output variable called `name`."""
+        for var in (*self.inputs, self.output):
+            if var.name == name:
+                return var
+        raise HybridtrackError(f"no variable {name!r}; the config has {', '.join((*self.input_names, self.output.name))}")
+
+    def validate(self) -> None:
+        """Raise `HybridtrackError` naming the first problem found."""
+        if len(self.inputs) != 2:
+            raise HybridtrackError(f"config needs two inputs (intensity, variation), got {len(self.inputs)}")
+        for var in self.inputs:
+            var.check(f"inputs.{var.name}")
+            if var.raw_range is None:
+                raise HybridtrackError(f"inputs.{var.name}: raw_range is missing")
+        self.output.check(f"output.{self.output.name}")
+        if len(set(self.input_names)) != 2 or self.output.name in self.input_names:
+            raise HybridtrackError(f"variable names must differ, got {list(self.input_names)} and {self.output.name!r}")
+        if not self.rules:
+            raise HybridtrackError("the rule table is empty")
+        for number, rule in enumerate(self.rules, start=1):
+            where = f"rules[{number}]"
+            if not rule.conditions:
+                raise HybridtrackError(f"{where}: a rule needs at least one condition")
+            for name, term in rule.conditions.items():
+                if name not in self.input_names:
+                    raise HybridtrackError(f"{where}: unknown input {name!r}; inputs are {', '.join(self.input_names)}")
+                if term not in self.variable(name).term_names:
+                    raise HybridtrackError(
+                        f"{where}: unknown term {term!r} for {name}; terms are {', '.join(self.variable(name).term_names)}"
+                    )
+            if rule.then not in self.output.term_names:
+                raise HybridtrackError(
+                    f"{where}: unknown output term {rule.then!r}; terms are {', '.join(self.output.term_names)}"
+                )
+        if len({rule.when for rule in self.rules}) != len(self.rules):
+            raise HybridtrackError("the rule table has two rules with the same conditions")
+        self._validate_bands()
+        if any(r < 3 for r in self.resolution) or len(self.resolution) != 2:
+            raise HybridtrackError(f"resolution needs two sample counts of at least 3, got {list(self.resolution)}")
+
+    def _validate_bands(self) -> None:
+        if not self.bands:
+            raise HybridtrackError("bands: no weather bands")
+        lo, hi = self.output.universe
+        edges = [band[1] for band in self.bands] + [self.bands[-1][2]]
+        if edges[0] != lo or edges[-1] != hi:
+            raise HybridtrackError(f"bands must cover the output universe {lo}-{hi}, they cover {edges[0]}-{edges[-1]}")
+        for (name, low, high), (next_name, next_low, _) in zip(self.bands, self.bands[1:]):
+            if next_low != high:
+                raise HybridtrackError(f"bands {name!r} and {next_name!r} must meet: {high} vs {next_low}")
+        for name, low, high in self.bands:
+            if not low < high:
+                raise HybridtrackError(f"band {name!r} is inverted or empty: {low}-{high}")
+        if len({band[0] for band in self.bands}) != len(self.bands):
+            raise HybridtrackError("bands: duplicate labels")
+
+    # -- TOML --------------------------------------------------------------------------------
+
+    def to_dict(self) -> dict:
+        """A plain dict in the TOML layout."""
+        def terms(var: Variable) -> dict:
+            return {t.name: {"shape": t.shape, "params": list(t.params)} for t in var.terms}
+
+        inputs = {}
+        for var in self.inputs:
+            inputs[var.name] = {"raw_range": list(var.raw_range), "unit": var.unit,
+                                "universe": list(var.universe), "terms": terms(var)}
+        return {
+            "name": self.name,
+            "resolution": {"input": self.resolution[0], "output": self.resolution[1]},
+            "inputs": inputs,
+            "output": {"name": self.output.name, "universe": list(self.output.universe), "terms": terms(self.output)},
+            "bands": {name: [low, high] for name, low, high in self.bands},
+            "rules": [{**rule.conditions, self.output.name: rule.then} for rule in self.rules],
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping, *, source: str = "config") -> FuzzyConfig:
+        """Build and validate a config from the TOML layout; unknown keys are refused."""
+        reader = _Reader(source)
+        data = reader.table(data, "", {"name", "resolution", "inputs", "output", "bands", "rules"})
+        default = cls()
+        inputs = tuple(
+            reader.variable(name, spec, f"inputs.{name}", is_input=True)
+            for name, spec in reader.table(data.get("inputs"), "inputs").items()
+        ) if "inputs" in data else default.inputs
+        output_spec = reader.table(data.get("output", {}), "output", {"name", "universe", "terms"})
+        output = reader.variable(output_spec.get("name", "weather"), output_spec, "output", is_input=False) \
+            if "output" in data else default.output
+        rules = default.rules
+        if "rules" in data:
+            if not isinstance(data["rules"], list):
+                raise HybridtrackError(f"{source}: rules must be an array of tables ([[rules]])")
+            rules = tuple(reader.rule(spec, number, output.name) for number, spec in enumerate(data["rules"], 1))
+        bands = default.bands
+        if "bands" in data:
+            bands = tuple((name, *reader.pair(value, f"bands.{name}"))
+                          for name, value in reader.table(data["bands"], "bands").items())
+        resolution = default.resolution
+        if "resolution" in data:
+            res = reader.table(data["resolution"], "resolution", {"input", "output"})
+            resolution = (reader.integer(res.get("input", resolution[0]), "resolution.input"),
+                          reader.integer(res.get("output", resolution[1]), "resolution.output"))
+        name = data.get("name", "custom")
+        if not isinstance(name, str):
+            raise HybridtrackError(f"{source}: name must be a string, got {name!r}")
+        try:
+            return cls(inputs=inputs, output=output, rules=rules, bands=bands, resolution=resolution, name=name)
+        except HybridtrackError as exc:
+            raise HybridtrackError(f"{source}: {exc}") from None
+
+    @classmethod
+    def from_toml(cls, path) -> FuzzyConfig:
+        """Load a config from a TOML file (see ``data/fuzzy-complete.toml``)."""
+        path = Path(path)
+        try:
+            with path.open("rb") as handle:
+                data = tomllib.load(handle)
+        except FileNotFoundError:
+            raise HybridtrackError(f"{path}: no such config file") from None
+        except IsADirectoryError:
+            raise HybridtrackError(f"{path}: is a folder, not a config file") from None
+        except UnicodeDecodeError as exc:
+            raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise HybridtrackError(f"{path}: not valid TOML: {exc}") from None
+        return cls.from_dict(data, source=str(path))
+
+    def to_toml(self, path) -> Path:
+        """Write the config as TOML; `from_toml` reads it back equal."""
+        import tomli_w
+
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(tomli_w.dumps(self.to_dict()))
+        return path
+
+    # -- MATLAB .fis -------------------------------------------------------------------------
+
+    @classmethod
+    def from_fis(cls, path, **options) -> FuzzyConfig:
+        """Load a MATLAB Mamdani ``.fis`` file; `options` as for `hybridtrack.fuzzy.fis.read_fis`."""
+        from .fis import read_fis
+
+        return read_fis(path, **options)
+
+    def to_fis(self, path) -> Path:
+        """Write the config as a MATLAB ``.fis`` file (see `hybridtrack.fuzzy.fis`)."""
+        from .fis import write_fis
+
+        return write_fis(self, path)
+
+
+class _Reader:
+    """Type-checks the TOML layout, naming the key of the first problem."""
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def fail(self, where: str, message: str):
+        raise HybridtrackError(f"{self.source}: {where}: {message}" if where else f"{self.source}: {message}")
+
+    def table(self, value, where: str, allowed: set[str] | None = None) -> dict:
+        if not isinstance(value, Mapping):
+            self.fail(where, f"must be a table, got {type(value).__name__}")
+        if allowed is not None:
+            unknown = sorted(set(value) - allowed)
+            if unknown:
+                self.fail(where, f"unknown key {unknown[0]!r}; allowed: {', '.join(sorted(allowed))}")
+        return dict(value)
+
+    def number(self, value, where: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(where, f"must be a number, got {value!r}")
+        return float(value)
+
+    def integer(self, value, where: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.fail(where, f"must be a whole number, got {value!r}")
+        return value
+
+    def pair(self, value, where: str) -> tuple[float, float]:
+        if not isinstance(value, list) or len(value) != 2:
+            self.fail(where, f"must be [low, high], got {value!r}")
+        return self.number(value[0], where), self.number(value[1], where)
+
+    def variable(self, name: str, spec, where: str, *, is_input: bool) -> Variable:
+        keys = {"raw_range", "unit", "universe", "terms"} if is_input else {"name", "universe", "terms"}
+        spec = self.table(spec, where, keys)
+        terms = []
+        for term_name, term_spec in self.table(spec.get("terms"), f"{where}.terms").items():
+            term_where = f"{where}.terms.{term_name}"
+            term_spec = self.table(term_spec, term_where, {"shape", "params"})
+            shape = term_spec.get("shape")
+            if not isinstance(shape, str):
+                self.fail(term_where, f"shape must be a string, got {shape!r}")
+            params = term_spec.get("params")
+            if not isinstance(params, list):
+                self.fail(term_where, f"params must be a list of numbers, got {params!r}")
+            terms.append(Term(term_name, shape, tuple(self.number(p, f"{term_where}.params") for p in params)))
+        universe = self.pair(spec.get("universe", [0.0, 10.0] if is_input else [0.0, 30.0]), f"{where}.universe")
+        if not is_input:
+            return Variable(name, universe, tuple(terms))
+        if "raw_range" not in spec:
+            self.fail(where, "raw_range is missing")
+        unit = spec.get("unit", "")
+        if not isinstance(unit, str):
+            self.fail(f"{where}.unit", f"must be a string, got {unit!r}")
+        return Variable(name, universe, tuple(terms), self.pair(spec["raw_range"], f"{where}.raw_range"), unit)
+
+    def rule(self, spec, number: int, output_name: str) -> Rule:
+        where = f"rules[{number}]"
+        spec = self.table(spec, where)
+        for key, value in spec.items():
+            if not isinstance(value, str):
+                self.fail(f"{where}.{key}", f"must be a term name, got {value!r}")
+        if output_name not in spec:
+            self.fail(where, f"says nothing of the output {output_name!r}")
+        then = spec.pop(output_name)
+        return Rule(spec, then)
