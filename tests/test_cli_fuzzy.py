@@ -1,0 +1,79 @@
+import json
+
+import pandas as pd
+import pytest
+
+from hybridtrack.cli import main
+from hybridtrack.fuzzy import FuzzyConfig
+
+
+def test_classify_one_reading_prints_score_label_and_rules(capsys):
+    assert main(["classify", "--intensity", "200.1", "--variation", "84.6"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("score 18.163 -> cloudy")
+    assert "rule 3: intensity is medium AND variation is large -> cloudy  fires 0.106" in out
+
+
+def test_classify_json(capsys):
+    assert main(["classify", "--intensity", "246", "--variation", "27", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["weather"] == "sunny" and data["score"] == pytest.approx(24.9064, abs=1e-4)
+    assert [r["firing"] for r in data["rules"]][0] == pytest.approx(0.411, abs=1e-3)
+
+
+def test_classify_a_file_with_named_columns(tmp_path, capsys):
+    src, out = tmp_path / "log.csv", tmp_path / "out.csv"
+    pd.DataFrame({"time": ["12:00", "12:01", "12:02", "12:03"], "I_mA": [246.0, 200.1, 143.4, None],
+                  "dI_mA": [27.0, 84.6, 45.0, 3.0]}).to_csv(src, index=False)
+    assert main(["classify", str(src), "--intensity-col", "I_mA", "--variation-col", "dI_mA", "--out", str(out)]) == 0
+    table = pd.read_csv(out)
+    assert list(table["sky"]) == ["sunny", "cloudy", "overcast", "unknown"]
+    assert "overcast 1, cloudy 1, sunny 1, unknown 1" in capsys.readouterr().out
+
+
+def test_classify_with_the_complete_config_and_a_fis(tmp_path, capsys):
+    assert main(["classify", "--intensity", "143.4", "--variation", "45", "--config", "data/fuzzy-complete.toml"]) == 0
+    assert "-> cloudy" in capsys.readouterr().out
+    fis = FuzzyConfig().to_fis(tmp_path / "published.fis")
+    assert main(["classify", "--intensity", "143.4", "--variation", "45", "--config", str(fis)]) == 0
+    assert "-> overcast" in capsys.readouterr().out
+
+
+def test_tune_writes_a_config_that_loads(tmp_path, capsys):
+    labels = tmp_path / "labels.csv"
+    pd.DataFrame({"intensity": [246.0, 200.1, 200.1, 143.4, 100.0], "variation": [27.0, 84.6, 93.6, 45.0, 150.0],
+                  "weather": ["sunny", "cloudy", "cloudy", "overcast", "cloudy"]}).to_csv(labels, index=False)
+    out, report = tmp_path / "tuned.toml", tmp_path / "report.json"
+    assert main(["tune", str(labels), "--out", str(out), "--method", "local", "--report", str(report)]) == 0
+    printed = capsys.readouterr().out
+    assert "label accuracy" in printed and f"wrote {out}" in printed
+    tuned = FuzzyConfig.from_toml(out)
+    assert tuned.name == "published-tuned"
+    data = json.loads(report.read_text())
+    assert data["accuracy_after"] >= data["accuracy_before"] and data["accuracy_after"] == 1.0
+
+
+def test_surface_writes_a_png(tmp_path):
+    out = tmp_path / "surface.png"
+    assert main(["surface", "--out", str(out), "--points", "41"]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 20_000
+
+
+@pytest.mark.parametrize("args, message", [
+    (["classify", "--intensity", "100"], "give --intensity and --variation"),
+    (["classify", "--intensity", "1", "--variation", "2", "--config", "missing.toml"], "missing.toml: no such config"),
+    (["classify", "nofile.csv"], "nofile.csv: no such file"),
+    (["tune", "nofile.csv", "--out", "x.toml"], "nofile.csv: no such file"),
+    (["surface", "--points", "2"], "--points must be between 5 and 1001"),
+])
+def test_fuzzy_commands_bad_input_one_line_status_2(capsys, args, message):
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+
+
+def test_classify_file_missing_column(tmp_path, capsys):
+    src = tmp_path / "log.csv"
+    src.write_text("a,b\n1,2\n")
+    assert main(["classify", str(src)]) == 2
+    assert "no column 'intensity'; columns are a, b" in capsys.readouterr().err

@@ -1,0 +1,62 @@
+"""The rule-table plugin and helper, run the way a user runs them."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from hybridtrack import HybridtrackError
+from hybridtrack.testing import RuleCaseFailure, load_cases, rule_table_cases
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run_pytest(folder, *args):
+    return subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-v", *args, str(folder)],
+                          capture_output=True, text=True, cwd=folder)
+
+
+def test_the_example_rule_tables_pass_and_have_readable_ids():
+    result = run_pytest(ROOT / "examples" / "rule_tables")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "test_site.rules.csv::row2-280mA-10mA-sunny PASSED" in result.stdout
+    assert "test_commissioning_readings[row4-143.4mA-45mA-overcast] PASSED" in result.stdout
+    assert "8 passed" in result.stdout
+
+
+def test_a_failing_row_shows_memberships_and_firings(tmp_path):
+    (tmp_path / "test_wrong.rules.csv").write_text("intensity,variation,weather\n246.0,27.0,overcast\n")
+    result = run_pytest(tmp_path)
+    assert result.returncode == 1
+    out = result.stdout
+    assert "expected overcast, got sunny for intensity 246 mA, variation 27 mA" in out
+    assert "intensity: weak 0.000, medium 0.135, strong 0.411" in out
+    assert "rule 1: intensity is strong AND variation is small -> sunny  fires 0.411" in out
+
+
+def test_a_broken_rule_table_is_a_collection_error_that_says_where(tmp_path):
+    (tmp_path / "test_broken.rules.csv").write_text("intensity,variation,weather\nbright,27.0,sunny\n")
+    result = run_pytest(tmp_path)
+    assert result.returncode != 0
+    assert "row 2, column 'intensity': 'bright' is not a number" in result.stdout
+
+
+def test_toml_cases_read_config_and_scores():
+    cases = load_cases(ROOT / "tests" / "test_complete.rules.toml")
+    assert cases[0].config_path.endswith("data/fuzzy-complete.toml")
+    assert [c.weather for c in cases] == ["sunny", "cloudy", "cloudy", "cloudy", "overcast"]
+    assert cases[3].score == 15.0 and cases[3].tolerance == 0.01
+
+
+def test_check_raises_a_rule_case_failure_with_the_explanation():
+    case = rule_table_cases(ROOT / "examples" / "rule_tables" / "commissioning.csv")[0].values[0]
+    case.check()
+    wrong = type(case)(case.intensity, case.variation, "cloudy", score=20.0, tolerance=0.1)
+    with pytest.raises(RuleCaseFailure, match=r"expected cloudy, got sunny; expected score 20 ± 0.1, got 24.9064"):
+        wrong.check()
+
+
+def test_missing_rule_table_is_a_clear_error(tmp_path):
+    with pytest.raises(HybridtrackError, match="no such file"):
+        load_cases(tmp_path / "nope.csv")
