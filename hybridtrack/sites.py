@@ -7,10 +7,10 @@ Kunming (linear Fresnel end loss) and a Delingha-type tower site (heliostats).
 
 from __future__ import annotations
 
-import zoneinfo
 from dataclasses import dataclass
 
 from .errors import HybridtrackError
+from .times import check_tz
 
 __all__ = ["Site", "get", "names", "custom", "BUILTIN"]
 
@@ -56,12 +56,7 @@ class Site:
             raise HybridtrackError(
                 f"site {self.name!r}: altitude {self.altitude} m is outside [-500, 9000] m"
             )
-        try:
-            zoneinfo.ZoneInfo(self.tz)
-        except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
-            raise HybridtrackError(
-                f"site {self.name!r}: unknown time zone {self.tz!r} (use an IANA name such as 'Asia/Shanghai')"
-            ) from None
+        check_tz(self.tz, f"site {self.name!r}: ")
 
 
 BUILTIN: dict[str, Site] = {

@@ -8,7 +8,18 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range"]
+__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "check_tz"]
+
+
+def check_tz(tz: str, where: str = "") -> str:
+    """Return `tz` if it is an IANA time-zone name, else raise `HybridtrackError`."""
+    import zoneinfo
+
+    try:
+        zoneinfo.ZoneInfo(str(tz))
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
+        raise HybridtrackError(f"{where}unknown time zone {tz!r} (use an IANA name such as 'Asia/Shanghai')") from None
+    return str(tz)
 
 
 def parse_date(text) -> dt.date:

@@ -1,0 +1,379 @@
+"""Synthetic skies: weather frames for any site, day or year, seeded and reproducible.
+
+A frame holds pvlib's columns ``ghi``, ``dni``, ``dhi`` (W/m²), ``wind_speed`` (m/s) and
+``temp_air`` (°C), plus the true sky label per step (``sky``) and the clear-sky irradiance
+it was built from (``ghi_clear``, ``dni_clear``, ``dhi_clear``), on a tz-aware index.
+
+How it is built:
+
+* **Clear sky**: pvlib's Ineichen model with the site's altitude and the Linke turbidity
+  looked up for the site and month (interpolated through the year), on SPA's apparent zenith.
+* **Sky regimes**: each day is ``sunny``, ``cloudy`` or ``overcast``. A ``mixed`` day changes
+  regime within the day, in spells of about one to four hours. Multi-day runs take a weather
+  per day, a sequence, or ``"climate"``, which draws day types from the site's monthly
+  climate (`CLIMATE`).
+* **Clouds**: an alternating renewal process in continuous time (lognormal clear gaps and
+  cloud passages, minutes to an hour), so the same seed gives the same clouds at any step.
+  Under a cloud the beam keeps a fraction τ of the clear DNI, and a share of the lost beam
+  reappears as diffuse light. In the clear gaps of a broken sky, light scattered off cloud
+  edges raises the diffuse, so GHI can briefly exceed the clear-sky GHI (cloud enhancement).
+  Overcast keeps DNI near zero (τ ≤ 0.02) and the diffuse at 20-40 % of the clear GHI.
+* **Closure**: ``ghi = dni·cos(apparent zenith) + dhi`` holds exactly, and everything is 0
+  while the sun is down.
+* **Wind**: a diurnal shape (calm at dawn, strongest mid-afternoon) times a lognormal
+  AR(1) fluctuation, plus optional gust events whose peaks can exceed the 17.2 m/s stow
+  threshold.
+* **Temperature**: the month's mean with a diurnal swing, smaller under overcast.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .errors import HybridtrackError
+from .sites import Site, get
+from .times import local_range, parse_freq
+
+__all__ = ["synthetic", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES",
+           "daily_summary"]
+
+DAY_TYPES = ("sunny", "cloudy", "overcast")
+WEATHERS = (*DAY_TYPES, "mixed", "climate")
+
+
+@dataclass(frozen=True)
+class RegimeParameters:
+    """How clouds come and go in one sky regime.
+
+    Durations are medians of lognormal distributions (minutes); τ is the fraction of the
+    clear-sky beam a cloud lets through, drawn uniformly per passage.
+    """
+
+    clear_median: float
+    cloud_median: float
+    spread: float
+    tau: tuple[float, float]
+    scatter: float  # share of the lost beam that reappears as diffuse
+    enhancement: tuple[float, float]  # diffuse boost in clear gaps, fraction of clear DHI
+
+
+REGIMES = {
+    "sunny": RegimeParameters(clear_median=150.0, cloud_median=3.0, spread=0.6, tau=(0.4, 0.85),
+                              scatter=0.3, enhancement=(0.0, 0.1)),
+    "cloudy": RegimeParameters(clear_median=9.0, cloud_median=14.0, spread=0.8, tau=(0.0, 0.12),
+                               scatter=0.35, enhancement=(0.3, 1.3)),
+    "overcast": RegimeParameters(clear_median=1e9, cloud_median=1e9, spread=0.0, tau=(0.0, 0.02),
+                                 scatter=0.0, enhancement=(0.0, 0.0)),
+}
+
+
+@dataclass(frozen=True)
+class Climate:
+    """A site's monthly climate for multi-day runs.
+
+    Parameters
+    ----------
+    sunshine : sequence of 12 floats
+        Relative sunshine per month (share of the possible hours with DNI ≥ 120 W/m²).
+    temperature : sequence of 12 floats
+        Monthly mean air temperature, °C.
+    wind : float
+        Mean wind speed, m/s.
+    source : str
+        Where the numbers come from.
+    """
+
+    sunshine: tuple[float, ...]
+    temperature: tuple[float, ...]
+    wind: float
+    source: str
+
+    #: Relative sunshine of each day type as this generator makes them (WMO threshold,
+    #: DNI ≥ 120 W/m², over the hours the sun is up): the mean of a year of each at both sites
+    #: (sunny 0.99 Lanzhou, 0.91 Nanjing; cloudy 0.40, 0.35). A test keeps the climate consistent.
+    DAY_SUNSHINE = {"sunny": 0.95, "cloudy": 0.37, "overcast": 0.0}
+    #: The share of cloudy days assumed in every month; the sunshine normal sets the rest.
+    CLOUDY_SHARE = 0.4
+
+    def day_fractions(self, month: int) -> dict[str, float]:
+        """Chance of a sunny, cloudy and overcast day in `month` (1-12).
+
+        A share `CLOUDY_SHARE` of days is cloudy. The sunny/overcast split of the rest is
+        solved so that the expected sunshine equals the month's normal, clipped to [0, 1].
+        """
+        s = self.sunshine[month - 1]
+        c = self.CLOUDY_SHARE
+        sunny = (s - c * self.DAY_SUNSHINE["cloudy"]) / self.DAY_SUNSHINE["sunny"]
+        sunny = float(np.clip(sunny, 0.0, 1.0 - c))
+        return {"sunny": sunny, "cloudy": c, "overcast": 1.0 - c - sunny}
+
+
+_NORMALS = ("Approximate 1991-2020 monthly normals of the China Meteorological Administration "
+            "(relative sunshine rounded to 1 %, temperatures to 0.5 °C) as reproduced in public climate "
+            "tables; not checked against the station records. Replace with your station's normals "
+            "for quantitative work.")
+
+#: Monthly climates of the two sites every feature serves.
+CLIMATE = {
+    "lanzhou": Climate(
+        sunshine=(0.54, 0.53, 0.51, 0.55, 0.55, 0.54, 0.53, 0.54, 0.49, 0.51, 0.55, 0.54),
+        temperature=(-4.5, 0.0, 6.5, 13.0, 17.5, 21.0, 23.0, 21.5, 16.5, 10.0, 3.0, -3.0),
+        wind=1.3, source=_NORMALS),
+    "nanjing": Climate(
+        sunshine=(0.41, 0.40, 0.40, 0.45, 0.45, 0.38, 0.46, 0.51, 0.46, 0.49, 0.48, 0.45),
+        temperature=(3.0, 5.5, 10.0, 16.0, 21.5, 25.0, 28.5, 28.0, 23.5, 18.0, 11.5, 5.0),
+        wind=2.4, source=_NORMALS),
+}
+
+
+def _climate_for(site: Site) -> Climate:
+    if site.name in CLIMATE:
+        return CLIMATE[site.name]
+    # a site without normals: a mid-latitude default, flagged in the frame's attrs
+    return Climate((0.5,) * 12, tuple(15.0 - 10.0 * np.cos(2 * np.pi * (m - 0.5) / 12.0) *
+                                      np.sign(site.latitude or 1.0) for m in range(1, 13)),
+                   2.5, "generic mid-latitude default (the site has no normals here)")
+
+
+def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
+    def bound(value, end_of_day: bool):
+        if isinstance(value, (pd.Timestamp, dt.datetime)) or (isinstance(value, str) and len(value.strip()) > 10):
+            stamp = pd.Timestamp(value)
+            return stamp.tz_localize(site.tz) if stamp.tz is None else stamp.tz_convert(site.tz)
+        return None
+
+    first, last = bound(start, False), bound(end, True) if end is not None else None
+    if first is None and (end is None or last is None):
+        return local_range(start, site.tz, end_date=end, freq=freq)
+    if first is None:
+        first = local_range(start, site.tz, freq=freq)[0]
+    if last is None:
+        last = local_range(end if end is not None else first.date(), site.tz, freq=freq)[-1]
+    if last < first:
+        raise HybridtrackError(f"the period ends ({last}) before it starts ({first})")
+    return pd.date_range(first, last, freq=parse_freq(freq))
+
+
+def _day_types(days: list, weather, climate: Climate, rng: np.random.Generator) -> list[str]:
+    if isinstance(weather, str):
+        if weather not in WEATHERS:
+            raise HybridtrackError(f"unknown weather {weather!r}; choose from {', '.join(WEATHERS)} or a per-day list")
+        if weather == "climate":
+            out = []
+            for day in days:
+                fractions = climate.day_fractions(day.month)
+                out.append(str(rng.choice(DAY_TYPES, p=[fractions[t] for t in DAY_TYPES])))
+            return out
+        return [weather] * len(days)
+    weather = list(weather)
+    if len(weather) != len(days):
+        raise HybridtrackError(f"{len(weather)} weathers given for {len(days)} days; give one per day")
+    for value in weather:
+        if value not in WEATHERS or value == "climate":
+            raise HybridtrackError(f"unknown day weather {value!r}; choose from sunny, cloudy, overcast, mixed")
+    return weather
+
+
+def _regime_spells(day_start: pd.Timestamp, day_type: str, rng: np.random.Generator) -> list[tuple]:
+    """(start, end, regime) spells covering one local day."""
+    day_end = day_start + pd.Timedelta(days=1)
+    if day_type != "mixed":
+        return [(day_start, day_end, day_type)]
+    spells, t = [], day_start + pd.Timedelta(hours=float(rng.uniform(5.0, 9.0)))
+    regime = str(rng.choice(DAY_TYPES))
+    spells.append((day_start, t, regime))
+    while t < day_end:
+        regime = str(rng.choice([r for r in DAY_TYPES if r != regime]))
+        length = pd.Timedelta(minutes=float(np.clip(rng.lognormal(np.log(120.0), 0.45), 45.0, 300.0)))
+        spells.append((t, min(t + length, day_end), regime))
+        t += length
+    return spells
+
+
+def _cloud_passages(t0: pd.Timestamp, t1: pd.Timestamp, regime: str, rng: np.random.Generator) -> list[tuple]:
+    """(start, end, tau, enhancement) of every cloud passage and clear gap in a spell."""
+    p = REGIMES[regime]
+    if regime == "overcast":
+        return [(t0, t1, float(rng.uniform(*p.tau)), 0.0, True)]
+    out, t = [], t0
+    in_cloud = bool(rng.random() < p.cloud_median / (p.cloud_median + p.clear_median))
+    while t < t1:
+        median = p.cloud_median if in_cloud else p.clear_median
+        length = pd.Timedelta(minutes=float(np.clip(rng.lognormal(np.log(median), p.spread), 0.5, 600.0)))
+        end = min(t + length, t1)
+        if in_cloud:
+            out.append((t, end, float(rng.uniform(*p.tau)), 0.0, True))
+        else:
+            out.append((t, end, 1.0, float(rng.uniform(*p.enhancement)), False))
+        t, in_cloud = end, not in_cloud
+    return out
+
+
+def _smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float, sigma: float) -> np.ndarray:
+    """Zero-mean AR(1) noise with time constant `minutes`, on a 1-minute grid, then interpolated."""
+    t = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+    n = int(np.ceil(t[-1])) + 2 if len(t) else 2
+    phi = np.exp(-1.0 / minutes)
+    shocks = rng.normal(0.0, sigma * np.sqrt(1 - phi**2), n)
+    from scipy.signal import lfilter
+
+    grid = lfilter([1.0], [1.0, -phi], shocks)
+    return np.interp(t, np.arange(n), grid)
+
+
+def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str] = "mixed", freq: str = "1min",
+              seed: int = 0, gusts_per_day: float = 0.0, gust_peak: tuple[float, float] = (14.0, 24.0),
+              wind_mean: float | None = None, climate: Climate | None = None) -> pd.DataFrame:
+    """A synthetic weather frame for `site` from `start` to `end`.
+
+    Parameters
+    ----------
+    site : Site or str
+    start, end : date, str or timestamp
+        A date alone means that whole local day; `end` defaults to `start`. Timestamps
+        (naive ones on the site's clock) cut the period within a day.
+    weather : {"sunny", "cloudy", "overcast", "mixed", "climate"} or sequence of str
+        One weather for every day, one per day, or ``"climate"`` to draw each day from the
+        site's monthly climate.
+    freq : str
+        Step, e.g. ``"1min"`` or ``"1s"``.
+    seed : int
+        Seeds every random draw: the same seed gives the same frame.
+    gusts_per_day : float
+        Mean number of gust events a day (Poisson), each lasting 2-10 minutes with a peak
+        drawn uniformly from `gust_peak` (m/s).
+    wind_mean : float, optional
+        Mean wind speed (m/s); the climate's by default.
+    climate : Climate, optional
+        Monthly climate; the site's own (`CLIMATE`) by default.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``ghi dni dhi wind_speed temp_air sky ghi_clear dni_clear dhi_clear``; attrs
+        record the site, seed, weather per day and the climate's source.
+    """
+    import pvlib
+
+    from .sun import solar_position
+
+    site = get(site)
+    climate = climate or _climate_for(site)
+    index = _period(site, start, end, freq)
+    if len(index) == 0:
+        raise HybridtrackError("the period holds no time steps")
+    if not 0 <= gusts_per_day <= 200:
+        raise HybridtrackError(f"gusts_per_day must be within 0-200, got {gusts_per_day!r}")
+    rng = np.random.default_rng(seed)
+    local = index.tz_convert(site.tz)
+    days = sorted(set(local.date))
+    day_types = _day_types(days, weather, climate, rng)
+
+    # regimes and cloud passages in continuous time
+    edges, tau, boost, regimes, clouded = [], [], [], [], []
+    for day, day_type in zip(days, day_types):
+        day_start = pd.Timestamp(day).tz_localize(site.tz, nonexistent="shift_forward", ambiguous=True)
+        for s0, s1, regime in _regime_spells(day_start, day_type, rng):
+            for c0, c1, t, e, cloud in _cloud_passages(s0, s1, regime, rng):
+                edges.append(c1)
+                tau.append(t)
+                boost.append(e)
+                regimes.append(DAY_TYPES.index(regime))
+                clouded.append(cloud)
+    which = np.searchsorted(pd.DatetimeIndex(edges).as_unit("ns").asi8, index.as_unit("ns").asi8, side="right")
+    which = np.minimum(which, len(edges) - 1)
+    step_tau, step_boost = np.asarray(tau)[which], np.asarray(boost)[which]
+    step_regime, step_cloud = np.asarray(regimes)[which], np.asarray(clouded)[which]
+
+    position = solar_position(index, site)
+    apparent_zenith = position["apparent_zenith"].to_numpy(float)
+    airmass = pvlib.atmosphere.get_relative_airmass(apparent_zenith)
+    pressure = pvlib.atmosphere.alt2pres(site.altitude)
+    linke = pvlib.clearsky.lookup_linke_turbidity(index, site.latitude, site.longitude)
+    with np.errstate(divide="ignore", invalid="ignore"):  # pvlib divides by airmass, infinite at night
+        clear = pvlib.clearsky.ineichen(apparent_zenith, pvlib.atmosphere.get_absolute_airmass(airmass, pressure),
+                                        linke.to_numpy(float), altitude=site.altitude)
+    ghi_c, dni_c, dhi_c = (np.nan_to_num(np.asarray(clear[k], float)) for k in ("ghi", "dni", "dhi"))
+    cos_z = np.cos(np.radians(apparent_zenith))
+    up = cos_z > 0.0
+    beam_c = dni_c * np.where(up, cos_z, 0.0)
+
+    overcast = step_regime == DAY_TYPES.index("overcast")
+    scatter = np.array([REGIMES[r].scatter for r in DAY_TYPES])[step_regime]
+    dni = dni_c * step_tau
+    edge_light = np.minimum(step_boost * dhi_c, 0.25 * ghi_c)  # cloud enhancement, at most +25 % of clear GHI
+    dhi = np.where(step_cloud, dhi_c + scatter * (1.0 - step_tau) * beam_c, dhi_c + edge_light)
+    overcast_share = np.clip(0.3 + _smooth_noise(index, rng, 90.0, 0.05), 0.2, 0.4)
+    dhi = np.where(overcast, overcast_share * ghi_c, dhi)
+    dni, dhi = np.where(up, dni, 0.0), np.where(up, dhi, 0.0)
+    ghi = dni * np.where(up, cos_z, 0.0) + dhi
+
+    hours = np.asarray((local - local.normalize()) / pd.Timedelta(hours=1), float)
+    mean_wind = climate.wind if wind_mean is None else float(wind_mean)
+    if not 0 <= mean_wind <= 40:
+        raise HybridtrackError(f"wind_mean must be within 0-40 m/s, got {wind_mean!r}")
+    diurnal = 1.0 + 0.5 * np.sin(2 * np.pi * (hours - 9.0) / 24.0)
+    wind = mean_wind * diurnal * np.exp(_smooth_noise(index, rng, 20.0, 0.35) - 0.06)
+    wind = np.maximum(wind, 0.0) + _gusts(index, rng, gusts_per_day, gust_peak)
+
+    month_mean = np.asarray(climate.temperature, float)[local.month.to_numpy() - 1]
+    swing = np.where(overcast, 2.5, 6.0)
+    temp = month_mean + swing * np.sin(2 * np.pi * (hours - 9.0) / 24.0) + _smooth_noise(index, rng, 60.0, 0.5)
+
+    frame = pd.DataFrame({
+        "ghi": ghi, "dni": dni, "dhi": dhi, "wind_speed": wind, "temp_air": temp,
+        "sky": pd.Categorical(np.asarray(DAY_TYPES)[step_regime], categories=list(DAY_TYPES)),
+        "ghi_clear": ghi_c, "dni_clear": dni_c, "dhi_clear": dhi_c,
+    }, index=index)
+    frame.attrs.update(site=site.name, seed=seed, freq=str(freq), source="synthetic",
+                       weather={str(d): w for d, w in zip(days, day_types)}, climate_source=climate.source)
+    return frame
+
+
+def _gusts(index: pd.DatetimeIndex, rng: np.random.Generator, per_day: float, peak: tuple[float, float]) -> np.ndarray:
+    """Added wind speed of gust events: a rise and fall over 2-10 minutes to a drawn peak."""
+    extra = np.zeros(len(index))
+    span_days = (index[-1] - index[0]) / pd.Timedelta(days=1) if len(index) > 1 else 0.0
+    count = rng.poisson(per_day * max(span_days, 1.0 / 24.0)) if per_day > 0 else 0
+    if count == 0:
+        return extra
+    t = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+    for centre, width, height in zip(rng.uniform(0.0, t[-1] if len(t) > 1 else 1.0, count),
+                                     rng.uniform(2.0, 10.0, count), rng.uniform(*peak, count)):
+        extra = np.maximum(extra, height * np.clip(1.0 - np.abs(t - centre) / (width / 2.0), 0.0, 1.0))
+    return extra
+
+
+def daily_summary(frame: pd.DataFrame, site: Site | str) -> pd.DataFrame:
+    """Per local day: DNI and GHI totals (kWh/m²), clearness index, sunshine share.
+
+    The daily clearness index is the day's GHI over the extraterrestrial irradiance on a
+    horizontal plane; the sunshine share is the share of daylight steps with DNI ≥ 120 W/m².
+    """
+    import pvlib
+
+    from .sun import solar_position
+
+    site = get(site)
+    position = solar_position(frame.index, site)
+    cos_z = np.clip(np.cos(np.radians(position["zenith"].to_numpy(float))), 0.0, None)
+    extra = pvlib.irradiance.get_extra_radiation(frame.index).to_numpy(float) * cos_z
+    step_hours = np.median(np.diff(frame.index.as_unit("ns").asi8)) / 3.6e12 if len(frame) > 1 else 1.0 / 60.0
+    day = frame.index.tz_convert(site.tz).date
+    up = position["altitude"].to_numpy(float) > 0
+    table = pd.DataFrame({"ghi": frame["ghi"].to_numpy(float), "dni": frame["dni"].to_numpy(float), "extra": extra,
+                          "up": up, "sunshine": up & (frame["dni"].to_numpy(float) >= 120.0)}, index=day)
+    grouped = table.groupby(level=0)
+    out = pd.DataFrame({
+        "dni_kwh_m2": grouped["dni"].sum() * step_hours / 1000.0,
+        "ghi_kwh_m2": grouped["ghi"].sum() * step_hours / 1000.0,
+        "clearness_index": grouped["ghi"].sum() / grouped["extra"].sum(),
+        "sunshine_share": grouped["sunshine"].sum() / grouped["up"].sum().clip(lower=1),
+    })
+    out.index.name = "date"
+    return out

@@ -1,0 +1,133 @@
+"""Synthetic skies: closure, night, clearness by weather, seasons, climate, reproducibility."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import HybridtrackError, sites
+from hybridtrack.sky import CLIMATE, Climate, daily_summary, synthetic
+from hybridtrack.sun import solar_position
+
+DAYS = {"lanzhou": ("2021-03-20", "2021-06-21", "2021-09-23", "2021-12-21"),
+        "nanjing": ("2013-03-20", "2013-06-21", "2013-09-23", "2013-12-22")}
+
+
+@pytest.fixture(scope="module")
+def days():
+    return {(site, date, weather): synthetic(site, date, weather=weather, seed=11)
+            for site, dates in DAYS.items() for date in dates for weather in ("sunny", "cloudy", "overcast", "mixed")}
+
+
+def test_frame_has_pvlib_columns_on_a_tz_aware_index(days):
+    frame = days[("lanzhou", "2021-06-21", "mixed")]
+    assert list(frame.columns[:5]) == ["ghi", "dni", "dhi", "wind_speed", "temp_air"]
+    assert str(frame.index.tz) == "Asia/Shanghai" and len(frame) == 1440
+    assert set(frame["sky"].astype(str)) <= {"sunny", "cloudy", "overcast"}
+    assert frame.attrs["weather"] == {"2021-06-21": "mixed"}
+
+
+def test_closure_and_nothing_at_night(days):
+    for (site, _, _), frame in days.items():
+        position = solar_position(frame.index, site)
+        cos_z = np.clip(np.cos(np.radians(position["apparent_zenith"])), 0, None)
+        np.testing.assert_allclose(frame["ghi"], frame["dni"] * cos_z + frame["dhi"], atol=1e-9)
+        night = position["apparent_altitude"] < 0
+        assert (frame.loc[night, ["ghi", "dni", "dhi"]] == 0).all().all()
+        assert (frame[["ghi", "dni", "dhi"]] >= 0).all().all()
+
+
+def test_clearness_index_by_weather(days):
+    for (site, date, weather), frame in days.items():
+        kt = daily_summary(frame, site)["clearness_index"].iloc[0]
+        if weather == "sunny":
+            assert kt > 0.6, (site, date, kt)
+        if weather == "overcast":
+            assert kt < 0.3, (site, date, kt)
+            assert frame["dni"].max() < 0.03 * frame["dni_clear"].max()
+
+
+def test_clear_sky_itself_matches_the_published_clearness(days):
+    """Issue: clear sky gives about 0.65 at Nanjing and 0.81 at Lanzhou in June."""
+    for site, expected in (("nanjing", 0.65), ("lanzhou", 0.81)):
+        frame = days[(site, DAYS[site][1], "sunny")]
+        clear = frame.assign(ghi=frame["ghi_clear"], dni=frame["dni_clear"])
+        assert daily_summary(clear, site)["clearness_index"].iloc[0] == pytest.approx(expected, abs=0.04)
+
+
+def test_seasonal_order_of_clear_days(days):
+    for site, (march, june, september, december) in DAYS.items():
+        dni = {d: daily_summary(days[(site, d, "sunny")], site)["ghi_kwh_m2"].iloc[0] for d in (march, june, december)}
+        assert dni[june] > dni[march] > dni[december]
+
+
+def test_cloudy_days_break_the_beam_and_enhance_briefly(days):
+    frame = days[("nanjing", "2013-06-21", "cloudy")]
+    up = frame["dni_clear"] > 300
+    blocked = (frame["dni"] < 0.15 * frame["dni_clear"])[up].mean()
+    assert 0.3 < blocked < 0.9  # broken clouds: the beam comes and goes
+    ratio = (frame["ghi"] / frame["ghi_clear"])[frame["ghi_clear"] > 200]
+    assert 1.0 < ratio.max() <= 1.25 + 1e-9  # cloud enhancement, bounded
+    # passages last minutes to an hour, not single steps
+    changes = np.flatnonzero(np.diff((frame["dni"] < 0.15 * frame["dni_clear"]).to_numpy().astype(int)))
+    assert np.median(np.diff(changes)) >= 3
+
+
+def test_same_seed_same_frame_any_step():
+    a = synthetic("lanzhou", "2021-09-23", weather="mixed", seed=4)
+    b = synthetic("lanzhou", "2021-09-23", weather="mixed", seed=4)
+    pd.testing.assert_frame_equal(a, b)
+    c = synthetic("lanzhou", "2021-09-23", weather="mixed", seed=5)
+    assert not a["dni"].equals(c["dni"])
+    # the clouds live in continuous time: 10-second steps see the same passages
+    fine = synthetic("lanzhou", "2021-09-23", weather="mixed", seed=4, freq="10s")
+    np.testing.assert_array_equal(fine["sky"].reindex(a.index).astype(str), a["sky"].astype(str))
+
+
+def test_multi_day_sequence_and_period_within_a_day():
+    frame = synthetic("nanjing", "2013-06-20", "2013-06-22", weather=["sunny", "overcast", "cloudy"], seed=1)
+    assert list(frame.attrs["weather"].values()) == ["sunny", "overcast", "cloudy"]
+    assert len(frame) == 3 * 1440
+    part = synthetic("nanjing", "2013-06-21 05:00", "2013-06-21 20:00", weather="sunny")
+    assert part.index[0].hour == 5 and part.index[-1].hour == 20 and len(part) == 901
+
+
+def test_gusts_can_exceed_the_stow_threshold():
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=2, gusts_per_day=6, gust_peak=(18, 24))
+    assert frame["wind_speed"].max() > 17.2
+    calm = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=2)
+    assert calm["wind_speed"].max() < 17.2 and (calm["wind_speed"] >= 0).all()
+    # diurnal shape: afternoon windier than dawn
+    hours = calm.index.hour
+    assert calm["wind_speed"][(hours >= 13) & (hours < 17)].mean() > calm["wind_speed"][(hours >= 3) & (hours < 7)].mean()
+
+
+def test_climate_day_fractions_reproduce_the_sunshine_normals():
+    for site in ("lanzhou", "nanjing"):
+        year = synthetic(site, "2021-01-01", "2021-12-31", weather="climate", seed=0, freq="10min")
+        sunshine = daily_summary(year, site)["sunshine_share"].mean()
+        assert sunshine == pytest.approx(np.mean(CLIMATE[site].sunshine), abs=0.07)
+        drawn = pd.Series(year.attrs["weather"]).value_counts(normalize=True)
+        assert set(drawn.index) == {"sunny", "cloudy", "overcast"}
+    fractions = CLIMATE["nanjing"].day_fractions(6)
+    assert sum(fractions.values()) == pytest.approx(1.0) and min(fractions.values()) >= 0
+    assert CLIMATE["lanzhou"].day_fractions(1)["sunny"] > CLIMATE["nanjing"].day_fractions(1)["sunny"]
+
+
+def test_custom_climate_and_any_site():
+    dull = Climate((0.1,) * 12, (10.0,) * 12, 1.0, "test")
+    assert dull.day_fractions(5)["sunny"] == 0.0
+    cape_town = sites.custom(-33.9, 18.4, "Africa/Johannesburg")
+    frame = synthetic(cape_town, "2024-12-21", weather="sunny", climate=dull)
+    assert frame["ghi"].max() > 900  # southern summer
+    assert frame.attrs["climate_source"] == "test"
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"weather": "stormy"}, "unknown weather 'stormy'"),
+    ({"weather": ["sunny", "cloudy"]}, "2 weathers given for 1 days"),
+    ({"gusts_per_day": -1}, "gusts_per_day must be within"),
+    ({"freq": "0s"}, "must be positive"),
+])
+def test_bad_sky_requests(kwargs, message):
+    with pytest.raises(HybridtrackError, match=message):
+        synthetic("lanzhou", "2021-06-21", **kwargs)
