@@ -1,0 +1,177 @@
+"""Recorded weather files: messy CSVs, pvlib formats, DST, derivations, resampling, clear errors."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from hybridtrack import HybridtrackError
+from hybridtrack.io import read_weather, validation_report
+
+ROOT = Path(__file__).resolve().parents[1]
+PVLIB_DATA = Path(os.path.dirname(pvlib.__file__)) / "data"
+
+
+def write(tmp_path, name, text, encoding="utf-8"):
+    path = tmp_path / name
+    path.write_bytes(text.encode(encoding) if isinstance(text, str) else text)
+    return path
+
+
+def test_semicolons_decimal_commas_header_block_and_units(tmp_path):
+    path = write(tmp_path, "logger.csv", "Station: Lanzhou roof\nLogger: CR1000\n\n"
+                 "Timestamp;Global [kW/m2];Direct Normal;Diffuse;Wind speed [km/h]\n"
+                 "2021-06-21 12:00;0,9005;850,0;110,2;36,0\n2021-06-21 12:01;0,9010;851,5;111,0;18,0\n")
+    frame = read_weather(path, tz="Asia/Shanghai")
+    assert list(frame.columns) == ["ghi", "dni", "dhi", "wind_speed"]
+    assert frame["ghi"].iloc[0] == pytest.approx(900.5) and frame["wind_speed"].iloc[0] == pytest.approx(10.0)
+    report = frame.attrs["validation"]
+    assert report["header_lines_skipped"] == 3 and report["separator"] == "semicolon" and report["decimal"] == ","
+    assert frame.index[0] == pd.Timestamp("2021-06-21 12:00", tz="Asia/Shanghai")
+
+
+def test_iso_stamps_with_offsets_keep_them_or_convert(tmp_path):
+    path = write(tmp_path, "iso.csv", "time,ghi,dni,dhi\n2021-06-21T12:00:00+08:00,900,800,100\n"
+                 "2021-06-21T12:01:00+08:00,901,801,100\n")
+    kept = read_weather(path)
+    assert kept.index[0].utcoffset() == pd.Timedelta(hours=8)
+    converted = read_weather(path, tz="UTC")
+    assert converted.index[0] == pd.Timestamp("2021-06-21 04:00", tz="UTC")
+
+
+def test_naive_stamps_need_a_time_zone(tmp_path):
+    path = write(tmp_path, "naive.csv", "time,ghi,dni,dhi\n2021-06-21 12:00,900,800,100\n2021-06-21 12:01,9,8,1\n")
+    with pytest.raises(HybridtrackError, match="naive time stamps.*give the time zone"):
+        read_weather(path)
+    assert str(read_weather(path, tz="Asia/Shanghai").index.tz) == "Asia/Shanghai"
+
+
+def test_dst_fall_back_and_spring_forward(tmp_path):
+    fall = pd.date_range("2021-11-07 00:00", "2021-11-07 03:00", freq="30min", tz="America/New_York")
+    path = write(tmp_path, "fall.csv", pd.DataFrame({"time": fall.tz_localize(None).strftime("%Y-%m-%d %H:%M"),
+                                                     "ghi": 0, "dni": 0, "dhi": 0}).to_csv(index=False))
+    frame = read_weather(path, tz="America/New_York")
+    assert frame.index.equals(fall) and frame.attrs["validation"]["dst_repeated"]["count"] == 4
+    spring = pd.date_range("2021-03-14 00:00", "2021-03-14 04:00", freq="30min")
+    path = write(tmp_path, "spring.csv", pd.DataFrame({"time": spring.strftime("%Y-%m-%d %H:%M"),
+                                                       "ghi": 0, "dni": 0, "dhi": 0}).to_csv(index=False))
+    frame = read_weather(path, tz="America/New_York")
+    dropped = frame.attrs["validation"]["dst_dropped"]
+    assert dropped["count"] == 2 and dropped["lines"] == [6, 7] and len(frame) == 7
+    assert "DST: dropped" in validation_report(frame)
+
+
+def test_missing_dni_by_closure_or_decomposition(tmp_path):
+    times = pd.date_range("2013-06-21 08:00", periods=5, freq="1h", tz="Asia/Shanghai")
+    ghi, dhi = np.array([400.0, 600, 800, 900, 850]), np.array([100.0, 120, 130, 140, 135])
+    path = write(tmp_path, "gd.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "ghi": ghi,
+                                                   "dhi": dhi}).to_csv(index=False))
+    with pytest.raises(HybridtrackError, match="dni missing; deriving it needs the sun's position"):
+        read_weather(path)
+    closure = read_weather(path, site="nanjing")
+    from hybridtrack.sun import solar_position
+
+    cos_z = np.cos(np.radians(solar_position(closure.index, "nanjing")["apparent_zenith"]))
+    np.testing.assert_allclose(closure["dni"] * cos_z + closure["dhi"], ghi, rtol=1e-9)
+    assert closure.attrs["dni_source"].startswith("closure")
+    path = write(tmp_path, "g.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "ghi": ghi})
+                 .to_csv(index=False))
+    erbs = read_weather(path, site="nanjing")
+    assert erbs.attrs["dni_source"].startswith("erbs") and (erbs["dni"] > 0).all() and (erbs["dhi"] > 0).all()
+    dirint = read_weather(path, site="nanjing", decomposition="dirint")
+    assert dirint.attrs["dni_source"].startswith("dirint")
+
+
+def test_five_minute_data_is_interpolated_to_the_control_step(tmp_path):
+    times = pd.date_range("2021-06-21 12:00", periods=4, freq="5min", tz="Asia/Shanghai")
+    path = write(tmp_path, "5min.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                                                     "ghi": [900, 950, 900, 850], "dni": [800, 850, 800, 750],
+                                                     "dhi": 100}).to_csv(index=False))
+    frame = read_weather(path, freq="1min")
+    assert len(frame) == 16 and frame["ghi"].iloc[1] == pytest.approx(910.0)
+    assert frame.attrs["resampling"].startswith("linear in time from 5min to 1min")
+    ten = read_weather(path, freq="10min")
+    assert ten["ghi"].iloc[0] == pytest.approx(925.0) and ten.attrs["resampling"] == "mean over each 10min step"
+
+
+def test_checks_sort_deduplicate_clip_flag_and_count(tmp_path):
+    path = write(tmp_path, "messy.csv", "time,ghi,dni,dhi,wind_speed\n"
+                 "2021-06-21 12:00,-3,0,0,2\n2021-06-21 12:02,900,800,100,3\n2021-06-21 12:01,905,5000,100,-4\n"
+                 "2021-06-21 12:02,900,800,100,3\n2021-06-21 12:03,,800,100,3\n2021-06-21 12:10,900,800,100,3\n")
+    frame = read_weather(path, tz="Asia/Shanghai")
+    report = frame.attrs["validation"]
+    assert report["unsorted"]["count"] == 1 and report["duplicates"]["count"] == 1
+    assert report["negative_clipped"]["ghi"]["lines"] == [2] and frame["ghi"].iloc[0] == 0.0
+    assert report["impossible"]["dni"]["lines"] == [4] and report["impossible"]["wind_speed"]["count"] == 1
+    assert report["nan"]["ghi"] == 1 and report["gaps"]["count"] == 1 and report["gaps"]["longest"] == "7min"
+    assert np.isnan(frame.loc["2021-06-21 12:01", "dni"])
+
+
+def test_pvlib_formats_go_through_pvlib(tmp_path):
+    tmy = read_weather(PVLIB_DATA / "723170TYA.CSV", format="tmy3")
+    assert len(tmy) == 8760 and set(tmy.columns) >= {"ghi", "dni", "dhi", "temp_air", "wind_speed"}
+    assert tmy.index.tz is not None and tmy.attrs["validation"]["format"] == "tmy3"
+    epw = write(tmp_path, "tiny.epw", EPW)
+    frame = read_weather(epw, format="epw")
+    assert len(frame) == 3 and frame["dni"].iloc[1] == 612.0 and frame["temp_air"].iloc[1] == pytest.approx(21.5)
+    with pytest.raises(HybridtrackError, match="pvlib could not read it as EPW"):
+        read_weather(write(tmp_path, "bad.epw", "not an epw\n"), format="epw")
+
+
+EPW_HEADER = ("LOCATION,Nanjing,JS,CHN,SYN,582380,31.93,118.90,8.0,7.1\nDESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\n"
+              "GROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,test\nCOMMENTS 2,test\n"
+              "DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n")
+
+
+def _epw_row(hour, ghi, dni, dhi, temp):
+    fields = [2013, 6, 21, hour, 0, "?", temp, 15.0, 60, 101000, 0, 0, 350, ghi, dni, dhi, 0, 0, 0, 0, 180, 3.0, 5, 5,
+              20.0, 77777, 9, 999999999, 0, 0.1, 0, 88, 0.2, 0, 1]
+    return ",".join(map(str, fields))
+
+
+EPW = EPW_HEADER + "\n".join(_epw_row(h, g, d, f, t) for h, g, d, f, t in
+                             ((11, 700, 600, 120, 21.0), (12, 720, 612, 125, 21.5), (13, 690, 590, 118, 21.9))) + "\n"
+
+
+def test_the_shipped_records_read_back_with_their_labels():
+    frame = read_weather(ROOT / "data" / "nanjing-2013-cloudy.csv")
+    assert len(frame) == 4 * 901 and set(frame["sky"].unique()) == {"cloudy"}
+    assert frame.attrs["validation"]["gaps"]["count"] == 3  # the nights between the four days
+
+
+def test_the_shipped_records_regenerate_byte_for_byte():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_typical_days", ROOT / "data" / "make_typical_days.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    for site, weather in (("lanzhou", "sunny"), ("nanjing", "overcast")):
+        assert module.make(site, weather) == (ROOT / "data" / module.file_name(site, weather)).read_text()
+
+
+@pytest.mark.parametrize("content, kwargs, message", [
+    (None, {}, "no such file"),
+    ("", {}, "the file is empty"),
+    (b"\x89PNG\r\n\x1a\n\x00\x00binary", {}, "looks binary"),
+    ("time,ghi\n2021-06-21 12:00,9\u00e900\n".encode("latin-1"), {"tz": "UTC"}, "line 2: not UTF-8"),
+    ("a,b\n1,2\n3,4\n", {}, "no time column found"),
+    ("time,pressure\n2021-06-21 12:00,1000\n2021-06-21 12:01,1000\n", {"tz": "UTC"}, "no irradiance column"),
+    ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,lots\n", {"tz": "UTC"}, "line 3, column 'ghi': 'lots' is not"),
+    ("time,ghi\nyesterday,900\nnoon,900\n", {"tz": "UTC"}, "line 2, column 'time': 'yesterday' is not a time"),
+    ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "UTC", "columns": {"dni": "Beam"}},
+     "no column 'Beam' \\(mapped to dni\\); columns are time, ghi"),
+    ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "Mars/Base"}, "unknown time zone 'Mars/Base'"),
+    ("time,ghi\n2021-06-21 12:00,9000\n2021-06-21 12:01,9100\n", {"tz": "UTC"}, "100% of values are outside.*wrong unit"),
+    ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "UTC", "units": {"ghi": "furlongs"}},
+     "unknown unit 'furlongs'"),
+    ("time,ghi\n2021-06-21 12:00,900\n", {"tz": "UTC"}, "fewer than two distinct time stamps"),
+    ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"format": "xlsx"}, "unknown format 'xlsx'"),
+])
+def test_bad_files_give_one_clear_line(tmp_path, content, kwargs, message):
+    path = tmp_path / "bad.csv" if content is None else write(tmp_path, "bad.csv", content)
+    with pytest.raises(HybridtrackError, match=message) as error:
+        read_weather(path, **kwargs)
+    assert "\n" not in str(error.value)
