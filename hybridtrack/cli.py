@@ -250,6 +250,113 @@ def _surface(args: argparse.Namespace) -> int:
     return 0
 
 
+# --- skies and records ----------------------------------------------------------------------
+
+
+def _parse_mapping(pairs, flag: str) -> dict[str, str]:
+    mapping = {}
+    for pair in pairs or []:
+        name, sep, value = pair.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise HybridtrackError(f"{flag} takes NAME=VALUE, got {pair!r}")
+        mapping[name.strip()] = value.strip()
+    return mapping
+
+
+def add_record_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--map``, ``--units``, ``--format``, ``--freq`` and ``--decomposition`` for recorded files."""
+    group = parser.add_argument_group("recorded file")
+    group.add_argument("--map", action="append", metavar="NAME=COLUMN",
+                       help="which file column holds ghi, dni, dhi, wind_speed, temp_air, photocurrent or time "
+                            "(repeatable), e.g. --map dni='Direct Normal'")
+    group.add_argument("--units", action="append", metavar="NAME=UNIT", help="unit of a column, e.g. --units ghi=kW/m2")
+    group.add_argument("--format", default="csv", help="csv (default), epw, tmy3, midc, srml, bsrn, surfrad, crn, solrad")
+    group.add_argument("--decomposition", choices=("erbs", "dirint"), default="erbs",
+                       help="how DNI and DHI are split from GHI alone (default erbs)")
+
+
+def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | None = None):
+    """`read_weather` with the flags of `add_record_arguments`."""
+    from .io import read_weather
+
+    return read_weather(path, columns=_parse_mapping(args.map, "--map"), tz=args.tz, format=args.format, site=site,
+                        units=_parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition)
+
+
+def _check_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", help="recorded weather file")
+    add_record_arguments(parser)
+    parser.add_argument("--tz", help="time zone of naive stamps, e.g. Asia/Shanghai")
+    parser.add_argument("--site", help="site, to derive missing irradiance components")
+    parser.add_argument("--freq", help="resample to this step, e.g. 1min")
+
+
+@command("check", "read a recorded weather file and print its validation summary", _check_arguments)
+def _check(args: argparse.Namespace) -> int:
+    from .io import validation_report
+
+    frame = read_record(args, args.file, site=args.site, freq=args.freq)
+    print(validation_report(frame))
+    return 0
+
+
+def _sky_arguments(parser: argparse.ArgumentParser) -> None:
+    add_site_arguments(parser)
+    parser.add_argument("--date", required=True, help="first local date, YYYY-MM-DD")
+    parser.add_argument("--days", type=int, default=1, help="number of days (default 1)")
+    parser.add_argument("--weather", default="mixed",
+                        help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
+    parser.add_argument("--freq", default="1min", help="step (default 1min)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
+    parser.add_argument("--out", help="write the weather frame (with sensor readings) as CSV")
+    parser.add_argument("--plot", metavar="PNG", help="draw irradiance, sensor readings and wind")
+
+
+@command("sky", "make a synthetic weather frame and show its sensor's view", _sky_arguments)
+def _sky(args: argparse.Namespace) -> int:
+    import datetime as dt
+
+    from .sensor import sensor_view
+    from .sky import synthetic
+    from .times import parse_date
+
+    site = site_from_arguments(args)
+    if not 1 <= args.days <= 3660:
+        raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    first = parse_date(args.date)
+    weather = args.weather.split(",") if "," in args.weather else args.weather
+    frame = sensor_view(synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather,
+                                  freq=args.freq, seed=args.seed, gusts_per_day=args.gusts_per_day), seed=args.seed)
+    print(_sky_table(frame, site).to_string(float_format=lambda v: f"{v:.2f}"))
+    if args.out:
+        frame.to_csv(args.out, float_format="%.3f", index_label="time")
+        print(f"wrote {len(frame)} rows to {args.out}")
+    if args.plot:
+        from .report import plot_sky, save_figure
+
+        print(f"plot: {save_figure(plot_sky(frame, site), args.plot)}")
+    return 0
+
+
+def _sky_table(frame: pd.DataFrame, site) -> pd.DataFrame:
+    """Per day: weather, DNI, clearness index, sunshine, and the classifier's share of each label."""
+    from .fuzzy import FuzzyWeatherClassifier
+    from .sky import daily_summary
+    from .sun import solar_position
+
+    table = daily_summary(frame, site)
+    table.insert(0, "weather", [frame.attrs.get("weather", {}).get(str(day), "?") for day in table.index])
+    up = solar_position(frame.index, site)["altitude"].to_numpy() > 10.0
+    labels = pd.Series(FuzzyWeatherClassifier().classify(frame["intensity_ma"].to_numpy()[up],
+                                                         frame["variation_ma"].to_numpy()[up]),
+                       index=frame.index[up].tz_convert(site.tz).date)
+    shares = labels.groupby(level=0).value_counts(normalize=True).unstack(fill_value=0.0)
+    for label in ("sunny", "cloudy", "overcast"):
+        table[f"fuzzy_{label}"] = shares.get(label, pd.Series(0.0, index=table.index)).reindex(table.index).fillna(0.0)
+    return table
+
+
 # --- entry point ----------------------------------------------------------------------------
 
 

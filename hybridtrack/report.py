@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["plot_sun_path", "plot_fuzzy_surface", "save_figure"]
+__all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "save_figure", "SKY_COLOURS"]
 
 
 def _pyplot():
@@ -122,4 +122,79 @@ def plot_fuzzy_surface(classifier, *, points: int = 121, title: str | None = Non
         axm.set_title(var.name, fontsize="medium")
         axm.legend(fontsize="small", ncols=len(var.terms), loc="upper center")
     fig.suptitle(title or f"fuzzy weather classifier: {config.name} ({len(config.rules)} rules)")
+    return fig
+
+
+SKY_COLOURS = {"sunny": "#f6c343", "cloudy": "#9db4c0", "overcast": "#5c6b73", "unknown": "#dddddd"}
+
+
+def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0) -> None:
+    """Shade the time axis by a categorical label (sky class or mode), one colour a label."""
+    import numpy as np
+
+    values = np.asarray(labels, dtype=object)
+    if len(values) == 0:
+        return
+    change = np.flatnonzero(values[1:] != values[:-1]) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [len(values)]])
+    step = (times[1] - times[0]) if len(times) > 1 else None
+    for a, b in zip(starts, ends):
+        right = times[b] if b < len(times) else times[-1] + step if step is not None else times[-1]
+        ax.axvspan(times[a], right, ymin=y0, ymax=y1, color=SKY_COLOURS.get(values[a], "#cccccc"), lw=0)
+
+
+def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = None):
+    """Irradiance, the sensor's readings with the classifier's verdict, and wind, on one time axis.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A weather frame with ``intensity_ma`` and ``variation_ma`` (`hybridtrack.sensor.sensor_view`).
+    site : Site or str
+    classifier : FuzzyWeatherClassifier, optional
+        The published one by default.
+    """
+    from matplotlib.patches import Patch
+
+    from .fuzzy import FuzzyWeatherClassifier
+    from .sites import get
+
+    plt = _pyplot()
+    site = get(site)
+    clf = classifier or FuzzyWeatherClassifier()
+    local = frame.index.tz_convert(site.tz).tz_localize(None)
+    fig, axes = plt.subplots(4, 1, figsize=(12, 9), sharex=True, height_ratios=[3, 0.35, 2.2, 1.4])
+    ax = axes[0]
+    for column, colour in (("ghi", "tab:orange"), ("dni", "tab:red"), ("dhi", "tab:blue")):
+        ax.plot(local, frame[column], label=column.upper(), color=colour, lw=0.9)
+    if "ghi_clear" in frame:
+        ax.plot(local, frame["ghi_clear"], label="clear-sky GHI", color="0.4", lw=0.8, ls="--")
+    ax.set_ylabel("W/m²")
+    ax.legend(loc="upper left", ncols=4, fontsize="small")
+    ax.set_title(title or f"{site.name}: {', '.join(f'{d} {w}' for d, w in frame.attrs.get('weather', {}).items())}"
+                 [:140])
+    band = axes[1]
+    predicted = clf.classify(frame["intensity_ma"].to_numpy(), frame["variation_ma"].to_numpy())
+    if "sky" in frame:
+        _label_band(band, local, frame["sky"].astype(str).to_numpy(), y0=0.5, y1=1.0)
+        band.text(1.005, 0.75, "true", transform=band.transAxes, va="center", fontsize="small")
+    _label_band(band, local, predicted, y0=0.0, y1=0.5 if "sky" in frame else 1.0)
+    band.text(1.005, 0.25, "fuzzy", transform=band.transAxes, va="center", fontsize="small")
+    band.set_yticks([])
+    band.legend(handles=[Patch(color=c, label=k) for k, c in SKY_COLOURS.items()], loc="upper left",
+                bbox_to_anchor=(0, -0.1), ncols=4, fontsize="x-small", frameon=False)
+    ax = axes[2]
+    ax.plot(local, frame["intensity_ma"], color="tab:purple", lw=0.9, label="photocurrent")
+    ax.plot(local, frame["variation_ma"], color="tab:green", lw=0.9, label="variation")
+    ax.set_ylabel("mA")
+    ax.legend(loc="upper left", fontsize="small")
+    ax = axes[3]
+    ax.plot(local, frame["wind_speed"], color="tab:gray", lw=0.8)
+    ax.axhline(17.2, color="tab:red", ls=":", lw=1)
+    ax.text(local[0], 17.6, "stow 17.2 m/s", color="tab:red", fontsize="x-small")
+    ax.set_ylabel("wind (m/s)")
+    ax.set_xlabel(f"local time ({site.tz})")
+    fig.autofmt_xdate()
+    fig.tight_layout()
     return fig

@@ -1,0 +1,47 @@
+import pandas as pd
+import pytest
+
+from hybridtrack.cli import main
+
+
+def test_check_prints_the_validation_summary(tmp_path, capsys):
+    path = tmp_path / "log.csv"
+    path.write_text("Site;Lanzhou\n\nStamp;Direct Normal;Global;Diffuse\n2021-06-21 12:00;800,0;900,0;100,0\n"
+                    "2021-06-21 12:01;801,0;901,0;-4,0\n2021-06-21 12:01;801,0;901,0;100,0\n")
+    assert main(["check", str(path), "--tz", "Asia/Shanghai", "--map", "time=Stamp", "--map", "dni=Direct Normal"]) == 0
+    out = capsys.readouterr().out
+    assert "3 rows read, 2 rows out, step 1min" in out
+    assert "semicolon-separated, decimal ','" in out and "dni <- 'Direct Normal'" in out
+    assert "duplicated stamps: count 1, lines 6" in out and "negative values clipped to 0: dhi count 1" in out
+
+
+def test_check_a_shipped_record(capsys):
+    assert main(["check", "data/lanzhou-2021-overcast.csv"]) == 0
+    assert "3604 rows read" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["check", "missing.csv"], "missing.csv: no such file"),
+    (["check", "data/lanzhou-2021-sunny.csv", "--map", "dni"], "--map takes NAME=VALUE, got 'dni'"),
+    (["check", "data/lanzhou-2021-sunny.csv", "--map", "beam=ghi"], "unknown column name 'beam'"),
+    (["check", "data/lanzhou-2021-sunny.csv", "--tz", "Nowhere/Land"], "unknown time zone 'Nowhere/Land'"),
+    (["sky", "--site", "lanzhou", "--date", "2021-06-31"], "date '2021-06-31' does not exist"),
+    (["sky", "--site", "lanzhou", "--date", "2021-06-21", "--weather", "foggy"], "unknown weather 'foggy'"),
+    (["sky", "--site", "lanzhou", "--date", "2021-06-21", "--days", "0"], "--days must be between 1 and 3660"),
+])
+def test_record_commands_bad_input(capsys, args, message):
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+
+
+def test_sky_prints_the_day_and_writes_csv_and_plot(tmp_path, capsys):
+    out, png = tmp_path / "sky.csv", tmp_path / "sky.png"
+    assert main(["sky", "--site", "nanjing", "--date", "2013-12-22", "--weather", "sunny,overcast", "--days", "2",
+                 "--out", str(out), "--plot", str(png)]) == 0
+    printed = capsys.readouterr().out
+    rows = {line.split()[0]: line.split()[1] for line in printed.splitlines() if line.startswith("2013-12-2")}
+    assert rows == {"2013-12-22": "sunny", "2013-12-23": "overcast"} and "fuzzy_cloudy" in printed
+    frame = pd.read_csv(out, index_col="time")
+    assert {"ghi", "dni", "dhi", "wind_speed", "temp_air", "sky", "intensity_ma", "variation_ma"} <= set(frame.columns)
+    assert len(frame) == 2 * 1440 and png.stat().st_size > 30_000
