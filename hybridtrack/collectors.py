@@ -23,6 +23,7 @@ __all__ = [
     "Collector",
     "KINDS",
     "sun_vector",
+    "across_angle",
     "trough_angle",
     "tracking_rate",
     "fresnel_angle",
@@ -56,12 +57,22 @@ def sun_vector(altitude, azimuth) -> np.ndarray:
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
 
+def across_angle(vectors: np.ndarray, axis_azimuth: float) -> np.ndarray:
+    """Angle (degrees) of vectors ``(..., 3)`` projected on the plane across a horizontal axis.
+
+    Measured from the horizontal direction at ``axis_azimuth + 90°`` through the zenith, the
+    single-axis convention of this module, within [-90, 270) so that a direction just below
+    either horizon stays next to 0 or 180.
+    """
+    b = np.radians(axis_azimuth)
+    across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
+    angle = np.degrees(np.arctan2(vectors[..., 2], across))
+    return np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
+
+
 def _cross_axis_angle(altitude, azimuth, axis_azimuth: float) -> np.ndarray:
     """Angle of the sun's projection on the plane across a horizontal axis (0-180°)."""
-    s = sun_vector(altitude, azimuth)
-    b = np.radians(axis_azimuth)
-    across = s[..., 0] * np.cos(b) - s[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
-    angle = np.degrees(np.arctan2(s[..., 2], across))
+    angle = across_angle(sun_vector(altitude, azimuth), axis_azimuth)
     return np.where(np.asarray(altitude, float) >= 0.0, angle, np.nan)
 
 
@@ -131,8 +142,12 @@ def fresnel_angle(altitude, azimuth, d: float, h: float, axis_azimuth: float = 0
     if not h > 0:
         raise HybridtrackError(f"receiver height h must be positive, got {h!r} m")
     sun = _cross_axis_angle(altitude, azimuth, axis_azimuth)
-    receiver = np.degrees(np.arctan2(h, -float(d)))
-    return _like(altitude, 0.5 * (sun + receiver), "fresnel_angle")
+    return _like(altitude, 0.5 * (sun + receiver_angle(d, h)), "fresnel_angle")
+
+
+def receiver_angle(d: float, h: float) -> float:
+    """Direction (trough convention, degrees) from a Fresnel row at lateral distance `d` to its receiver."""
+    return float(np.degrees(np.arctan2(h, -float(d))))
 
 
 def fresnel_end_loss(altitude, azimuth, d: float, h: float):
