@@ -4,4 +4,13 @@ from .errors import HybridtrackError
 
 __version__ = "0.1.0"
 
-__all__ = ["HybridtrackError", "__version__"]
+__all__ = ["HybridtrackError", "simulate", "__version__"]
+
+
+def __getattr__(name: str):
+    # the simulator pulls in pvlib, scikit-fuzzy and filterpy; load it on first use only
+    if name == "simulate":
+        from .simulation import simulate
+
+        return simulate
+    raise AttributeError(f"module 'hybridtrack' has no attribute {name!r}")
