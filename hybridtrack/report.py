@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "save_figure", "SKY_COLOURS"]
+__all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_compare", "save_figure", "SKY_COLOURS", "MODE_COLOURS"]
 
 
 def _pyplot():
@@ -197,4 +197,122 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
     ax.set_xlabel(f"local time ({site.tz})")
     fig.autofmt_xdate()
     fig.tight_layout()
+    return fig
+
+
+MODE_COLOURS = {"sensor": "#2a9d8f", "astronomical": "#e9c46a", "search": "#f4a261", "stow_wind": "#e76f51",
+                "stow_night": "#264653"}
+
+
+def plot_run(result, *, title: str | None = None):
+    """A run on one time axis: irradiance, sky class, mode, target and actual angle, pointing error."""
+    import numpy as np
+    from matplotlib.patches import Patch
+
+    plt = _pyplot()
+    log = result.log
+    local = log.index.tz_convert(result.site.tz).tz_localize(None)
+    sun_up = np.isfinite(log["target_true"].to_numpy())
+    fig, axes = plt.subplots(5, 1, figsize=(12, 10), sharex=True, height_ratios=[2, 0.3, 0.3, 2.4, 1.8])
+    ax = axes[0]
+    ax.plot(local, log["dni"], color="tab:red", lw=0.9, label="DNI")
+    ax.set_ylabel("W/m²")
+    ax.legend(loc="upper left", fontsize="small")
+    summary = result.summary
+    err = summary["tracking_error_deg"]
+    ax.set_title(title or (f"{summary['site']} · {summary['collector']} · {summary['strategy']}: RMS "
+                           f"{err['rms'] if err['rms'] is not None else float('nan'):.3f}°, p95 "
+                           f"{err['p95'] if err['p95'] is not None else float('nan'):.3f}°, energy "
+                           f"{summary['energy_capture'] if summary['energy_capture'] is not None else float('nan'):.1%}"))
+    _label_band(axes[1], local, log["sky"].astype(str).to_numpy())
+    axes[1].set_yticks([])
+    axes[1].set_ylabel("sky", rotation=0, ha="right", va="center")
+    bands = axes[2]
+    values = log["mode"].astype(str).to_numpy()
+    change = np.flatnonzero(values[1:] != values[:-1]) + 1
+    for a, b in zip(np.concatenate([[0], change]), np.concatenate([change, [len(values)]])):
+        bands.axvspan(local[a], local[min(b, len(local) - 1)], color=MODE_COLOURS.get(values[a], "#ccc"), lw=0)
+    bands.set_yticks([])
+    bands.set_ylabel("mode", rotation=0, ha="right", va="center")
+    bands.legend(handles=[Patch(color=c, label=m) for m, c in MODE_COLOURS.items()] +
+                 [Patch(color=c, label=f"sky {k}") for k, c in SKY_COLOURS.items() if k != "unknown"],
+                 loc="upper left", bbox_to_anchor=(0, -0.2), ncols=8, fontsize="x-small", frameon=False)
+    ax = axes[3]
+    ax.plot(local, log["target_true"], color="k", lw=0.8, label="true target")
+    ax.plot(local, log["angle"], color="tab:blue", lw=0.9, ls="--", label="actual angle")
+    ax.set_ylabel("angle (°)" if result.collector.single_axis else "elevation axis (°)")
+    ax.legend(loc="upper left", fontsize="small")
+    ax = axes[4]
+    error = log["error"].where(sun_up & log["mode"].isin(["sensor", "astronomical", "search"]))
+    ax.plot(local, error, color="tab:purple", lw=0.7)
+    for y in (-0.5, 0.5):
+        ax.axhline(y, color="tab:red", ls=":", lw=0.8)
+    ax.set_ylabel("pointing error (°)")
+    finite = np.abs(error.dropna())
+    if len(finite):
+        limit = max(1.0, min(float(finite.quantile(0.99)) * 1.3, 10.0))
+        ax.set_ylim(-limit if result.collector.single_axis else 0, limit)
+    ax.set_xlabel(f"local time ({result.site.tz})")
+    fig.autofmt_xdate()
+    fig.tight_layout()
+    return fig
+
+
+STRATEGY_COLOURS = {"hybrid": "#2a9d8f", "hybrid-nocal": "#8ab17d", "astronomical": "#e9c46a", "sensor": "#e76f51"}
+
+
+def plot_compare(results: dict, *, title: str | None = None):
+    """Strategies side by side on the same weather: pointing error over time, and the key metrics.
+
+    Parameters
+    ----------
+    results : dict of str to Result
+        One `hybridtrack.simulation.Result` per strategy, all on the same frame.
+    """
+    import numpy as np
+
+    plt = _pyplot()
+    first = next(iter(results.values()))
+    local = first.log.index.tz_convert(first.site.tz).tz_localize(None)
+    fig = plt.figure(figsize=(12, 9), layout="constrained")
+    grid = fig.add_gridspec(4, 3, height_ratios=[1.4, 0.3, 2.6, 1.8])
+    ax = fig.add_subplot(grid[0, :])
+    ax.plot(local, first.log["dni"], color="tab:red", lw=0.8)
+    ax.set_ylabel("DNI (W/m²)")
+    band = fig.add_subplot(grid[1, :], sharex=ax)
+    _label_band(band, local, first.log["sky"].astype(str).to_numpy())
+    band.set_yticks([])
+    band.set_ylabel("sky", rotation=0, ha="right", va="center")
+    err_ax = fig.add_subplot(grid[2, :], sharex=ax)
+    for name, result in results.items():
+        log = result.log
+        error = log["error"].where(log["mode"].isin(["sensor", "astronomical", "search"]) & (log["dni"] > 0))
+        err_ax.plot(local, error, lw=0.8, label=name, color=STRATEGY_COLOURS.get(name))
+    for y in (-0.5, 0.5):
+        err_ax.axhline(y, color="k", ls=":", lw=0.7)
+    err_ax.set_ylim(-2, 2)
+    err_ax.set_ylabel("pointing error (°), clipped to ±2")
+    err_ax.legend(loc="upper left", ncols=len(results), fontsize="small")
+    metrics = (("RMS error (°)", lambda s: s["tracking_error_deg"]["rms"]),
+               ("p95 error (°)", lambda s: s["tracking_error_deg"]["p95"]),
+               ("energy capture", lambda s: s["energy_capture"]))
+    names = list(results)
+    for k, (label, pick) in enumerate(metrics):
+        bar = fig.add_subplot(grid[3, k])
+        values = [pick(results[n].summary) for n in names]
+        values = [np.nan if v is None else v for v in values]
+        bar.bar(range(len(names)), values, color=[STRATEGY_COLOURS.get(n, "grey") for n in names])
+        bar.set_xticks(range(len(names)), names, rotation=20, fontsize="small")
+        bar.set_title(label, fontsize="medium")
+        for x, v in enumerate(values):
+            if np.isfinite(v):
+                bar.text(x, v, f"{v:.3f}" if label != "energy capture" else f"{v:.1%}", ha="center", va="bottom",
+                         fontsize="x-small")
+        if label == "energy capture":
+            finite = [v for v in values if np.isfinite(v)]
+            if finite:
+                bar.set_ylim(max(0.0, min(finite) - 0.05), 1.0)
+    summary = first.summary
+    fig.suptitle(title or f"{summary['site']} · {summary['collector']} · {summary['start'][:10]}"
+                          f"{' to ' + summary['end'][:10] if summary['end'][:10] != summary['start'][:10] else ''}")
     return fig

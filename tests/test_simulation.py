@@ -1,0 +1,255 @@
+"""The hybrid controller and the simulator: acceptance behaviours on short seeded runs."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import HybridtrackError, simulate
+from hybridtrack.collectors import Collector
+from hybridtrack.control import ControllerConfig
+from hybridtrack.fuzzy import FuzzyWeatherClassifier
+from hybridtrack.simulation import LOG_COLUMNS, SimulationConfig
+from hybridtrack.sky import synthetic
+from hybridtrack.world import Imperfections
+
+MIXED = {"lanzhou": "2021-06-21", "nanjing": "2013-12-22"}
+
+
+@pytest.fixture(scope="module")
+def mixed_runs():
+    runs = {}
+    for site, date in MIXED.items():
+        frame = synthetic(site, date, weather="mixed", seed=3)
+        for strategy in ("hybrid", "hybrid-nocal", "astronomical", "sensor"):
+            runs[(site, strategy)] = simulate(frame, site, strategy=strategy)
+    return runs
+
+
+def perfect(**controller):
+    return SimulationConfig(imperfections=Imperfections.none(), controller=ControllerConfig(**controller))
+
+
+def test_log_and_summary_have_the_promised_shape(mixed_runs):
+    result = mixed_runs[("lanzhou", "hybrid")]
+    assert set(LOG_COLUMNS) <= set(result.log.columns)
+    assert result.log.index.equals(synthetic("lanzhou", MIXED["lanzhou"], weather="mixed", seed=3).index)
+    assert set(result.summary) >= {"tracking_error_deg", "within_0_5_deg", "energy_capture", "moves", "travel_deg",
+                                   "mode_share", "sky_share", "mode_switches", "stow_events", "site", "collector",
+                                   "strategy", "steps", "start", "end"}
+    assert set(result.summary["tracking_error_deg"]) >= {"rms", "p95", "max"}
+    assert result.summary["steps"] == 1440 and result.summary["site"] == "lanzhou"
+    assert abs(sum(result.summary["mode_share"].values()) - 1) < 1e-4
+    assert list(result.events.columns) == ["time", "from", "to", "reason"] and result.events["reason"].str.len().min() > 3
+
+
+@pytest.mark.parametrize("site", list(MIXED))
+def test_hybrid_beats_both_single_strategies_with_p95_within_half_a_degree(mixed_runs, site):
+    hybrid = mixed_runs[(site, "hybrid")].summary
+    for other in ("astronomical", "sensor"):
+        rival = mixed_runs[(site, other)].summary
+        assert hybrid["tracking_error_deg"]["rms"] < rival["tracking_error_deg"]["rms"]
+        assert hybrid["energy_capture"] > rival["energy_capture"]
+    assert hybrid["tracking_error_deg"]["p95"] < 0.5
+    assert hybrid["within_0_5_deg"] > 0.95
+
+
+@pytest.mark.parametrize("site", list(MIXED))
+def test_astronomical_carries_the_bias_and_hybrid_removes_most_of_it(mixed_runs, site):
+    astro = mixed_runs[(site, "astronomical")].summary["tracking_error_deg"]["mean"]
+    nocal = mixed_runs[(site, "hybrid-nocal")].summary["tracking_error_deg"]["mean"]
+    hybrid = mixed_runs[(site, "hybrid")].summary["tracking_error_deg"]["mean"]
+    assert astro < -0.25  # clock behind, encoder off, axis turned: the open loop trails
+    assert abs(hybrid) < 0.35 * abs(astro)
+    assert abs(nocal) > abs(hybrid)  # without calibration the cloudy hours keep the bias
+
+
+def test_sensor_only_loses_time_under_cloud(mixed_runs):
+    log = mixed_runs[("nanjing", "sensor")].log
+    cloudy = log["sky"].isin(["cloudy", "overcast"]) & (log["dni"] > 0) & log["target_true"].notna()
+    lost = (log.loc[cloudy, "error"].abs() > 1.0).mean()
+    hybrid = mixed_runs[("nanjing", "hybrid")].log
+    assert lost > 0.1 and (hybrid.loc[cloudy, "error"].abs() > 1.0).mean() < 0.01
+    assert mixed_runs[("nanjing", "sensor")].summary["mode_share"]["search"] > 0
+
+
+def gusty_frame():
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
+    wind = np.full(len(frame), 3.0)
+    gust = frame.index.get_loc(pd.Timestamp("2021-06-21 11:00", tz="Asia/Shanghai"))
+    wind[gust:gust + 4] = [18.0, 22.0, 19.0, 16.0]
+    wind[gust + 4:gust + 9] = 13.0  # breezy but above release: stay stowed
+    return frame.assign(wind_speed=wind), gust
+
+
+def test_a_gust_stows_within_one_scan_and_holds_until_the_release_rule():
+    frame, gust = gusty_frame()
+    result = simulate(frame, "lanzhou")
+    log = result.log
+    assert log["mode"].iloc[gust - 1] != "stow_wind" and log["mode"].iloc[gust] == "stow_wind"
+    assert abs(log["angle"].iloc[gust + 1] - (90.0 - result.config.imperfections.encoder_offset)) < 0.1
+    stowed = log.iloc[gust + 1:gust + 19]
+    assert (stowed["mode"] == "stow_wind").all() and stowed["angle"].nunique() == 1  # never moves while stowed
+    calm_from = gust + 9  # wind at or below 12 m/s from here on
+    resume = log.index[log["mode"].ne("stow_wind") & (np.arange(len(log)) > gust)][0]
+    assert resume == log.index[calm_from + 10]
+    assert result.summary["stow_events"] == 1
+    assert "wind 18.0 m/s > 17.2" in result.events["reason"].tolist()
+
+
+def test_wind_hovering_around_the_threshold_does_not_chatter():
+    frame = synthetic("nanjing", "2013-06-21", weather="sunny", seed=2)
+    hover = 17.2 + 0.5 * np.sin(np.arange(len(frame)) * 1.3)
+    result = simulate(frame.assign(wind_speed=hover), "nanjing")
+    assert result.summary["stow_events"] == 1  # one stow, held: never released under hovering wind
+
+
+class FlickeringSky(FuzzyWeatherClassifier):
+    """A classifier whose verdict flips between sunny and cloudy every two minutes."""
+
+    def score(self, intensity, variation, **kwargs):
+        return np.where((np.arange(len(np.atleast_1d(intensity))) // 2) % 2 == 0, 25.0, 15.0)
+
+
+def test_a_flickering_sky_does_not_flip_modes_every_minute():
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=4)
+    result = simulate(frame, "lanzhou", classifier=FlickeringSky())
+    events = result.events
+    tracking = events[events["from"].isin(["sensor", "astronomical"]) & events["to"].isin(["sensor", "astronomical"])]
+    assert len(tracking) > 20  # the sky does keep changing its mind
+    assert (tracking["time"].diff().dropna() >= pd.Timedelta("5min")).all()  # but the mode waits out the dwell
+    shorter = simulate(frame, "lanzhou", classifier=FlickeringSky(),
+                       config=SimulationConfig(controller=ControllerConfig(dwell="1min"))).events
+    assert len(shorter) > 1.5 * len(events)
+
+
+def test_filterpy_reference_and_fast_kalman_give_the_same_run():
+    frame = synthetic("nanjing", "2013-03-20 06:00", "2013-03-20 14:00", weather="mixed", seed=5)
+    fast = simulate(frame, "nanjing")
+    reference = simulate(frame, "nanjing", config=SimulationConfig(controller=ControllerConfig(kalman="filterpy")))
+    np.testing.assert_allclose(fast.log["target"], reference.log["target"], atol=1e-9)
+    np.testing.assert_allclose(fast.log["angle"], reference.log["angle"], atol=1e-9)
+    assert fast.summary == reference.summary
+
+
+def test_bulk_nights_match_step_by_step():
+    from hybridtrack.control import run_controller
+    from hybridtrack.simulation import simulate as run
+
+    frame = synthetic("lanzhou", "2021-03-19", "2021-03-21", weather="mixed", seed=6, gusts_per_day=1)
+    captured = {}
+
+    def spy(inputs, config, drives, **kw):
+        captured["args"] = (inputs, config, drives, kw)
+        return run_controller(inputs, config, drives, **kw)
+
+    import hybridtrack.simulation as module
+
+    original = module.run_controller
+    module.run_controller = spy
+    try:
+        run(frame, "lanzhou")
+    finally:
+        module.run_controller = original
+    inputs, config, drives, kw = captured["args"]
+    kw = {k: v for k, v in kw.items() if k != "progress"}
+    bulk = run_controller(inputs, config, drives, bulk_nights=True, **kw)
+    steps = run_controller(inputs, config, drives, bulk_nights=False, **kw)
+    for name in ("mode", "sensor_status", "target", "angle", "reading", "calibration", "moves", "travel"):
+        np.testing.assert_array_equal(getattr(bulk, name), getattr(steps, name))
+    assert bulk.events == steps.events
+
+
+def test_intermittent_drive_error_is_bounded_by_deadband_and_sun_motion():
+    frame = synthetic("nanjing", "2013-12-22", weather="sunny", seed=7)
+    for lead in (True, False):
+        result = simulate(frame, "nanjing", strategy="astronomical", config=perfect(lead=lead, sun_model="spa"))
+        log = result.log
+        tracking = log["mode"].eq("astronomical") & log["target_true"].notna() & (log.index.hour >= 8) \
+            & (log.index.hour < 17)
+        rate = log["target_true"].diff().abs().max()  # the fastest sun motion in one step
+        bound = result.config.drive.deadband + (rate if not lead else 0) + 2 * result.config.drive.resolution
+        assert log.loc[tracking, "error"].abs().max() <= bound
+    # the drive moves only past the deadband
+    target, reading = log["target"].to_numpy(), log["angle"].shift(1).to_numpy()
+    moved = np.flatnonzero(np.diff(log["angle"].to_numpy()) != 0) + 1
+    day = [i for i in moved if log["mode"].iloc[i] == "astronomical"]
+    assert all(abs(target[i] - reading[i]) > 0.4 - result.config.drive.resolution for i in day)
+
+
+def test_calibration_corrects_an_encoder_offset():
+    frame = synthetic("lanzhou", "2021-06-21", weather="cloudy", seed=8)
+    offset_only = SimulationConfig(imperfections=dataclasses.replace(Imperfections.none(), encoder_offset=0.6))
+    astro = simulate(frame, "lanzhou", strategy="astronomical", config=offset_only).summary["tracking_error_deg"]
+    hybrid = simulate(frame, "lanzhou", strategy="hybrid", config=offset_only)
+    assert astro["mean"] == pytest.approx(-0.6, abs=0.15)
+    late = hybrid.log.between_time("11:00", "18:00")
+    assert late["calibration"].iloc[-1] == pytest.approx(0.6, abs=0.08)
+    assert abs(hybrid.summary["tracking_error_deg"]["mean"]) < 0.15
+
+
+def test_day_cycle_wakes_before_sunrise_and_stows_at_sunset():
+    frame = synthetic("nanjing", "2013-12-22", weather="sunny", seed=9)  # sunrise near 07:00, after 05:00
+    result = simulate(frame, "nanjing", config=perfect())
+    events = result.events
+    wake = events.loc[events["reason"] == "awake and sun up", "time"].iloc[0]
+    sleep = events.loc[events["to"] == "stow_night", "time"].iloc[0]
+    sun_up = result.log.index[result.log["target_true"].notna()]
+    assert pd.Timedelta("20min") <= sun_up[0] - wake <= pd.Timedelta("35min")
+    assert abs(sleep - sun_up[-1]) <= pd.Timedelta("3min")
+    at_sunrise = result.log.loc[sun_up[0]]
+    assert abs(at_sunrise["angle"] - max(at_sunrise["target_true"], 0.0)) < 1.0  # pre-positioned
+
+
+@pytest.mark.parametrize("collector", ["trough-ew", "fresnel", "heliostat"])
+def test_every_collector_tracks(collector):
+    frame = synthetic("lanzhou", "2021-09-23", weather="sunny", seed=10)
+    result = simulate(frame, "lanzhou", collector=collector)
+    summary = result.summary
+    assert summary["collector"] == collector
+    assert summary["tracking_error_deg"]["p95"] < 0.5
+    # a heliostat with the trough's 0.4° deadband: its beam moves twice its normal's error
+    assert summary["energy_capture"] > (0.9 if collector != "heliostat" else 0.8)
+    if collector == "heliostat":
+        assert {"angle_azimuth", "target_true_azimuth"} <= set(result.log.columns)
+        assert (result.log["error"].dropna() >= 0).all()  # an angle between normals
+        assert result.log["angle_azimuth"].nunique() > 10 and result.log["angle"].nunique() > 10  # both axes move
+
+
+def test_config_round_trips_and_refuses_unknown_keys(tmp_path):
+    config = SimulationConfig(controller=ControllerConfig(strategy="sensor", dwell="7min"),
+                              imperfections=Imperfections(clock_error=-90.0), seed=4)
+    assert SimulationConfig.from_toml(config.to_toml(tmp_path / "run.toml")) == config
+    (tmp_path / "bad.toml").write_text("[controller]\nstrategy = 'magic'\n")
+    with pytest.raises(HybridtrackError, match="unknown strategy 'magic'"):
+        SimulationConfig.from_toml(tmp_path / "bad.toml")
+    (tmp_path / "bad2.toml").write_text("[imperfections]\nclock_eror = 3\n")
+    with pytest.raises(HybridtrackError, match="imperfections.clock_eror: unknown key"):
+        SimulationConfig.from_toml(tmp_path / "bad2.toml")
+    (tmp_path / "bad3.toml").write_text("[drive]\ndeadband = 'wide'\n")
+    with pytest.raises(HybridtrackError, match="drive.deadband: must be a number"):
+        SimulationConfig.from_toml(tmp_path / "bad3.toml")
+
+
+def test_result_saves_log_summary_events_and_report(tmp_path, mixed_runs):
+    written = mixed_runs[("lanzhou", "hybrid")].save(tmp_path / "run")
+    assert json.loads(written["summary"].read_text())["strategy"] == "hybrid"
+    assert written["report"].stat().st_size > 50_000
+    log = pd.read_parquet(written["log"]) if written["log"].suffix == ".parquet" else pd.read_csv(written["log"])
+    assert len(log) == 1440
+    csv = mixed_runs[("lanzhou", "hybrid")].save(tmp_path / "csv", plot=False, log_format="csv")
+    assert csv["log"].name == "log.csv" and "report" not in csv
+
+
+@pytest.mark.parametrize("frame, message", [
+    (pd.DataFrame({"dni": [1.0, 2.0]}, index=pd.date_range("2021-06-21", periods=2, freq="min")), "naive"),
+    (pd.DataFrame({"ghi": [1.0, 2.0]}, index=pd.date_range("2021-06-21", periods=2, freq="min", tz="UTC")),
+     "no 'dni' column"),
+    (pd.DataFrame({"dni": [1.0, 2.0]}, index=pd.DatetimeIndex(["2021-06-21 12:01", "2021-06-21 12:00"], tz="UTC")),
+     "increasing"),
+])
+def test_bad_frames_are_refused(frame, message):
+    with pytest.raises(HybridtrackError, match=message):
+        simulate(frame, "lanzhou")
