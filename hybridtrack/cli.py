@@ -301,33 +301,17 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _sky_arguments(parser: argparse.ArgumentParser) -> None:
-    add_site_arguments(parser)
-    parser.add_argument("--date", required=True, help="first local date, YYYY-MM-DD")
-    parser.add_argument("--days", type=int, default=1, help="number of days (default 1)")
-    parser.add_argument("--weather", default="mixed",
-                        help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
-    parser.add_argument("--freq", default="1min", help="step (default 1min)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
+    _synthetic_arguments(parser)
     parser.add_argument("--out", help="write the weather frame (with sensor readings) as CSV")
     parser.add_argument("--plot", metavar="PNG", help="draw irradiance, sensor readings and wind")
 
 
 @command("sky", "make a synthetic weather frame and show its sensor's view", _sky_arguments)
 def _sky(args: argparse.Namespace) -> int:
-    import datetime as dt
-
     from .sensor import sensor_view
-    from .sky import synthetic
-    from .times import parse_date
 
     site = site_from_arguments(args)
-    if not 1 <= args.days <= 3660:
-        raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
-    first = parse_date(args.date)
-    weather = args.weather.split(",") if "," in args.weather else args.weather
-    frame = sensor_view(synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather,
-                                  freq=args.freq, seed=args.seed, gusts_per_day=args.gusts_per_day), seed=args.seed)
+    frame = sensor_view(_synthetic_frame(args, site), seed=args.seed)
     print(_sky_table(frame, site).to_string(float_format=lambda v: f"{v:.2f}"))
     if args.out:
         frame.to_csv(args.out, float_format="%.3f", index_label="time")
@@ -386,9 +370,10 @@ def _simulation_config(args: argparse.Namespace, seed: int | None = None):
     return config
 
 
-def _synthetic_arguments(parser: argparse.ArgumentParser, *, default_site: str | None = None) -> None:
-    add_site_arguments(parser, default=default_site)
-    parser.add_argument("--date", required=True, help="first local date, YYYY-MM-DD")
+def _synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: bool = True) -> None:
+    """Site, dates, weather, step, seed and gusts of synthetic days."""
+    add_site_arguments(parser)
+    parser.add_argument("--date", required=date_required, help="first local date, YYYY-MM-DD")
     parser.add_argument("--days", type=int, default=1, help="number of days (default 1)")
     parser.add_argument("--weather", default="mixed",
                         help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
@@ -521,13 +506,7 @@ def _replay(args: argparse.Namespace) -> int:
 
 def _compare_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", nargs="?", help="recorded weather file to replay (else synthetic days from --date)")
-    add_site_arguments(parser)
-    parser.add_argument("--date", help="first local date of synthetic days, YYYY-MM-DD")
-    parser.add_argument("--days", type=int, default=1, help="number of synthetic days (default 1)")
-    parser.add_argument("--weather", default="mixed", help="synthetic weather (default mixed)")
-    parser.add_argument("--freq", default="1min", help="synthetic step (default 1min)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
+    _synthetic_arguments(parser, date_required=False)
     add_record_arguments(parser)
     parser.add_argument("--step", default="1min", help="control step a record is resampled to (default 1min)")
     add_run_arguments(parser)

@@ -49,7 +49,8 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["read_weather", "read_table", "validation_report", "WEATHER_COLUMNS", "PVLIB_FORMATS", "LIMITS"]
+__all__ = ["read_weather", "read_table", "read_toml", "write_toml", "validation_report", "WEATHER_COLUMNS",
+           "PVLIB_FORMATS", "LIMITS"]
 
 #: The columns of a weather frame, in order.
 WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent")
@@ -146,6 +147,35 @@ def read_table(path) -> pd.DataFrame:
         raise HybridtrackError(f"{path}: the table has no rows")
     frame.attrs["source"] = str(path)
     return frame
+
+
+def read_toml(path, what: str = "config") -> dict:
+    """A TOML file as a dict, or one clear error naming the file (missing, not UTF-8, bad TOML)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise HybridtrackError(f"{path}: no such {what} file") from None
+    except IsADirectoryError:
+        raise HybridtrackError(f"{path}: is a folder, not a {what} file") from None
+    except UnicodeDecodeError as exc:
+        raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise HybridtrackError(f"{path}: not valid TOML: {exc}") from None
+
+
+def write_toml(data: dict, path) -> Path:
+    """Write a dict as TOML, creating folders; `read_toml` reads it back equal."""
+    import tomli_w
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(tomli_w.dumps(data), encoding="utf-8")
+    return path
 
 
 # --- weather files --------------------------------------------------------------------------

@@ -112,29 +112,15 @@ class SimulationConfig:
     @classmethod
     def from_toml(cls, path) -> SimulationConfig:
         """Load from a TOML file; keys left out keep their defaults."""
-        try:
-            import tomllib
-        except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-            import tomli as tomllib
-        path = Path(path)
-        try:
-            data = tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise HybridtrackError(f"{path}: no such config file") from None
-        except UnicodeDecodeError:
-            raise HybridtrackError(f"{path}: not UTF-8 text") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise HybridtrackError(f"{path}: not valid TOML: {exc}") from None
-        return cls.from_dict(data, source=str(path))
+        from .io import read_toml
+
+        return cls.from_dict(read_toml(path), source=str(path))
 
     def to_toml(self, path) -> Path:
         """Write as TOML; `from_toml` reads it back equal."""
-        import tomli_w
+        from .io import write_toml
 
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(tomli_w.dumps(self.to_dict()))
-        return path
+        return write_toml(self.to_dict(), path)
 
 
 @dataclass

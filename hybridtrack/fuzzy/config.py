@@ -23,11 +23,6 @@ from pathlib import Path
 
 from ..errors import HybridtrackError
 
-try:  # Python 3.11+
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
-
 __all__ = ["Term", "Variable", "Rule", "FuzzyConfig", "SHAPES", "LABELS"]
 
 #: Membership shapes and their parameter counts.
@@ -390,28 +385,15 @@ class FuzzyConfig:
     @classmethod
     def from_toml(cls, path) -> FuzzyConfig:
         """Load a config from a TOML file (see ``data/fuzzy-complete.toml``)."""
-        path = Path(path)
-        try:
-            with path.open("rb") as handle:
-                data = tomllib.load(handle)
-        except FileNotFoundError:
-            raise HybridtrackError(f"{path}: no such config file") from None
-        except IsADirectoryError:
-            raise HybridtrackError(f"{path}: is a folder, not a config file") from None
-        except UnicodeDecodeError as exc:
-            raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise HybridtrackError(f"{path}: not valid TOML: {exc}") from None
-        return cls.from_dict(data, source=str(path))
+        from ..io import read_toml
+
+        return cls.from_dict(read_toml(path), source=str(path))
 
     def to_toml(self, path) -> Path:
         """Write the config as TOML; `from_toml` reads it back equal."""
-        import tomli_w
+        from ..io import write_toml
 
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(tomli_w.dumps(self.to_dict()))
-        return path
+        return write_toml(self.to_dict(), path)
 
     # -- MATLAB .fis -------------------------------------------------------------------------
 
