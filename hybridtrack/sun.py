@@ -31,6 +31,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 from .sites import Site, get
+from .times import clock_hours
 
 __all__ = [
     "solar_position",
@@ -186,10 +187,6 @@ def _check_times(times) -> pd.DatetimeIndex:
     return index
 
 
-def _hours_of_day(local: pd.DatetimeIndex) -> np.ndarray:
-    return np.asarray((local - local.normalize()) / pd.Timedelta(hours=1), float)
-
-
 def _plc(
     index: pd.DatetimeIndex, site: Site, declination: str, equation_of_time: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -203,7 +200,7 @@ def _plc(
     else:
         eot = plc_equation_of_time(day, year)
     # true solar time: clock + (longitude - zone meridian)/15 + Et/60
-    solar_time = _hours_of_day(local) + (site.longitude - 15.0 * zone_hours) / 15.0 + eot / 60.0
+    solar_time = clock_hours(local) + (site.longitude - 15.0 * zone_hours) / 15.0 + eot / 60.0
     hour_angle = (15.0 * (solar_time - 12.0) + 180.0) % 360.0 - 180.0
     return dec, hour_angle, eot
 

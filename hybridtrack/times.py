@@ -8,7 +8,19 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "check_tz"]
+__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "check_tz", "clock_hours"]
+
+
+def clock_hours(local: pd.DatetimeIndex):
+    """What the local clock reads, in hours (13:30 -> 13.5).
+
+    Not the time since midnight: on a DST day the two differ by the hour the clock skipped
+    or repeated.
+    """
+    import numpy as np
+
+    return (np.asarray(local.hour, float) + np.asarray(local.minute, float) / 60.0
+            + (np.asarray(local.second, float) + np.asarray(local.microsecond, float) / 1e6) / 3600.0)
 
 
 def check_tz(tz: str, where: str = "") -> str:

@@ -124,3 +124,14 @@ def test_naive_times_are_refused_clearly():
 def test_unknown_model_options_are_refused(options, message):
     with pytest.raises(HybridtrackError, match=message):
         solar_position(day("2013-06-21", "nanjing", "1h"), "nanjing", **options)
+
+
+@pytest.mark.parametrize("date", ["2021-03-14", "2021-11-07"])
+def test_plc_model_reads_the_clock_on_dst_days(date):
+    """On a DST day the clock reading, not the time since midnight, gives the solar time."""
+    denver = sites.custom(39.74, -104.99, "America/Denver", 1609)
+    times = pd.date_range(f"{date} 08:00", f"{date} 17:00", freq="30min", tz="America/Denver")
+    spa = solar_position(times, denver, "spa")
+    plc = solar_position(times, denver, "plc")
+    assert np.abs(spa["hour_angle"] - plc["hour_angle"]).max() < 0.5
+    assert np.abs(spa["altitude"] - plc["altitude"]).max() < 0.5
