@@ -18,7 +18,23 @@ Modes, and why the controller is in each:
     its rate;
 ``search``
     the sensor-only strategy's way back to a sun that left the fine sensor's field of view:
-    the coarse cells tell the side, and the drive sweeps toward it at `search_speed`.
+    the coarse cells tell the side, and the drive sweeps toward it at `search_speed`;
+``fault``
+    the encoder stopped answering a commanded move: the position is unknown, so the drive
+    halts (no move at all) until the next morning, when the controller probes again.
+
+Faults the controller guards against, each logged in the events:
+
+* a sensor reading repeated exactly for `stuck_scans` scans (a real one always has noise)
+  is judged stuck. One further from the model than `sensor_plausibility` is judged
+  implausible. The comparison is with the uncorrected model, so a drifting sensor cannot
+  drag the calibration along with it, and the calibration is bounded by the same amount.
+  Neither kind of reading is ever tracked.
+* an encoder reading that jumps away from where the last commanded move should have left
+  it is a glitch: it is ignored for that scan, and accepted only if it persists for
+  `encoder_confirm` scans. A reading that does not move when the drive was commanded to is
+  a frozen encoder, and puts the controller in ``fault``.
+* an anemometer reading that is not a number counts as a gust: stow.
 
 The sky class picks between sensor and astronomical: sunny means sensor, anything else
 astronomical. A minimum dwell keeps a flickering sky from flipping the mode every minute.
@@ -53,10 +69,10 @@ __all__ = ["ControllerConfig", "STRATEGIES", "MODES", "SENSOR_STATUS", "FastKalm
 log = logging.getLogger("hybridtrack.control")
 
 STRATEGIES = ("hybrid", "hybrid-nocal", "astronomical", "sensor")
-MODES = ("stow_night", "stow_wind", "astronomical", "sensor", "search")
-STOW_NIGHT, STOW_WIND, ASTRONOMICAL, SENSOR, SEARCH = range(len(MODES))
-SENSOR_STATUS = ("ok", "low light", "out of view", "invalid reading", "outlier", "not read")
-OK, LOW_LIGHT, OUT_OF_VIEW, INVALID, OUTLIER, NOT_READ = range(len(SENSOR_STATUS))
+MODES = ("stow_night", "stow_wind", "astronomical", "sensor", "search", "fault")
+STOW_NIGHT, STOW_WIND, ASTRONOMICAL, SENSOR, SEARCH, FAULT = range(len(MODES))
+SENSOR_STATUS = ("ok", "low light", "out of view", "invalid reading", "outlier", "not read", "stuck", "implausible")
+OK, LOW_LIGHT, OUT_OF_VIEW, INVALID, OUTLIER, NOT_READ, STUCK, IMPLAUSIBLE = range(len(SENSOR_STATUS))
 SKY_CODES = ("sunny", "cloudy", "overcast", "unknown")
 
 
@@ -93,6 +109,13 @@ class ControllerConfig:
         the filter restarts from the latest reading: a filter that drifted away from the sun
         must not go on rejecting it.
     reacquire : int
+    sensor_plausibility : float
+        Degrees: a sensor reading further from the (calibrated) model is implausible, and
+        the calibration never exceeds it.
+    stuck_scans : int
+        Identical sensor readings in a row that mark the sensor stuck.
+    encoder_confirm : int
+        Scans a jumped encoder reading must persist before it is believed.
     calibration_max_rate : float
         Degrees per minute: calibration learns only while the model's target moves no faster.
         The offset it learns is meant to be a slow bias; where the geometry turns fast (an
@@ -122,6 +145,9 @@ class ControllerConfig:
     gate: float = 4.0
     reacquire: int = 3
     calibration_max_rate: float = 1.0
+    sensor_plausibility: float = 2.0
+    stuck_scans: int = 3
+    encoder_confirm: int = 3
     search_speed: float = 5.0
     lead: bool = True
     kalman: str = "fast"
@@ -152,8 +178,12 @@ class ControllerConfig:
         if not (self.process_noise > 0 and self.gate > 0 and self.search_speed > 0 and self.calibration_max_rate > 0):
             raise HybridtrackError("controller: process_noise, gate, search_speed and calibration_max_rate must be "
                                    "positive")
-        if not (isinstance(self.reacquire, int) and self.reacquire >= 1):
-            raise HybridtrackError(f"controller: reacquire must be a whole number of readings, got {self.reacquire!r}")
+        for name in ("reacquire", "stuck_scans", "encoder_confirm"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+                raise HybridtrackError(f"controller: {name} must be a whole number of at least 1, got {value!r}")
+        if not self.sensor_plausibility > 0:
+            raise HybridtrackError("controller: sensor_plausibility must be positive")
 
     @property
     def uses_sensor(self) -> bool:
@@ -272,6 +302,9 @@ class ControllerInputs:
     truth: np.ndarray  # (N, axes)
     noise: np.ndarray  # (N, axes) standard normal draws for the sensor
     sensor_fault: np.ndarray | None = None  # (N, axes): NaN none, else the reading the sensor gives
+    sensor_dropout: np.ndarray | None = None  # (N,) bool: the sensor gives no reading at all
+    sensor_drift: np.ndarray | None = None  # (N,) degrees added to every sensor reading
+    clock_step: np.ndarray | None = None  # (N,) seconds the controller clock jumped at this scan (detected)
     encoder_fault: np.ndarray | None = None  # (N, axes): added to the reading (a wild count)
     encoder_frozen: np.ndarray | None = None  # (N,) bool: the encoder repeats its last reading
 
@@ -309,14 +342,26 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
     loss, tau = config.minutes("sensor_loss"), config.minutes("calibration_tau")
     gate2 = config.gate**2
     stow = [d.stow for d in drives]
+    circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]  # an axis that turns all the way round
+
+    def turn(a: int, difference: float) -> float:
+        """A difference of angles on axis `a`: the short way round on a circular axis."""
+        return (difference + 180.0) % 360.0 - 180.0 if circular[a] else difference
+
     low = [d.limits[0] for d in drives]
     high = [d.limits[1] for d in drives]
-    actual = list(stow)
+    actual = [stow[a] - encoder_offset for a in range(axes)]  # parked where the controller believes stow is
     last_reading = [math.nan] * axes
     calibration = [0.0] * axes
     calibrated = [0.0] * axes  # minutes of readings the calibration has averaged
     filter_ready = [False] * axes
     rejected = [0] * axes  # gated readings in a row
+    last_measured = [math.nan] * axes
+    repeats = [0] * axes  # identical sensor readings in a row
+    commanded = [0.0] * axes  # the move commanded at the last scan
+    believed = [math.nan] * axes  # the reading the controller uses
+    jumped = [0] * axes  # scans a jumped encoder reading has persisted
+    limit = config.sensor_plausibility
     mode, mode_since = STOW_NIGHT, -math.inf
     calm_since = -math.inf
     invalid_since = math.nan
@@ -338,6 +383,9 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
     encoder_fault = [inputs.encoder_fault[:, a].tolist() for a in range(axes)] \
         if inputs.encoder_fault is not None else None
     frozen = inputs.encoder_frozen.tolist() if inputs.encoder_frozen is not None else None
+    dropout = inputs.sensor_dropout.tolist() if inputs.sensor_dropout is not None else None
+    drift = inputs.sensor_drift.tolist() if inputs.sensor_drift is not None else None
+    clock_step = inputs.clock_step.tolist() if inputs.clock_step is not None else None
 
     # where each sleeping stretch ends, and whether a gust falls in it
     asleep = ~np.asarray(inputs.awake, bool)
@@ -348,7 +396,7 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
             if len(wake_at) else n
         next_wake[:n] = np.where(np.arange(n) > (wake_at[-1] if len(wake_at) else -1), n, next_wake[:n])
     gusts = np.concatenate([[0], np.cumsum(~(np.asarray(inputs.wind, float) <= wind_stow))])
-    can_skip = bulk_nights and sensor_fault is None and encoder_fault is None and frozen is None
+    can_skip = bulk_nights and encoder_fault is None and frozen is None and clock_step is None
     next_wake, gusts = next_wake.tolist(), gusts.tolist()
 
     out_mode: list = []
@@ -367,6 +415,10 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
         events.append((i, MODES[mode], MODES[new], reason))
         log.debug("step %d: %s -> %s (%s)", i, MODES[mode], MODES[new], reason)
         mode, mode_since = new, minutes[i]
+
+    def alarm(i: int, reason: str) -> None:
+        events.append((i, MODES[mode], MODES[mode], reason))
+        log.info("step %d: %s", i, reason)
 
     i = 0
     reported = 0
@@ -393,7 +445,9 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
                 previous_t = minutes[j - 1]
                 i = j
                 continue
-        # -- what the encoder says ------------------------------------------------------------
+        # -- what the encoder says, and whether to believe it ---------------------------------
+        if clock_step is not None and clock_step[i]:
+            alarm(i, f"controller clock stepped by {clock_step[i]:+.0f} s against the scan timer; clock re-based")
         reading = []
         for a in range(axes):
             if frozen is not None and frozen[i] and not math.isnan(last_reading[a]):
@@ -402,8 +456,32 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
                 value = round((actual[a] + encoder_offset) / resolution[a]) * resolution[a]
                 if encoder_fault is not None:
                     value += encoder_fault[a][i]
-            reading.append(value)
+            previous = last_reading[a]
             last_reading[a] = value
+            if math.isnan(believed[a]) or mode == FAULT:
+                believed[a] = value
+                reading.append(value)
+                continue
+            expected = believed[a] + commanded[a]
+            tolerance = 2.0 * resolution[a] + 1e-9
+            if commanded[a] and abs(value - previous) < 0.5 * resolution[a] \
+                    and abs(commanded[a]) > tolerance and mode != FAULT:
+                switch(i, FAULT, f"encoder frozen: commanded {commanded[a]:+.2f}°, reading unchanged; drive halted")
+                believed[a] = value
+            elif abs(value - expected) > tolerance:
+                jumped[a] += 1
+                if jumped[a] >= config.encoder_confirm:
+                    alarm(i, f"encoder reading {value:.3f}° held for {jumped[a]} scans; believed")
+                    believed[a] = value
+                    jumped[a] = 0
+                else:
+                    if jumped[a] == 1:
+                        alarm(i, f"encoder glitch: read {value:.3f}°, expected {expected:.3f}°; ignored")
+                    believed[a] = expected
+            else:
+                jumped[a] = 0
+                believed[a] = value
+            reading.append(believed[a])
         w = wind[i]
         gusty = not (w <= wind_stow)  # NaN counts as gusty: the safe reading
         if resting and not awake[i] and not gusty:
@@ -419,7 +497,7 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
         # -- wind -----------------------------------------------------------------------------
         if gusty:
             calm_since = math.inf
-            if mode != STOW_WIND:
+            if mode != STOW_WIND and mode != FAULT:
                 switch(i, STOW_WIND, "wind reading invalid" if math.isnan(w) else f"wind {w:.1f} m/s > {wind_stow}")
         elif w <= wind_release:
             if calm_since == math.inf or calm_since == -math.inf:
@@ -430,7 +508,10 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
             switch(i, ASTRONOMICAL if uses_model else SENSOR,
                    f"wind at or below {wind_release} m/s for {config.wind_hold}")
         # -- day cycle ------------------------------------------------------------------------
-        if mode != STOW_WIND:
+        if mode == FAULT:
+            if awake[i] and i and not awake[i - 1]:
+                switch(i, ASTRONOMICAL if uses_model else SENSOR, "a new day: probing the encoder again")
+        elif mode != STOW_WIND:
             if not awake[i]:
                 if mode != STOW_NIGHT:
                     switch(i, STOW_NIGHT, "outside working hours or sun down")
@@ -439,12 +520,24 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
         # -- the sensor -----------------------------------------------------------------------
         status = NOT_READ
         valid = [False] * axes
-        if uses_sensor and awake[i] and mode != STOW_WIND:
+        if uses_sensor and awake[i] and mode != STOW_WIND and mode != FAULT:
             status = OK
             for a in range(axes):
-                offset = truth[a][i] - actual[a]
+                offset = turn(a, truth[a][i] - actual[a])
                 fault = sensor_fault[a][i] if sensor_fault is not None else math.nan
                 measured = fault if not math.isnan(fault) else offset + sensor_bias + sensor_noise * noise[a][i]
+                if drift is not None:
+                    measured += drift[i]
+                if dropout is not None and dropout[i]:
+                    measured = math.nan
+                if measured == last_measured[a]:
+                    repeats[a] += 1
+                else:
+                    repeats[a] = 0
+                last_measured[a] = measured
+                if repeats[a] >= config.stuck_scans - 1:
+                    status = status if status != OK else STUCK
+                    continue
                 if not dni[i] >= direct_threshold:
                     status = status if status != OK else LOW_LIGHT
                     continue
@@ -455,10 +548,16 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
                     status = status if status != OK else INVALID
                     continue
                 z = reading[a] + measured
+                m0 = model[a][i]
+                # in pointing terms: a heliostat's azimuth axis turns 1/cos(elevation) times faster
+                bound = limit / max(math.cos(math.radians(model[1][i])), 0.05) if axes == 2 and a == 0 else limit
+                if uses_model and not math.isnan(m0) and abs(turn(a, z - m0)) > bound:
+                    status = status if status != OK else IMPLAUSIBLE
+                    continue
                 kf = filters[a]
                 if not filter_ready[a]:
-                    m0, m1 = model[a][i], model[a][i - 1] if i else math.nan
-                    rate = (m0 - m1) / dt if uses_model and dt > 0 and not math.isnan(m0 - m1) else 0.0
+                    m1 = model[a][i - 1] if i else math.nan
+                    rate = turn(a, m0 - m1) / dt if uses_model and dt > 0 and not math.isnan(m0 - m1) else 0.0
                     kf.reset(z, rate)
                     filter_ready[a] = True
                     valid[a] = True
@@ -476,13 +575,14 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
                     kf.update(z)
                 rejected[a] = 0
                 valid[a] = True
-                m0, m1 = model[a][i], model[a][i - 1] if i else math.nan
-                steady = abs(m0 - m1) <= config.calibration_max_rate * dt
+                m1 = model[a][i - 1] if i else math.nan
+                steady = abs(turn(a, m0 - m1)) <= config.calibration_max_rate * dt
                 if calibrates and steady:
                     # a running mean of the first readings, then forgetting with time constant tau
                     calibrated[a] += dt
                     alpha = max(1.0 - math.exp(-dt / tau), dt / calibrated[a] if calibrated[a] < tau else 0.0)
-                    calibration[a] += alpha * (kf.angle - m0 - calibration[a])
+                    calibration[a] += alpha * turn(a, kf.angle - m0 - calibration[a])
+                    calibration[a] = max(-bound, min(bound, calibration[a]))
             for a in range(axes):
                 if filter_ready[a] and not valid[a]:
                     filters[a].predict(dt)  # no update: the filter coasts
@@ -500,7 +600,8 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
                     switch(i, SEARCH, "sun out of the sensor's view")
             else:
                 want_sensor = uses_sensor and sky[i] == 0
-                if mode == SENSOR and not sensor_ok and t - invalid_since >= loss:
+                faulty = status in (STUCK, IMPLAUSIBLE, INVALID)  # judged wrong, not merely clouded
+                if mode == SENSOR and not sensor_ok and (faulty or t - invalid_since >= loss):
                     switch(i, ASTRONOMICAL, f"sensor lost ({SENSOR_STATUS[status]})")
                 elif mode == SENSOR and not want_sensor and t - mode_since >= dwell:
                     switch(i, ASTRONOMICAL, f"sky {SKY_CODES[sky[i]]}")
@@ -512,6 +613,13 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
         for a in range(axes):
             drive = drives[a]
             speed = drive.speed
+            commanded[a] = 0.0
+            if mode == FAULT:  # position unknown: never move
+                out_target[a].append(reading[a])
+                out_angle[a].append(actual[a])
+                out_reading[a].append(reading[a])
+                out_cal[a].append(calibration[a])
+                continue
             if stowing:
                 target = stow[a]  # in encoder terms: the controller does not know its encoder's offset
                 speed = drive.stow_speed
@@ -523,14 +631,18 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
                 else:
                     target = reading[a]
             elif mode == SEARCH:
-                target = reading[a] + math.copysign(config.search_speed * dt, truth[a][i] - actual[a])
+                target = reading[a] + math.copysign(config.search_speed * dt, turn(a, truth[a][i] - actual[a]))
             else:
                 m = model[a][i]
                 target = (m + calibration[a]) if not math.isnan(m) else stow[a]
                 if lead and i and not math.isnan(m):
                     previous = model[a][i - 1]
                     if not math.isnan(previous) and m != previous:
-                        target += math.copysign(half_band[a], m - previous)
+                        target += math.copysign(half_band[a], turn(a, m - previous))
+                if circular[a]:  # the nearest way to the same direction, within the limits
+                    target = reading[a] + turn(a, target - reading[a])
+                    if not low[a] <= target <= high[a]:
+                        target += 360.0 if target < low[a] else -360.0
             target = min(max(target, low[a]), high[a])
             error = target - reading[a]
             held = mode == STOW_WIND and abs(reading[a] - stow[a]) <= drive.deadband  # stowed: never move
@@ -538,6 +650,7 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
             if not held and abs(error) > threshold:
                 step = max(-speed * dt, min(speed * dt, error))
                 new = min(max(actual[a] + step, low[a]), high[a])
+                commanded[a] = new - actual[a]
                 travel[a] += abs(new - actual[a])
                 moves[a] += 1
                 actual[a] = new

@@ -66,8 +66,8 @@ def summarize(log: pd.DataFrame, *, site: str, collector: str, strategy: str, mo
     captured = np.sum((dni * incidence * gained)[offered & tracking])
     modes = log["mode"].value_counts(normalize=True)
     sky_up = log.loc[sun_up, "sky"].value_counts(normalize=True) if sun_up.any() else pd.Series(dtype=float)
-    tracking_events = events[events["from"].isin(TRACKING_MODES) & events["to"].isin(TRACKING_MODES)] \
-        if len(events) else events
+    tracking_events = events[events["from"].isin(TRACKING_MODES) & events["to"].isin(TRACKING_MODES)
+                             & (events["from"] != events["to"])] if len(events) else events
     return {
         "site": site, "collector": collector, "strategy": strategy, "steps": int(len(log)),
         "start": log.index[0].isoformat(), "end": log.index[-1].isoformat(),
@@ -76,8 +76,10 @@ def summarize(log: pd.DataFrame, *, site: str, collector: str, strategy: str, mo
         "energy_capture": round(float(captured / ideal), 5) if ideal > 0 else None,
         "moves": int(moves), "travel_deg": round(float(travel), 3),
         "mode_share": {m: round(float(modes.get(m, 0.0)), 5) for m in
-                       ("sensor", "astronomical", "search", "stow_wind", "stow_night")},
+                       ("sensor", "astronomical", "search", "stow_wind", "stow_night", "fault")},
         "sky_share": {k: round(float(sky_up.get(k, 0.0)), 5) for k in ("sunny", "cloudy", "overcast", "unknown")},
         "mode_switches": int(len(tracking_events)),
-        "stow_events": int((events["to"] == "stow_wind").sum()) if len(events) else 0,
+        "stow_events": int(((events["to"] == "stow_wind") & (events["from"] != "stow_wind")).sum()) if len(events) else 0,
+        "faults": int(((events["to"] == "fault") & (events["from"] != "fault")).sum()) if len(events) else 0,
+        "alarms": int((events["from"] == events["to"]).sum()) if len(events) else 0,
     }

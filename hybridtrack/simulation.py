@@ -28,7 +28,19 @@ from .sensor import SensorModel
 from .sun import solar_position
 from .world import Imperfections, incidence_cosine, mounting_rotation, true_targets
 
-__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS"]
+__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS", "CLOCK_STEP_SECONDS"]
+
+#: A jump of the controller's clock against its scan timer larger than this is a clock step.
+CLOCK_STEP_SECONDS = 5.0
+#: The faults `simulate` can inject, with what each array holds.
+FAULTS = {
+    "sensor": "(N,) or (N, axes): the reading the sensor gives (degrees); NaN where it works",
+    "sensor_dropout": "(N,) bool: the sensor gives no reading",
+    "sensor_drift": "(N,): degrees added to every sensor reading (a drifting bias)",
+    "encoder": "(N,) or (N, axes): degrees added to the encoder reading (a wild count)",
+    "encoder_frozen": "(N,) bool: the encoder repeats its last reading",
+    "clock": "(N,): seconds added to the controller's clock",
+}
 
 LOG_COLUMNS = ("target_true", "target", "angle", "error", "mode", "sky", "sky_score", "sensor_valid",
                "sensor_status", "intensity_ma", "variation_ma", "wind_speed", "dni", "calibration")
@@ -46,7 +58,8 @@ class SimulationConfig:
     sensor : SensorModel
     drive : Drive
         The drive of a single-axis collector. A heliostat uses it for its elevation axis
-        (limits 0-90°, stow 90°) and, widened to 0-360° with stow at 180°, for its azimuth axis.
+        (limits 0-90°, stow 90°) and for its azimuth axis, which turns all the way round:
+        limits -180° to 540° (a cable wrap of one turn either way), stow at 180°.
     seed : int
         Seeds the sensor noise.
     """
@@ -179,7 +192,7 @@ def _has_parquet() -> bool:
 def _drives(collector: Collector, drive: Drive) -> list[Drive]:
     if collector.kind != "heliostat":
         return [drive]
-    return [dataclasses.replace(drive, limits=(0.0, 360.0), stow=180.0),
+    return [dataclasses.replace(drive, limits=(-180.0, 540.0), stow=180.0),
             dataclasses.replace(drive, limits=(0.0, 90.0), stow=90.0)]
 
 
@@ -199,11 +212,11 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def _working(local: pd.DatetimeIndex, hours: tuple[str, str]) -> np.ndarray:
-    from .times import parse_clock
+    from .times import clock_hours, parse_clock
 
     start, end = (parse_clock(h) for h in hours)
-    clock = np.asarray((local - local.normalize()) / pd.Timedelta(minutes=1), float)
-    return (clock >= start.hour * 60 + start.minute) & (clock <= end.hour * 60 + end.minute)
+    clock = clock_hours(local)
+    return (clock >= start.hour + start.minute / 60.0) & (clock <= end.hour + end.minute / 60.0)
 
 
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
@@ -227,10 +240,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     classifier : FuzzyWeatherClassifier, optional
         The sky classifier; the published one by default.
     faults : dict, optional
-        Injected faults for testing, arrays of one value per step: ``sensor`` (N, axes) or
-        (N,), the reading the sensor gives, NaN where it works; ``encoder`` (N, axes) or (N,),
-        degrees added to the encoder reading; ``encoder_frozen`` (N,) bool; ``clock`` (N,),
-        seconds added to the controller's clock.
+        Injected faults for testing, one array value per step; see `FAULTS`.
     progress : callable, optional
         Called with the number of steps done since its last call (e.g. a tqdm bar's update).
 
@@ -247,13 +257,21 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     index = frame.index
     n = len(index)
     faults = faults or {}
+    unknown = sorted(set(faults) - set(FAULTS))
+    if unknown:
+        raise HybridtrackError(f"unknown fault {unknown[0]!r}; known: {', '.join(FAULTS)}")
     imp = config.imperfections
     drives = _drives(collector, config.drive)
     axes = len(drives)
 
-    # the controller's view: its clock, its site, its sun model, the nominal geometry
-    clock_shift = pd.to_timedelta(imp.clock_error + _fault(faults, "clock", n, 0.0), unit="s")
-    controller_times = index + clock_shift
+    # the controller's view: its clock, its site, its sun model, the nominal geometry. Its
+    # scan timer runs on its own, so a step of the clock against it is seen and taken out;
+    # a slow drift is not.
+    clock = imp.clock_error + _fault(faults, "clock", n, 0.0)
+    jumps = np.diff(clock, prepend=clock[0])
+    stepped = np.abs(jumps) > CLOCK_STEP_SECONDS
+    clock = clock - np.cumsum(np.where(stepped, jumps, 0.0))
+    controller_times = index + pd.to_timedelta(clock, unit="s")
     controller_site = sites.Site(site.name, float(np.clip(site.latitude + imp.latitude_error, -90, 90)),
                                  float((site.longitude + imp.longitude_error + 180) % 360 - 180), site.altitude, site.tz)
     believed = solar_position(controller_times, controller_site, config.controller.sun_model)
@@ -294,7 +312,10 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         noise=rng.standard_normal((n, axes)),
         sensor_fault=_axes_fault(faults, "sensor", n, axes, np.nan),
         encoder_fault=_axes_fault(faults, "encoder", n, axes, 0.0),
-        encoder_frozen=np.asarray(faults["encoder_frozen"], bool) if "encoder_frozen" in faults else None,
+        encoder_frozen=_mask(faults, "encoder_frozen", n),
+        sensor_dropout=_mask(faults, "sensor_dropout", n),
+        sensor_drift=_fault(faults, "sensor_drift", n, 0.0) if "sensor_drift" in faults else None,
+        clock_step=np.where(stepped, jumps, 0.0) if stepped.any() else None,
     )
     out = run_controller(inputs, config.controller, drives, encoder_offset=imp.encoder_offset,
                          sensor_bias=imp.sensor_bias, sensor_noise=imp.sensor_noise,
@@ -308,6 +329,15 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                         moves=int(out.moves.sum()), travel=float(out.travel.sum()), events=events,
                         sun_up=true_alt > 0, incidence=incidence_cosine(true_alt, true_az, collector))
     return Result(log, summary, events, site, collector, config)
+
+
+def _mask(faults: dict, name: str, n: int) -> np.ndarray | None:
+    if name not in faults:
+        return None
+    values = np.asarray(faults[name], bool)
+    if values.shape != (n,):
+        raise HybridtrackError(f"fault {name!r} needs one value per step ({n}), got shape {values.shape}")
+    return values
 
 
 def _fault(faults: dict, name: str, n: int, default: float) -> np.ndarray:
@@ -351,7 +381,7 @@ def _log(index, collector: Collector, truth, out, sky_label, sky_score, intensit
     }, index=index)
     if not collector.single_axis:
         log["target_true_azimuth"] = truth[:, 0]
-        log["target_azimuth"] = out.target[:, 0]
-        log["angle_azimuth"] = out.angle[:, 0]
+        log["target_azimuth"] = out.target[:, 0] % 360.0  # the axis may have wound past a turn
+        log["angle_azimuth"] = out.angle[:, 0] % 360.0
         log["calibration_azimuth"] = out.calibration[:, 0]
     return log

@@ -1,0 +1,211 @@
+"""Fault scenarios: each injected fault leads to a safe, logged outcome (docs/robustness.md)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import simulate, sites
+from hybridtrack.cli import main
+from hybridtrack.sky import synthetic
+
+INVALID = {"low light", "out of view", "invalid reading", "outlier", "stuck", "implausible"}
+
+
+def check_safety(result):
+    """What every run must keep true, whatever went wrong."""
+    log, drives = result.log, result.config.drive
+    low, high = (0.0, 90.0) if not result.collector.single_axis else drives.limits
+    assert log["angle"].between(low - 1e-9, high + 1e-9).all()
+    assert log["target"].between(low - 1e-9, high + 1e-9).all()
+    # never moves while stowed for wind: once at stow, the angle stays until the mode ends
+    mode = log["mode"].astype(str).to_numpy()
+    angle = log["angle"].to_numpy()
+    for start in np.flatnonzero((mode == "stow_wind") & (np.roll(mode, 1) != "stow_wind")):
+        end = start
+        while end + 1 < len(mode) and mode[end + 1] == "stow_wind":
+            end += 1
+        settled = start + 2  # reached stow within two scans at stow speed
+        assert np.ptp(angle[settled:end + 1]) == 0 if end > settled else True
+    # never tracks a sensor it has judged invalid for longer than the allowed loss
+    loss = int(result.config.controller.minutes("sensor_loss"))
+    invalid = log["sensor_status"].isin(INVALID).to_numpy()
+    run = 0
+    for i in range(len(log)):
+        run = run + 1 if invalid[i] else 0
+        assert not (mode[i] == "sensor" and run > loss + 1), log.index[i]
+
+
+def sunny_day(site="lanzhou", date="2021-06-21", seed=1):
+    return synthetic(site, date, weather="sunny", seed=seed)
+
+
+def between(frame, start, end):
+    clock = frame.index.tz_convert(frame.index.tz)
+    mask = (clock >= pd.Timestamp(f"{clock[0].date()} {start}", tz=frame.index.tz)) & \
+           (clock < pd.Timestamp(f"{clock[0].date()} {end}", tz=frame.index.tz))
+    return np.asarray(mask)
+
+
+def tracked(result, mask=None):
+    log = result.log
+    keep = log["mode"].isin(["sensor", "astronomical"]) & (log["dni"] > 0) & log["target_true"].notna()
+    if mask is not None:
+        keep &= mask
+    return log.loc[keep, "error"]
+
+
+def test_sensor_dropout_in_full_sun_hands_over_to_the_model():
+    frame = sunny_day()
+    dropout = between(frame, "11:00", "13:00")
+    result = simulate(frame, "lanzhou", faults={"sensor_dropout": dropout})
+    check_safety(result)
+    log = result.log
+    assert (log.loc[dropout, "sensor_status"] == "invalid reading").all()
+    lost = result.events[result.events["reason"] == "sensor lost (invalid reading)"]
+    assert len(lost) == 1 and lost["time"].iloc[0] <= pd.Timestamp("2021-06-21 11:04", tz="Asia/Shanghai")
+    assert tracked(result, dropout).abs().max() < 0.5  # the calibrated model carries on
+    assert (log.loc[between(frame, "13:30", "16:00"), "mode"] == "sensor").mean() > 0.8  # and it comes back
+
+
+def test_a_stuck_sensor_is_recognised_and_not_followed():
+    frame = sunny_day()
+    stuck = np.where(between(frame, "11:00", "14:00"), 0.0, np.nan)  # says "perfectly aligned", forever
+    result = simulate(frame, "lanzhou", faults={"sensor": stuck})
+    check_safety(result)
+    statuses = result.log.loc[between(frame, "11:05", "14:00"), "sensor_status"]
+    assert (statuses == "stuck").all()
+    assert "sensor lost (stuck)" in result.events["reason"].tolist()
+    assert tracked(result, between(frame, "11:00", "14:00")).abs().max() < 0.6
+    handover = result.events.loc[result.events["reason"] == "sensor lost (stuck)", "time"].iloc[0]
+    assert handover <= pd.Timestamp("2021-06-21 11:03", tz="Asia/Shanghai")  # at once, not after the loss time
+
+
+def test_a_drifting_sensor_bias_is_bounded_by_the_plausibility_check():
+    frame = sunny_day("nanjing", "2013-06-21")
+    hours = np.asarray((frame.index - frame.index[0]) / pd.Timedelta(hours=1))
+    drift = np.clip((hours - 8.0) * 0.8, 0.0, None)  # 0.8° an hour from 08:00
+    result = simulate(frame, "nanjing", faults={"sensor_drift": drift})
+    check_safety(result)
+    limit = result.config.controller.sensor_plausibility
+    assert tracked(result).abs().max() < limit + 0.6
+    assert "implausible" in set(result.log["sensor_status"].astype(str))
+    assert result.events["reason"].str.contains("implausible").any()
+    late = result.log.loc[between(frame, "15:00", "18:00")]
+    assert (late["mode"] == "astronomical").all() and late["calibration"].abs().max() <= limit
+
+
+def test_nan_and_negative_bursts_in_irradiance():
+    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=2)
+    dni = frame["dni"].to_numpy().copy()
+    dni[between(frame, "10:00", "10:30")] = np.nan
+    dni[between(frame, "14:00", "14:20")] = -40.0
+    result = simulate(frame.assign(dni=dni), "lanzhou")
+    check_safety(result)
+    nan_stretch = result.log.loc[between(frame, "10:00", "10:30")]
+    assert (nan_stretch["sky"] == "unknown").any() and not (nan_stretch["sensor_status"] == "ok").any()
+    assert (result.log.loc[between(frame, "10:05", "10:30"), "mode"] == "astronomical").all()
+    assert np.isfinite(result.summary["tracking_error_deg"]["rms"])
+
+
+def test_a_step_in_the_controller_clock_is_seen_and_taken_out():
+    frame = sunny_day()
+    clock = np.where(between(frame, "12:00", "23:59"), 600.0, 0.0)  # ten minutes forward at noon
+    result = simulate(frame, "lanzhou", strategy="astronomical", faults={"clock": clock})
+    clean = simulate(frame, "lanzhou", strategy="astronomical")
+    check_safety(result)
+    assert result.events["reason"].str.contains("clock stepped by \\+600 s").sum() == 1
+    afternoon = between(frame, "12:00", "18:00")
+    np.testing.assert_allclose(tracked(result, afternoon), tracked(clean, afternoon), atol=1e-9)
+
+
+def test_an_encoder_glitch_is_ignored():
+    frame = sunny_day()
+    glitch = np.zeros(len(frame))
+    at = int(np.flatnonzero(between(frame, "12:00", "12:01"))[0])
+    glitch[at] = 512 * 360.0 / 4096  # one flipped Gray-code bit: 512 counts, 45°
+    clean = simulate(frame, "lanzhou")
+    result = simulate(frame, "lanzhou", faults={"encoder": glitch})
+    check_safety(result)
+    assert result.events["reason"].str.startswith("encoder glitch").sum() == 1
+    assert result.summary["travel_deg"] == pytest.approx(clean.summary["travel_deg"], abs=1.0)
+    np.testing.assert_allclose(result.log["angle"], clean.log["angle"], atol=0.5)
+
+
+def test_a_frozen_encoder_halts_the_drive_until_the_next_morning():
+    frame = synthetic("nanjing", "2013-06-21", "2013-06-22", weather="sunny", seed=3)
+    frozen = np.asarray((frame.index >= pd.Timestamp("2013-06-21 12:00", tz="Asia/Shanghai"))
+                        & (frame.index < pd.Timestamp("2013-06-21 21:00", tz="Asia/Shanghai")))
+    result = simulate(frame, "nanjing", faults={"encoder_frozen": frozen})
+    check_safety(result)
+    events = result.events
+    halt = events[events["to"] == "fault"]
+    assert len(halt) == 1 and "encoder frozen" in halt["reason"].iloc[0]
+    after = result.log.loc[halt["time"].iloc[0]:pd.Timestamp("2013-06-22 04:00", tz="Asia/Shanghai")]
+    assert after["angle"].nunique() <= 2 and (after["mode"] == "fault").all()  # at most the scan that found it
+    assert "a new day: probing the encoder again" in events["reason"].tolist()
+    next_day = result.log.loc[pd.Timestamp("2013-06-22 10:00", tz="Asia/Shanghai"):
+                              pd.Timestamp("2013-06-22 14:00", tz="Asia/Shanghai"), "mode"]
+    assert (next_day == "sensor").mean() > 0.5
+    assert result.summary["faults"] == 1
+
+
+def test_a_storm_all_day_keeps_the_collector_stowed():
+    frame = sunny_day().assign(wind_speed=25.0)
+    result = simulate(frame, "lanzhou")
+    check_safety(result)
+    assert result.summary["stow_events"] == 1 and result.summary["energy_capture"] == 0.0
+    assert result.summary["mode_share"]["sensor"] == 0.0 and result.summary["mode_share"]["astronomical"] == 0.0
+    assert result.log["angle"].nunique() == 1
+
+
+def test_a_day_with_no_direct_sun_at_all():
+    frame = synthetic("nanjing", "2013-06-21", weather="overcast", seed=4).assign(dni=0.0)
+    result = simulate(frame, "nanjing")
+    check_safety(result)
+    assert result.summary["energy_capture"] is None and result.summary["tracking_error_deg"]["rms"] is None
+    assert result.summary["mode_share"]["sensor"] == 0.0
+    assert set(result.log["sensor_status"].astype(str)) <= {"low light", "not read"}
+
+
+@pytest.mark.parametrize("date, sun", [("2022-06-21", "never sets"), ("2022-12-21", "never rises")])
+def test_a_site_where_the_sun_never_sets_or_never_rises(date, sun):
+    tromso = sites.custom(69.65, 18.96, "Europe/Oslo", name="tromso")
+    frame = synthetic(tromso, date, weather="sunny", seed=5)
+    result = simulate(frame, tromso)
+    check_safety(result)
+    if sun == "never sets":
+        assert result.log["target_true"].notna().all()
+        awake = result.log["mode"].isin(["sensor", "astronomical"])
+        hours = result.log.index.hour[awake.to_numpy()]
+        assert hours.min() >= 5 and hours.max() <= 20  # the working hours still rule
+        assert result.summary["tracking_error_deg"]["p95"] < 0.5
+    else:
+        assert result.log["target_true"].isna().all() and result.summary["moves"] == 0
+        assert result.summary["mode_share"]["stow_night"] == 1.0
+
+
+def test_the_southern_hemisphere():
+    alice = sites.custom(-23.70, 133.88, "Australia/Darwin", 545, name="alice-springs")
+    frame = synthetic(alice, "2022-12-21", weather="mixed", seed=6)
+    runs = {s: simulate(frame, alice, strategy=s) for s in ("hybrid", "astronomical")}
+    for result in runs.values():
+        check_safety(result)
+    assert runs["hybrid"].summary["tracking_error_deg"]["rms"] < runs["astronomical"].summary["tracking_error_deg"]["rms"]
+    assert runs["hybrid"].summary["tracking_error_deg"]["p95"] < 0.5
+
+
+def test_replaying_a_file_across_a_dst_change(tmp_path, capsys):
+    denver = sites.custom(39.74, -104.99, "America/Denver", 1609, name="denver")
+    frame = synthetic(denver, "2021-03-14", weather="sunny", seed=7)
+    local = frame.index.tz_convert("America/Denver").tz_localize(None)
+    path = tmp_path / "denver.csv"
+    pd.DataFrame({"time": local.strftime("%Y-%m-%d %H:%M"), "ghi": frame["ghi"].round(1), "dni": frame["dni"].round(1),
+                  "dhi": frame["dhi"].round(1)}).to_csv(path, index=False)
+    out = tmp_path / "out"
+    assert main(["replay", str(path), "--lat", "39.74", "--lon", "-104.99", "--tz", "America/Denver", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "naive stamps localised to America/Denver" in printed
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["steps"] == len(frame) and summary["tracking_error_deg"]["p95"] < 0.5
