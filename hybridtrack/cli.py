@@ -273,6 +273,8 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--format", default="csv", help="csv (default), epw, tmy3, midc, srml, bsrn, surfrad, crn, solrad")
     group.add_argument("--decomposition", choices=("erbs", "dirint"), default="erbs",
                        help="how DNI and DHI are split from GHI alone (default erbs)")
+    group.add_argument("--strict", action="store_true",
+                       help="refuse the file at the first thing the checks would repair (default: repair and report)")
 
 
 def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | None = None):
@@ -280,7 +282,8 @@ def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | N
     from .io import read_weather
 
     return read_weather(path, columns=_parse_mapping(args.map, "--map"), tz=args.tz, format=args.format, site=site,
-                        units=_parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition)
+                        units=_parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition,
+                        strict=args.strict)
 
 
 def _check_arguments(parser: argparse.ArgumentParser) -> None:

@@ -19,13 +19,16 @@ What it accepts and how it decides:
   one fixed offset, else UTC. Naive stamps are localised with `tz` and refused without it.
   Repeated stamps in a DST fall-back are resolved by their order. Stamps that fall in a
   spring-forward gap cannot exist; they are dropped and reported.
+* **Unreadable values**: text in a few rows of a numeric column (a bad stretch of a logger
+  file) becomes NaN, counted with its lines, and the rest is read; text in half or more of a
+  column is refused.
 * **Checks**, each counted in the summary with the first offending file lines: unsorted
   stamps (sorted), duplicated stamps (the first kept), gaps (left as gaps), NaN (kept),
   small negative values (above -50 W/m², sensor offsets at night: clipped to 0).
   Physically impossible values are flagged, set to NaN, and counted: irradiance below
   -50 W/m², GHI above 1500, DNI above 1400, DHI above 1000, wind below 0 or above 75 m/s,
   temperature outside -90..65 °C. A column where most values are impossible is refused as
-  a unit mistake.
+  a unit mistake. With ``strict=True`` each of these repairs is an error instead.
 * **Missing components**: DNI from GHI and DHI by closure, or from GHI alone by a pvlib
   decomposition (Erbs by default, or DIRINT); DHI or GHI by closure. Each needs the sun's
   position, so a site. The choice is recorded in ``attrs["dni_source"]`` (and
@@ -255,12 +258,15 @@ def _fixed_zone(offset: str) -> dt.timezone:
     """``'+08:00'`` or ``'+0800'`` -> a fixed-offset time zone."""
     sign = -1 if offset.startswith("-") else 1
     digits = offset[1:].replace(":", "")
-    return dt.timezone(sign * dt.timedelta(hours=int(digits[:2]), minutes=int(digits[2:4] or 0)))
+    hours, minutes = int(digits[:2]), int(digits[2:4] or 0)
+    if hours > 14 or minutes >= 60:
+        raise HybridtrackError(f"UTC offset {offset!r} is not a real one (beyond ±14:00)")
+    return dt.timezone(sign * dt.timedelta(hours=hours, minutes=minutes))
 
 
 def _parse_time(path: Path, values: pd.Series, header: str, tz: str | None, first_line: int, report: dict):
     text = values.astype(str).str.strip()
-    has_offset = text.str.contains(r"(?:[+-]\d{2}:?\d{2}|Z)$", regex=True)
+    has_offset = text.str.contains(r"\d(?:[+-]\d{2}:?\d{2}|Z)$", regex=True)  # an offset follows the time
     try:
         parsed = pd.to_datetime(text, utc=bool(has_offset.any()), format="mixed")
     except (ValueError, TypeError, OverflowError) as exc:
@@ -281,8 +287,12 @@ def _parse_time(path: Path, values: pd.Series, header: str, tz: str | None, firs
             report["time"] = f"stamps with UTC offsets, converted to {tz}"
             return index.tz_convert(tz), np.ones(len(index), bool)
         if offsets.nunique() == 1:
+            try:
+                zone = _fixed_zone(offsets.iloc[0])
+            except HybridtrackError as exc:
+                raise HybridtrackError(f"{path}: line {first_line}, column {header!r}: {exc}") from None
             report["time"] = f"stamps with UTC offset {offsets.iloc[0]}, kept"
-            return index.tz_convert(_fixed_zone(offsets.iloc[0])), np.ones(len(index), bool)
+            return index.tz_convert(zone), np.ones(len(index), bool)
         report["time"] = f"stamps with {offsets.nunique()} different UTC offsets, kept as UTC (give a time zone to convert)"
         return index, np.ones(len(index), bool)
     if tz is None:
@@ -325,7 +335,7 @@ def _convert_units(path: Path, name: str, values: pd.Series, unit: str | None) -
     return values * factor, (None if factor == 1.0 else f"{unit} x {factor:g}")
 
 
-def _read_csv_weather(path: Path, columns, tz, units, report) -> tuple[pd.DataFrame, dict]:
+def _read_csv_weather(path: Path, columns, tz, units, report, strict: bool) -> tuple[pd.DataFrame, dict]:
     text = _text(path)
     lines, header_at, sep = _locate_table(path, text)
     body = "\n".join(lines[header_at:])
@@ -338,6 +348,10 @@ def _read_csv_weather(path: Path, columns, tz, units, report) -> tuple[pd.DataFr
     except (pd.errors.ParserError, ValueError) as exc:
         raise HybridtrackError(f"{path}: cannot read the table: {str(exc).splitlines()[0]}") from None
     raw.columns = headers if len(headers) == len(raw.columns) else raw.columns
+    repeated = sorted({h for h in raw.columns if list(raw.columns).count(h) > 1})
+    if repeated:
+        raise HybridtrackError(f"{path}: line {header_at + 1}: column {repeated[0]!r} appears more than once in the "
+                               "header; rename one")
     if raw.empty:
         raise HybridtrackError(f"{path}: the table has a header but no rows")
     first_line = header_at + 2  # 1-based file line of the first data row
@@ -364,11 +378,16 @@ def _read_csv_weather(path: Path, columns, tz, units, report) -> tuple[pd.DataFr
             strings = strings.str.replace(",", ".", regex=False)
         values = pd.to_numeric(strings.replace({"": np.nan, "nan": np.nan, "NaN": np.nan, "NA": np.nan, "-": np.nan}),
                                errors="coerce")
-        bad = values.isna() & ~strings.isin(["", "nan", "NaN", "NA", "-"])
+        bad = (values.isna() & ~strings.isin(["", "nan", "NaN", "NA", "-"])).to_numpy()
         if bad.any():
-            row = int(np.flatnonzero(bad.to_numpy())[0])
-            raise HybridtrackError(f"{path}: line {first_line + row}, column {header!r}: {raw[header].iloc[row]!r} "
-                                   "is not a number")
+            row = int(np.flatnonzero(bad)[0])
+            where = f"{path}: line {first_line + row}, column {header!r}: {raw[header].iloc[row]!r} is not a number"
+            filled = int((~strings.isin(["", "nan", "NaN", "NA", "-"])).sum())
+            if strict or bad.sum() * 2 >= max(filled, 1):
+                raise HybridtrackError(where if strict else f"{where} (nor are {bad.sum()} of its {filled} values)")
+            report.setdefault("unreadable", {})[name] = {"count": int(bad.sum()), "lines": _line_numbers(first_line,
+                                                                                                          np.flatnonzero(bad)),
+                                                         "first": str(raw[header].iloc[row]), "action": "set to NaN"}
         unit = (units or {}).get(name) or _split_header(header)[1]
         values, note = _convert_units(path, name, values, unit)
         if note:
@@ -484,6 +503,25 @@ def _check(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
 _HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "temp_air": "K", "photocurrent": "A"}
 
 
+_REPAIRS = {
+    "unreadable": "text in a numeric column", "dst_dropped": "a time stamp that does not exist in the time zone",
+    "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",
+    "impossible": "a physically impossible value", "negative_clipped": "a negative irradiance",
+}
+
+
+def _refuse_repairs(path: Path, report: dict) -> None:
+    """In strict mode, the first thing the checks would have repaired is an error."""
+    for key, what in _REPAIRS.items():
+        if key not in report:
+            continue
+        entry = report[key]
+        if "lines" in entry:
+            raise HybridtrackError(f"{path}: line {entry['lines'][0]}: {what} (strict)")
+        column, detail = next(iter(entry.items()))
+        raise HybridtrackError(f"{path}: line {detail['lines'][0]}, column {column!r}: {what} (strict)")
+
+
 def _unit(name: str) -> str:
     return {"wind_speed": "m/s", "temp_air": "°C", "photocurrent": "mA"}.get(name, "W/m²")
 
@@ -578,7 +616,7 @@ def _resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) 
 
 def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | None = None, format: str = "csv",
                  site=None, units: Mapping[str, str] | None = None, freq: str | None = None,
-                 decomposition: str = "erbs") -> pd.DataFrame:
+                 decomposition: str = "erbs", strict: bool = False) -> pd.DataFrame:
     """A recorded weather file as a checked weather frame.
 
     Parameters
@@ -599,6 +637,10 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         Resample to this step (e.g. ``"1min"``); irregular data is resampled to its median step.
     decomposition : {"erbs", "dirint"}
         How DNI and DHI are split from GHI alone.
+    strict : bool
+        Refuse, rather than repair and report, anything the checks find: text in a numeric
+        column, unsorted or duplicated stamps, impossible or negative values, DST stamps that
+        do not exist. The error names the first offending line.
 
     Returns
     -------
@@ -617,7 +659,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         check_tz(tz)
     report: dict = {"source": str(path)}
     if fmt == "csv":
-        frame, meta = _read_csv_weather(path, columns, tz, units, report)
+        frame, meta = _read_csv_weather(path, columns, tz, units, report, strict)
     elif fmt in PVLIB_FORMATS:
         frame, meta = _read_pvlib(path, fmt, tz, report)
     else:
@@ -631,6 +673,8 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
     elif site is not None:
         site = get(site)
     frame = _check(path, frame, report)
+    if strict:
+        _refuse_repairs(path, report)
     attrs: dict = {}
     frame = _complete(path, frame, site, decomposition, attrs)
     frame = _resample(frame, freq, report, attrs)
@@ -655,7 +699,7 @@ def validation_report(frame: pd.DataFrame) -> str:
                      f"{report.get('header_lines_skipped', 0)} header lines skipped")
     lines.append("  columns: " + ", ".join(f"{k} <- {v!r}" for k, v in report.get("columns", {}).items()))
     lines.append(f"  time: {report.get('time', '?')}")
-    labels = {"dst_dropped": "DST: dropped", "dst_repeated": "DST: repeated hour", "unsorted": "unsorted",
+    labels = {"unreadable": "unreadable values (NaN)", "dst_dropped": "DST: dropped", "dst_repeated": "DST: repeated hour", "unsorted": "unsorted",
               "duplicates": "duplicated stamps", "gaps": "gaps", "nan": "NaN kept", "negative_clipped":
               "negative values clipped to 0", "impossible": "impossible values flagged (NaN)",
               "units_converted": "units converted", "resampled": "resampled"}
@@ -666,8 +710,8 @@ def validation_report(frame: pd.DataFrame) -> str:
         source = frame.attrs.get(f"{name}_source")
         if source and source != "measured":
             lines.append(f"  {name}: {source}")
-    issues = [k for k in ("dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "impossible")
-              if k in report]
+    issues = [k for k in ("unreadable", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped",
+                          "impossible") if k in report]
     kinds = f"{len(issues)} kind{'s' if len(issues) > 1 else ''}"
     lines.append("  verdict: " + ("clean" if not issues else f"usable, with {kinds} of issue noted above"))
     return "\n".join(lines)
