@@ -209,3 +209,24 @@ def test_replaying_a_file_across_a_dst_change(tmp_path, capsys):
 
     summary = json.loads((out / "summary.json").read_text())
     assert summary["steps"] == len(frame) and summary["tracking_error_deg"]["p95"] < 0.5
+
+
+def test_a_replay_interrupted_by_a_bad_stretch_reports_it_and_carries_on(tmp_path, capsys):
+    frame = synthetic("nanjing", "2013-06-21", weather="mixed", seed=8)
+    local = frame.index.strftime("%Y-%m-%dT%H:%M:%S+08:00")
+    table = pd.DataFrame({"time": local, "ghi": frame["ghi"].round(1).astype(str), "dni": frame["dni"].round(1).astype(str),
+                          "dhi": frame["dhi"].round(1).astype(str), "wind_speed": frame["wind_speed"].round(2).astype(str)})
+    bad = slice(700, 720)  # twenty minutes of a logger writing garbage around noon
+    table.loc[table.index[bad], ["ghi", "dni", "dhi"]] = "ERR#"
+    path = tmp_path / "record.csv"
+    table.to_csv(path, index=False)
+    out = tmp_path / "out"
+    assert main(["replay", str(path), "--site", "nanjing", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "unreadable values (NaN): ghi count 20, lines 702, 703, 704, 705, 706" in printed
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["steps"] == len(frame) and summary["tracking_error_deg"]["p95"] < 0.5
+    log = pd.read_parquet(out / "log.parquet") if (out / "log.parquet").exists() else pd.read_csv(out / "log.csv")
+    assert log["mode"].iloc[bad].isin(["astronomical", "stow_night"]).all()  # no sensor, no sky: the model

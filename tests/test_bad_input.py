@@ -1,0 +1,133 @@
+"""The bad input matrix (docs/robustness.md): every mistake, through the API and the CLI alike.
+
+Each row makes the bad input, calls the Python API (which must raise HybridtrackError) and
+the command line (which must print one line naming the problem and exit with status 2),
+and checks both say the same thing.
+"""
+
+import pytest
+
+from hybridtrack import HybridtrackError, sites
+from hybridtrack.cli import main
+from hybridtrack.fuzzy import FuzzyConfig
+from hybridtrack.io import read_weather
+from hybridtrack.simulation import SimulationConfig
+from hybridtrack.sun import solar_position
+from hybridtrack.times import local_range
+
+GOOD_ROWS = "2021-06-21 12:00,900,800,100,3\n2021-06-21 12:01,901,801,101,3\n2021-06-21 12:02,902,802,102,3\n"
+HEADER = "time,ghi,dni,dhi,wind_speed\n"
+
+
+def weather_file(content):
+    def make(tmp):
+        path = tmp / "weather.csv"
+        if content is not None:
+            path.write_bytes(content if isinstance(content, bytes) else content.encode("utf-8"))
+        return path
+    return make
+
+
+def config_file(text, name="config.toml"):
+    def make(tmp):
+        path = tmp / name
+        path.write_text(text)
+        return path
+    return make
+
+
+# (id, make the input, API call, CLI args, message both must contain)
+MATRIX = [
+    ("file missing", weather_file(None), lambda p: read_weather(p, tz="UTC"),
+     lambda p: ["check", str(p), "--tz", "UTC"], "no such file"),
+    ("file empty", weather_file(""), lambda p: read_weather(p, tz="UTC"),
+     lambda p: ["check", str(p), "--tz", "UTC"], "the file is empty"),
+    ("file binary", weather_file(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR"), lambda p: read_weather(p, tz="UTC"),
+     lambda p: ["check", str(p), "--tz", "UTC"], "looks binary"),
+    ("not UTF-8", weather_file((HEADER + "2021-06-21 12:00,9\xe900,1,1,1\n").encode("latin-1")),
+     lambda p: read_weather(p, tz="UTC"), lambda p: ["check", str(p), "--tz", "UTC"], "line 2: not UTF-8"),
+    ("no time column", weather_file("ghi,dni\n1,2\n3,4\n"), lambda p: read_weather(p, tz="UTC"),
+     lambda p: ["check", str(p), "--tz", "UTC"], "no time column found"),
+    ("unknown column in mapping", weather_file(HEADER + GOOD_ROWS),
+     lambda p: read_weather(p, tz="UTC", columns={"dni": "Beam"}),
+     lambda p: ["check", str(p), "--tz", "UTC", "--map", "dni=Beam"], "no column 'Beam' (mapped to dni)"),
+    ("unsorted (strict)", weather_file(HEADER + "2021-06-21 12:01,1,1,1,1\n2021-06-21 12:00,1,1,1,1\n"),
+     lambda p: read_weather(p, tz="UTC", strict=True), lambda p: ["check", str(p), "--tz", "UTC", "--strict"],
+     "line 3: time stamps out of order (strict)"),
+    ("duplicated (strict)", weather_file(HEADER + GOOD_ROWS + "2021-06-21 12:02,1,1,1,1\n"),
+     lambda p: read_weather(p, tz="UTC", strict=True), lambda p: ["check", str(p), "--tz", "UTC", "--strict"],
+     "line 5: a repeated time stamp (strict)"),
+    ("text in a numeric column", weather_file(HEADER + "2021-06-21 12:00,bright,1,1,1\n2021-06-21 12:01,sunny,1,1,1\n"),
+     lambda p: read_weather(p, tz="UTC"), lambda p: ["check", str(p), "--tz", "UTC"],
+     "line 2, column 'ghi': 'bright' is not a number"),
+    ("negative wind (strict)", weather_file(HEADER + GOOD_ROWS + "2021-06-21 12:03,900,800,100,-4\n"),
+     lambda p: read_weather(p, tz="UTC", strict=True), lambda p: ["check", str(p), "--tz", "UTC", "--strict"],
+     "line 5, column 'wind_speed': a physically impossible value (strict)"),
+    ("GHI 5000 W/m2 throughout", weather_file(HEADER + "2021-06-21 12:00,5000,800,100,3\n2021-06-21 12:01,5100,8,1,3\n"),
+     lambda p: read_weather(p, tz="UTC"), lambda p: ["check", str(p), "--tz", "UTC"],
+     "column 'ghi': 100% of values are outside -50..1500 (W/m²); wrong unit?"),
+    ("naive stamps without a time zone", weather_file(HEADER + GOOD_ROWS), lambda p: read_weather(p),
+     lambda p: ["check", str(p)], "naive time stamps"),
+    ("unknown time zone", weather_file(HEADER + GOOD_ROWS), lambda p: read_weather(p, tz="Moon/Tranquility"),
+     lambda p: ["check", str(p), "--tz", "Moon/Tranquility"], "unknown time zone 'Moon/Tranquility'"),
+    ("fuzzy config: unknown key", config_file("colour = 'blue'\n"), lambda p: FuzzyConfig.from_toml(p),
+     lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)], "unknown key 'colour'"),
+    ("fuzzy config: wrong type", config_file("[resolution]\ninput = 'fine'\n"), lambda p: FuzzyConfig.from_toml(p),
+     lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)],
+     "resolution.input: must be a whole number"),
+    ("fuzzy config: inverted membership", config_file(
+        "[output]\nterms.overcast = {shape='trimf', params=[10, 5, 0]}\nterms.cloudy = {shape='trimf', "
+        "params=[10, 15, 20]}\nterms.sunny = {shape='trimf', params=[20, 25, 30]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: ["surface", "--config", str(p), "--out", str(p) + ".png"],
+     "output.weather.terms.overcast: trimf parameters must be in order"),
+    ("fuzzy config: rule with unknown term", config_file(
+        "[[rules]]\nintensity = 'dazzling'\nvariation = 'small'\nweather = 'sunny'\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)],
+     "rules[1]: unknown term 'dazzling' for intensity"),
+    ("run config: unknown key", config_file("[drive]\ndeadbnd = 0.2\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: ["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--config", str(p)],
+     "drive.deadbnd: unknown key"),
+    ("run config: wrong type", config_file("[imperfections]\nclock_error = 'late'\n"),
+     lambda p: SimulationConfig.from_toml(p),
+     lambda p: ["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--config", str(p)],
+     "imperfections.clock_error: must be a number"),
+    ("latitude beyond 90", lambda tmp: None, lambda p: sites.custom(95.0, 10.0, "UTC"),
+     lambda p: ["sun", "--lat", "95", "--lon", "10", "--tz", "UTC", "--date", "2021-06-21"],
+     "latitude 95.0 is outside [-90, 90]"),
+    ("site with unknown time zone", lambda tmp: None, lambda p: sites.custom(30.0, 10.0, "Nowhere/Land"),
+     lambda p: ["simulate", "--lat", "30", "--lon", "10", "--tz", "Nowhere/Land", "--date", "2021-06-21"],
+     "unknown time zone 'Nowhere/Land'"),
+    ("unknown site", lambda tmp: None, lambda p: sites.get("atlantis"),
+     lambda p: ["simulate", "--site", "atlantis", "--date", "2021-06-21"], "unknown site 'atlantis'"),
+    ("date that does not exist", lambda tmp: None, lambda p: local_range("2021-02-29", "UTC"),
+     lambda p: ["simulate", "--site", "nanjing", "--date", "2021-02-29"], "date '2021-02-29' does not exist"),
+    ("month that does not exist", lambda tmp: None, lambda p: local_range("2021-13-01", "UTC"),
+     lambda p: ["sky", "--site", "nanjing", "--date", "2021-13-01"], "date '2021-13-01' does not exist"),
+    ("naive times to the sun model", lambda tmp: None,
+     lambda p: solar_position(__import__("pandas").date_range("2021-06-21", periods=2, freq="h"), "nanjing"),
+     None, "naive"),
+]
+
+
+@pytest.mark.parametrize("make, api, cli, message", [row[1:] for row in MATRIX], ids=[row[0] for row in MATRIX])
+def test_bad_input_is_one_clear_line_from_api_and_cli(tmp_path, capsys, make, api, cli, message):
+    path = make(tmp_path)
+    with pytest.raises(HybridtrackError) as error:
+        api(path)
+    assert message in str(error.value) and "\n" not in str(error.value)
+    if cli is None:
+        return
+    assert main(cli(path)) == 2
+    captured = capsys.readouterr()
+    assert captured.err.count("\n") == 1 and message in captured.err
+    assert captured.err.startswith("hybridtrack: error: ") and "Traceback" not in captured.err
+
+
+def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):
+    path = tmp_path / "messy.csv"
+    path.write_text(HEADER + "2021-06-21 12:01,1,1,1,1\n2021-06-21 12:00,1,1,1,-4\n2021-06-21 12:00,1,1,1,1\n"
+                    "2021-06-21 12:02,oops,1,1,1\n2021-06-21 12:03,5,1,1,1\n2021-06-21 12:04,5,1,1,1\n")
+    frame = read_weather(path, tz="UTC")
+    report = frame.attrs["validation"]
+    assert {"unsorted", "duplicates", "impossible", "unreadable"} <= set(report)
+    assert report["unreadable"]["ghi"]["lines"] == [5] and len(frame) == 5
