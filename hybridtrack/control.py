@@ -214,10 +214,12 @@ class FastKalman:
         self.p00, self.p01, self.p11 = 1.0, 0.0, 0.1
 
     def reset(self, angle: float, rate: float) -> None:
+        """Start again at `angle` (degrees) moving at `rate` (degrees per minute)."""
         self.x0, self.x1 = angle, rate
         self.p00, self.p01, self.p11 = 1.0, 0.0, 0.1
 
     def predict(self, dt: float) -> None:
+        """Advance the state `dt` minutes (white-noise acceleration model)."""
         q = self.q
         self.x0 += dt * self.x1
         p00, p01, p11 = self.p00, self.p01, self.p11
@@ -226,9 +228,11 @@ class FastKalman:
         self.p11 = p11 + q * dt
 
     def innovation(self, z: float) -> tuple[float, float]:
+        """The residual of a measurement `z` and its variance."""
         return z - self.x0, self.p00 + self.r
 
     def update(self, z: float) -> None:
+        """Take in a measurement of the angle, degrees."""
         y, s = z - self.x0, self.p00 + self.r
         k0, k1 = self.p00 / s, self.p01 / s
         self.x0 += k0 * y
@@ -240,10 +244,12 @@ class FastKalman:
 
     @property
     def angle(self) -> float:
+        """Filtered angle, degrees."""
         return self.x0
 
     @property
     def rate(self) -> float:
+        """Filtered rate, degrees per minute."""
         return self.x1
 
 
@@ -260,27 +266,33 @@ class FilterpyKalman:
         self.reset(0.0, 0.0)
 
     def reset(self, angle: float, rate: float) -> None:
+        """Start again at `angle` (degrees) moving at `rate` (degrees per minute)."""
         self.kf.x = np.array([[angle], [rate]])
         self.kf.P = np.array([[1.0, 0.0], [0.0, 0.1]])
 
     def predict(self, dt: float) -> None:
+        """Advance the state `dt` minutes (white-noise acceleration model)."""
         q = self.q
         self.kf.F = np.array([[1.0, dt], [0.0, 1.0]])
         self.kf.Q = q * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
         self.kf.predict()
 
     def innovation(self, z: float) -> tuple[float, float]:
+        """The residual of a measurement `z` and its variance."""
         return z - float(self.kf.x[0, 0]), float(self.kf.P[0, 0] + self.kf.R[0, 0])
 
     def update(self, z: float) -> None:
+        """Take in a measurement of the angle, degrees."""
         self.kf.update(np.array([[z]]))
 
     @property
     def angle(self) -> float:
+        """Filtered angle, degrees."""
         return float(self.kf.x[0, 0])
 
     @property
     def rate(self) -> float:
+        """Filtered rate, degrees per minute."""
         return float(self.kf.x[1, 0])
 
 

@@ -277,6 +277,12 @@ def _parse_time(path: Path, values: pd.Series, header: str, tz: str | None, firs
         bad = int(np.flatnonzero(parsed.isna().to_numpy())[0])
         raise HybridtrackError(f"{path}: line {first_line + bad}, column {header!r}: {text.iloc[bad]!r} is not a time stamp")
     index = pd.DatetimeIndex(parsed)
+    years = np.asarray(index.year)
+    odd = np.flatnonzero((years < 1900) | (years > 2200))
+    if len(odd):  # '-0.5' or '1,5' parse as dates in year 0; no logger recorded then
+        bad = int(odd[0])
+        raise HybridtrackError(f"{path}: line {first_line + bad}, column {header!r}: {text.iloc[bad]!r} is not a "
+                               "plausible time stamp (outside 1900-2200)")
     if has_offset.any():
         if not has_offset.all():
             bad = int(np.flatnonzero(~has_offset.to_numpy())[0])

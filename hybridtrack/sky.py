@@ -37,7 +37,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 from .sites import Site, get
-from .times import local_range, parse_freq
+from .times import clock_hours, local_range, parse_freq
 
 __all__ = ["synthetic", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES",
            "daily_summary"]
@@ -141,14 +141,17 @@ def _climate_for(site: Site) -> Climate:
 
 
 def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
-    def bound(value, end_of_day: bool):
+    """The steps from `start` to `end` on the site's clock; a date alone means its whole day."""
+    def stamp(value):
+        """A timestamp on the site's clock, or None for a plain date."""
         if isinstance(value, (pd.Timestamp, dt.datetime)) or (isinstance(value, str) and len(value.strip()) > 10):
-            stamp = pd.Timestamp(value)
-            return stamp.tz_localize(site.tz) if stamp.tz is None else stamp.tz_convert(site.tz)
+            moment = pd.Timestamp(value)
+            return moment.tz_localize(site.tz) if moment.tz is None else moment.tz_convert(site.tz)
         return None
 
-    first, last = bound(start, False), bound(end, True) if end is not None else None
-    if first is None and (end is None or last is None):
+    first = stamp(start)
+    last = stamp(end) if end is not None else None
+    if first is None and last is None:
         return local_range(start, site.tz, end_date=end, freq=freq)
     if first is None:
         first = local_range(start, site.tz, freq=freq)[0]
@@ -313,7 +316,7 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     dni, dhi = np.where(up, dni, 0.0), np.where(up, dhi, 0.0)
     ghi = dni * np.where(up, cos_z, 0.0) + dhi
 
-    hours = np.asarray((local - local.normalize()) / pd.Timedelta(hours=1), float)
+    hours = clock_hours(local)
     mean_wind = climate.wind if wind_mean is None else float(wind_mean)
     if not 0 <= mean_wind <= 40:
         raise HybridtrackError(f"wind_mean must be within 0-40 m/s, got {wind_mean!r}")

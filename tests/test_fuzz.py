@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 import tomli_w
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from hybridtrack import HybridtrackError
@@ -71,6 +71,11 @@ def test_read_weather_survives_random_bytes(payload):
 @FUZZ
 @given(csv_files(), st.sampled_from([None, "UTC", "Asia/Shanghai", "America/Denver"]), st.booleans(),
        st.sampled_from([None, "1min", "5min"]))
+# what the fuzzer found, kept: a header naming a column twice, a number read as a UTC offset
+# of -24 h, and numbers read as dates in year 0
+@example(b"time,time,GHI\n,,", None, False, None)
+@example(b"time,GHI\n-2360,", None, False, None)
+@example(b"time;Timestamp;GHI\n-0.5;;\n1,5;;", "UTC", False, None)
 def test_read_weather_survives_csv_shaped_files(payload, tz, strict, freq):
     frame = survives(lambda p: read_weather(p, tz=tz, strict=strict, freq=freq, site="lanzhou"), payload, ".csv")
     if frame is not None:

@@ -142,6 +142,7 @@ def test_each_complete_rules_term_peaks_give_its_label(case):
     (lambda: FuzzyConfig(bands=(("overcast", 0, 10), ("cloudy", 12, 20), ("sunny", 20, 30))), "must meet"),
     (lambda: FuzzyConfig(bands=(("overcast", 0, 10), ("cloudy", 10, 20))), "must cover"),
     (lambda: FuzzyConfig(rules=PUBLISHED_RULES + PUBLISHED_RULES[:1]), "same conditions"),
+    (lambda: FuzzyConfig().with_params("intensity", "medium", (0.0, 1.5)), "'weak' and 'medium' overlap completely"),
 ])
 def test_invalid_configs_are_refused(make, message):
     with pytest.raises(HybridtrackError, match=message):

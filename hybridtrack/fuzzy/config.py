@@ -132,6 +132,11 @@ class Variable:
             raise HybridtrackError(f"{where}: duplicate term names in {list(self.term_names)}")
         for term in self.terms:
             term.check(f"{where}.terms.{term.name}")
+        for k, term in enumerate(self.terms):
+            for other in self.terms[k + 1:]:
+                if term.shape == other.shape and term.params == other.params:
+                    raise HybridtrackError(f"{where}: terms {term.name!r} and {other.name!r} overlap completely "
+                                           f"({term.shape} {list(term.params)}); rules could not tell them apart")
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@
 Samples are rows of raw ``intensity`` and ``variation`` (mA) with a target ``weather`` label,
 a target ``score``, or both. The loss is the mean squared score error against target
 scores. Against labels it is a squared hinge: zero once the score sits inside its label's
-band by `margin` units, growing with the distance outside. A reading that fires no rule
+band by `margin` units, growing with the distance outside, plus one for every wrong label
+(so the fit cannot park scores just across a band edge). A reading that fires no rule
 costs as much as being a whole band off. The input terms' parameters are optimised
 derivative-free (differential evolution, then bounded Powell) in a parameterisation that keeps every term valid:
 centres stay inside the universe and in their original order, widths stay positive, and
@@ -113,8 +114,11 @@ def _metrics(clf, config, scores, samples, margin) -> dict:
         lo = np.array([bands[label][0] for label in labels]) + margin
         hi = np.array([bands[label][1] for label in labels]) - margin
         outside = np.maximum(lo - scores, 0.0) + np.maximum(scores - hi, 0.0)
-        losses.append(np.where(np.isnan(scores), penalty, outside**2))
-        out["accuracy"] = float(np.mean(clf.label(scores) == labels))
+        wrong = clf.label(scores) != labels
+        # a wrong label costs a unit on top of its distance: a score parked just across a
+        # band edge is nearly free to a squared hinge, but it is still a wrong answer
+        losses.append(np.where(np.isnan(scores), penalty, outside**2 + wrong))
+        out["accuracy"] = float(np.mean(~wrong))
     out["loss"] = float(np.mean(np.sum(losses, axis=0)))
     return out
 
