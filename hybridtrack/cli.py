@@ -571,6 +571,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args._run(args)
+    except BrokenPipeError:  # the reader went away (`| head`): not a mistake, just stop
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except HybridtrackError as exc:
         print(f"hybridtrack: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

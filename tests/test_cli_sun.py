@@ -48,3 +48,13 @@ def test_every_command_has_help(capsys):
             main([name, "--help"])
         assert stop.value.code == 0
         assert "usage: hybridtrack" in capsys.readouterr().out
+
+
+def test_a_closed_pipe_is_not_an_error(tmp_path):
+    import subprocess
+    import sys
+
+    script = "import sys; from hybridtrack.cli import main; sys.exit(main(sys.argv[1:]))"
+    run = subprocess.run(f'"{sys.executable}" -c "{script}" sun --date 2013-06-21 --freq 1min | head -n 2',
+                         shell=True, capture_output=True, text=True)
+    assert run.stdout.count("\n") == 2 and "error" not in run.stderr
