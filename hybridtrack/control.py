@@ -61,6 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .drive import encoder_reading
 from .errors import HybridtrackError
 
 __all__ = ["ControllerConfig", "STRATEGIES", "MODES", "SENSOR_STATUS", "FastKalman", "FilterpyKalman",
@@ -465,7 +466,7 @@ def run_controller(inputs: ControllerInputs, config: ControllerConfig, drives, *
             if frozen is not None and frozen[i] and not math.isnan(last_reading[a]):
                 value = last_reading[a]
             else:
-                value = round((actual[a] + encoder_offset) / resolution[a]) * resolution[a]
+                value = encoder_reading(actual[a] + encoder_offset, resolution[a])
                 if encoder_fault is not None:
                     value += encoder_fault[a][i]
             previous = last_reading[a]

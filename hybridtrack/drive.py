@@ -83,11 +83,3 @@ class Drive:
     def resolution(self) -> float:
         """Degrees per encoder count."""
         return 360.0 / 2**self.encoder_bits
-
-    def read(self, angle: float) -> float:
-        """The encoder reading at a true axis angle (including its zero offset), degrees."""
-        return encoder_reading(angle, self.resolution)
-
-    def clamp(self, angle: float) -> float:
-        """A command clamped into the mechanical limits."""
-        return min(max(angle, self.limits[0]), self.limits[1])

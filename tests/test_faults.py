@@ -6,6 +6,7 @@ import pytest
 
 from hybridtrack import simulate, sites
 from hybridtrack.cli import main
+from hybridtrack.drive import gray_decode, gray_encode
 from hybridtrack.sky import synthetic
 
 INVALID = {"low light", "out of view", "invalid reading", "outlier", "stuck", "implausible"}
@@ -118,11 +119,20 @@ def test_a_step_in_the_controller_clock_is_seen_and_taken_out():
     np.testing.assert_allclose(tracked(result, afternoon), tracked(clean, afternoon), atol=1e-9)
 
 
+def test_gray_code_round_trips_and_one_flipped_bit_is_one_wild_count():
+    counts = np.arange(4096)
+    assert (gray_decode(gray_encode(counts)) == counts).all()
+    steps = gray_encode(counts[1:]) ^ gray_encode(counts[:-1])
+    assert all(bin(int(step)).count("1") == 1 for step in steps)  # neighbouring counts differ in one bit
+
+
 def test_an_encoder_glitch_is_ignored():
     frame = sunny_day()
     glitch = np.zeros(len(frame))
     at = int(np.flatnonzero(between(frame, "12:00", "12:01"))[0])
-    glitch[at] = 512 * 360.0 / 4096  # one flipped Gray-code bit: 512 counts, 45°
+    count = 1200  # a reading of about 105°; one bit of its Gray code flips on the wire
+    wild = int(gray_decode(gray_encode(count) ^ (1 << 9)))
+    glitch[at] = (wild - count) * 360.0 / 4096
     clean = simulate(frame, "lanzhou")
     result = simulate(frame, "lanzhou", faults={"encoder": glitch})
     check_safety(result)
