@@ -177,22 +177,15 @@ def _classify(args: argparse.Namespace) -> int:
         explanation = clf.explain(args.intensity, args.variation)
         print(json.dumps(explanation.to_dict(), indent=2) if args.json else explanation)
         return 0
-    from .io import read_table
+    from .io import numeric_columns, read_table
 
     table = read_table(args.file)
-    for column in (args.intensity_col, args.variation_col):
-        if column.lower() not in table.columns:
+    wanted = [args.intensity_col.lower(), args.variation_col.lower()]
+    for column in wanted:
+        if column not in table.columns:
             raise HybridtrackError(f"{args.file}: no column {column!r}; columns are {', '.join(table.columns)}")
-    readings = {}
-    for column in (args.intensity_col, args.variation_col):
-        values = pd.to_numeric(table[column.lower()], errors="coerce")
-        bad = values.isna() & table[column.lower()].notna()
-        if bad.any():
-            row = int(np.flatnonzero(bad.to_numpy())[0])
-            raise HybridtrackError(f"{args.file}: row {row + 2}, column {column!r}: "
-                                   f"{table[column.lower()].iloc[row]!r} is not a number")
-        readings[column] = values.to_numpy(float)
-    table["sky_score"] = clf.score(readings[args.intensity_col], readings[args.variation_col], engine=args.engine)
+    readings = numeric_columns(table[wanted], wanted, str(args.file))
+    table["sky_score"] = clf.score(readings[wanted[0]].to_numpy(), readings[wanted[1]].to_numpy(), engine=args.engine)
     table["sky"] = clf.label(table["sky_score"].to_numpy())
     if args.out:
         table.to_csv(args.out, index=False, float_format="%.6g")
@@ -458,8 +451,8 @@ def _demo(args: argparse.Namespace) -> int:
     site = sites.get("lanzhou")
     frame = synthetic(site, "2021-06-21", weather="mixed", seed=5, gusts_per_day=2.0)
     result = simulate(frame, site, collector=Collector("fresnel"), strategy="hybrid")
-    print(f"demo: Lanzhou linear Fresnel row, 2021-06-21, mixed sky with gusts (seed 5), hybrid strategy, default "
-          f"imperfections")
+    print("demo: Lanzhou linear Fresnel row, 2021-06-21, mixed sky with gusts (seed 5), hybrid strategy, default "
+          "imperfections")
     print(summary_table({"hybrid": result.summary}))
     written = result.save(args.out)
     print(f"wrote {written['report']} (the day at a glance), {written['summary']}, {written['log']}, "

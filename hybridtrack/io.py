@@ -52,7 +52,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["read_weather", "read_table", "read_toml", "write_toml", "validation_report", "WEATHER_COLUMNS",
+__all__ = ["read_weather", "read_table", "read_toml", "write_toml", "read_text", "numeric_columns", "validation_report", "WEATHER_COLUMNS",
            "PVLIB_FORMATS", "LIMITS"]
 
 #: The columns of a weather frame, in order.
@@ -97,6 +97,31 @@ TYPICAL_YEAR = 2019  # any year that is not a leap year
 
 
 # --- small tables ---------------------------------------------------------------------------
+
+
+def read_text(path) -> str:
+    """A text file's contents, or one clear error: missing, a folder, binary, not UTF-8, empty."""
+    path = Path(path)
+    return _text(path)
+
+
+def numeric_columns(frame: pd.DataFrame, columns, where: str) -> pd.DataFrame:
+    """`frame` with `columns` (those present) as floats; text in one names its row and column.
+
+    Row numbers count the header as row 1, as a spreadsheet shows them.
+    """
+    frame = frame.copy()
+    for column in columns:
+        if column not in frame.columns:
+            continue
+        values = pd.to_numeric(frame[column], errors="coerce")
+        bad = (values.isna() & frame[column].notna()).to_numpy()
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise HybridtrackError(f"{where}: row {row + 2}, column {column!r}: {frame[column].iloc[row]!r} "
+                                   "is not a number")
+        frame[column] = values.astype(float)
+    return frame
 
 
 def _text(path: Path) -> str:

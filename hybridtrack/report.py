@@ -128,8 +128,9 @@ def plot_fuzzy_surface(classifier, *, points: int = 121, title: str | None = Non
 SKY_COLOURS = {"sunny": "#f6c343", "cloudy": "#9db4c0", "overcast": "#5c6b73", "unknown": "#dddddd"}
 
 
-def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0) -> None:
+def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0, colours: dict | None = None) -> None:
     """Shade the time axis by a categorical label (sky class or mode), one colour a label."""
+    colours = SKY_COLOURS if colours is None else colours
     import numpy as np
 
     values = np.asarray(labels, dtype=object)
@@ -141,7 +142,7 @@ def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0) -> None:
     step = (times[1] - times[0]) if len(times) > 1 else None
     for a, b in zip(starts, ends):
         right = times[b] if b < len(times) else times[-1] + step if step is not None else times[-1]
-        ax.axvspan(times[a], right, ymin=y0, ymax=y1, color=SKY_COLOURS.get(values[a], "#cccccc"), lw=0)
+        ax.axvspan(times[a], right, ymin=y0, ymax=y1, color=colours.get(values[a], "#cccccc"), lw=0)
 
 
 def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = None):
@@ -201,7 +202,7 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
 
 
 MODE_COLOURS = {"sensor": "#2a9d8f", "astronomical": "#e9c46a", "search": "#f4a261", "stow_wind": "#e76f51",
-                "stow_night": "#264653"}
+                "stow_night": "#264653", "fault": "#9b2226"}
 
 
 def plot_run(result, *, title: str | None = None):
@@ -228,10 +229,7 @@ def plot_run(result, *, title: str | None = None):
     axes[1].set_yticks([])
     axes[1].set_ylabel("sky", rotation=0, ha="right", va="center")
     bands = axes[2]
-    values = log["mode"].astype(str).to_numpy()
-    change = np.flatnonzero(values[1:] != values[:-1]) + 1
-    for a, b in zip(np.concatenate([[0], change]), np.concatenate([change, [len(values)]])):
-        bands.axvspan(local[a], local[min(b, len(local) - 1)], color=MODE_COLOURS.get(values[a], "#ccc"), lw=0)
+    _label_band(bands, local, log["mode"].astype(str).to_numpy(), colours=MODE_COLOURS)
     bands.set_yticks([])
     bands.set_ylabel("mode", rotation=0, ha="right", va="center")
     bands.legend(handles=[Patch(color=c, label=m) for m, c in MODE_COLOURS.items()] +

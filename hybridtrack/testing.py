@@ -98,16 +98,13 @@ def _optional(value) -> float | None:
 
 
 def _config_reference(path: Path) -> str | None:
+    from .io import read_text, read_toml
+
     if path.suffix.lower() == ".toml":
-        try:
-            import tomllib
-        except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-            import tomli as tomllib
-        with path.open("rb") as handle:
-            reference = tomllib.load(handle).get("config")
+        reference = read_toml(path, "rule table").get("config")
     else:
         reference = None
-        for line in path.read_text(encoding="utf-8-sig").splitlines():
+        for line in read_text(path).splitlines():
             stripped = line.strip()
             if stripped.startswith("#") and stripped[1:].strip().lower().startswith("config:"):
                 reference = stripped[1:].strip()[len("config:"):].strip()

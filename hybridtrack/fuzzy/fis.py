@@ -176,14 +176,10 @@ def read_fis(path, *, raw_ranges=None, bands=None, resolution=None) -> FuzzyConf
     resolution : (int, int), optional
         Sampling of the input and output universes; the default config's by default.
     """
+    from ..io import read_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise HybridtrackError(f"{path}: no such .fis file") from None
-    except UnicodeDecodeError as exc:
-        raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    sections = _sections(path, text)
+    sections = _sections(path, read_text(path))
     if "System" not in sections:
         raise HybridtrackError(f"{path}: no [System] section; is this a MATLAB .fis file?")
     system = _keys(path, sections["System"], "System")

@@ -75,17 +75,9 @@ def read_samples(source) -> pd.DataFrame:
         raise HybridtrackError(f"{where}: needs a 'weather' or a 'score' column to fit to")
     if frame.empty:
         raise HybridtrackError(f"{where}: no rows")
-    for column in ("intensity", "variation", "score", "tolerance"):
-        if column in frame.columns:
-            values = pd.to_numeric(frame[column], errors="coerce")
-            bad = values.isna() & frame[column].notna()
-            if bad.any():
-                row = int(np.flatnonzero(bad.to_numpy())[0])
-                raise HybridtrackError(
-                    f"{where}: row {row + 2}, column {column!r}: {frame[column].iloc[row]!r} is not a number"
-                )
-            frame[column] = values
-    return frame
+    from ..io import numeric_columns
+
+    return numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where)
 
 
 def evaluate(config: FuzzyConfig, samples: pd.DataFrame, margin: float = 0.5) -> dict:
