@@ -1,0 +1,7 @@
+"""``python -m hybridtrack``: the same as the ``hybridtrack`` command."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,59 @@
+"""The ``hybridtrack`` command line.
+
+Every command has ``--help``. A mistake a user can make (bad file, column, site, date or
+parameter) prints one line, ``hybridtrack: error: ...``, and exits with status 2.
+
+Each module of this package registers the commands of one concern with `base.command`;
+importing them here is what puts them on the command line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from .. import __version__
+from ..errors import HybridtrackError
+from . import sun, fuzzy, records, runs  # noqa: F401, I001  (each registers its commands, in this order)
+from .base import _COMMANDS, _HELP, EXIT_USAGE
+
+__all__ = ["main", "build_parser", "EXIT_USAGE"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser with every registered command."""
+    parser = argparse.ArgumentParser(
+        prog="hybridtrack",
+        description="Weather-aware hybrid sun tracking for concentrating solar collectors.",
+    )
+    parser.add_argument("--version", action="version", version=f"hybridtrack {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name, (add_arguments, run) in _COMMANDS.items():
+        child = sub.add_parser(name, help=_HELP[name], description=_HELP[name])
+        add_arguments(child)
+        child.set_defaults(_run=run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args._run(args)
+    except BrokenPipeError:  # the reader went away (`| head`): not a mistake, just stop
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except HybridtrackError as exc:
+        print(f"hybridtrack: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except OSError as exc:
+        name = f" {exc.filename}" if exc.filename else ""
+        print(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,160 @@
+"""What every command shares: the command registry, and the flags for sites, collectors,
+recorded files, synthetic days and runs."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+
+from .. import sites
+from ..errors import HybridtrackError
+
+EXIT_USAGE = 2
+
+_COMMANDS: dict[str, tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = {}
+_HELP: dict[str, str] = {}
+
+
+def command(name: str, help: str, arguments: Callable[[argparse.ArgumentParser], None]):
+    """Register the decorated function as sub-command `name`; `arguments` adds its flags."""
+
+    def register(run):
+        _COMMANDS[name] = (arguments, run)
+        _HELP[name] = help
+        return run
+
+    return register
+
+
+def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None = None) -> None:
+    """``--site NAME`` or ``--lat --lon --tz [--altitude]``."""
+    group = parser.add_argument_group("site", f"a built-in site ({', '.join(sites.names())}) or coordinates")
+    group.add_argument("--site", default=None, help=f"built-in site name{f' (default {default})' if default else ''}")
+    group.add_argument("--lat", type=float, help="latitude, degrees north")
+    group.add_argument("--lon", type=float, help="longitude, degrees east")
+    group.add_argument("--tz", help="IANA time zone of the local clock, e.g. Asia/Shanghai")
+    group.add_argument("--altitude", type=float, default=0.0, help="metres above sea level (with --lat/--lon)")
+    parser.set_defaults(_default_site=default)
+
+
+def site_from_arguments(args: argparse.Namespace) -> sites.Site:
+    """The site the user named, or the one given by coordinates."""
+    coordinates = (args.lat, args.lon, args.tz)
+    if args.site is not None:
+        if any(value is not None for value in coordinates):
+            raise HybridtrackError("give either --site or --lat/--lon/--tz, not both")
+        return sites.get(args.site)
+    if all(value is not None for value in coordinates):
+        return sites.custom(args.lat, args.lon, args.tz, args.altitude)
+    if any(value is not None for value in coordinates):
+        raise HybridtrackError("--lat, --lon and --tz go together; one of them is missing")
+    if args._default_site:
+        return sites.get(args._default_site)
+    raise HybridtrackError("no site: give --site NAME or --lat LAT --lon LON --tz TZ")
+
+
+def add_collector_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--collector`` and the geometry flags of each kind."""
+    from ..collectors import KINDS
+
+    group = parser.add_argument_group("collector")
+    group.add_argument("--collector", choices=KINDS, default="trough-ns", help="collector kind (default trough-ns)")
+    group.add_argument("--axis-azimuth", type=float, help="trough/Fresnel axis azimuth, degrees from north")
+    group.add_argument("--row-distance", type=float, default=5.0,
+                       help="Fresnel: signed row distance from the receiver line, m, east positive (default 5)")
+    group.add_argument("--receiver-height", type=float, default=10.0, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--aim", type=float, nargs=3, default=(0.0, 20.0, 100.0), metavar=("E", "N", "U"),
+                       help="heliostat: aim point from the mirror centre, m (default 0 20 100)")
+
+
+def collector_from_arguments(args: argparse.Namespace):
+    """The `Collector` the flags describe."""
+    from ..collectors import Collector
+
+    return Collector(args.collector, args.axis_azimuth, args.row_distance, args.receiver_height, tuple(args.aim))
+
+
+def parse_mapping(pairs, flag: str) -> dict[str, str]:
+    mapping = {}
+    for pair in pairs or []:
+        name, sep, value = pair.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise HybridtrackError(f"{flag} takes NAME=VALUE, got {pair!r}")
+        mapping[name.strip()] = value.strip()
+    return mapping
+
+
+def add_record_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--map``, ``--units``, ``--format``, ``--freq`` and ``--decomposition`` for recorded files."""
+    group = parser.add_argument_group("recorded file")
+    group.add_argument("--map", action="append", metavar="NAME=COLUMN",
+                       help="which file column holds ghi, dni, dhi, wind_speed, temp_air, photocurrent or time "
+                            "(repeatable), e.g. --map dni='Direct Normal'")
+    group.add_argument("--units", action="append", metavar="NAME=UNIT", help="unit of a column, e.g. --units ghi=kW/m2")
+    group.add_argument("--format", default="csv",
+                       help="csv (default), epw, tmy3, midc, srml, bsrn, surfrad, crn, solrad")
+    group.add_argument("--decomposition", choices=("erbs", "dirint"), default="erbs",
+                       help="how DNI and DHI are split from GHI alone (default erbs)")
+    group.add_argument("--strict", action="store_true",
+                       help="refuse the file at the first thing the checks would repair (default: repair and report)")
+
+
+def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | None = None):
+    """`read_weather` with the flags of `add_record_arguments`."""
+    from ..io import read_weather
+
+    return read_weather(path, columns=parse_mapping(args.map, "--map"), tz=args.tz, format=args.format, site=site,
+                        units=parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition,
+                        strict=args.strict)
+
+
+def add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    """Collector, strategy, config and output flags shared by simulate, replay and compare."""
+    from ..control import STRATEGIES
+
+    add_collector_arguments(parser)
+    group = parser.add_argument_group("run")
+    group.add_argument("--strategy", choices=STRATEGIES, default="hybrid", help="tracking strategy (default hybrid)")
+    group.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
+    group.add_argument("--perfect", action="store_true", help="no imperfections: a perfectly built and set-up field")
+    group.add_argument("--out", help="folder for log, events.csv, summary.json and report.png")
+
+
+def simulation_config(args: argparse.Namespace, seed: int | None = None):
+    import dataclasses
+
+    from ..simulation import SimulationConfig
+    from ..world import Imperfections
+
+    config = SimulationConfig.from_toml(args.config) if args.config else SimulationConfig()
+    if args.perfect:
+        config = dataclasses.replace(config, imperfections=Imperfections.none())
+    if seed is not None:
+        config = dataclasses.replace(config, seed=seed)
+    return config
+
+
+def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: bool = True) -> None:
+    """Site, dates, weather, step, seed and gusts of synthetic days."""
+    add_site_arguments(parser)
+    parser.add_argument("--date", required=date_required, help="first local date, YYYY-MM-DD")
+    parser.add_argument("--days", type=int, default=1, help="number of days (default 1)")
+    parser.add_argument("--weather", default="mixed",
+                        help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
+    parser.add_argument("--freq", default="1min", help="step (default 1min)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed of sky and sensor (default 0)")
+    parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
+
+
+def synthetic_frame(args: argparse.Namespace, site):
+    import datetime as dt
+
+    from ..sky import synthetic
+    from ..times import parse_date
+
+    if not 1 <= args.days <= 3660:
+        raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    first = parse_date(args.date)
+    weather = args.weather.split(",") if "," in args.weather else args.weather
+    return synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather, freq=args.freq,
+                     seed=args.seed, gusts_per_day=args.gusts_per_day)

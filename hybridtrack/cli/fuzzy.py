@@ -1,0 +1,109 @@
+"""The fuzzy sky classifier's commands: ``classify``, ``tune`` and ``surface``."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import HybridtrackError
+from .base import command
+
+
+def load_fuzzy_config(path):
+    from ..fuzzy import FuzzyConfig
+
+    if path is None:
+        return FuzzyConfig.default()
+    if str(path).lower().endswith(".fis"):
+        return FuzzyConfig.from_fis(path)
+    return FuzzyConfig.from_toml(path)
+
+
+def _classify_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", nargs="?", help="CSV of readings to classify (instead of --intensity/--variation)")
+    parser.add_argument("--intensity", type=float, help="sensor photocurrent, mA")
+    parser.add_argument("--variation", type=float, help="its variation over the window, mA")
+    parser.add_argument("--config", help="classifier config (.toml or MATLAB .fis); the published one by default")
+    parser.add_argument("--json", action="store_true", help="print JSON: score, weather and each rule's firing")
+    parser.add_argument("--intensity-col", default="intensity", help="file: column of the photocurrent (mA)")
+    parser.add_argument("--variation-col", default="variation", help="file: column of the variation (mA)")
+    parser.add_argument("--out", help="file: write the readings with sky_score and sky columns here")
+    parser.add_argument("--engine", choices=("fast", "skfuzzy"), default="fast", help="inference engine")
+
+
+@command("classify", "classify sky readings with the fuzzy classifier", _classify_arguments)
+def _classify(args: argparse.Namespace) -> int:
+    import json
+
+    from ..fuzzy import FuzzyWeatherClassifier
+
+    clf = FuzzyWeatherClassifier(load_fuzzy_config(args.config))
+    if args.file is None:
+        if args.intensity is None or args.variation is None:
+            raise HybridtrackError("give --intensity and --variation, or a CSV file of readings")
+        explanation = clf.explain(args.intensity, args.variation)
+        print(json.dumps(explanation.to_dict(), indent=2) if args.json else explanation)
+        return 0
+    from ..io import numeric_columns, read_table
+
+    table = read_table(args.file)
+    wanted = [args.intensity_col.lower(), args.variation_col.lower()]
+    for column in wanted:
+        if column not in table.columns:
+            raise HybridtrackError(f"{args.file}: no column {column!r}; columns are {', '.join(table.columns)}")
+    readings = numeric_columns(table[wanted], wanted, str(args.file))
+    table["sky_score"] = clf.score(readings[wanted[0]].to_numpy(), readings[wanted[1]].to_numpy(), engine=args.engine)
+    table["sky"] = clf.label(table["sky_score"].to_numpy())
+    if args.out:
+        table.to_csv(args.out, index=False, float_format="%.6g")
+        print(f"wrote {len(table)} rows to {args.out}")
+    counts = table["sky"].value_counts()
+    print(", ".join(f"{label} {counts.get(label, 0)}" for label in [b[0] for b in clf.config.bands] + ["unknown"]))
+    return 0
+
+
+def _tune_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("labels", help="CSV (or TOML [[case]]) of intensity, variation and weather and/or score")
+    parser.add_argument("--config", help="starting config (.toml or .fis); the published one by default")
+    parser.add_argument("--out", required=True, help="where to write the tuned config (.toml or .fis)")
+    parser.add_argument("--method", choices=("global", "local"), default="global",
+                        help="global: population search then Powell (default); local: Powell only")
+    parser.add_argument("--margin", type=float, default=0.5, help="how far inside its band a label's score should sit")
+    parser.add_argument("--seed", type=int, default=0, help="seed for reproducible fits (default 0)")
+    parser.add_argument("--report", help="also write the before/after report as JSON here")
+
+
+@command("tune", "fit the classifier's membership functions to labelled readings", _tune_arguments)
+def _tune(args: argparse.Namespace) -> int:
+    import json
+
+    from ..fuzzy.tuning import tune
+
+    tuned, report = tune(load_fuzzy_config(args.config), args.labels, method=args.method, margin=args.margin,
+                         seed=args.seed)
+    out = tuned.to_fis(args.out) if args.out.lower().endswith(".fis") else tuned.to_toml(args.out)
+    print(report)
+    for name, change in report.changed.items():
+        print(f"  {name}: {change['before']} -> {change['after']}")
+    print(f"wrote {out}")
+    if args.report:
+        with open(args.report, "w") as handle:
+            json.dump(report.to_dict(), handle, indent=2)
+    return 0
+
+
+def _surface_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--config", help="classifier config (.toml or .fis); the published one by default")
+    parser.add_argument("--out", default="surface.png", help="image to write (default surface.png)")
+    parser.add_argument("--points", type=int, default=121, help="grid points along each input (default 121)")
+
+
+@command("surface", "draw the classifier's decision surface and membership functions", _surface_arguments)
+def _surface(args: argparse.Namespace) -> int:
+    from ..fuzzy import FuzzyWeatherClassifier
+    from ..report import plot_fuzzy_surface, save_figure
+
+    if not 5 <= args.points <= 1001:
+        raise HybridtrackError(f"--points must be between 5 and 1001, got {args.points}")
+    clf = FuzzyWeatherClassifier(load_fuzzy_config(args.config))
+    print(f"wrote {save_figure(plot_fuzzy_surface(clf, points=args.points), args.out)}")
+    return 0

@@ -1,0 +1,74 @@
+"""Weather frames: ``check`` a recorded file, make a synthetic ``sky``."""
+
+from __future__ import annotations
+
+import argparse
+
+import pandas as pd
+
+from .base import (
+    add_record_arguments,
+    add_synthetic_arguments,
+    command,
+    read_record,
+    site_from_arguments,
+    synthetic_frame,
+)
+
+
+def _check_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", help="recorded weather file")
+    add_record_arguments(parser)
+    parser.add_argument("--tz", help="time zone of naive stamps, e.g. Asia/Shanghai")
+    parser.add_argument("--site", help="site, to derive missing irradiance components")
+    parser.add_argument("--freq", help="resample to this step, e.g. 1min")
+
+
+@command("check", "read a recorded weather file and print its validation summary", _check_arguments)
+def _check(args: argparse.Namespace) -> int:
+    from ..io import validation_report
+
+    frame = read_record(args, args.file, site=args.site, freq=args.freq)
+    print(validation_report(frame))
+    return 0
+
+
+def _sky_arguments(parser: argparse.ArgumentParser) -> None:
+    add_synthetic_arguments(parser)
+    parser.add_argument("--out", help="write the weather frame (with sensor readings) as CSV")
+    parser.add_argument("--plot", metavar="PNG", help="draw irradiance, sensor readings and wind")
+
+
+@command("sky", "make a synthetic weather frame and show its sensor's view", _sky_arguments)
+def _sky(args: argparse.Namespace) -> int:
+    from ..sensor import sensor_view
+
+    site = site_from_arguments(args)
+    frame = sensor_view(synthetic_frame(args, site), seed=args.seed)
+    print(_sky_table(frame, site).to_string(float_format=lambda v: f"{v:.2f}"))
+    if args.out:
+        frame.to_csv(args.out, float_format="%.3f", index_label="time")
+        print(f"wrote {len(frame)} rows to {args.out}")
+    if args.plot:
+        from ..report import plot_sky, save_figure
+
+        print(f"plot: {save_figure(plot_sky(frame, site), args.plot)}")
+    return 0
+
+
+def _sky_table(frame: pd.DataFrame, site) -> pd.DataFrame:
+    """Per day: weather, DNI, clearness index, sunshine, and the classifier's share of each label."""
+    from ..fuzzy import FuzzyWeatherClassifier
+    from ..sky import daily_summary
+    from ..sun import solar_position
+
+    table = daily_summary(frame, site)
+    table.insert(0, "weather", [frame.attrs.get("weather", {}).get(str(day), "?") for day in table.index])
+    up = solar_position(frame.index, site)["altitude"].to_numpy() > 10.0
+    labels = pd.Series(FuzzyWeatherClassifier().classify(frame["intensity_ma"].to_numpy()[up],
+                                                         frame["variation_ma"].to_numpy()[up]),
+                       index=frame.index[up].tz_convert(site.tz).date)
+    shares = labels.groupby(level=0).value_counts(normalize=True).unstack(fill_value=0.0)
+    for label in ("sunny", "cloudy", "overcast"):
+        table[f"fuzzy_{label}"] = shares.get(label, pd.Series(0.0, index=table.index)).reindex(table.index).fillna(0.0)
+    return table

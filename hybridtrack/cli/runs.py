@@ -1,0 +1,173 @@
+"""Running the tracker: ``demo``, ``simulate``, ``replay`` and ``compare``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import pandas as pd
+
+from .. import sites
+from ..errors import HybridtrackError
+from .base import (
+    add_record_arguments,
+    add_run_arguments,
+    add_site_arguments,
+    add_synthetic_arguments,
+    collector_from_arguments,
+    command,
+    read_record,
+    simulation_config,
+    site_from_arguments,
+    synthetic_frame,
+)
+
+
+def _run(frame, site, args, strategy: str, config, *, label: str = ""):
+    from tqdm import tqdm
+
+    from ..simulation import simulate
+
+    days = (frame.index[-1] - frame.index[0]) / pd.Timedelta(days=1)
+    with tqdm(total=len(frame), unit="step", desc=label or strategy, disable=days < 2, leave=False,
+              file=sys.stderr) as bar:
+        return simulate(frame, site, collector=collector_from_arguments(args), strategy=strategy, config=config,
+                        progress=bar.update)
+
+
+def summary_table(summaries: dict[str, dict]) -> str:
+    """Key metrics of one or more runs, one column each."""
+    rows = [("steps", lambda s: f"{s['steps']:,}"),
+            ("tracking error RMS (°)", lambda s: _fmt(s["tracking_error_deg"]["rms"], ".3f")),
+            ("tracking error p95 (°)", lambda s: _fmt(s["tracking_error_deg"]["p95"], ".3f")),
+            ("tracking error max (°)", lambda s: _fmt(s["tracking_error_deg"]["max"], ".3f")),
+            ("mean error, bias (°)", lambda s: _fmt(s["tracking_error_deg"]["mean"], "+.3f")),
+            ("within 0.5° (DNI share)", lambda s: _fmt(s["within_0_5_deg"], ".1%")),
+            ("energy capture", lambda s: _fmt(s["energy_capture"], ".2%")),
+            ("moves", lambda s: f"{s['moves']:,}"),
+            ("travel (°)", lambda s: f"{s['travel_deg']:,.0f}"),
+            ("mode switches", lambda s: f"{s['mode_switches']}"),
+            ("wind stow events", lambda s: f"{s['stow_events']}")]
+    rows += [(f"mode {m}", lambda s, m=m: _fmt(s["mode_share"][m], ".1%"))
+             for m in ("sensor", "astronomical", "search", "stow_wind", "stow_night")]
+    rows += [(f"sky {k} (sun up)", lambda s, k=k: _fmt(s["sky_share"][k], ".1%"))
+             for k in ("sunny", "cloudy", "overcast")]
+    table = pd.DataFrame({name: [pick(summary) for _, pick in rows] for name, summary in summaries.items()},
+                         index=[label for label, _ in rows])
+    return table.to_string()
+
+
+def _fmt(value, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def _finish(result, args, *, heading: str) -> None:
+    print(heading)
+    print(summary_table({result.summary["strategy"]: result.summary}))
+    if args.out:
+        written = result.save(args.out)
+        print("wrote " + ", ".join(str(p) for p in written.values()))
+
+
+def _demo_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", default="hybridtrack-demo", help="folder for the results (default hybridtrack-demo)")
+
+
+@command("demo", "a built-in mixed-sky day at Lanzhou: run the hybrid tracker, print the summary, "
+                 "write the report", _demo_arguments)
+def _demo(args: argparse.Namespace) -> int:
+    from ..collectors import Collector
+    from ..simulation import simulate
+    from ..sky import synthetic
+
+    site = sites.get("lanzhou")
+    frame = synthetic(site, "2021-06-21", weather="mixed", seed=5, gusts_per_day=2.0)
+    result = simulate(frame, site, collector=Collector("fresnel"), strategy="hybrid")
+    print("demo: Lanzhou linear Fresnel row, 2021-06-21, mixed sky with gusts (seed 5), hybrid strategy, default "
+          "imperfections")
+    print(summary_table({"hybrid": result.summary}))
+    written = result.save(args.out)
+    print(f"wrote {written['report']} (the day at a glance), {written['summary']}, {written['log']}, "
+          f"{written['events']}")
+    return 0
+
+
+def _simulate_arguments(parser: argparse.ArgumentParser) -> None:
+    add_synthetic_arguments(parser)
+    add_run_arguments(parser)
+
+
+@command("simulate", "run a tracker over synthetic days", _simulate_arguments)
+def _simulate(args: argparse.Namespace) -> int:
+    site = site_from_arguments(args)
+    frame = synthetic_frame(args, site)
+    result = _run(frame, site, args, args.strategy, simulation_config(args, args.seed))
+    _finish(result, args, heading=f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, "
+                                  f"{args.weather}), {result.collector.kind}, {args.strategy}")
+    return 0
+
+
+def _replay_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", help="recorded weather file (CSV or a pvlib format)")
+    add_site_arguments(parser)
+    add_record_arguments(parser)
+    parser.add_argument("--step", default="1min", help="control step the record is resampled to (default 1min)")
+    add_run_arguments(parser)
+
+
+def _replay_frame(args: argparse.Namespace):
+    site = site_from_arguments(args)
+    frame = read_record(args, args.file, site=site, freq=args.step)
+    from ..io import validation_report
+
+    print(validation_report(frame))
+    return site, frame
+
+
+@command("replay", "run a tracker over a recorded weather file", _replay_arguments)
+def _replay(args: argparse.Namespace) -> int:
+    site, frame = _replay_frame(args)
+    result = _run(frame, site, args, args.strategy, simulation_config(args))
+    _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, {args.strategy}")
+    return 0
+
+
+def _compare_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", nargs="?", help="recorded weather file to replay (else synthetic days from --date)")
+    add_synthetic_arguments(parser, date_required=False)
+    add_record_arguments(parser)
+    parser.add_argument("--step", default="1min", help="control step a record is resampled to (default 1min)")
+    add_run_arguments(parser)
+
+
+@command("compare", "run every strategy on the same weather and compare them", _compare_arguments)
+def _compare(args: argparse.Namespace) -> int:
+    from ..control import STRATEGIES
+
+    if args.file is None and args.date is None:
+        raise HybridtrackError("give a recorded FILE, or --date for synthetic days")
+    if args.file is not None:
+        site, frame = _replay_frame(args)
+        config = simulation_config(args)
+    else:
+        site = site_from_arguments(args)
+        frame = synthetic_frame(args, site)
+        config = simulation_config(args, args.seed)
+    results = {strategy: _run(frame, site, args, strategy, config) for strategy in STRATEGIES}
+    first = next(iter(results.values()))
+    print(f"{site.name}, {first.summary['start'][:10]} to {first.summary['end'][:10]}, {first.collector.kind}: "
+          "every strategy on the same weather and world")
+    print(summary_table({name: r.summary for name, r in results.items()}))
+    if args.out:
+        import json
+        from pathlib import Path
+
+        from ..report import plot_compare, save_figure
+
+        folder = Path(args.out)
+        for name, result in results.items():
+            result.save(folder / name, plot=False)
+        (folder / "comparison.json").write_text(json.dumps({n: r.summary for n, r in results.items()}, indent=2) + "\n")
+        print(f"wrote {save_figure(plot_compare(results), folder / 'comparison.png')}, {folder / 'comparison.json'} "
+              f"and one folder per strategy")
+    return 0
