@@ -7,7 +7,7 @@ Two signals come from one sensor head on the collector:
   view, weighted by the cosine of the pointing offset) plus a share of the diffuse light.
   The defaults put a clear noon at Lanzhou in June near 300 mA, a clear Nanjing noon near
   250 mA (the published sunny reading is 246 mA), bright overcast near 80-110 mA and night
-  at the 30 mA dark current: the field range 30-300 mA of ``domain.md`` §4.
+  at the 30 mA dark current: the field range 30-300 mA of the published classifier (docs/physics.md).
   A recorded ``photocurrent`` column is used as it is.
 * **Variation**: how much the intensity moved over a trailing window (the range max − min),
   the classifier's second input. The default window, 20 minutes, was chosen by measurement.
@@ -18,15 +18,31 @@ Two signals come from one sensor head on the collector:
   a short window, so under one the light looks steady and dim (overcast). The price of
   20 minutes is that a sky stays "cloudy" for up to 20 minutes after the clouds go, which
   is the cautious side for a tracker.
-* **Pointing**: the angular offset between the collector's aim and the sun, as the
-  quadrant cells measure it, with noise and bias. It is valid only above a direct-light
-  threshold and inside the field of view. The default threshold, 120 W/m², is the WMO's
-  threshold for sunshine: below it the sun casts no distinct shadow, so the quadrants cannot
-  resolve its direction.
+* **Pointing**: a four-quadrant (or shadow-band) cell balances the light on its quadrants, so
+  it reports the brightness-weighted centre of what falls in its field of view, not the sun
+  (`SensorScene`, `read_pointing`). Under a clear sky the beam outweighs everything else in a
+  few degrees and the centre is the sun. Under broken cloud a bright, sunlit cloud edge near a
+  veiled sun pulls the centre toward it, and a closed loop follows. The light in view is the
+  beam, the symmetric circumsolar aureole and that bright patch, apportioned with the Perez
+  all-weather model's circumsolar brightening (Perez et al. 1990), from the frame's own DNI and
+  DHI, so a pull appears only where the frame's light says a cloud is near the sun. The
+  reading's noise grows as the light in view falls (an amplifier's noise against a smaller
+  signal). It is valid only with enough light in view: the sensor's own "sun present" output,
+  not the DNI, which it cannot know. A coarse, wide-angle stage tells the side the sun is on.
+
+References
+----------
+Perez, R., Ineichen, P., Seals, R., Michalsky, J. & Stewart, R. (1990). Modeling daylight
+availability and irradiance components from direct and global irradiance. *Solar Energy* 44(5),
+271-289. doi:10.1016/0038-092X(90)90055-H
+
+Buie, D., Monger, A. G. & Dey, C. J. (2003). Sunshape distributions for terrestrial solar
+simulations. *Solar Energy* 74(2), 113-122. doi:10.1016/S0038-092X(03)00125-7
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,7 +50,8 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN"]
+__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "SensorScene", "sensor_scene", "read_pointing",
+           "read_photocurrent", "coarse_side"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
@@ -57,13 +74,26 @@ class SensorModel:
     current_noise : float
         Standard deviation of the photocurrent noise, mA.
     direct_threshold : float
-        DNI below which the pointing signal is invalid, W/m².
+        W/m² of light in the fine cells' view below which the sensor says it sees no sun
+        (the WMO's sunshine threshold, 120 W/m², applied to what the cells see).
     field_of_view : float
-        Half-angle inside which the sensor sees the sun, degrees.
+        Half-angle of the fine (pointing) cells' view, degrees.
+    coarse_field_of_view : float
+        Half-angle of the wide-angle acquisition cells, degrees (digital sun sensors' coarse
+        stages see about ±60°).
     noise : float
-        Standard deviation of the measured pointing offset, degrees.
+        Standard deviation of the measured pointing offset at 1000 W/m² in view, degrees;
+        it grows as 1000 W/m² over the light in view.
     bias : float
-        Constant error of the measured pointing offset, degrees.
+        Sensor-to-axis mounting error: a constant offset of the reading, degrees.
+    patch_distance : tuple of float
+        Degrees: the bright cloud patch's centroid lies this far from the sun (a cloud edge
+        inside the view that a cloud veiling or about to veil the sun presents).
+    view_share : float
+        Share of the Perez circumsolar light that falls inside the fine view. For an aureole
+        whose radiance falls as the inverse square of the angle from the sun (Buie et al.
+        2003 measure slopes of about -2), the share within 10° of Perez's 25° circumsolar
+        region is ln(10/0.27)/ln(25/0.27) ≈ 0.8.
     """
 
     dark_current: float = 30.0
@@ -73,17 +103,27 @@ class SensorModel:
     current_noise: float = 0.5
     direct_threshold: float = 120.0
     field_of_view: float = 10.0
+    coarse_field_of_view: float = 60.0
     noise: float = 0.03
     bias: float = 0.0
+    patch_distance: tuple[float, float] = (2.0, 6.0)
+    view_share: float = 0.8
 
     def __post_init__(self) -> None:
         checks = [("dark_current", self.dark_current >= 0), ("responsivity", self.responsivity > 0),
                   ("diffuse_share", 0 <= self.diffuse_share <= 1), ("current_noise", self.current_noise >= 0),
-                  ("direct_threshold", self.direct_threshold >= 0), ("field_of_view", 0 < self.field_of_view <= 90),
-                  ("noise", self.noise >= 0)]
+                  ("direct_threshold", 0 < self.direct_threshold <= 1500),
+                  ("field_of_view", 0 < self.field_of_view <= 90),
+                  ("coarse_field_of_view", self.field_of_view <= self.coarse_field_of_view <= 90),
+                  ("noise", 0 <= self.noise <= 5), ("bias", abs(self.bias) <= 5),
+                  ("view_share", 0 <= self.view_share <= 1)]
+        object.__setattr__(self, "patch_distance", tuple(float(v) for v in self.patch_distance))
         for name, ok in checks:
-            if not ok:
+            if not ok or not np.all(np.isfinite(getattr(self, name))):
                 raise HybridtrackError(f"sensor: {name} = {getattr(self, name)!r} is out of range")
+        if not (len(self.patch_distance) == 2 and 0 <= self.patch_distance[0] <= self.patch_distance[1] <= 30):
+            raise HybridtrackError(f"sensor: patch_distance {list(self.patch_distance)} must be [low, high] "
+                                   "within 0-30 degrees")
         try:
             if pd.Timedelta(self.window) <= pd.Timedelta(0):
                 raise ValueError
@@ -120,21 +160,6 @@ class SensorModel:
         rolling = intensity.rolling(pd.Timedelta(self.window), min_periods=1)
         return (rolling.max() - rolling.min()).rename("variation_ma")
 
-    def pointing(self, offset, dni, *, rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """The measured pointing offset (degrees) and whether it is valid.
-
-        Valid where DNI is at least `direct_threshold` and the true offset is inside the
-        field of view (and both are finite); invalid readings are NaN.
-        """
-        true = np.asarray(offset, float)
-        beam = np.asarray(dni, float)
-        valid = np.isfinite(true) & np.isfinite(beam) & (beam >= self.direct_threshold) \
-            & (np.abs(true) <= self.field_of_view)
-        measured = true + self.bias
-        if rng is not None and self.noise > 0:
-            measured = measured + rng.normal(0.0, self.noise, np.shape(true))
-        return np.where(valid, measured, np.nan), valid
-
 
 def sensor_view(frame: pd.DataFrame, model: SensorModel | None = None, *, seed: int = 0) -> pd.DataFrame:
     """The frame with the sensor's ``intensity_ma`` and ``variation_ma`` columns added.
@@ -150,3 +175,165 @@ def sensor_view(frame: pd.DataFrame, model: SensorModel | None = None, *, seed: 
     out.attrs = dict(frame.attrs)
     out.attrs["intensity_source"] = "recorded" if RECORDED_COLUMN in frame.columns else "sensor model"
     return out
+
+
+@dataclass
+class SensorScene:
+    """The light a sensor facing the sun would have in view, per step (world side).
+
+    Attributes
+    ----------
+    beam : numpy.ndarray
+        DNI, W/m².
+    aureole : numpy.ndarray
+        Symmetric circumsolar light inside the fine view, W/m² on a sun-facing plane.
+    patch : numpy.ndarray
+        The bright cloud patch's light inside the fine view, W/m² on a sun-facing plane.
+    patch_offset : numpy.ndarray
+        (N, 2) degrees from the sun to the patch's centroid, in the sensor's two axes.
+    diffuse : numpy.ndarray
+        DHI, W/m² (for the photocurrent).
+    """
+
+    beam: np.ndarray
+    aureole: np.ndarray
+    patch: np.ndarray
+    patch_offset: np.ndarray
+    diffuse: np.ndarray
+
+
+def _circumsolar(frame: pd.DataFrame, position: pd.DataFrame) -> np.ndarray:
+    """Perez's circumsolar diffuse on a plane facing the sun, W/m² (0 with the sun down)."""
+    import pvlib
+
+    zenith = position["zenith"].to_numpy(float)
+    up = zenith < 90.0
+    out = np.zeros(len(frame))
+    if not up.any():
+        return out
+    index = frame.index[up]
+    dhi = np.nan_to_num(frame["dhi"].to_numpy(float)[up])
+    dni = np.nan_to_num(frame["dni"].to_numpy(float)[up])
+    azimuth = position["azimuth"].to_numpy(float)[up]
+    airmass = pvlib.atmosphere.get_relative_airmass(zenith[up])
+    extra = pvlib.irradiance.get_extra_radiation(index).to_numpy(float)
+    parts = pvlib.irradiance.perez(zenith[up], azimuth, dhi, dni, extra, zenith[up], azimuth, airmass,
+                                   return_components=True)
+    out[up] = np.nan_to_num(np.asarray(parts["poa_circumsolar"], float))
+    return np.maximum(out, 0.0)
+
+
+def _patch_side(index: pd.DatetimeIndex, clearness: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Which side of the sun the bright edge is on, -1 to 1, continuous in time.
+
+    A cloud arriving at the sun (direct light falling) shows its sunlit edge on the side it comes
+    from; one leaving (light rising), on the side it goes to. The side follows the sign of the
+    change in the beam's clearness (DNI over clear-sky DNI), remembered with a 10-minute time
+    constant, so it is continuous in time and moves with the frame's own cloud passages.
+    """
+    from scipy.signal import lfilter
+
+    minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+    if len(minutes) < 3:
+        return np.zeros(len(minutes))
+    change = np.gradient(clearness, minutes)
+    push = -np.clip(change / 0.05, -1.0, 1.0)  # a fall of 5 % of the clear beam a minute: fully on one side
+    step = float(np.median(np.diff(minutes)))
+    keep = np.exp(-step / 10.0)
+    return lfilter([1.0 - keep], [1.0, -keep], push)
+
+
+def _smooth(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float) -> np.ndarray:
+    """A unit-variance AR(1) process with time constant `minutes`, on the index."""
+    from .sky import smooth_noise
+
+    return smooth_noise(index, rng, minutes, 1.0)
+
+
+def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel, *, clear_dni=None,
+                 clear_dhi=None, rng: np.random.Generator) -> SensorScene:
+    """What a sun-facing sensor has in view at each step of a weather frame (world side).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        ``dni`` and ``dhi`` (recorded or synthetic).
+    position : pandas.DataFrame
+        The true sun (``zenith``, ``azimuth``) on the same index.
+    model : SensorModel
+    clear_dni, clear_dhi : array-like
+        Clear-sky DNI and DHI on the same index (a synthetic frame's ``dni_clear`` and
+        ``dhi_clear``; pvlib's Ineichen model for a recorded one).
+    rng : numpy.random.Generator
+        Seeds the patch's distance from the sun and its direction.
+
+    Notes
+    -----
+    The diffuse light above what the clear sky would give (DHI − clear DHI) is cloud light;
+    its circumsolar share (Perez et al. 1990) is the patch, off the sun. The rest of the
+    circumsolar light is the aureole, centred on the sun. The patch sits `patch_distance` from
+    the sun (a seeded AR(1) between the bounds, time constant 30 min) in a direction that turns
+    slowly (AR(1), 2 h), on the side `_patch_side` says.
+    """
+    dni = np.clip(np.nan_to_num(frame["dni"].to_numpy(float)), 0.0, None)
+    dhi = np.clip(np.nan_to_num(frame["dhi"].to_numpy(float)), 0.0, None)
+    clear_dni = np.nan_to_num(np.asarray(clear_dni, float))
+    clear_dhi = np.nan_to_num(np.asarray(clear_dhi, float))
+    circumsolar = _circumsolar(frame.assign(dni=dni, dhi=dhi), position) * model.view_share
+    cloud_share = np.divide(np.clip(dhi - clear_dhi, 0.0, None), dhi, out=np.zeros_like(dhi), where=dhi > 0)
+    clearness = np.clip(np.divide(dni, np.maximum(clear_dni, 50.0)), 0.0, 1.2)
+    side = _patch_side(frame.index, clearness, rng)
+    low, high = model.patch_distance
+    distance = low + (high - low) * 0.5 * (1.0 + np.tanh(_smooth(frame.index, rng, 30.0)))
+    direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * _smooth(frame.index, rng, 120.0)
+    offset = (side * distance)[:, None] * np.stack([np.cos(direction), np.sin(direction)], axis=1)
+    return SensorScene(beam=dni, aureole=circumsolar * (1.0 - cloud_share), patch=circumsolar * cloud_share,
+                       patch_offset=offset, diffuse=dhi)
+
+
+def read_pointing(offsets, beam: float, aureole: float, patch: float, patch_offset, noise, model: SensorModel):
+    """What the fine cells report for one scan: the offset per axis and whether they see a sun.
+
+    Parameters
+    ----------
+    offsets : sequence of float
+        Degrees from the sensor's axis to the true sun, per axis (the mounting bias included).
+    beam, aureole, patch : float
+        The scene's light (`SensorScene`) at this scan, W/m².
+    patch_offset : sequence of float
+        Degrees from the sun to the patch, per axis.
+    noise : sequence of float
+        Standard normal draws, per axis.
+    model : SensorModel
+
+    Returns
+    -------
+    (list of float, bool)
+        The reported offsets (NaN when nothing is in view) and the "sun present" output.
+    """
+    fov = model.field_of_view
+    sun_in = max(abs(o) for o in offsets) <= fov
+    spot = [o + p for o, p in zip(offsets, patch_offset)]
+    patch_in = max(abs(s) for s in spot) <= fov
+    sun_light = (beam * math.cos(math.radians(max(abs(o) for o in offsets))) + aureole) if sun_in else 0.0
+    patch_light = patch if patch_in else 0.0
+    light = sun_light + patch_light
+    if not light >= model.direct_threshold:
+        return [math.nan] * len(offsets), False
+    sigma = model.noise * 1000.0 / light
+    return [(sun_light * o + patch_light * s) / light + sigma * z for o, s, z in zip(offsets, spot, noise)], True
+
+
+def read_photocurrent(offset: float, beam: float, diffuse: float, noise: float, model: SensorModel) -> float:
+    """The photocurrent (mA) for one scan, with the sensor `offset` degrees off the sun."""
+    off = abs(offset)
+    direct = beam * math.cos(math.radians(off)) if off <= model.coarse_field_of_view else 0.0
+    current = model.dark_current + model.responsivity * (direct + model.diffuse_share * diffuse)
+    return max(current + model.current_noise * noise, 0.0)
+
+
+def coarse_side(offset: float, beam: float, model: SensorModel) -> int:
+    """The acquisition cells' answer: the side the sun is on (-1 or +1), or 0 if they see no sun."""
+    if beam >= model.direct_threshold and abs(offset) <= model.coarse_field_of_view:
+        return 1 if offset > 0 else -1
+    return 0

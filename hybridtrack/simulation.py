@@ -1,10 +1,10 @@
-"""Run the hybrid controller over a weather frame and score it against the true sun.
+"""Run a tracking controller over a weather frame and score it against the true sun.
 
-Data flows one way (``design.md``). Everything that does not depend on the controller's own
-state is computed for the whole frame at once: the true sun (SPA) and the true targets of
-the misaligned mounting, the controller's sun (its model, clock and site), the sensor's
-photocurrent and variation, and the fuzzy sky class. Then the controller steps through
-time (`hybridtrack.control.run_controller`), and the log is scored (`hybridtrack.metrics`).
+The world (`hybridtrack.world.World`: the true sun, mount, sensor physics, encoder and actuator)
+and the controller (`hybridtrack.control.Controller`: what a PLC has) are built apart. What
+does not depend on anyone's state is computed for the whole frame at once: the world's true
+sun and sensor scene, the controller's plan from its own clock. Then each scan the world
+observes, the controller decides and the world moves; the log is scored (`hybridtrack.metrics`).
 """
 
 from __future__ import annotations
@@ -19,19 +19,17 @@ import pandas as pd
 
 from . import sites
 from .collectors import Collector
-from .control import MODES, SENSOR_STATUS, SKY_CODES, ControllerConfig, ControllerInputs, run_controller
+from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
+                      make_plan)
 from .drive import Drive
 from .errors import HybridtrackError
 from .fuzzy import FuzzyConfig, FuzzyWeatherClassifier
 from .metrics import summarize
+from .mounting import incidence_cosine
 from .sensor import SensorModel
-from .sun import solar_position
-from .world import Imperfections, incidence_cosine, mounting_rotation, true_targets
+from .world import Imperfections, World
 
-__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS", "CLOCK_STEP_SECONDS"]
-
-#: A jump of the controller's clock against its scan timer larger than this is a clock step.
-CLOCK_STEP_SECONDS = 5.0
+__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
 #: The faults `simulate` can inject, with what each array holds.
 FAULTS = {
     "sensor": "(N,) or (N, axes): the reading the sensor gives (degrees); NaN where it works",
@@ -211,38 +209,31 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     return frame
 
 
-def _working(local: pd.DatetimeIndex, hours: tuple[str, str]) -> np.ndarray:
-    from .times import clock_hours, parse_clock
-
-    start, end = (parse_clock(h) for h in hours)
-    clock = clock_hours(local)
-    return (clock >= start.hour + start.minute / 60.0) & (clock <= end.hour + end.minute / 60.0)
-
-
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
              config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
-             faults: dict | None = None, progress=None) -> Result:
-    """Run the hybrid controller over a weather frame.
+             faults: dict | None = None, progress=None, bulk_nights: bool = True) -> Result:
+    """Run a tracking controller over a weather frame.
 
     Parameters
     ----------
     frame : pandas.DataFrame
-        A weather frame (``dni``; ``dhi``, ``wind_speed`` and a recorded ``photocurrent``
-        when there are) on a tz-aware, increasing index.
+        A weather frame (``dni``; ``dhi``, ``wind_speed``, a recorded ``photocurrent`` and the
+        true ``sky`` when there are) on a tz-aware, increasing index.
     site : Site or str
     collector : str or Collector
         ``trough-ns``, ``trough-ew``, ``fresnel`` or ``heliostat``, or a `Collector` with
         its geometry.
     strategy : str, optional
-        ``hybrid`` (default), ``hybrid-nocal``, ``astronomical`` or ``sensor``; overrides
-        the config's.
+        One of ``hybridtrack.control.STRATEGIES``; overrides the config's.
     config : SimulationConfig, optional
     classifier : FuzzyWeatherClassifier, optional
-        The sky classifier; the published one by default.
+        The controller's sky classifier; the published one by default.
     faults : dict, optional
         Injected faults for testing, one array value per step; see `FAULTS`.
     progress : callable, optional
         Called with the number of steps done since its last call (e.g. a tqdm bar's update).
+    bulk_nights : bool
+        Record a night asleep at stow in one go (the same result, faster; a test keeps it so).
 
     Returns
     -------
@@ -254,81 +245,82 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     site = sites.get(site)
     collector = Collector(collector) if isinstance(collector, str) else collector
     frame = _check_frame(frame)
-    index = frame.index
-    n = len(index)
-    faults = faults or {}
-    unknown = sorted(set(faults) - set(FAULTS))
-    if unknown:
-        raise HybridtrackError(f"unknown fault {unknown[0]!r}; known: {', '.join(FAULTS)}")
-    imp = config.imperfections
+    faults = _check_faults(faults or {}, len(frame), 2 if collector.kind == "heliostat" else 1)
     drives = _drives(collector, config.drive)
-    axes = len(drives)
+    world = World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults)
+    if config.controller.strategy == "hybrid-oracle" and not world.has_true_sky:
+        raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
+                               "have one)")
+    mount = None
+    if config.controller.strategy == "astronomical-commissioned":
+        from .commissioning import commission
 
-    # the controller's view: its clock, its site, its sun model, the nominal geometry. Its
-    # scan timer runs on its own, so a step of the clock against it is seen and taken out;
-    # a slow drift is not.
-    clock = imp.clock_error + _fault(faults, "clock", n, 0.0)
-    jumps = np.diff(clock, prepend=clock[0])
-    stepped = np.abs(jumps) > CLOCK_STEP_SECONDS
-    clock = clock - np.cumsum(np.where(stepped, jumps, 0.0))
-    controller_times = index + pd.to_timedelta(clock, unit="s")
-    controller_site = sites.Site(site.name, float(np.clip(site.latitude + imp.latitude_error, -90, 90)),
-                                 float((site.longitude + imp.longitude_error + 180) % 360 - 180), site.altitude, site.tz)
-    believed = solar_position(controller_times, controller_site, config.controller.sun_model)
-    model = true_targets(believed["altitude"].to_numpy(), believed["azimuth"].to_numpy(), collector, night=True)
-    # awake from 30 minutes before its sunrise (to pre-position) to its sunset, within working hours
-    soon = solar_position(controller_times + pd.Timedelta(minutes=30), controller_site, config.controller.sun_model)
-    sun_up = believed["altitude"].to_numpy() > config.controller.min_altitude
-    rising = (soon["altitude"].to_numpy() > config.controller.min_altitude) & ~sun_up \
-        & (soon["altitude"].to_numpy() > believed["altitude"].to_numpy())
-    awake = _working(controller_times.tz_convert(site.tz), config.controller.working_hours) & (sun_up | rising)
-
-    # the true world: SPA where the sun can be up, the misaligned mounting
-    candidate = believed["altitude"].to_numpy() > -3.0
-    true_alt = np.full(n, -90.0)
-    true_az = np.zeros(n)
-    if candidate.any():
-        truth_sun = solar_position(index[candidate], site, "spa")
-        true_alt[candidate] = truth_sun["altitude"].to_numpy()
-        true_az[candidate] = truth_sun["azimuth"].to_numpy()
-    truth = true_targets(true_alt, true_az, collector, mounting_rotation(imp, collector.axis))
-
-    # the sensor and the sky class, for the whole frame at once
-    sensor = dataclasses.replace(config.sensor, bias=imp.sensor_bias, noise=imp.sensor_noise)
-    rng = np.random.default_rng(config.seed)
-    weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
-    intensity = sensor.photocurrent(weather, rng=rng)
-    variation = sensor.variation(intensity)
+        mount = commission(site, collector, config, frame.index[0], classifier=classifier)
+    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
+                     config.controller, mount)
     clf = classifier or FuzzyWeatherClassifier(FuzzyConfig.default())
-    sky_score = clf.score(intensity.to_numpy(), variation.to_numpy())
-    sky_label = clf.label(sky_score)
-    sky_code = np.array([SKY_CODES.index(v) if v in SKY_CODES else 3 for v in sky_label], np.int8)
-    wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.zeros(n)
-    dni = frame["dni"].to_numpy(float)
-
-    inputs = ControllerInputs(
-        minutes=np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float), awake=awake, wind=wind,
-        sky=sky_code, dni=dni, model=model, truth=np.nan_to_num(truth, nan=0.0) if axes else truth,
-        noise=rng.standard_normal((n, axes)),
-        sensor_fault=_axes_fault(faults, "sensor", n, axes, np.nan),
-        encoder_fault=_axes_fault(faults, "encoder", n, axes, 0.0),
-        encoder_frozen=_mask(faults, "encoder_frozen", n),
-        sensor_dropout=_mask(faults, "sensor_dropout", n),
-        sensor_drift=_fault(faults, "sensor_drift", n, 0.0) if "sensor_drift" in faults else None,
-        clock_step=np.where(stepped, jumps, 0.0) if stepped.any() else None,
-    )
-    out = run_controller(inputs, config.controller, drives, encoder_offset=imp.encoder_offset,
-                         sensor_bias=imp.sensor_bias, sensor_noise=imp.sensor_noise,
-                         field_of_view=sensor.field_of_view, direct_threshold=sensor.direct_threshold,
-                         progress=progress)
-
-    log = _log(index, collector, truth, out, sky_label, sky_score, intensity, variation, wind, dni)
+    window = pd.Timedelta(config.sensor.window) / pd.Timedelta(minutes=1)
+    controller = Controller(config.controller, drives, plan, clf, window)
+    _run(world, controller, config.controller.wind_stow, progress, bulk_nights and not faults)
+    out = controller.outputs()
+    index = frame.index
+    log = _log(index, collector, world, out, clf)
     events = pd.DataFrame([(index[i], a, b, why) for i, a, b, why in out.events],
                           columns=["time", "from", "to", "reason"])
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                         moves=int(out.moves.sum()), travel=float(out.travel.sum()), events=events,
-                        sun_up=true_alt > 0, incidence=incidence_cosine(true_alt, true_az, collector))
+                        sun_up=world.altitude > 0,
+                        incidence=incidence_cosine(world.altitude, world.azimuth, collector))
+    if mount is not None:
+        summary["calibration"] = _mount_summary(mount, collector)
     return Result(log, summary, events, site, collector, config)
+
+
+def _mount_summary(mount: MountEstimate, collector: Collector) -> dict:
+    """A fitted mount in degrees, named as the world's `Imperfections` fields it estimates."""
+    out = {"axis_azimuth_error": round(mount.axis_azimuth_error, 5), "axis_tilt_error": round(mount.axis_tilt_error, 5)}
+    names = ["encoder_offset"] if collector.single_axis else ["encoder_offset_azimuth", "encoder_offset"]
+    out.update({name: round(float(v), 5) for name, v in zip(names, mount.encoder_offset)})
+    return out
+
+
+def _run(world: World, controller: Controller, wind_stow: float, progress, bulk_nights: bool) -> None:
+    """Step world and controller together: the world observes, the controller decides, the world moves."""
+    n = world.n
+    obs = Observation(world.axes)
+    wind_ok = np.concatenate([[0], np.cumsum(~(world.wind <= wind_stow))])
+    i = reported = 0
+    while i < n:
+        if progress is not None and i - reported >= 8192:
+            progress(i - reported)
+            reported = i
+        if bulk_nights and controller.resting and not controller.awake[i]:
+            j = controller.sleeps_until(i)
+            if j > i + 1 and wind_ok[j] == wind_ok[i]:
+                controller.rest(i, j, world.minutes[j - 1])
+                world.rest(i, j)
+                i = j
+                continue
+        world.observe(i, obs)
+        world.move(i, controller.step(obs))
+        i += 1
+    if progress is not None and n > reported:
+        progress(n - reported)
+
+
+def _check_faults(faults: dict, n: int, axes: int) -> dict:
+    unknown = sorted(set(faults) - set(FAULTS))
+    if unknown:
+        raise HybridtrackError(f"unknown fault {unknown[0]!r}; known: {', '.join(FAULTS)}")
+    checked = {}
+    for name, values in faults.items():
+        if name in ("sensor_dropout", "encoder_frozen"):
+            checked[name] = _mask(faults, name, n)
+        elif name in ("sensor", "encoder"):
+            checked[name] = _axes_fault(faults, name, n, axes, np.nan if name == "sensor" else 0.0)
+        else:
+            checked[name] = _fault(faults, name, n, 0.0)
+    return checked
 
 
 def _mask(faults: dict, name: str, n: int) -> np.ndarray | None:
@@ -360,28 +352,32 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
     return np.where(np.isnan(values), default, values) if not np.isnan(default) else values
 
 
-def _log(index, collector: Collector, truth, out, sky_label, sky_score, intensity, variation, wind, dni) -> pd.DataFrame:
+def _log(index, collector: Collector, world: World, out, classifier) -> pd.DataFrame:
     from .collectors import sun_vector
 
+    truth = world.truth
+    angle = np.array(world.angles, float).T.reshape(-1, world.axes)
     main = 0 if collector.single_axis else 1  # a heliostat's main columns are its elevation axis
     if collector.single_axis:
-        error = out.angle[:, 0] - truth[:, 0]
+        error = angle[:, 0] - truth[:, 0]
     else:  # the angle between the actual and the required mirror normal
-        actual = sun_vector(out.angle[:, 1], out.angle[:, 0])
+        actual = sun_vector(angle[:, 1], angle[:, 0])
         wanted = sun_vector(truth[:, 1], truth[:, 0])
         error = np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
+    sky = np.asarray(SKY_CODES, dtype=object)[out.sky]
     log = pd.DataFrame({
-        "target_true": truth[:, main], "target": out.target[:, main], "angle": out.angle[:, main], "error": error,
+        "target_true": truth[:, main], "target": out.target[:, main], "angle": angle[:, main], "error": error,
         "mode": pd.Categorical(np.asarray(MODES)[out.mode], categories=list(MODES)),
-        "sky": pd.Categorical(np.asarray(sky_label, dtype=object), categories=[*SKY_CODES]),
-        "sky_score": sky_score, "sensor_valid": out.sensor_status == 0,
+        "sky": pd.Categorical(sky, categories=list(SKY_CODES)),
+        "sky_score": out.sky_score, "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical(np.asarray(SENSOR_STATUS)[out.sensor_status], categories=list(SENSOR_STATUS)),
-        "intensity_ma": intensity.to_numpy(), "variation_ma": variation.to_numpy(), "wind_speed": wind, "dni": dni,
-        "calibration": out.calibration[:, main],
+        "intensity_ma": out.intensity, "variation_ma": out.variation, "wind_speed": world.wind,
+        "dni": world.frame_dni, "calibration": out.calibration[:, main], "sensor_sun": out.sun[:, main],
     }, index=index)
     if not collector.single_axis:
         log["target_true_azimuth"] = truth[:, 0]
         log["target_azimuth"] = out.target[:, 0] % 360.0  # the axis may have wound past a turn
-        log["angle_azimuth"] = out.angle[:, 0] % 360.0
+        log["angle_azimuth"] = angle[:, 0] % 360.0
         log["calibration_azimuth"] = out.calibration[:, 0]
+        log["sensor_sun_azimuth"] = out.sun[:, 0]
     return log

@@ -39,7 +39,7 @@ from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_range, parse_freq
 
-__all__ = ["synthetic", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES",
+__all__ = ["synthetic", "clear_sky", "smooth_noise", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES",
            "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
@@ -217,7 +217,7 @@ def _cloud_passages(t0: pd.Timestamp, t1: pd.Timestamp, regime: str, rng: np.ran
     return out
 
 
-def _smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float, sigma: float) -> np.ndarray:
+def smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float, sigma: float) -> np.ndarray:
     """Zero-mean AR(1) noise with time constant `minutes`, on a 1-minute grid, then interpolated."""
     t = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
     n = int(np.ceil(t[-1])) + 2 if len(t) else 2
@@ -227,6 +227,27 @@ def _smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: fl
 
     grid = lfilter([1.0], [1.0, -phi], shocks)
     return np.interp(t, np.arange(n), grid)
+
+
+def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clear-sky GHI, DNI and DHI (W/m², 0 at night): pvlib's Ineichen model with the site's
+    altitude and the Linke turbidity looked up for the site and month.
+
+    References
+    ----------
+    Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
+    turbidity coefficient. *Solar Energy* 73(3), 151-157. doi:10.1016/S0038-092X(02)00045-2
+    """
+    import pvlib
+
+    apparent_zenith = np.asarray(apparent_zenith, float)
+    airmass = pvlib.atmosphere.get_relative_airmass(apparent_zenith)
+    pressure = pvlib.atmosphere.alt2pres(site.altitude)
+    linke = pvlib.clearsky.lookup_linke_turbidity(index, site.latitude, site.longitude)
+    with np.errstate(divide="ignore", invalid="ignore"):  # pvlib divides by airmass, infinite at night
+        clear = pvlib.clearsky.ineichen(apparent_zenith, pvlib.atmosphere.get_absolute_airmass(airmass, pressure),
+                                        linke.to_numpy(float), altitude=site.altitude)
+    return tuple(np.nan_to_num(np.asarray(clear[k], float)) for k in ("ghi", "dni", "dhi"))
 
 
 def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str] = "mixed", freq: str = "1min",
@@ -261,8 +282,6 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
         Columns ``ghi dni dhi wind_speed temp_air sky ghi_clear dni_clear dhi_clear``; attrs
         record the site, seed, weather per day and the climate's source.
     """
-    import pvlib
-
     from .sun import solar_position
 
     site = get(site)
@@ -295,13 +314,7 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
 
     position = solar_position(index, site)
     apparent_zenith = position["apparent_zenith"].to_numpy(float)
-    airmass = pvlib.atmosphere.get_relative_airmass(apparent_zenith)
-    pressure = pvlib.atmosphere.alt2pres(site.altitude)
-    linke = pvlib.clearsky.lookup_linke_turbidity(index, site.latitude, site.longitude)
-    with np.errstate(divide="ignore", invalid="ignore"):  # pvlib divides by airmass, infinite at night
-        clear = pvlib.clearsky.ineichen(apparent_zenith, pvlib.atmosphere.get_absolute_airmass(airmass, pressure),
-                                        linke.to_numpy(float), altitude=site.altitude)
-    ghi_c, dni_c, dhi_c = (np.nan_to_num(np.asarray(clear[k], float)) for k in ("ghi", "dni", "dhi"))
+    ghi_c, dni_c, dhi_c = clear_sky(index, site, apparent_zenith)
     cos_z = np.cos(np.radians(apparent_zenith))
     up = cos_z > 0.0
     beam_c = dni_c * np.where(up, cos_z, 0.0)
@@ -311,7 +324,7 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     dni = dni_c * step_tau
     edge_light = np.minimum(step_boost * dhi_c, 0.25 * ghi_c)  # cloud enhancement, at most +25 % of clear GHI
     dhi = np.where(step_cloud, dhi_c + scatter * (1.0 - step_tau) * beam_c, dhi_c + edge_light)
-    overcast_share = np.clip(0.3 + _smooth_noise(index, rng, 90.0, 0.05), 0.2, 0.4)
+    overcast_share = np.clip(0.3 + smooth_noise(index, rng, 90.0, 0.05), 0.2, 0.4)
     dhi = np.where(overcast, overcast_share * ghi_c, dhi)
     dni, dhi = np.where(up, dni, 0.0), np.where(up, dhi, 0.0)
     ghi = dni * np.where(up, cos_z, 0.0) + dhi
@@ -321,12 +334,12 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     if not 0 <= mean_wind <= 40:
         raise HybridtrackError(f"wind_mean must be within 0-40 m/s, got {wind_mean!r}")
     diurnal = 1.0 + 0.5 * np.sin(2 * np.pi * (hours - 9.0) / 24.0)
-    wind = mean_wind * diurnal * np.exp(_smooth_noise(index, rng, 20.0, 0.35) - 0.06)
+    wind = mean_wind * diurnal * np.exp(smooth_noise(index, rng, 20.0, 0.35) - 0.06)
     wind = np.maximum(wind, 0.0) + _gusts(index, rng, gusts_per_day, gust_peak)
 
     month_mean = np.asarray(climate.temperature, float)[local.month.to_numpy() - 1]
     swing = np.where(overcast, 2.5, 6.0)
-    temp = month_mean + swing * np.sin(2 * np.pi * (hours - 9.0) / 24.0) + _smooth_noise(index, rng, 60.0, 0.5)
+    temp = month_mean + swing * np.sin(2 * np.pi * (hours - 9.0) / 24.0) + smooth_noise(index, rng, 60.0, 0.5)
 
     frame = pd.DataFrame({
         "ghi": ghi, "dni": dni, "dhi": dhi, "wind_speed": wind, "temp_air": temp,

@@ -1,31 +1,48 @@
-"""The world the controller lives in: the true sun, the true mounting, the imperfections.
+"""The world the controller lives in (the plant): the true sun, the true mounting, the sensor's
+physics, the encoder and the actuator.
 
-Metrics are scored against this world; the controller never sees it. The controller
-knows only its clock, its site coordinates, its sun model, its sensor and its encoder.
-Every imperfection here is something it does not know about:
+Metrics are scored against this world; the controller never sees it. Each scan the world
+fills an `Observation` with what the controller's instruments read, the controller decides,
+and the world moves (`World.observe`, `World.move`). Every imperfection here is something the
+controller does not know about:
 
 * the collector's true axis is turned by `axis_azimuth_error` and tilted by
   `axis_tilt_error` from the nominal one (a rotation of the mounting frame);
 * the encoder's zero is off by `encoder_offset`, so its readings are shifted;
 * the controller's clock runs `clock_error` seconds ahead (negative: behind);
 * its site coordinates are off by `latitude_error` and `longitude_error`;
-* the sun sensor reads the pointing offset with `sensor_bias` and `sensor_noise`.
+* the sun sensor is mounted `sensor_bias` off the collector's axis, and its reading has
+  `sensor_noise` (1σ at 1000 W/m² in view, growing as the light falls).
 
 The defaults are the size found in commissioned fields: a few tenths of a degree of axis
 misalignment, an encoder zero three counts off (0.26°), a PLC clock 45 s behind, site
-coordinates from a map (about 1 km).
+coordinates from a map (about 1 km), a sensor bracket aligned to about 1 mrad (0.06°), and
+a fine sensor's noise of 0.03° at full sun (commercial fine sun sensors quote < 0.1°).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+import pandas as pd
 
-from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
+from . import sites
+from .collectors import Collector
+from .control.modes import SKY_CODES
+from .control.observation import Observation
+from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
+from .mounting import mount_targets, mounting_rotation
+from .sensor import RECORDED_COLUMN, SensorModel, coarse_side, read_photocurrent, read_pointing, sensor_scene
+from .sun import solar_position
 
-__all__ = ["Imperfections", "mounting_rotation", "true_targets", "incidence_cosine"]
+__all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
+
+#: Degrees the mechanism's hard stops lie beyond the drive's software limits.
+HARD_STOP_MARGIN = 1.0
 
 
 @dataclass(frozen=True)
@@ -43,8 +60,10 @@ class Imperfections:
         Seconds the controller's clock runs ahead of true time.
     latitude_error, longitude_error : float
         Degrees the controller's site coordinates are off.
-    sensor_bias, sensor_noise : float
-        Degrees: constant error and standard deviation of the sun sensor's pointing offset.
+    sensor_bias : float
+        Degrees the sun sensor is mounted off the collector's axis.
+    sensor_noise : float
+        Degrees, 1σ of the sensor's reading at 1000 W/m² in view.
     """
 
     axis_azimuth_error: float = 0.3
@@ -53,7 +72,7 @@ class Imperfections:
     clock_error: float = -45.0
     latitude_error: float = 0.008
     longitude_error: float = 0.01
-    sensor_bias: float = 0.02
+    sensor_bias: float = 0.06
     sensor_noise: float = 0.03
 
     def __post_init__(self) -> None:
@@ -74,61 +93,176 @@ class Imperfections:
         return cls(**{f.name: 0.0 for f in fields(cls)})
 
 
-def mounting_rotation(imperfections: Imperfections, axis_azimuth: float) -> np.ndarray:
-    """Rotation taking world vectors into the true mounting's nominal frame (3x3).
 
-    The true axis is the nominal one turned about the vertical by the azimuth error and
-    tilted about the horizontal cross-axis direction by the tilt error.
+
+def installed_site(site: sites.Site, imperfections: Imperfections) -> sites.Site:
+    """The site as the installer told the controller: off by the coordinate errors."""
+    latitude = float(np.clip(site.latitude + imperfections.latitude_error, -90, 90))
+    longitude = float((site.longitude + imperfections.longitude_error + 180) % 360 - 180)
+    return sites.Site(site.name, latitude, longitude, site.altitude, site.tz)
+
+
+class World:
+    """The plant one collector lives in, over one weather frame.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The weather (``dni``, ``dhi``, ``wind_speed``; a recorded ``photocurrent`` is used as
+        recorded; a ``sky`` column is the true sky, for the oracle policy only).
+    site : Site
+    collector : Collector
+    imperfections : Imperfections
+    sensor : SensorModel
+        The sensor's physics; its `bias` and `noise` are taken from `imperfections`.
+    drives : list of Drive
+    seed : int
+    faults : dict
+        Injected faults, one array per step (see ``hybridtrack.simulation.FAULTS``).
     """
-    turn = np.radians(imperfections.axis_azimuth_error)
-    tilt = np.radians(imperfections.axis_tilt_error)
-    b = np.radians(axis_azimuth)
-    # about z (clockwise from above, as azimuth grows)
-    rz = np.array([[np.cos(turn), -np.sin(turn), 0.0], [np.sin(turn), np.cos(turn), 0.0], [0.0, 0.0, 1.0]])
-    across = np.array([np.cos(b), -np.sin(b), 0.0])  # horizontal, perpendicular to the nominal axis
-    k = np.array([[0, -across[2], across[1]], [across[2], 0, -across[0]], [-across[1], across[0], 0]])
-    rt = np.eye(3) + np.sin(tilt) * k + (1 - np.cos(tilt)) * (k @ k)  # Rodrigues: tilt about `across`
-    return (rt @ rz).T  # world -> mounting
 
+    def __init__(self, frame: pd.DataFrame, site: sites.Site, collector: Collector, imperfections: Imperfections,
+                 sensor: SensorModel, drives: list[Drive], seed: int, faults: dict):
+        index = frame.index
+        self.n, self.axes = len(index), len(drives)
+        self.index, self.site, self.collector, self.imperfections = index, site, collector, imperfections
+        self.sensor = dataclasses.replace(sensor, bias=imperfections.sensor_bias, noise=imperfections.sensor_noise)
+        self.drives = drives
+        self.faults = faults
+        rng = np.random.default_rng(seed)
+        position = self._true_sun()
+        self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
+        rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis)
+        self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation)
+        clear_dni, clear_dhi = self._clear_sky(frame, position)
+        weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
+        scene = sensor_scene(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi, rng=rng)
+        self._scene = (scene.beam.tolist(), scene.aureole.tolist(), scene.patch.tolist(),
+                       [scene.patch_offset[:, k].tolist() for k in range(2)], scene.diffuse.tolist())
+        self._truth = [np.nan_to_num(self.truth[:, a]).tolist() for a in range(self.axes)]
+        self._noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
+        self._current_noise = rng.standard_normal(self.n).tolist()
+        recorded = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
+        self._recorded_current = recorded.tolist() if recorded is not None else None
+        self.frame_dni = frame["dni"].to_numpy(float)
+        self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.zeros(self.n)
+        self._wind = self.wind.tolist()
+        self._sky = self._true_sky(frame)
+        self.minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+        self._minutes = self.minutes.tolist()
+        self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
+        self.actual = [d.stow - imperfections.encoder_offset for d in drives]  # parked where stow reads
+        self.angles = [[math.nan] * self.n for _ in drives]
+        self._last_encoder = [math.nan] * self.axes
+        self._faults = {name: (np.asarray(v).tolist() if np.ndim(v) == 1 else [np.asarray(v)[:, a].tolist()
+                                                                                for a in range(self.axes)])
+                        for name, v in faults.items() if name != "clock"}
 
-def true_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,
-                 night: bool = False) -> np.ndarray:
-    """Target angles of a collector, in its own (possibly misaligned) frame.
+    # -- set up ----------------------------------------------------------------------------------
 
-    Returns shape (N, 1) for single-axis collectors (trough convention) and (N, 2) for a
-    heliostat (normal azimuth and elevation). NaN while the sun is down, unless `night`:
-    then the geometry is followed below the horizon too (to pre-position before sunrise).
-    """
-    alt = np.asarray(altitude, float)
-    s = sun_vector(alt, np.asarray(azimuth, float))
-    rot = np.eye(3) if rotation is None else rotation
-    if collector.kind == "heliostat":
-        normals = heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim) @ rot.T
-        az, el = normal_angles(normals)
-        out = np.stack([az, el], axis=-1)
-    else:
-        sun = across_angle(s @ rot.T, collector.axis)
-        if collector.kind == "fresnel":
-            sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
-        out = sun[:, None]
-    if not night:
-        out[alt < 0] = np.nan
-    return out
+    def _true_sun(self) -> pd.DataFrame:
+        """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
+        cheap = solar_position(self.index, self.site, "plc")["altitude"].to_numpy()
+        candidate = cheap > -3.0
+        position = pd.DataFrame({"altitude": -90.0, "azimuth": 0.0, "zenith": 180.0}, index=self.index)
+        if candidate.any():
+            spa = solar_position(self.index[candidate], self.site, "spa")
+            position.loc[candidate, ["altitude", "azimuth", "zenith"]] = \
+                np.column_stack([spa["altitude"], spa["azimuth"], 90.0 - spa["altitude"]])
+        return position
 
+    def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+        if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:
+            return frame["dni_clear"].to_numpy(float), frame["dhi_clear"].to_numpy(float)
+        from .sky import clear_sky
 
-def incidence_cosine(altitude, azimuth, collector: Collector) -> np.ndarray:
-    """Cosine of the sun's incidence on a perfectly tracking aperture.
+        _, dni, dhi = clear_sky(self.index, self.site, position["zenith"].to_numpy(float))
+        return dni, dhi
 
-    For a single-axis collector it is the part of the sun vector across the axis; a
-    heliostat's is the cosine of half the angle between sun and aim point. Zero at night.
-    """
-    alt = np.asarray(altitude, float)
-    s = sun_vector(alt, np.asarray(azimuth, float))
-    if collector.kind == "heliostat":
-        r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
-        cos = np.sqrt(np.clip((1.0 + s @ r) / 2.0, 0.0, 1.0))
-    else:
-        b = np.radians(collector.axis)
-        along = s[:, 0] * np.sin(b) + s[:, 1] * np.cos(b)
-        cos = np.sqrt(np.clip(1.0 - along**2, 0.0, 1.0))
-    return np.where(alt > 0, cos, 0.0)
+    @staticmethod
+    def _true_sky(frame: pd.DataFrame) -> list | None:
+        if "sky" not in frame.columns:
+            return None
+        labels = frame["sky"].astype(object).to_numpy()
+        return [SKY_CODES.index(v) if v in SKY_CODES else SKY_CODES.index("unknown") for v in labels]
+
+    @property
+    def has_true_sky(self) -> bool:
+        """Whether the frame carries the true sky label (needed by the oracle policy)."""
+        return self._sky is not None
+
+    def controller_clock(self) -> pd.DatetimeIndex:
+        """What the controller's clock shows at each scan: true time plus its error and any clock fault."""
+        seconds = np.full(self.n, self.imperfections.clock_error)
+        if "clock" in self.faults:
+            seconds = seconds + np.nan_to_num(np.asarray(self.faults["clock"], float))
+        return self.index + pd.to_timedelta(seconds, unit="s")
+
+    def controller_site(self) -> sites.Site:
+        """The site as the installer told the controller."""
+        return installed_site(self.site, self.imperfections)
+
+    # -- each scan -------------------------------------------------------------------------------
+
+    def _offset(self, a: int, i: int) -> float:
+        """Degrees from the sensor's axis to the true sun on axis `a` (the mounting bias included)."""
+        difference = self._truth[a][i] - self.actual[a]
+        if self.circular[a]:
+            difference = (difference + 180.0) % 360.0 - 180.0
+        return difference + self.sensor.bias
+
+    def _encoder(self, a: int, i: int) -> float:
+        faults = self._faults
+        if "encoder_frozen" in faults and faults["encoder_frozen"][i] and not math.isnan(self._last_encoder[a]):
+            return self._last_encoder[a]
+        value = encoder_reading(self.actual[a] + self.imperfections.encoder_offset, self.drives[a].resolution)
+        if "encoder" in faults:
+            value += faults["encoder"][a][i]
+        self._last_encoder[a] = value
+        return value
+
+    def observe(self, i: int, obs: Observation) -> None:
+        """Fill `obs` with what the controller's instruments read at scan `i`."""
+        beam, aureole, patch, patch_offset, diffuse = self._scene
+        offsets = [self._offset(a, i) for a in range(self.axes)]
+        noise = [self._noise[a][i] for a in range(self.axes)]
+        reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
+                                        [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
+        self._sensor_faults(i, reported, obs)
+        if "sensor_dropout" not in self._faults or not self._faults["sensor_dropout"][i]:
+            obs.valid = valid or obs.valid
+        obs.i, obs.t, obs.wind = i, self._minutes[i], self._wind[i]
+        for a in range(self.axes):
+            obs.encoder[a] = self._encoder(a, i)
+            obs.coarse[a] = coarse_side(offsets[a], beam[i], self.sensor)
+        worst = max(abs(o) for o in offsets)
+        obs.intensity = self._recorded_current[i] if self._recorded_current is not None else \
+            read_photocurrent(worst, beam[i], diffuse[i], self._current_noise[i], self.sensor)
+        obs.true_sky = self._sky[i] if self._sky is not None else -1
+
+    def _sensor_faults(self, i: int, reported: list, obs: Observation) -> None:
+        """The sensor's reading after any injected fault: a wrong value, a drift, a dropout."""
+        faults = self._faults
+        obs.valid = False
+        for a in range(self.axes):
+            value = reported[a]
+            if "sensor" in faults and not math.isnan(faults["sensor"][a][i]):
+                value = faults["sensor"][a][i]
+                obs.valid = True  # a faulty sensor still says it sees the sun
+            if "sensor_drift" in faults:
+                value += faults["sensor_drift"][i]
+            if "sensor_dropout" in faults and faults["sensor_dropout"][i]:
+                value = math.nan
+            obs.offset[a] = value
+
+    def move(self, i: int, moves: list) -> None:
+        """Drive each axis by the commanded move; the hard stops hold it. Record the angle at `i`."""
+        for a, drive in enumerate(self.drives):
+            low, high = drive.limits
+            self.actual[a] = min(max(self.actual[a] + moves[a], low - HARD_STOP_MARGIN), high + HARD_STOP_MARGIN)
+            self.angles[a][i] = self.actual[a]
+
+    def rest(self, i: int, j: int) -> None:
+        """Scans `i` to `j` - 1 with nothing moving."""
+        for a in range(self.axes):
+            self.angles[a][i:j] = [self.actual[a]] * (j - i)

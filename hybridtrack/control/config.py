@@ -1,0 +1,166 @@
+"""What the controller is told: its strategy and the datasheet constants of its own parts."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pandas as pd
+
+from ..errors import HybridtrackError
+
+__all__ = ["ControllerConfig", "STRATEGIES"]
+
+#: The tracking policies. The last two are references that measure the classifier:
+#: ``hybrid-always`` trusts the sensor whenever it reads valid, ``hybrid-oracle`` knows the true sky.
+STRATEGIES = ("hybrid", "hybrid-nocal", "astronomical", "astronomical-commissioned", "sensor",
+              "hybrid-always", "hybrid-oracle")
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """How the controller behaves, and what it knows of its own parts.
+
+    Parameters
+    ----------
+    strategy : str
+        One of `STRATEGIES`. ``hybrid``: sensor under a sky the fuzzy classifier calls sunny,
+        computed sun otherwise, calibrated from the sensor; ``hybrid-nocal``: the same without
+        calibration; ``hybrid-always``: the sensor whenever it reads valid (no classifier);
+        ``hybrid-oracle``: the sensor whenever the *true* sky is sunny (a reference, needs the
+        frame's ``sky`` column); ``astronomical``: open loop as installed;
+        ``astronomical-commissioned``: open loop after a one-time commissioning fit of the
+        mounting from a clear day of sensor readings; ``sensor``: closed loop only, as sold.
+    sun_model : {"plc", "spa"}
+        The controller's sun model.
+    dwell : str
+        Minimum time between switches of sensor and astronomical mode.
+    wind_stow, wind_release : float
+        m/s: stow above `wind_stow`; resume once at or below `wind_release` for `wind_hold`.
+    wind_hold : str
+    working_hours : tuple of str
+        Local clock times the controller works between.
+    min_altitude : float
+        Degrees: the computed sun must be above this to track.
+    calibration_tau : str
+        Time constant of the continuous calibration.
+    sensor_loss : str
+        How long an invalid sensor is tolerated in sensor mode.
+    process_noise : float
+        Kalman white-noise acceleration intensity, deg²/min³.
+    gate : float
+        Innovation gate, in standard deviations. After `reacquire` readings in a row fail it,
+        the filter restarts from the latest reading.
+    reacquire : int
+    sensor_plausibility : float
+        Degrees: a sensor reading further from the (calibrated) model is implausible.
+    stuck_scans : int
+        Identical sensor readings in a row that mark the sensor stuck.
+    encoder_confirm : int
+        Scans a jumped encoder reading must persist before it is believed.
+    calibration_max_rate : float
+        Degrees per minute: calibration learns only while the model's target moves no faster.
+    search_speed : float
+        Degrees per minute of the sensor-only acquisition; commercial sensor trackers acquire at
+        their drive's speed (30°/min here).
+    coast : str
+        Sensor-only strategy: how long to keep moving at the filtered rate through a gap in
+        the sensor's signal before holding still.
+    lead : bool
+        Aim half a deadband ahead of the sun, in its direction of motion. ``False`` is the
+        published field practice (aim at the sun).
+    sensor_noise : float
+        Degrees, 1σ: the sensor's datasheet accuracy at full sun, the Kalman filter's R. The
+        default is half the < 0.1° accuracy quoted for commercial fine sun sensors.
+    kalman : {"fast", "filterpy"}
+        ``filterpy`` runs filterpy's KalmanFilter, the reference; ``fast`` the same
+        equations in plain floats (a test keeps them equal).
+    """
+
+    strategy: str = "hybrid"
+    sun_model: str = "plc"
+    dwell: str = "5min"
+    wind_stow: float = 17.2
+    wind_release: float = 12.0
+    wind_hold: str = "10min"
+    working_hours: tuple[str, str] = ("05:00", "20:00")
+    min_altitude: float = 0.0
+    calibration_tau: str = "30min"
+    sensor_loss: str = "3min"
+    process_noise: float = 1e-3
+    gate: float = 4.0
+    reacquire: int = 3
+    calibration_max_rate: float = 1.0
+    sensor_plausibility: float = 2.0
+    stuck_scans: int = 3
+    encoder_confirm: int = 3
+    search_speed: float = 30.0
+    coast: str = "10min"
+    lead: bool = True
+    sensor_noise: float = 0.05
+    kalman: str = "fast"
+
+    def __post_init__(self) -> None:
+        from ..times import parse_clock
+
+        object.__setattr__(self, "working_hours", tuple(self.working_hours))
+        if self.strategy not in STRATEGIES:
+            raise HybridtrackError(f"unknown strategy {self.strategy!r}; choose from {', '.join(STRATEGIES)}")
+        if self.sun_model not in ("plc", "spa"):
+            raise HybridtrackError(f"unknown sun model {self.sun_model!r}; choose 'plc' or 'spa'")
+        if self.kalman not in ("fast", "filterpy"):
+            raise HybridtrackError(f"unknown Kalman engine {self.kalman!r}; choose 'fast' or 'filterpy'")
+        for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast"):
+            try:
+                if pd.Timedelta(getattr(self, name)) <= pd.Timedelta(0):
+                    raise ValueError
+            except ValueError:
+                raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive duration") from None
+        for name in ("wind_stow", "wind_release", "min_altitude", "process_noise", "gate", "calibration_max_rate",
+                     "sensor_plausibility", "search_speed", "sensor_noise"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise HybridtrackError(f"controller: {name} must be a finite number, got {value!r}")
+        if not 0 < self.wind_release <= self.wind_stow <= 60:
+            raise HybridtrackError(f"controller: wind_release {self.wind_release} must be positive and at most "
+                                   f"wind_stow {self.wind_stow} (at most 60 m/s)")
+        if len(self.working_hours) != 2:
+            raise HybridtrackError("controller: working_hours needs a start and an end")
+        for clock in self.working_hours:
+            parse_clock(clock)
+        if not (0 < self.process_noise <= 10 and 0 < self.gate <= 100 and 0 < self.search_speed <= 600
+                and 0 < self.calibration_max_rate <= 100 and 0 < self.sensor_noise <= 5):
+            raise HybridtrackError("controller: process_noise (0-10], gate (0-100], search_speed (0-600], "
+                                   "calibration_max_rate (0-100] and sensor_noise (0-5] are out of range")
+        if not -10 <= self.min_altitude <= 30:
+            raise HybridtrackError(f"controller: min_altitude {self.min_altitude} is outside -10 to 30 degrees")
+        for name, least in (("reacquire", 1), ("stuck_scans", 2), ("encoder_confirm", 1)):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and not isinstance(value, bool) and least <= value <= 10_000):
+                raise HybridtrackError(f"controller: {name} must be a whole number of at least {least}, got {value!r}")
+        if not 0 < self.sensor_plausibility <= 45:
+            raise HybridtrackError("controller: sensor_plausibility must be within (0, 45] degrees")
+
+    @property
+    def uses_sensor(self) -> bool:
+        """Whether the strategy ever tracks the sensor."""
+        return self.strategy not in ("astronomical", "astronomical-commissioned")
+
+    @property
+    def uses_model(self) -> bool:
+        """Whether the strategy ever follows the computed sun."""
+        return self.strategy != "sensor"
+
+    @property
+    def calibrates(self) -> bool:
+        """Whether the model is corrected from the sensor while it runs."""
+        return self.strategy in ("hybrid", "hybrid-always", "hybrid-oracle")
+
+    @property
+    def sensor_only(self) -> bool:
+        """The closed-loop-only strategy, with its acquisition, coasting and parking."""
+        return self.strategy == "sensor"
+
+    def minutes(self, name: str) -> float:
+        """A duration field in minutes."""
+        return pd.Timedelta(getattr(self, name)) / pd.Timedelta(minutes=1)

@@ -1,0 +1,375 @@
+"""The controller: what a PLC does each scan, from its own readings, config and state.
+
+Each scan it takes an `Observation` (encoder, sensor, photocurrent, anemometer) and its plan
+(`plan.make_plan`: the computed sun and the working day from its own clock), and returns how far
+to move each axis. The pieces, each in its own module: the encoder monitor, the wind guard, the
+sky watch, the sensor gate with its Kalman filter, the calibrator; here they are put together
+with the day cycle, the mode choice, the target and the drive command. It never sees the world.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..drive import Drive
+from .calibration import Calibrator
+from .config import ControllerConfig
+from .encoder import EncoderMonitor
+from .modes import (ASTRONOMICAL, FAULT, FAULTY, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR, SENSOR_STATUS,
+                    SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
+from .observation import Observation
+from .plan import ControllerPlan
+from .sensing import SensorGate
+from .skywatch import ClassifierTable, SkyWatch
+from .wind import WindGuard
+
+__all__ = ["Controller", "ControllerOutputs"]
+
+log = logging.getLogger("hybridtrack.control")
+
+
+@dataclass
+class ControllerOutputs:
+    """Per scan: mode, sensor status, sky class and score, the photocurrent read and its variation
+    (NaN while asleep), and per axis the target, the encoder reading used, the calibration offset
+    and the filtered sun angle where a reading was taken; moves and travel per axis; events as
+    (scan, from mode, to mode, reason)."""
+
+    mode: np.ndarray
+    sensor_status: np.ndarray
+    sky: np.ndarray
+    sky_score: np.ndarray
+    intensity: np.ndarray
+    variation: np.ndarray
+    target: np.ndarray
+    reading: np.ndarray
+    calibration: np.ndarray
+    sun: np.ndarray
+    moves: np.ndarray
+    travel: np.ndarray
+    events: list
+
+
+class Controller:
+    """A tracking controller for one collector of one or two axes.
+
+    Parameters
+    ----------
+    config : ControllerConfig
+    drives : list of Drive
+        The datasheet of each axis's drive and encoder (deadband, speeds, limits, stow).
+    plan : ControllerPlan
+    classifier : FuzzyWeatherClassifier
+        The sky classifier, run as a table (`skywatch.ClassifierTable`).
+    window_minutes : float
+        The trailing window of the photocurrent's variation.
+    """
+
+    def __init__(self, config: ControllerConfig, drives: list[Drive], plan: ControllerPlan, classifier,
+                 window_minutes: float):
+        self.config = config
+        self.drives = drives
+        self.axes = len(drives)
+        self.model = [plan.model[:, a].tolist() for a in range(self.axes)]
+        self.awake = plan.awake.tolist()
+        self.clock_steps = plan.clock_steps.tolist()
+        n = len(self.awake)
+        resolution = [d.resolution for d in drives]
+        self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
+        self.encoders = [EncoderMonitor(r, config.encoder_confirm) for r in resolution]
+        self.wind = WindGuard(config.wind_stow, config.wind_release, config.minutes("wind_hold"))
+        self.sky = SkyWatch(ClassifierTable(classifier), window_minutes)
+        variance = [config.sensor_noise**2 + r * r / 12.0 for r in resolution]
+        self.gates = [SensorGate(config.kalman, config.process_noise, v, config.stuck_scans, config.gate,
+                                 config.reacquire) for v in variance]
+        self.calibrators = [Calibrator(config.minutes("calibration_tau"), config.calibration_max_rate)
+                            for _ in drives]
+        self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
+        self.coast_for = config.minutes("coast")
+        self.mode, self.mode_since = STOW_NIGHT, -math.inf
+        self.invalid_since = math.nan
+        self.previous_t = math.nan
+        self.resting = False
+        self.park = [d.stow for d in drives]  # the sensor-only tracker parks where it found the sun
+        self.found_today = False
+        self.events: list = []
+        self.out = {name: [0] * n for name in ("mode", "status", "sky")}
+        self.out.update({name: [math.nan] * n for name in ("score", "variation", "intensity")})
+        self.out_axes = {name: [[math.nan] * n for _ in drives] for name in ("target", "reading", "calibration", "sun")}
+        self.moves = [0] * self.axes
+        self.travel = [0.0] * self.axes
+
+    # -- bookkeeping -----------------------------------------------------------------------------
+
+    def _switch(self, i: int, new: int, reason: str, t: float) -> None:
+        self.events.append((i, MODES[self.mode], MODES[new], reason))
+        log.debug("scan %d: %s -> %s (%s)", i, MODES[self.mode], MODES[new], reason)
+        self.mode, self.mode_since = new, t
+
+    def _alarm(self, i: int, reason: str) -> None:
+        self.events.append((i, MODES[self.mode], MODES[self.mode], reason))
+        log.info("scan %d: %s", i, reason)
+
+    def _turn(self, a: int, difference: float) -> float:
+        """A difference of angles on axis `a`: the short way round on a circular axis."""
+        return (difference + 180.0) % 360.0 - 180.0 if self.circular[a] else difference
+
+    def _record(self, i: int, status: int, targets: list, reading: list) -> None:
+        out, per_axis = self.out, self.out_axes
+        out["mode"][i] = self.mode
+        out["status"][i] = status
+        for a in range(self.axes):
+            per_axis["target"][a][i] = targets[a]
+            per_axis["reading"][a][i] = reading[a]
+            per_axis["calibration"][a][i] = self.calibrators[a].offset
+
+    def sleeps_until(self, i: int) -> int:
+        """The first scan from `i` at which the controller wakes (len of the plan if never)."""
+        awake = self.awake
+        j = i
+        while j < len(awake) and not awake[j]:
+            j += 1
+        return j
+
+    def rest(self, i: int, j: int, last_t: float) -> None:
+        """Scans `i` to `j` - 1 asleep at stow with nothing happening (the last at timer `last_t`):
+        recorded in bulk, as stepping through them would."""
+        count = j - i
+        reading = [monitor.believed for monitor in self.encoders]
+        self.previous_t = last_t
+        out, per_axis = self.out, self.out_axes
+        out["mode"][i:j] = [STOW_NIGHT] * count
+        out["status"][i:j] = [NOT_READ] * count
+        out["sky"][i:j] = [UNKNOWN] * count
+        for a in range(self.axes):
+            per_axis["target"][a][i:j] = [self._night_target(a)] * count
+            per_axis["reading"][a][i:j] = [reading[a]] * count
+            per_axis["calibration"][a][i:j] = [self.calibrators[a].offset] * count
+            per_axis["sun"][a][i:j] = [math.nan] * count
+
+    # -- one scan --------------------------------------------------------------------------------
+
+    def step(self, obs: Observation) -> list[float]:
+        """Take one scan's readings; return the move to make on each axis, degrees."""
+        i, t = obs.i, obs.t
+        dt = t - self.previous_t if not math.isnan(self.previous_t) else 1.0
+        self.previous_t = t
+        awake = self.awake[i]
+        if self.clock_steps[i]:
+            self._alarm(i, f"controller clock stepped by {self.clock_steps[i]:+.0f} s against the scan timer; "
+                           "clock re-based")
+        reading = self._read_encoders(i, t, obs)
+        gusty = self.wind.update(t, obs.wind)
+        if self.resting and not awake and not gusty:
+            self.out["sky"][i] = UNKNOWN
+            self._record(i, NOT_READ, [self._night_target(a) for a in range(self.axes)], reading)
+            return [0.0] * self.axes
+        self._day_and_wind(i, t, awake, gusty, obs.wind)
+        sky = self._watch_sky(i, t, obs)
+        status, valid = self._sense(i, t, dt, obs, reading, awake, sky)
+        self._choose_mode(i, t, status, valid, sky, obs)
+        targets, moves = self._command(i, t, dt, reading, valid, obs)
+        self._record(i, status, targets, reading)
+        if self.mode == STOW_NIGHT:
+            for gate in self.gates:
+                gate.forget()
+        return moves
+
+    def _read_encoders(self, i: int, t: float, obs: Observation) -> list[float]:
+        reading = []
+        for a, monitor in enumerate(self.encoders):
+            value, note, frozen = monitor.read(obs.encoder[a], self.mode == FAULT)
+            if frozen and self.mode != FAULT:
+                self._switch(i, FAULT, note, t)
+            elif note:
+                self._alarm(i, note)
+            reading.append(value)
+        return reading
+
+    def _day_and_wind(self, i: int, t: float, awake: bool, gusty: bool, wind: float) -> None:
+        mode, config = self.mode, self.config
+        resume = SENSOR if config.sensor_only else ASTRONOMICAL
+        if gusty and mode not in (STOW_WIND, FAULT):
+            self._switch(i, STOW_WIND, "wind reading invalid" if math.isnan(wind)
+                         else f"wind {wind:.1f} m/s > {config.wind_stow}", t)
+        elif mode == STOW_WIND and not gusty and self.wind.released(t):
+            self._switch(i, resume, f"wind at or below {config.wind_release} m/s for {config.wind_hold}", t)
+        mode = self.mode
+        if mode == FAULT:
+            if awake and i and not self.awake[i - 1]:
+                self._switch(i, resume, "a new day: probing the encoder again", t)
+        elif mode != STOW_WIND:
+            if not awake and mode != STOW_NIGHT:
+                self._switch(i, STOW_NIGHT, "outside working hours or sun down", t)
+                self.found_today = False
+            elif awake and mode == STOW_NIGHT:
+                self._switch(i, resume, "awake and sun up" if config.uses_model else "awake (working hours)", t)
+
+    def _watch_sky(self, i: int, t: float, obs: Observation) -> int:
+        code, score, variation = self.sky.update(t, obs.intensity)
+        self.out["intensity"][i] = obs.intensity
+        self.out["sky"][i] = code
+        self.out["score"][i] = score
+        self.out["variation"][i] = variation
+        return code
+
+    def _trusts_sensor(self, sky: int, obs: Observation) -> bool:
+        """Whether the policy wants the sensor now (and so lets it calibrate the model)."""
+        strategy = self.config.strategy
+        if strategy == "hybrid-always" or strategy == "sensor":
+            return True
+        if strategy == "hybrid-oracle":
+            return obs.true_sky == SUNNY
+        return sky == SUNNY
+
+    def _sense(self, i: int, t: float, dt: float, obs: Observation, reading: list, awake: bool,
+               sky: int) -> tuple[int, list]:
+        config = self.config
+        valid = [False] * self.axes
+        if not (config.uses_sensor and awake and self.mode not in (STOW_WIND, FAULT)):
+            return NOT_READ, valid
+        status = OK
+        trusted = config.calibrates and self._trusts_sensor(sky, obs)
+        for a, gate in enumerate(self.gates):
+            verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a])
+            if verdict == OK:
+                verdict = self._offer(i, a, dt, reading[a] + obs.offset[a], trusted)
+            valid[a] = verdict == OK
+            if valid[a]:
+                self.out_axes["sun"][a][i] = gate.filter.angle
+            if verdict != OK and status == OK:
+                status = verdict
+        for a, gate in enumerate(self.gates):
+            if not valid[a]:
+                gate.coast(dt)
+        if all(valid):
+            self.invalid_since = math.nan
+            if config.sensor_only and not self.found_today:
+                self.park = [g.filter.angle for g in self.gates]
+                self.found_today = True
+        elif math.isnan(self.invalid_since):
+            self.invalid_since = t
+        return status, valid
+
+    def _plausibility_bound(self, i: int, a: int) -> float:
+        limit = self.config.sensor_plausibility
+        if self.axes == 2 and a == 0:  # in pointing terms a heliostat's azimuth axis turns 1/cos(elevation) faster
+            return limit / max(math.cos(math.radians(self.model[1][i])), 0.05)
+        return limit
+
+    def _offer(self, i: int, a: int, dt: float, z: float, trusted: bool) -> int:
+        """Offer the sensor's sun angle on axis `a` to the gate, and let a trusted one calibrate."""
+        config, gate, calibrator = self.config, self.gates[a], self.calibrators[a]
+        m0 = self.model[a][i]
+        m1 = self.model[a][i - 1] if i else math.nan
+        bound = self._plausibility_bound(i, a)
+        has_model = config.uses_model and not math.isnan(m0)
+        miss = self._turn(a, z - m0 - calibrator.offset) if has_model else math.nan
+        rate = self._turn(a, m0 - m1) / dt if has_model and dt > 0 and not math.isnan(m1) else 0.0
+        verdict = gate.take(z, dt, miss, bound, rate)
+        if verdict == OK and trusted and has_model:
+            calibrator.learn(dt, self._turn(a, gate.filter.angle - m0), self._turn(a, m0 - m1), bound)
+        return verdict
+
+    def _choose_mode(self, i: int, t: float, status: int, valid: list, sky: int, obs: Observation) -> None:
+        mode = self.mode
+        if mode not in (ASTRONOMICAL, SENSOR, SEARCH):
+            return
+        sensor_ok = self.config.uses_sensor and all(valid)
+        if self.config.sensor_only:
+            if mode == SEARCH and sensor_ok:
+                self._switch(i, SENSOR, "sun back in the sensor's view", t)
+            elif mode == SENSOR and status == OUT_OF_VIEW:
+                self._switch(i, SEARCH, "the acquisition cells see the sun outside the fine view", t)
+            return
+        want = self.config.uses_sensor and self._trusts_sensor(sky, obs)
+        lost_for = t - self.invalid_since
+        if mode == SENSOR and not sensor_ok and (status in FAULTY or lost_for >= self.loss):
+            self._switch(i, ASTRONOMICAL, f"sensor lost ({SENSOR_STATUS[status]})", t)
+        elif mode == SENSOR and not want and t - self.mode_since >= self.dwell:
+            reason = "true sky not sunny" if self.config.strategy == "hybrid-oracle" else f"sky {SKY_CODES[sky]}"
+            self._switch(i, ASTRONOMICAL, reason, t)
+        elif mode == ASTRONOMICAL and want and sensor_ok and t - self.mode_since >= self.dwell:
+            self._switch(i, SENSOR, "sensor valid and trusted" if self.config.strategy == "hybrid-always"
+                         else "sky sunny and sensor valid", t)
+
+    # -- targets and the drive ---------------------------------------------------------------------
+
+    def _night_target(self, a: int) -> float:
+        return self.park[a] if self.config.sensor_only else self.drives[a].stow
+
+    def _target(self, i: int, a: int, t: float, dt: float, reading: float, valid: bool, obs: Observation) -> float:
+        mode, gate, drive = self.mode, self.gates[a], self.drives[a]
+        half_band = drive.deadband / 2.0 if self.config.lead else 0.0
+        if mode == STOW_WIND:
+            return drive.stow
+        if mode == STOW_NIGHT:
+            return self._night_target(a)
+        if mode == SENSOR:
+            coasting = not valid and t - self.invalid_since <= self.coast_for
+            if gate.ready and (valid or not self.config.sensor_only or coasting):
+                return gate.filter.angle + math.copysign(half_band, gate.filter.rate)
+            return reading  # hold
+        if mode == SEARCH:
+            side = obs.coarse[a]
+            return reading + side * self.config.search_speed * dt if side else reading
+        m = self.model[a][i]
+        if math.isnan(m):
+            return drive.stow
+        target = m + self.calibrators[a].offset
+        previous = self.model[a][i - 1] if i else math.nan
+        if half_band and not math.isnan(previous) and m != previous:
+            target += math.copysign(half_band, self._turn(a, m - previous))
+        if self.circular[a]:  # the nearest way to the same direction, within the limits
+            target = reading + self._turn(a, target - reading)
+            low, high = drive.limits
+            if not low <= target <= high:
+                target += 360.0 if target < low else -360.0
+        return target
+
+    def _command(self, i: int, t: float, dt: float, reading: list, valid: list,
+                 obs: Observation) -> tuple[list, list]:
+        targets, moves = [], []
+        mode = self.mode
+        stowing = mode == STOW_NIGHT or mode == STOW_WIND
+        self.resting = mode == STOW_NIGHT and not self.awake[i]
+        for a, drive in enumerate(self.drives):
+            monitor = self.encoders[a]
+            monitor.commanded = 0.0
+            if mode == FAULT:  # position unknown: never move
+                targets.append(reading[a])
+                moves.append(0.0)
+                continue
+            low, high = drive.limits
+            target = min(max(self._target(i, a, t, dt, reading[a], valid[a], obs), low), high)
+            error = target - reading[a]
+            held = mode == STOW_WIND and abs(reading[a] - drive.stow) <= drive.deadband  # stowed: never move
+            threshold = drive.resolution if stowing or mode == SEARCH else drive.deadband
+            step = 0.0
+            if not held and abs(error) > threshold:
+                speed = drive.stow_speed if stowing else drive.speed
+                step = max(-speed * dt, min(speed * dt, error))
+                monitor.commanded = step
+                self.moves[a] += 1
+                self.travel[a] += abs(step)
+                self.resting = False
+            targets.append(target)
+            moves.append(step)
+        return targets, moves
+
+    def outputs(self) -> ControllerOutputs:
+        """Everything recorded, as arrays."""
+        out, per_axis = self.out, self.out_axes
+
+        def columns(name):
+            return np.array(per_axis[name], float).T.reshape(-1, self.axes)
+
+        return ControllerOutputs(np.array(out["mode"], np.int8), np.array(out["status"], np.int8),
+                                 np.array(out["sky"], np.int8), np.array(out["score"], float),
+                                 np.array(out["intensity"], float), np.array(out["variation"], float),
+                                 columns("target"), columns("reading"), columns("calibration"), columns("sun"),
+                                 np.array(self.moves), np.array(self.travel), self.events)

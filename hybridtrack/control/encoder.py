@@ -1,0 +1,50 @@
+"""Whether to believe the encoder: glitches ignored until confirmed, a frozen encoder caught."""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["EncoderMonitor"]
+
+
+class EncoderMonitor:
+    """One axis's encoder, judged against where the last commanded move should have left it.
+
+    A reading that jumps away from the expected position is a glitch: ignored for that scan,
+    believed only once it has persisted for `confirm` scans. A reading that does not change
+    although the drive was commanded to move is a frozen encoder.
+    """
+
+    __slots__ = ("resolution", "confirm", "believed", "last", "jumped", "commanded")
+
+    def __init__(self, resolution: float, confirm: int):
+        self.resolution = resolution
+        self.confirm = confirm
+        self.believed = math.nan
+        self.last = math.nan
+        self.jumped = 0
+        self.commanded = 0.0
+
+    def read(self, value: float, trust_blindly: bool) -> tuple[float, str | None, bool]:
+        """The reading to use, an alarm text or None, and whether the encoder looks frozen."""
+        previous, self.last = self.last, value
+        if math.isnan(self.believed) or trust_blindly:
+            self.believed = value
+            return value, None, False
+        expected = self.believed + self.commanded
+        tolerance = 2.0 * self.resolution + 1e-9
+        if self.commanded and abs(value - previous) < 0.5 * self.resolution and abs(self.commanded) > tolerance:
+            self.believed = value
+            return value, f"encoder frozen: commanded {self.commanded:+.2f}°, reading unchanged; drive halted", True
+        if abs(value - expected) <= tolerance:
+            self.jumped = 0
+            self.believed = value
+            return value, None, False
+        self.jumped += 1
+        if self.jumped >= self.confirm:
+            self.jumped = 0
+            self.believed = value
+            return value, f"encoder reading {value:.3f}° held for {self.confirm} scans; believed", False
+        self.believed = expected
+        note = f"encoder glitch: read {value:.3f}°, expected {expected:.3f}°; ignored" if self.jumped == 1 else None
+        return expected, note, False

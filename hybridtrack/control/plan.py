@@ -1,0 +1,116 @@
+"""What the controller works out from its own clock alone: the computed sun and its working day.
+
+None of it depends on the controller's state, so it is computed for the whole run at once.
+Each value at a scan uses only that scan's clock reading and the clock's history, as the PLC's
+own per-scan computation would:
+
+* the controller's clock is compared with its scan timer; a jump of more than
+  `CLOCK_STEP_SECONDS` between two scans is a clock step, logged and taken out (the clock is
+  re-based on the timer); a slow drift is not seen here;
+* the computed sun at the (re-based) clock, the believed site and the controller's sun model;
+* the computed target of each axis on the mount as the controller believes it to be (nominal,
+  or corrected by a commissioning fit), in encoder coordinates;
+* awake: within working hours and with the computed sun up, or rising within 30 minutes (to
+  pre-position). The sensor-only tracker has no sun model: it is awake within working hours.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from ..collectors import Collector
+from ..mounting import mount_targets, mounting_rotation
+from ..sites import Site
+from ..sun import solar_position
+from ..times import clock_hours, parse_clock
+from .config import ControllerConfig
+
+__all__ = ["MountEstimate", "ControllerPlan", "make_plan", "CLOCK_STEP_SECONDS"]
+
+#: A jump of the controller's clock against its scan timer larger than this is a clock step.
+CLOCK_STEP_SECONDS = 5.0
+#: How long before its computed sunrise the controller wakes to pre-position.
+PRE_POSITION = pd.Timedelta(minutes=30)
+
+
+@dataclass(frozen=True)
+class MountEstimate:
+    """The controller's belief about its own mount, in the world's `Imperfections` terms.
+
+    Parameters
+    ----------
+    axis_azimuth_error, axis_tilt_error : float
+        Degrees.
+    encoder_offset : tuple of float
+        Degrees, per axis: the encoder reads the true angle plus this.
+    """
+
+    axis_azimuth_error: float = 0.0
+    axis_tilt_error: float = 0.0
+    encoder_offset: tuple[float, ...] = field(default=(0.0,))
+
+    def targets(self, altitude, azimuth, collector: Collector) -> np.ndarray:
+        """Computed targets in encoder coordinates, (N, axes); the geometry is followed below the horizon."""
+        rotation = mounting_rotation(self.axis_azimuth_error, self.axis_tilt_error, collector.axis)
+        targets = mount_targets(altitude, azimuth, collector, rotation, night=True)
+        return targets + np.resize(np.asarray(self.encoder_offset, float), targets.shape[1])
+
+
+@dataclass
+class ControllerPlan:
+    """Per scan: timer (minutes), computed targets (N, axes), awake, and clock steps (seconds, 0 if none)."""
+
+    minutes: np.ndarray
+    model: np.ndarray
+    awake: np.ndarray
+    clock_steps: np.ndarray
+
+
+def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeIndex, np.ndarray]:
+    """The clock with its steps against the scan timer taken out, and the steps in seconds."""
+    elapsed = np.asarray((clock - clock[0]) / pd.Timedelta(seconds=1), float)
+    drift = elapsed - 60.0 * minutes
+    jumps = np.diff(drift, prepend=drift[0])
+    steps = np.where(np.abs(jumps) > CLOCK_STEP_SECONDS, jumps, 0.0)
+    return clock - pd.to_timedelta(np.cumsum(steps), unit="s"), steps
+
+
+def _working(local: pd.DatetimeIndex, hours: tuple[str, str]) -> np.ndarray:
+    start, end = (parse_clock(h) for h in hours)
+    clock = clock_hours(local)
+    return (clock >= start.hour + start.minute / 60.0) & (clock <= end.hour + end.minute / 60.0)
+
+
+def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collector: Collector,
+              config: ControllerConfig, mount: MountEstimate | None = None) -> ControllerPlan:
+    """The controller's plan from what its clock shows at each scan and its scan timer.
+
+    Parameters
+    ----------
+    clock : pandas.DatetimeIndex
+        The controller clock's reading at each scan (tz-aware).
+    minutes : numpy.ndarray
+        The scan timer, minutes since the run began.
+    site : Site
+        The site as the controller was told it.
+    collector : Collector
+    config : ControllerConfig
+    mount : MountEstimate, optional
+        The controller's belief about its mount; nominal by default.
+    """
+    clock, steps = _rebased(clock, minutes)
+    working = _working(clock.tz_convert(site.tz), config.working_hours)
+    sun = solar_position(clock, site, config.sun_model)
+    altitude = sun["altitude"].to_numpy()
+    model = (mount or MountEstimate()).targets(altitude, sun["azimuth"].to_numpy(), collector)
+    if config.sensor_only:
+        awake = working
+    else:
+        soon = solar_position(clock + PRE_POSITION, site, config.sun_model)["altitude"].to_numpy()
+        up = altitude > config.min_altitude
+        rising = (soon > config.min_altitude) & ~up & (soon > altitude)
+        awake = working & (up | rising)
+    return ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps)

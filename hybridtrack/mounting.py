@@ -1,0 +1,76 @@
+"""Where a collector on a (possibly misaligned) mount must point: pure geometry.
+
+Both sides use it: the world with the mount's true errors, the controller with its own
+estimate of them (none, or a commissioning fit). Frame: x east, y north, z up.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
+
+__all__ = ["mounting_rotation", "mount_targets", "incidence_cosine"]
+
+
+def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_azimuth: float) -> np.ndarray:
+    """Rotation taking world vectors into a misaligned mounting's nominal frame (3x3).
+
+    The true axis is the nominal one (at `axis_azimuth`) turned about the vertical by
+    `axis_azimuth_error` (clockwise from above) and tilted about the horizontal cross-axis
+    direction by `axis_tilt_error` (its far end up), all in degrees. For a heliostat the same
+    two angles describe the pedestal's tilt, as in the pedestal terms of heliostat pointing
+    models (Stone 1986, SAND85-8015).
+    """
+    turn = np.radians(axis_azimuth_error)
+    tilt = np.radians(axis_tilt_error)
+    b = np.radians(axis_azimuth)
+    # about z (clockwise from above, as azimuth grows)
+    rz = np.array([[np.cos(turn), -np.sin(turn), 0.0], [np.sin(turn), np.cos(turn), 0.0], [0.0, 0.0, 1.0]])
+    across = np.array([np.cos(b), -np.sin(b), 0.0])  # horizontal, perpendicular to the nominal axis
+    k = np.array([[0, -across[2], across[1]], [across[2], 0, -across[0]], [-across[1], across[0], 0]])
+    rt = np.eye(3) + np.sin(tilt) * k + (1 - np.cos(tilt)) * (k @ k)  # Rodrigues: tilt about `across`
+    return (rt @ rz).T  # world -> mounting
+
+
+def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,
+                 night: bool = False) -> np.ndarray:
+    """Target angles of a collector on a mount turned by `rotation` (`mounting_rotation`), degrees.
+
+    Returns shape (N, 1) for single-axis collectors (trough convention) and (N, 2) for a
+    heliostat (normal azimuth and elevation). NaN while the sun is down, unless `night`:
+    then the geometry is followed below the horizon too (to pre-position before sunrise).
+    """
+    alt = np.asarray(altitude, float)
+    s = sun_vector(alt, np.asarray(azimuth, float))
+    rot = np.eye(3) if rotation is None else rotation
+    if collector.kind == "heliostat":
+        normals = heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim) @ rot.T
+        az, el = normal_angles(normals)
+        out = np.stack([az, el], axis=-1)
+    else:
+        sun = across_angle(s @ rot.T, collector.axis)
+        if collector.kind == "fresnel":
+            sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
+        out = sun[:, None]
+    if not night:
+        out[alt < 0] = np.nan
+    return out
+
+
+def incidence_cosine(altitude, azimuth, collector: Collector) -> np.ndarray:
+    """Cosine of the sun's incidence on a perfectly tracking aperture.
+
+    For a single-axis collector it is the part of the sun vector across the axis; a
+    heliostat's is the cosine of half the angle between sun and aim point. Zero at night.
+    """
+    alt = np.asarray(altitude, float)
+    s = sun_vector(alt, np.asarray(azimuth, float))
+    if collector.kind == "heliostat":
+        r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
+        cos = np.sqrt(np.clip((1.0 + s @ r) / 2.0, 0.0, 1.0))
+    else:
+        b = np.radians(collector.axis)
+        along = s[:, 0] * np.sin(b) + s[:, 1] * np.cos(b)
+        cos = np.sqrt(np.clip(1.0 - along**2, 0.0, 1.0))
+    return np.where(alt > 0, cos, 0.0)
