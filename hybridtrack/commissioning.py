@@ -1,10 +1,17 @@
-"""Commissioning an open-loop tracker: one clear day tracked on the sun sensor, then a mount fit.
+"""A controller that has been running before the run begins: commissioning and warm calibration.
 
-What a field does at start-up: a day of closed-loop tracking on the sensor gives the sun's angle
-in encoder coordinates through the day, and a least-squares fit of the mount's errors
-(`hybridtrack.control.mountfit`) corrects the computed targets from then on. The day is a
-synthetic clear day at the same site, the day before the run starts, in the same world (the
-same mount, clock and sensor errors).
+Every real field commissions its open-loop trackers once, and a hybrid controller that has run
+for a while carries its calibration into the next day. Both come from the same place here: a
+synthetic clear day at the same site in the same world (the same mount, clock and sensor
+errors), run through the same controller:
+
+* `commission`: the clear day at commissioning (`Imperfections.commissioned_days_ago` before the
+  run, when the clock was set) tracked on the sensor whenever it reads valid, with the same online
+  mount estimator the hybrid runs (`hybridtrack.control.mountfit`); the mount it ends the day
+  with is frozen for the run (``astronomical-commissioned``).
+* `warm_memory`: the clear day before the run, run with the calibrating strategy itself; its mount fit and offsets
+  at the end of the day are where the run starts (``hybrid``, ``hybrid-always``,
+  ``hybrid-oracle``), so no policy is judged on a first morning it would never see in the field.
 """
 
 from __future__ import annotations
@@ -15,14 +22,28 @@ import pandas as pd
 
 from .collectors import Collector
 from .control import MountEstimate
-from .control.mountfit import fit_mount
-from .world import installed_site
+from .control.mountfit import parameter_names
 
-__all__ = ["commission"]
+__all__ = ["commission", "warm_memory", "clear_day"]
+
+
+def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy: str, days_before: float,
+              classifier=None):
+    """The run of `strategy` over a clear day at `site`, `days_before` local days before `start`,
+    with the controller's clock as it was then."""
+    from .simulation import simulate
+    from .sky import synthetic
+
+    day = (start.tz_convert(site.tz) - pd.Timedelta(days=days_before)).date()
+    frame = synthetic(site, day, weather="sunny", seed=config.seed)
+    age = max(config.imperfections.commissioned_days_ago - days_before, 0.0)
+    setup = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy),
+                                imperfections=dataclasses.replace(config.imperfections, commissioned_days_ago=age))
+    return simulate(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
 
 
 def commission(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> MountEstimate:
-    """The mount fitted from a clear day of sensor tracking before `start`.
+    """The mount fitted online over a clear day of sensor tracking at commissioning, then frozen.
 
     Parameters
     ----------
@@ -31,18 +52,14 @@ def commission(site, collector: Collector, config, start: pd.Timestamp, *, class
     config : SimulationConfig
         The run's config: its world and controller are the ones commissioned.
     start : pandas.Timestamp
-        The run's first step; commissioning takes the local day before.
+        The run's first step.
     classifier : FuzzyWeatherClassifier, optional
     """
-    from .simulation import simulate
-    from .sky import synthetic
+    days = max(config.imperfections.commissioned_days_ago, 1.0)
+    run = clear_day(site, collector, config, start, "hybrid-always", days, classifier)
+    return MountEstimate.from_parameters(parameter_names(collector), run.memory["theta"])
 
-    day = (start.tz_convert(site.tz) - pd.Timedelta(days=1)).date()
-    frame = synthetic(site, day, weather="sunny", seed=config.seed)
-    tracking = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy="sensor"))
-    run = simulate(frame, site, collector=collector, config=tracking, classifier=classifier)
-    columns = ["sensor_sun"] if collector.single_axis else ["sensor_sun_azimuth", "sensor_sun"]
-    clock = run.log.index + pd.Timedelta(seconds=config.imperfections.clock_error)
-    mount, _ = fit_mount(clock, run.log[columns].to_numpy(float), installed_site(site, config.imperfections),
-                         collector, config.controller)
-    return mount
+
+def warm_memory(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> dict:
+    """What the run's own strategy carries out of the clear day before (`Controller.memory`)."""
+    return clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier).memory

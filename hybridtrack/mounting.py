@@ -13,24 +13,29 @@ from .collectors import Collector, across_angle, heliostat_normal, normal_angles
 __all__ = ["mounting_rotation", "mount_targets", "incidence_cosine"]
 
 
-def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_azimuth: float) -> np.ndarray:
+def _about(direction: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues' rotation by `angle` radians about the unit vector `direction`."""
+    x, y, z = direction
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+
+
+def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_azimuth: float,
+                      axis_roll_error: float = 0.0) -> np.ndarray:
     """Rotation taking world vectors into a misaligned mounting's nominal frame (3x3).
 
     The true axis is the nominal one (at `axis_azimuth`) turned about the vertical by
-    `axis_azimuth_error` (clockwise from above) and tilted about the horizontal cross-axis
-    direction by `axis_tilt_error` (its far end up), all in degrees. For a heliostat the same
-    two angles describe the pedestal's tilt, as in the pedestal terms of heliostat pointing
-    models (Stone 1986, SAND85-8015).
+    `axis_azimuth_error` (clockwise from above), tilted about the horizontal cross-axis
+    direction by `axis_tilt_error` (its far end up) and rolled about its own nominal direction
+    by `axis_roll_error`, all in degrees. For a single-axis collector a roll is the same as an
+    encoder offset; for a heliostat's pedestal the tilt and roll are its two tilt components,
+    and the turn is the same as an azimuth encoder offset (Stone 1986).
     """
-    turn = np.radians(axis_azimuth_error)
-    tilt = np.radians(axis_tilt_error)
     b = np.radians(axis_azimuth)
-    # about z (clockwise from above, as azimuth grows)
-    rz = np.array([[np.cos(turn), -np.sin(turn), 0.0], [np.sin(turn), np.cos(turn), 0.0], [0.0, 0.0, 1.0]])
-    across = np.array([np.cos(b), -np.sin(b), 0.0])  # horizontal, perpendicular to the nominal axis
-    k = np.array([[0, -across[2], across[1]], [across[2], 0, -across[0]], [-across[1], across[0], 0]])
-    rt = np.eye(3) + np.sin(tilt) * k + (1 - np.cos(tilt)) * (k @ k)  # Rodrigues: tilt about `across`
-    return (rt @ rz).T  # world -> mounting
+    turn = _about(np.array([0.0, 0.0, 1.0]), np.radians(axis_azimuth_error))
+    tilt = _about(np.array([np.cos(b), -np.sin(b), 0.0]), np.radians(axis_tilt_error))
+    roll = _about(np.array([np.sin(b), np.cos(b), 0.0]), np.radians(axis_roll_error))
+    return (roll @ tilt @ turn).T  # world -> mounting
 
 
 def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,

@@ -79,8 +79,8 @@ class SensorModel:
     field_of_view : float
         Half-angle of the fine (pointing) cells' view, degrees.
     coarse_field_of_view : float
-        Half-angle of the wide-angle acquisition cells, degrees (digital sun sensors' coarse
-        stages see about ±60°).
+        Half-angle of the wide-angle acquisition cells, degrees: commercial trackers' coarse
+        cells look east and west down to the horizon, so the sun is found from any angle.
     noise : float
         Standard deviation of the measured pointing offset at 1000 W/m² in view, degrees;
         it grows as 1000 W/m² over the light in view.
@@ -103,7 +103,7 @@ class SensorModel:
     current_noise: float = 0.5
     direct_threshold: float = 120.0
     field_of_view: float = 10.0
-    coarse_field_of_view: float = 60.0
+    coarse_field_of_view: float = 90.0
     noise: float = 0.03
     bias: float = 0.0
     patch_distance: tuple[float, float] = (2.0, 6.0)
@@ -224,23 +224,23 @@ def _circumsolar(frame: pd.DataFrame, position: pd.DataFrame) -> np.ndarray:
 
 
 def _patch_side(index: pd.DatetimeIndex, clearness: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Which side of the sun the bright edge is on, -1 to 1, continuous in time.
+    """Which side of the sun the bright cloud light is on, -1 to 1, continuous in time.
 
-    A cloud arriving at the sun (direct light falling) shows its sunlit edge on the side it comes
-    from; one leaving (light rising), on the side it goes to. The side follows the sign of the
-    change in the beam's clearness (DNI over clear-sky DNI), remembered with a 10-minute time
-    constant, so it is continuous in time and moves with the frame's own cloud passages.
+    The side flips at every cloud passage's edge, where the beam's clearness (DNI over clear-sky
+    DNI) crosses one half: the nearest sunlit edge moves from one side of the sun to the other
+    as the cloud crosses it. The flip is smoothed with a 2-minute time constant so the patch
+    moves through the sun rather than jumping.
     """
     from scipy.signal import lfilter
 
     minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
-    if len(minutes) < 3:
+    if len(minutes) < 2:
         return np.zeros(len(minutes))
-    change = np.gradient(clearness, minutes)
-    push = -np.clip(change / 0.05, -1.0, 1.0)  # a fall of 5 % of the clear beam a minute: fully on one side
-    step = float(np.median(np.diff(minutes)))
-    keep = np.exp(-step / 10.0)
-    return lfilter([1.0 - keep], [1.0, -keep], push)
+    clear = clearness >= 0.5
+    crossings = np.concatenate([[0], np.cumsum(clear[1:] != clear[:-1])])
+    sign = rng.choice([-1.0, 1.0]) * np.where(crossings % 2 == 0, 1.0, -1.0)
+    keep = np.exp(-float(np.median(np.diff(minutes))) / 2.0)
+    return lfilter([1.0 - keep], [1.0, -keep], sign, zi=[keep * sign[0]])[0]
 
 
 def _smooth(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float) -> np.ndarray:
@@ -273,7 +273,7 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     its circumsolar share (Perez et al. 1990) is the patch, off the sun. The rest of the
     circumsolar light is the aureole, centred on the sun. The patch sits `patch_distance` from
     the sun (a seeded AR(1) between the bounds, time constant 30 min) in a direction that turns
-    slowly (AR(1), 2 h), on the side `_patch_side` says.
+    as the clouds move (AR(1), 20 min), on the side `_patch_side` says.
     """
     dni = np.clip(np.nan_to_num(frame["dni"].to_numpy(float)), 0.0, None)
     dhi = np.clip(np.nan_to_num(frame["dhi"].to_numpy(float)), 0.0, None)
@@ -285,7 +285,7 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     side = _patch_side(frame.index, clearness, rng)
     low, high = model.patch_distance
     distance = low + (high - low) * 0.5 * (1.0 + np.tanh(_smooth(frame.index, rng, 30.0)))
-    direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * _smooth(frame.index, rng, 120.0)
+    direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * _smooth(frame.index, rng, 20.0)
     offset = (side * distance)[:, None] * np.stack([np.cos(direction), np.sin(direction)], axis=1)
     return SensorScene(beam=dni, aureole=circumsolar * (1.0 - cloud_share), patch=circumsolar * cloud_share,
                        patch_offset=offset, diffuse=dhi)
@@ -312,11 +312,11 @@ def read_pointing(offsets, beam: float, aureole: float, patch: float, patch_offs
         The reported offsets (NaN when nothing is in view) and the "sun present" output.
     """
     fov = model.field_of_view
-    sun_in = max(abs(o) for o in offsets) <= fov
+    worst = abs(offsets[0]) if len(offsets) == 1 else max(abs(offsets[0]), abs(offsets[1]))
     spot = [o + p for o, p in zip(offsets, patch_offset)]
-    patch_in = max(abs(s) for s in spot) <= fov
-    sun_light = (beam * math.cos(math.radians(max(abs(o) for o in offsets))) + aureole) if sun_in else 0.0
-    patch_light = patch if patch_in else 0.0
+    spread = abs(spot[0]) if len(spot) == 1 else max(abs(spot[0]), abs(spot[1]))
+    sun_light = beam * math.cos(math.radians(worst)) + aureole if worst <= fov else 0.0
+    patch_light = patch if spread <= fov else 0.0
     light = sun_light + patch_light
     if not light >= model.direct_threshold:
         return [math.nan] * len(offsets), False

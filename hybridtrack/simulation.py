@@ -21,6 +21,8 @@ from . import sites
 from .collectors import Collector
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
+from .control.mountfit import parameter_names
+from .control.plan import east_park
 from .drive import Drive
 from .errors import HybridtrackError
 from .fuzzy import FuzzyConfig, FuzzyWeatherClassifier
@@ -147,6 +149,8 @@ class Result:
         The metrics written to ``summary.json`` (`hybridtrack.metrics`).
     events : pandas.DataFrame
         Every mode change: ``time``, ``from``, ``to``, ``reason``.
+    memory : dict
+        What the controller would carry into a next run (its mount fit and offsets).
     """
 
     log: pd.DataFrame
@@ -155,6 +159,7 @@ class Result:
     site: sites.Site
     collector: Collector
     config: SimulationConfig
+    memory: dict | None = None
 
     def save(self, folder, *, plot: bool = True, log_format: str = "auto") -> dict[str, Path]:
         """Write ``log.parquet`` (or ``log.csv``), ``events.csv``, ``summary.json`` and ``report.png``."""
@@ -211,7 +216,7 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
              config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
-             faults: dict | None = None, progress=None, bulk_nights: bool = True) -> Result:
+             faults: dict | None = None, progress=None, bulk_nights: bool = True, warm_start: bool = True) -> Result:
     """Run a tracking controller over a weather frame.
 
     Parameters
@@ -234,6 +239,10 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         Called with the number of steps done since its last call (e.g. a tqdm bar's update).
     bulk_nights : bool
         Record a night asleep at stow in one go (the same result, faster; a test keeps it so).
+    warm_start : bool
+        Start as a controller that has been running: ``astronomical-commissioned`` is
+        commissioned, and the calibrating strategies carry their calibration, from a clear day
+        before the run (`hybridtrack.commissioning`). ``False`` starts from nothing.
 
     Returns
     -------
@@ -251,37 +260,51 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     if config.controller.strategy == "hybrid-oracle" and not world.has_true_sky:
         raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
                                "have one)")
-    mount = None
-    if config.controller.strategy == "astronomical-commissioned":
-        from .commissioning import commission
-
-        mount = commission(site, collector, config, frame.index[0], classifier=classifier)
+    mount, memory = _history(site, collector, config, frame.index[0], classifier, warm_start)
     plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
                      config.controller, mount)
     clf = classifier or FuzzyWeatherClassifier(FuzzyConfig.default())
     window = pd.Timedelta(config.sensor.window) / pd.Timedelta(minutes=1)
-    controller = Controller(config.controller, drives, plan, clf, window)
+    controller = Controller(config.controller, drives, plan, clf, window, east_park(collector), memory)
     _run(world, controller, config.controller.wind_stow, progress, bulk_nights and not faults)
     out = controller.outputs()
     index = frame.index
-    log = _log(index, collector, world, out, clf)
+    log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config.sensor))
     events = pd.DataFrame([(index[i], a, b, why) for i, a, b, why in out.events],
                           columns=["time", "from", "to", "reason"])
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                         moves=int(out.moves.sum()), travel=float(out.travel.sum()), events=events,
                         sun_up=world.altitude > 0,
                         incidence=incidence_cosine(world.altitude, world.azimuth, collector))
-    if mount is not None:
-        summary["calibration"] = _mount_summary(mount, collector)
-    return Result(log, summary, events, site, collector, config)
+    summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
+    return Result(log, summary, events, site, collector, config, controller.memory())
 
 
-def _mount_summary(mount: MountEstimate, collector: Collector) -> dict:
-    """A fitted mount in degrees, named as the world's `Imperfections` fields it estimates."""
-    out = {"axis_azimuth_error": round(mount.axis_azimuth_error, 5), "axis_tilt_error": round(mount.axis_tilt_error, 5)}
-    names = ["encoder_offset"] if collector.single_axis else ["encoder_offset_azimuth", "encoder_offset"]
-    out.update({name: round(float(v), 5) for name, v in zip(names, mount.encoder_offset)})
-    return out
+def _history(site, collector, config, start, classifier, warm_start):
+    """What the controller brings from before the run: a commissioned mount, a warm calibration."""
+    from .commissioning import commission, warm_memory
+
+    if config.controller.strategy == "astronomical-commissioned":  # an open loop is always commissioned
+        return commission(site, collector, config, start, classifier=classifier), None
+    if warm_start and config.controller.calibrates:
+        return None, warm_memory(site, collector, config, start, classifier=classifier)
+    return None, None
+
+
+def _calibration_summary(mount: MountEstimate | None, fitted: dict | None, out, collector: Collector) -> dict | None:
+    """The mount the controller ends with, in degrees, named as the world's `Imperfections` fields
+    it estimates, with each one's 1σ (a fit) and the residual offset on top; None without one."""
+    names = parameter_names(collector)
+    if fitted is not None:
+        summary = {name: round(float(v), 5) for name, v in zip(names, fitted["theta"])}
+        summary["std"] = {name: round(float(v), 5) for name, v in zip(names, fitted["std"])}
+        summary["pedestal_frozen"] = bool(fitted["frozen"])
+        return summary
+    if mount is None:
+        return None
+    values = [mount.axis_azimuth_error, mount.axis_tilt_error] if collector.single_axis \
+        else [mount.axis_tilt_error, mount.axis_roll_error]
+    return {name: round(float(v), 5) for name, v in zip(names, [*values, *mount.encoder_offset])}
 
 
 def _run(world: World, controller: Controller, wind_stow: float, progress, bulk_nights: bool) -> None:
@@ -352,7 +375,18 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
     return np.where(np.isnan(values), default, values) if not np.isnan(default) else values
 
 
-def _log(index, collector: Collector, world: World, out, classifier) -> pd.DataFrame:
+def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, sensor: SensorModel) -> pd.DataFrame:
+    """The sky as the exact classifier calls the controller's own readings (the log's ``sky``):
+    the photocurrent read (NaN while asleep), its variation over the sensor's window, the score."""
+    reading = pd.Series(intensity, index=index, name="intensity_ma")
+    variation = sensor.variation(reading).to_numpy(copy=True)
+    variation[np.isnan(intensity)] = np.nan
+    score = np.asarray(classifier.score(intensity, variation), float)
+    return pd.DataFrame({"intensity_ma": intensity, "variation_ma": variation, "sky_score": score,
+                         "sky": classifier.label(score)}, index=index)
+
+
+def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> pd.DataFrame:
     from .collectors import sun_vector
 
     truth = world.truth
@@ -364,14 +398,13 @@ def _log(index, collector: Collector, world: World, out, classifier) -> pd.DataF
         actual = sun_vector(angle[:, 1], angle[:, 0])
         wanted = sun_vector(truth[:, 1], truth[:, 0])
         error = np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
-    sky = np.asarray(SKY_CODES, dtype=object)[out.sky]
     log = pd.DataFrame({
         "target_true": truth[:, main], "target": out.target[:, main], "angle": angle[:, main], "error": error,
         "mode": pd.Categorical(np.asarray(MODES)[out.mode], categories=list(MODES)),
-        "sky": pd.Categorical(sky, categories=list(SKY_CODES)),
-        "sky_score": out.sky_score, "sensor_valid": out.sensor_status == 0,
+        "sky": pd.Categorical(sky["sky"].to_numpy(object), categories=list(SKY_CODES)),
+        "sky_score": sky["sky_score"].to_numpy(), "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical(np.asarray(SENSOR_STATUS)[out.sensor_status], categories=list(SENSOR_STATUS)),
-        "intensity_ma": out.intensity, "variation_ma": out.variation, "wind_speed": world.wind,
+        "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(), "wind_speed": world.wind,
         "dni": world.frame_dni, "calibration": out.calibration[:, main], "sensor_sun": out.sun[:, main],
     }, index=index)
     if not collector.single_axis:

@@ -57,7 +57,14 @@ class Imperfections:
     encoder_offset : float
         Degrees the encoder's zero is off; the reading is the true angle plus this.
     clock_error : float
-        Seconds the controller's clock runs ahead of true time.
+        Seconds the controller's clock ran ahead of true time when it was set, at commissioning.
+    clock_drift : float
+        Seconds a day the controller's clock gains (negative: loses). A PLC's real-time clock runs
+        on an uncompensated watch crystal; Siemens gives ±60 s a month at 25 °C for the S7-1200
+        (±2 s a day). The default is half that bound.
+    commissioned_days_ago : float
+        Days between commissioning (when the clock was set and an open loop's mount was fitted)
+        and the start of the run: the clock has drifted for that long.
     latitude_error, longitude_error : float
         Degrees the controller's site coordinates are off.
     sensor_bias : float
@@ -70,6 +77,8 @@ class Imperfections:
     axis_tilt_error: float = 0.2
     encoder_offset: float = 0.26
     clock_error: float = -45.0
+    clock_drift: float = 1.0
+    commissioned_days_ago: float = 30.0
     latitude_error: float = 0.008
     longitude_error: float = 0.01
     sensor_bias: float = 0.06
@@ -77,15 +86,16 @@ class Imperfections:
 
     def __post_init__(self) -> None:
         limits = {"axis_azimuth_error": 10.0, "axis_tilt_error": 10.0, "encoder_offset": 10.0, "clock_error": 3600.0,
-                  "latitude_error": 1.0, "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0}
+                  "clock_drift": 100.0, "commissioned_days_ago": 3660.0, "latitude_error": 1.0,
+                  "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0}
         for f in fields(self):
             value = getattr(self, f.name)
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
                 raise HybridtrackError(f"imperfections: {f.name} must be a number, got {value!r}")
             if abs(value) > limits[f.name]:
                 raise HybridtrackError(f"imperfections: {f.name} = {value} is beyond ±{limits[f.name]:g}")
-        if self.sensor_noise < 0:
-            raise HybridtrackError("imperfections: sensor_noise must not be negative")
+        if self.sensor_noise < 0 or self.commissioned_days_ago < 0:
+            raise HybridtrackError("imperfections: sensor_noise and commissioned_days_ago must not be negative")
 
     @classmethod
     def none(cls) -> Imperfections:
@@ -192,8 +202,11 @@ class World:
         return self._sky is not None
 
     def controller_clock(self) -> pd.DatetimeIndex:
-        """What the controller's clock shows at each scan: true time plus its error and any clock fault."""
-        seconds = np.full(self.n, self.imperfections.clock_error)
+        """What the controller's clock shows at each scan: true time plus its error, its drift since
+        it was set, and any clock fault."""
+        imp = self.imperfections
+        age = imp.commissioned_days_ago + np.asarray((self.index - self.index[0]) / pd.Timedelta(days=1), float)
+        seconds = imp.clock_error + imp.clock_drift * age
         if "clock" in self.faults:
             seconds = seconds + np.nan_to_num(np.asarray(self.faults["clock"], float))
         return self.index + pd.to_timedelta(seconds, unit="s")

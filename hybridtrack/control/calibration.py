@@ -24,6 +24,11 @@ class Calibrator:
         self.tau = tau_minutes
         self.max_rate = max_rate
 
+    def carry(self, offset: float) -> None:
+        """Start from an offset learned earlier, past the running-mean phase."""
+        self.offset = float(offset)
+        self.learned = self.tau
+
     def learn(self, dt: float, residual: float, model_step: float, bound: float) -> None:
         """Move toward `residual` (filtered sun less the model), unless the target turns fast."""
         if not abs(model_step) <= self.max_rate * dt or math.isnan(residual):

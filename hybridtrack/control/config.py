@@ -66,6 +66,10 @@ class ControllerConfig:
     coast : str
         Sensor-only strategy: how long to keep moving at the filtered rate through a gap in
         the sensor's signal before holding still.
+    dusk_current : float
+        mA: the sensor-only tracker sleeps once its photocurrent has stayed below this for
+        30 minutes, and wakes when it rises above it (5 mA over the 30 mA dark current, about
+        20 W/m² of light: civil twilight).
     lead : bool
         Aim half a deadband ahead of the sun, in its direction of motion. ``False`` is the
         published field practice (aim at the sun).
@@ -96,6 +100,7 @@ class ControllerConfig:
     encoder_confirm: int = 3
     search_speed: float = 30.0
     coast: str = "10min"
+    dusk_current: float = 35.0
     lead: bool = True
     sensor_noise: float = 0.05
     kalman: str = "fast"
@@ -117,7 +122,7 @@ class ControllerConfig:
             except ValueError:
                 raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive duration") from None
         for name in ("wind_stow", "wind_release", "min_altitude", "process_noise", "gate", "calibration_max_rate",
-                     "sensor_plausibility", "search_speed", "sensor_noise"):
+                     "sensor_plausibility", "search_speed", "sensor_noise", "dusk_current"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise HybridtrackError(f"controller: {name} must be a finite number, got {value!r}")

@@ -19,6 +19,7 @@ from ..drive import Drive
 from .calibration import Calibrator
 from .config import ControllerConfig
 from .encoder import EncoderMonitor
+from .mountfit import MountEstimator
 from .modes import (ASTRONOMICAL, FAULT, FAULTY, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR, SENSOR_STATUS,
                     SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
@@ -31,13 +32,22 @@ __all__ = ["Controller", "ControllerOutputs"]
 
 log = logging.getLogger("hybridtrack.control")
 
+#: Minutes of darkness after which the sensor-only tracker sleeps.
+DUSK_MINUTES = 30.0
+#: Minutes between the readings the mount fit takes: readings a minute apart are correlated
+#: through the filter and the sun has hardly moved, so more would add time, not information.
+FIT_EVERY = 5.0
+#: The policies that decide on the fuzzy classifier's sky.
+CLASSIFYING = ("hybrid", "hybrid-nocal")
+
 
 @dataclass
 class ControllerOutputs:
     """Per scan: mode, sensor status, sky class and score, the photocurrent read and its variation
-    (NaN while asleep), and per axis the target, the encoder reading used, the calibration offset
-    and the filtered sun angle where a reading was taken; moves and travel per axis; events as
-    (scan, from mode, to mode, reason)."""
+    (NaN while asleep), and per axis the target, the encoder reading used, the calibration (the
+    correction made to the computed target) and the filtered sun angle where a reading was
+    taken; per mount parameter its fitted value and 1σ (N, parameters; empty without a fit);
+    moves and travel per axis; events as (scan, from mode, to mode, reason)."""
 
     mode: np.ndarray
     sensor_status: np.ndarray
@@ -49,6 +59,8 @@ class ControllerOutputs:
     reading: np.ndarray
     calibration: np.ndarray
     sun: np.ndarray
+    fit: np.ndarray
+    fit_std: np.ndarray
     moves: np.ndarray
     travel: np.ndarray
     events: list
@@ -67,10 +79,16 @@ class Controller:
         The sky classifier, run as a table (`skywatch.ClassifierTable`).
     window_minutes : float
         The trailing window of the photocurrent's variation.
+    park : list of float
+        Where the sensor-only tracker waits before its first morning (toward the eastern
+        horizon, as installers set such trackers); after that, where it first found the sun.
+    memory : dict, optional
+        What a controller that has been running carries over (`Controller.memory`): its mount
+        fit and calibration offsets.
     """
 
     def __init__(self, config: ControllerConfig, drives: list[Drive], plan: ControllerPlan, classifier,
-                 window_minutes: float):
+                 window_minutes: float, park: list[float], memory: dict | None = None):
         self.config = config
         self.drives = drives
         self.axes = len(drives)
@@ -88,18 +106,34 @@ class Controller:
                                  config.reacquire) for v in variance]
         self.calibrators = [Calibrator(config.minutes("calibration_tau"), config.calibration_max_rate)
                             for _ in drives]
+        self.jacobian, self.weight = plan.jacobian, plan.weight
+        self.fit = MountEstimator(self.axes, config.sensor_noise) if plan.jacobian is not None else None
+        self.theta = np.zeros(2 + self.axes)
+        self.fit_since = 0.0
+        self.fitted_at = [-math.inf] * self.axes
+        self.recorded_updates = -1
+        self.mount_at: tuple = (-1, -1)
+        self.mount: list = []
+        self.fit_row = ([], [])
+        if memory:
+            self._recall(memory)
         self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
         self.coast_for = config.minutes("coast")
         self.mode, self.mode_since = STOW_NIGHT, -math.inf
         self.invalid_since = math.nan
         self.previous_t = math.nan
         self.resting = False
-        self.park = [d.stow for d in drives]  # the sensor-only tracker parks where it found the sun
+        self.park = list(park)
+        self.dark_since = math.nan
+        self.was_awake = False
+        self.was_awake = False
         self.found_today = False
         self.events: list = []
         self.out = {name: [0] * n for name in ("mode", "status", "sky")}
         self.out.update({name: [math.nan] * n for name in ("score", "variation", "intensity")})
         self.out_axes = {name: [[math.nan] * n for _ in drives] for name in ("target", "reading", "calibration", "sun")}
+        fitted = len(self.theta) if self.fit is not None else 0
+        self.out_fit = {name: [[math.nan] * n for _ in range(fitted)] for name in ("value", "std")}
         self.moves = [0] * self.axes
         self.travel = [0.0] * self.axes
 
@@ -125,7 +159,14 @@ class Controller:
         for a in range(self.axes):
             per_axis["target"][a][i] = targets[a]
             per_axis["reading"][a][i] = reading[a]
-            per_axis["calibration"][a][i] = self.calibrators[a].offset
+            per_axis["calibration"][a][i] = self._correction(i, a)
+        if self.fit is not None:
+            if self.fit.updates != self.recorded_updates:
+                self.recorded_updates = self.fit.updates
+                self.fit_row = (self.fit.theta.tolist(), self.fit.std())
+            for k in range(len(self.theta)):
+                self.out_fit["value"][k][i] = self.fit_row[0][k]
+                self.out_fit["std"][k][i] = self.fit_row[1][k]
 
     def sleeps_until(self, i: int) -> int:
         """The first scan from `i` at which the controller wakes (len of the plan if never)."""
@@ -148,8 +189,12 @@ class Controller:
         for a in range(self.axes):
             per_axis["target"][a][i:j] = [self._night_target(a)] * count
             per_axis["reading"][a][i:j] = [reading[a]] * count
-            per_axis["calibration"][a][i:j] = [self.calibrators[a].offset] * count
+            per_axis["calibration"][a][i:j] = [self._correction(i, a)] * count
             per_axis["sun"][a][i:j] = [math.nan] * count
+        if self.fit is not None:
+            for k, (value, std) in enumerate(zip(self.fit.theta, self.fit.std())):
+                self.out_fit["value"][k][i:j] = [value] * count
+                self.out_fit["std"][k][i:j] = [std] * count
 
     # -- one scan --------------------------------------------------------------------------------
 
@@ -158,17 +203,19 @@ class Controller:
         i, t = obs.i, obs.t
         dt = t - self.previous_t if not math.isnan(self.previous_t) else 1.0
         self.previous_t = t
-        awake = self.awake[i]
+        awake = self.awake[i] and (not self.config.sensor_only or self._daylight(t, obs.intensity))
         if self.clock_steps[i]:
             self._alarm(i, f"controller clock stepped by {self.clock_steps[i]:+.0f} s against the scan timer; "
                            "clock re-based")
         reading = self._read_encoders(i, t, obs)
         gusty = self.wind.update(t, obs.wind)
         if self.resting and not awake and not gusty:
+            self.was_awake = False
             self.out["sky"][i] = UNKNOWN
             self._record(i, NOT_READ, [self._night_target(a) for a in range(self.axes)], reading)
             return [0.0] * self.axes
         self._day_and_wind(i, t, awake, gusty, obs.wind)
+        self.was_awake = awake
         sky = self._watch_sky(i, t, obs)
         status, valid = self._sense(i, t, dt, obs, reading, awake, sky)
         self._choose_mode(i, t, status, valid, sky, obs)
@@ -178,6 +225,15 @@ class Controller:
             for gate in self.gates:
                 gate.forget()
         return moves
+
+    def _daylight(self, t: float, intensity: float) -> bool:
+        """The sensor-only tracker's day: light above dusk, or dark for less than 30 minutes."""
+        if intensity >= self.config.dusk_current:
+            self.dark_since = math.nan
+            return True
+        if math.isnan(self.dark_since):
+            self.dark_since = t
+        return t - self.dark_since < DUSK_MINUTES
 
     def _read_encoders(self, i: int, t: float, obs: Observation) -> list[float]:
         reading = []
@@ -200,18 +256,22 @@ class Controller:
             self._switch(i, resume, f"wind at or below {config.wind_release} m/s for {config.wind_hold}", t)
         mode = self.mode
         if mode == FAULT:
-            if awake and i and not self.awake[i - 1]:
+            if awake and not self.was_awake:
                 self._switch(i, resume, "a new day: probing the encoder again", t)
         elif mode != STOW_WIND:
             if not awake and mode != STOW_NIGHT:
-                self._switch(i, STOW_NIGHT, "outside working hours or sun down", t)
+                self._switch(i, STOW_NIGHT, "dark for 30 minutes" if config.sensor_only
+                             else "outside working hours or sun down", t)
                 self.found_today = False
             elif awake and mode == STOW_NIGHT:
-                self._switch(i, resume, "awake and sun up" if config.uses_model else "awake (working hours)", t)
+                self._switch(i, resume, "awake and sun up" if config.uses_model else "daylight", t)
 
     def _watch_sky(self, i: int, t: float, obs: Observation) -> int:
-        code, score, variation = self.sky.update(t, obs.intensity)
+        """Read the photocurrent; the policies that use the classifier also classify the sky."""
         self.out["intensity"][i] = obs.intensity
+        if self.config.strategy not in CLASSIFYING:
+            return UNKNOWN
+        code, score, variation = self.sky.update(t, obs.intensity)
         self.out["sky"][i] = code
         self.out["score"][i] = score
         self.out["variation"][i] = variation
@@ -261,19 +321,67 @@ class Controller:
             return limit / max(math.cos(math.radians(self.model[1][i])), 0.05)
         return limit
 
+    def _correction(self, i: int, a: int) -> float:
+        """What calibration adds to the computed target of axis `a`: the fitted mount, then the offset."""
+        offset = self.calibrators[a].offset
+        if self.fit is None:
+            return offset
+        if self.mount_at != (i, self.fit.updates):
+            self.mount_at = (i, self.fit.updates)
+            self.mount = (self.jacobian[i] @ self.theta).tolist()
+        return self.mount[a] + offset
+
     def _offer(self, i: int, a: int, dt: float, z: float, trusted: bool) -> int:
         """Offer the sensor's sun angle on axis `a` to the gate, and let a trusted one calibrate."""
-        config, gate, calibrator = self.config, self.gates[a], self.calibrators[a]
+        config, gate = self.config, self.gates[a]
         m0 = self.model[a][i]
         m1 = self.model[a][i - 1] if i else math.nan
         bound = self._plausibility_bound(i, a)
         has_model = config.uses_model and not math.isnan(m0)
-        miss = self._turn(a, z - m0 - calibrator.offset) if has_model else math.nan
+        miss = self._turn(a, z - m0 - self._correction(i, a)) if has_model else math.nan
         rate = self._turn(a, m0 - m1) / dt if has_model and dt > 0 and not math.isnan(m1) else 0.0
         verdict = gate.take(z, dt, miss, bound, rate)
         if verdict == OK and trusted and has_model:
-            calibrator.learn(dt, self._turn(a, gate.filter.angle - m0), self._turn(a, m0 - m1), bound)
+            self._learn(i, a, dt, z, m0, m1, bound)
         return verdict
+
+    def _learn(self, i: int, a: int, dt: float, z: float, m0: float, m1: float, bound: float) -> None:
+        """A trusted reading: the mount fit learns from it, then the residual offset on top."""
+        t = self.previous_t
+        if self.fit is not None and t - self.fitted_at[a] >= FIT_EVERY:
+            self.fitted_at[a] = t
+            self.fit.forget(t - self.fit_since)
+            self.fit_since = t
+            w = self.weight[i, a]
+            self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w)
+            self.theta = self.fit.theta
+        mount = self._correction(i, a) - self.calibrators[a].offset
+        residual = self._turn(a, self.gates[a].filter.angle - m0 - mount)
+        self.calibrators[a].learn(dt, residual, self._turn(a, m0 - m1), bound)
+
+    def memory(self) -> dict:
+        """What this controller would carry into a next run: its mount fit and offsets."""
+        fit = self.fit
+        state = {"offsets": [c.offset for c in self.calibrators]}
+        if fit is not None:
+            state.update(theta=fit.theta.tolist(), p=fit.p.copy(), information=fit.information.copy(),
+                         frozen=fit.axis_frozen, updates=fit.updates)
+        return state
+
+    def _recall(self, memory: dict) -> None:
+        for calibrator, offset in zip(self.calibrators, memory.get("offsets", [])):
+            calibrator.carry(offset)
+        if self.fit is not None and "theta" in memory:
+            fit = self.fit
+            fit.theta, fit.p = np.array(memory["theta"], float), np.array(memory["p"], float)
+            fit.information, fit.axis_frozen = memory["information"].copy(), memory["frozen"]
+            fit.updates = memory["updates"]
+            self.theta = np.array(fit.theta)
+
+    def fitted_mount(self) -> dict | None:
+        """The fitted parameters, their 1σ, and whether the pedestal terms are frozen."""
+        return None if self.fit is None else {"theta": self.fit.theta.tolist(), "std": self.fit.std(),
+                                              "frozen": self.fit.axis_frozen, "condition": self.fit.condition}
 
     def _choose_mode(self, i: int, t: float, status: int, valid: list, sky: int, obs: Observation) -> None:
         mode = self.mode
@@ -320,7 +428,7 @@ class Controller:
         m = self.model[a][i]
         if math.isnan(m):
             return drive.stow
-        target = m + self.calibrators[a].offset
+        target = m + self._correction(i, a)
         previous = self.model[a][i - 1] if i else math.nan
         if half_band and not math.isnan(previous) and m != previous:
             target += math.copysign(half_band, self._turn(a, m - previous))
@@ -368,8 +476,12 @@ class Controller:
         def columns(name):
             return np.array(per_axis[name], float).T.reshape(-1, self.axes)
 
+        def fit(name):
+            return np.array(self.out_fit[name], float).T.reshape(len(self.awake), -1)
+
         return ControllerOutputs(np.array(out["mode"], np.int8), np.array(out["status"], np.int8),
                                  np.array(out["sky"], np.int8), np.array(out["score"], float),
                                  np.array(out["intensity"], float), np.array(out["variation"], float),
                                  columns("target"), columns("reading"), columns("calibration"), columns("sun"),
+                                 fit("value"), fit("std"),
                                  np.array(self.moves), np.array(self.travel), self.events)

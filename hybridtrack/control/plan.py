@@ -11,7 +11,8 @@ own per-scan computation would:
 * the computed target of each axis on the mount as the controller believes it to be (nominal,
   or corrected by a commissioning fit), in encoder coordinates;
 * awake: within working hours and with the computed sun up, or rising within 30 minutes (to
-  pre-position). The sensor-only tracker has no sun model: it is awake within working hours.
+  pre-position). The sensor-only tracker has no sun model and no working hours: it wakes and
+  sleeps by the light its sensor reads (`Controller`), so its plan is awake throughout.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from ..sun import solar_position
 from ..times import clock_hours, parse_clock
 from .config import ControllerConfig
 
-__all__ = ["MountEstimate", "ControllerPlan", "make_plan", "CLOCK_STEP_SECONDS"]
+__all__ = ["MountEstimate", "ControllerPlan", "make_plan", "east_park", "CLOCK_STEP_SECONDS"]
 
 #: A jump of the controller's clock against its scan timer larger than this is a clock step.
 CLOCK_STEP_SECONDS = 5.0
@@ -42,31 +43,46 @@ class MountEstimate:
 
     Parameters
     ----------
-    axis_azimuth_error, axis_tilt_error : float
-        Degrees.
+    axis_azimuth_error, axis_tilt_error, axis_roll_error : float
+        Degrees (see `hybridtrack.mounting.mounting_rotation`).
     encoder_offset : tuple of float
         Degrees, per axis: the encoder reads the true angle plus this.
     """
 
     axis_azimuth_error: float = 0.0
     axis_tilt_error: float = 0.0
+    axis_roll_error: float = 0.0
     encoder_offset: tuple[float, ...] = field(default=(0.0,))
+
+    @classmethod
+    def from_parameters(cls, names: list[str], values) -> MountEstimate:
+        """From fitted parameters named as in `hybridtrack.control.mountfit.parameter_names`."""
+        given = dict(zip(names, (float(v) for v in values)))
+        encoders = (given.get("encoder_offset_azimuth", 0.0), given["encoder_offset"]) \
+            if "encoder_offset_azimuth" in given else (given["encoder_offset"],)
+        return cls(given.get("axis_azimuth_error", 0.0), given.get("axis_tilt_error", 0.0),
+                   given.get("axis_roll_error", 0.0), encoders)
 
     def targets(self, altitude, azimuth, collector: Collector) -> np.ndarray:
         """Computed targets in encoder coordinates, (N, axes); the geometry is followed below the horizon."""
-        rotation = mounting_rotation(self.axis_azimuth_error, self.axis_tilt_error, collector.axis)
+        rotation = mounting_rotation(self.axis_azimuth_error, self.axis_tilt_error, collector.axis,
+                                     self.axis_roll_error)
         targets = mount_targets(altitude, azimuth, collector, rotation, night=True)
         return targets + np.resize(np.asarray(self.encoder_offset, float), targets.shape[1])
 
 
 @dataclass
 class ControllerPlan:
-    """Per scan: timer (minutes), computed targets (N, axes), awake, and clock steps (seconds, 0 if none)."""
+    """Per scan: timer (minutes), computed targets (N, axes), awake, clock steps (seconds, 0 if
+    none), and for a controller that fits its mount the targets' derivatives by the mount's
+    parameters (N, axes, parameters) with each axis's weight in pointing terms (N, axes)."""
 
     minutes: np.ndarray
     model: np.ndarray
     awake: np.ndarray
     clock_steps: np.ndarray
+    jacobian: np.ndarray | None = None
+    weight: np.ndarray | None = None
 
 
 def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeIndex, np.ndarray]:
@@ -107,10 +123,24 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     altitude = sun["altitude"].to_numpy()
     model = (mount or MountEstimate()).targets(altitude, sun["azimuth"].to_numpy(), collector)
     if config.sensor_only:
-        awake = working
+        awake = np.ones(len(clock), bool)
     else:
         soon = solar_position(clock + PRE_POSITION, site, config.sun_model)["altitude"].to_numpy()
         up = altitude > config.min_altitude
         rising = (soon > config.min_altitude) & ~up & (soon > altitude)
         awake = working & (up | rising)
-    return ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps)
+    plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps)
+    if config.calibrates:
+        from .mountfit import jacobian
+
+        plan.jacobian = jacobian(altitude, sun["azimuth"].to_numpy(), collector)
+        plan.weight = np.ones(model.shape)
+        if not collector.single_axis:  # an azimuth error counts cos(elevation) in pointing terms
+            plan.weight[:, 0] = np.cos(np.radians(np.clip(model[:, 1], 0.0, 90.0)))
+    return plan
+
+
+def east_park(collector: Collector) -> list[float]:
+    """Where an installer parks a sensor-only tracker before its first morning: toward a sun 5°
+    above the eastern horizon, on the nominal mount."""
+    return MountEstimate(encoder_offset=(0.0, 0.0)).targets([5.0], [90.0], collector)[0].tolist()

@@ -19,6 +19,9 @@ from .modes import SKY_CODES, UNKNOWN
 
 __all__ = ["ClassifierTable", "SkyWatch"]
 
+#: Tables already made, by (classifier type, config, points): a year's run and its warm-up day share one.
+_TABLES: dict = {}
+
 
 class ClassifierTable:
     """A fuzzy classifier tabulated on a grid of its normalised inputs (0-10 each).
@@ -31,10 +34,15 @@ class ClassifierTable:
     """
 
     def __init__(self, classifier, points: int = 201):
-        grid = np.linspace(0.0, 10.0, points)
-        x, y = np.meshgrid(grid, grid, indexing="ij")
-        scores = np.asarray(classifier.score(x.ravel(), y.ravel(), raw=False), float).reshape(points, points)
-        self.scores = scores.tolist()
+        key = (type(classifier), classifier.config, points)
+        if key not in _TABLES:
+            grid = np.linspace(0.0, 10.0, points)
+            x, y = np.meshgrid(grid, grid, indexing="ij")
+            scores = np.asarray(classifier.score(x.ravel(), y.ravel(), raw=False), float)
+            if len(_TABLES) >= 16:
+                _TABLES.pop(next(iter(_TABLES)))
+            _TABLES[key] = scores.reshape(points, points).tolist()
+        self.scores = _TABLES[key]
         self.step = 10.0 / (points - 1)
         self.last = points - 1
         inputs = classifier.config.inputs
