@@ -275,13 +275,15 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     the sun (a seeded AR(1) between the bounds, time constant 30 min) in a direction that turns
     as the clouds move (AR(1), 20 min), on the side `_patch_side` says.
     """
-    dni = np.clip(np.nan_to_num(frame["dni"].to_numpy(float)), 0.0, None)
-    dhi = np.clip(np.nan_to_num(frame["dhi"].to_numpy(float)), 0.0, None)
+    dni = np.clip(frame["dni"].to_numpy(float), 0.0, None)  # NaN stays NaN: light nobody knows
+    dhi = np.clip(frame["dhi"].to_numpy(float), 0.0, None)
     clear_dni = np.nan_to_num(np.asarray(clear_dni, float))
     clear_dhi = np.nan_to_num(np.asarray(clear_dhi, float))
-    circumsolar = _circumsolar(frame.assign(dni=dni, dhi=dhi), position) * model.view_share
-    cloud_share = np.divide(np.clip(dhi - clear_dhi, 0.0, None), dhi, out=np.zeros_like(dhi), where=dhi > 0)
-    clearness = np.clip(np.divide(dni, np.maximum(clear_dni, 50.0)), 0.0, 1.2)
+    circumsolar = _circumsolar(frame.assign(dni=np.nan_to_num(dni), dhi=np.nan_to_num(dhi)), position) \
+        * model.view_share
+    cloud_share = np.divide(np.clip(np.nan_to_num(dhi) - clear_dhi, 0.0, None), dhi, out=np.zeros_like(dhi),
+                            where=np.nan_to_num(dhi) > 0)
+    clearness = np.clip(np.divide(np.nan_to_num(dni), np.maximum(clear_dni, 50.0)), 0.0, 1.2)
     side = _patch_side(frame.index, clearness, rng)
     low, high = model.patch_distance
     distance = low + (high - low) * 0.5 * (1.0 + np.tanh(_smooth(frame.index, rng, 30.0)))

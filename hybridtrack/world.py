@@ -241,9 +241,8 @@ class World:
         noise = [self._noise[a][i] for a in range(self.axes)]
         reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
                                         [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
+        obs.valid = valid
         self._sensor_faults(i, reported, obs)
-        if "sensor_dropout" not in self._faults or not self._faults["sensor_dropout"][i]:
-            obs.valid = valid or obs.valid
         obs.i, obs.t, obs.wind = i, self._minutes[i], self._wind[i]
         for a in range(self.axes):
             obs.encoder[a] = self._encoder(a, i)
@@ -254,9 +253,9 @@ class World:
         obs.true_sky = self._sky[i] if self._sky is not None else -1
 
     def _sensor_faults(self, i: int, reported: list, obs: Observation) -> None:
-        """The sensor's reading after any injected fault: a wrong value, a drift, a dropout."""
+        """The sensor's reading after any injected fault: a wrong value (the sensor still says it
+        sees the sun), a drift, or a dropout (no number at all)."""
         faults = self._faults
-        obs.valid = False
         for a in range(self.axes):
             value = reported[a]
             if "sensor" in faults and not math.isnan(faults["sensor"][a][i]):

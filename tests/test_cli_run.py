@@ -4,6 +4,7 @@ import pandas as pd
 import pytest
 
 from hybridtrack.cli import main
+from hybridtrack.control import STRATEGIES
 
 
 def test_demo_prints_the_summary_and_writes_the_report(tmp_path, capsys):
@@ -66,7 +67,7 @@ def test_compare_runs_every_strategy_side_by_side(tmp_path, capsys):
                  "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     header = next(line for line in printed.splitlines() if "hybrid" in line and "astronomical" in line)
-    assert header.split() == ["hybrid", "hybrid-nocal", "astronomical", "sensor"]
+    assert header.split() == list(STRATEGIES)
     data = json.loads((out / "comparison.json").read_text())
     assert data["hybrid"]["tracking_error_deg"]["rms"] < data["astronomical"]["tracking_error_deg"]["rms"]
     assert (out / "comparison.png").stat().st_size > 50_000 and (out / "sensor" / "summary.json").exists()

@@ -8,7 +8,7 @@ from hypothesis.extra.numpy import arrays
 from hybridtrack.collectors import (
     fresnel_angle, heliostat_normal, jack_heights, sun_vector, trough_angle,
 )
-from hybridtrack.control import MODES, ControllerConfig, ControllerInputs, run_controller
+from hybridtrack.control import MODES, STRATEGIES, Controller, ControllerConfig, ControllerPlan, Observation
 from hybridtrack.drive import Drive
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
 
@@ -66,35 +66,41 @@ def test_both_engines_agree_everywhere(pairs):
 
 
 @st.composite
-def controller_inputs(draw):
+def controller_runs(draw):
     n = draw(st.integers(5, 150))
     start = draw(st.floats(5, 170))
     steps = draw(arrays(float, n, elements=st.floats(-2, 2)))
     model = np.clip(start + np.cumsum(steps), -20, 200)  # may wander outside the limits
     wind = draw(arrays(float, n, elements=st.one_of(st.floats(0, 30), st.just(float("nan")))))
     awake = draw(arrays(bool, n))
-    sky = draw(arrays(np.int8, n, elements=st.integers(0, 3)))
-    dni = draw(arrays(float, n, elements=st.floats(-10, 1000)))
-    offset = draw(arrays(float, n, elements=st.floats(-1, 1)))
-    strategy = draw(st.sampled_from(["hybrid", "hybrid-nocal", "astronomical", "sensor"]))
-    inputs = ControllerInputs(minutes=np.arange(n, dtype=float), awake=awake, wind=wind, sky=sky, dni=dni,
-                              model=model[:, None], truth=(model + offset)[:, None],
-                              noise=np.zeros((n, 1)))
-    return inputs, strategy
+    intensity = draw(arrays(float, n, elements=st.one_of(st.floats(0, 400), st.just(float("nan")))))
+    offset = draw(arrays(float, n, elements=st.one_of(st.floats(-3, 3), st.just(float("nan")))))
+    valid = draw(arrays(bool, n))
+    strategy = draw(st.sampled_from(list(STRATEGIES)))
+    plan = ControllerPlan(np.arange(n, dtype=float), model[:, None], awake, np.zeros(n))
+    return plan, wind, intensity, offset, valid, strategy
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(controller_inputs())
+@given(controller_runs())
 def test_the_controller_stays_in_limits_stows_on_gusts_and_moves_only_past_the_deadband(case):
-    inputs, strategy = case
+    plan, wind, intensity, offset, valid, strategy = case
     drive = Drive()
-    out = run_controller(inputs, ControllerConfig(strategy=strategy), [drive], encoder_offset=0.0, sensor_bias=0.0,
-                         sensor_noise=0.03, field_of_view=10.0, direct_threshold=120.0)
-    angle = out.angle[:, 0]
-    assert np.all((angle >= drive.limits[0]) & (angle <= drive.limits[1]))
+    config = ControllerConfig(strategy=strategy)
+    controller = Controller(config, [drive], plan, CLASSIFIER, 20.0, [10.0])
+    obs, angle = Observation(1), drive.stow
+    angles = []
+    for i in range(len(wind)):  # a perfect plant: the encoder reads the angle, the sensor what it is given
+        obs.i, obs.t, obs.wind, obs.intensity, obs.true_sky = i, float(i), wind[i], intensity[i], 0
+        obs.encoder[0], obs.offset[0], obs.valid = angle, offset[i], bool(valid[i])
+        obs.coarse[0] = 0 if np.isnan(offset[i]) else int(np.sign(offset[i]) or 1)
+        angle = min(max(angle + controller.step(obs)[0], drive.limits[0]), drive.limits[1])
+        angles.append(angle)
+    out = controller.outputs()
+    angle = np.array(angles)
     assert np.all((out.target[:, 0] >= drive.limits[0]) & (out.target[:, 0] <= drive.limits[1]))
     modes = np.asarray(MODES)[out.mode]
-    gust = ~(inputs.wind <= 17.2)
+    gust = ~(wind <= 17.2)
     assert np.all(modes[gust] == "stow_wind")
     previous = np.concatenate([[drive.stow], angle[:-1]])
     moved = angle != previous

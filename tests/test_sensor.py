@@ -6,7 +6,7 @@ import pytest
 
 from hybridtrack import HybridtrackError
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
-from hybridtrack.sensor import SensorModel, sensor_view
+from hybridtrack.sensor import SensorModel, coarse_side, read_photocurrent, read_pointing, sensor_view
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import solar_position
 
@@ -57,19 +57,42 @@ def test_recorded_photocurrent_is_used_as_is():
     assert (view["intensity_ma"] == 123.0).all() and view.attrs["intensity_source"] == "recorded"
 
 
-def test_pointing_signal_valid_only_with_sun_in_view():
-    model = SensorModel(noise=0.0, bias=0.05)
-    measured, valid = model.pointing([0.2, 0.2, 15.0, np.nan, 0.1], [800, 100, 800, 800, np.nan])
-    assert list(valid) == [True, False, False, False, False]
-    assert measured[0] == pytest.approx(0.25) and np.isnan(measured[1:]).all()
-    rng = np.random.default_rng(0)
-    noisy, _ = SensorModel(noise=0.03).pointing(np.zeros(20000), np.full(20000, 900.0), rng=rng)
-    assert noisy.std() == pytest.approx(0.03, rel=0.05)
+def test_under_a_clear_sky_the_sensor_reports_the_sun_offset_and_its_noise():
+    model = SensorModel(noise=0.03)
+    reading, valid = read_pointing([0.25], 900.0, 20.0, 0.0, [3.0], [0.0], model)
+    assert valid and reading[0] == pytest.approx(0.25)
+    # noise is 0.03° at 1000 W/m² in view and grows as 1000 over the light in view
+    reading, _ = read_pointing([0.0], 480.0, 20.0, 0.0, [0.0], [1.0], model)
+    assert reading[0] == pytest.approx(0.03 * 1000.0 / (480.0 * np.cos(0.0) + 20.0))
 
 
-def test_direct_response_falls_with_offset_and_field_of_view():
-    model = SensorModel(field_of_view=10.0)
-    np.testing.assert_allclose(model.direct_response([0.0, 5.0, 11.0]), [1.0, np.cos(np.radians(5.0)), 0.0])
+def test_a_bright_patch_pulls_the_reading_to_the_brightness_weighted_centre():
+    model = SensorModel(noise=0.0)
+    # sun 0.5° off the axis with 300 W/m² of beam and 20 of aureole; a 100 W/m² patch 4° from the sun
+    reading, valid = read_pointing([0.5], 300.0, 20.0, 100.0, [4.0], [0.0], model)
+    sun = 300.0 * np.cos(np.radians(0.5)) + 20.0
+    assert valid and reading[0] == pytest.approx((sun * 0.5 + 100.0 * 4.5) / (sun + 100.0))
+    # the patch outside the fine view pulls nothing; the sun outside it leaves the patch alone in view
+    assert read_pointing([0.5], 300.0, 20.0, 100.0, [12.0], [0.0], model)[0][0] == pytest.approx(0.5)
+    alone, valid = read_pointing([11.0], 300.0, 20.0, 150.0, [-4.0], [0.0], model)
+    assert valid and alone[0] == pytest.approx(7.0)
+
+
+def test_too_little_light_in_view_is_no_reading():
+    model = SensorModel()
+    reading, valid = read_pointing([0.1], 90.0, 10.0, 0.0, [0.0], [0.0], model)  # 100 W/m² < 120
+    assert not valid and np.isnan(reading[0])
+    reading, valid = read_pointing([0.1], float("nan"), 10.0, 0.0, [0.0], [0.0], model)  # unknown light
+    assert not valid
+
+
+def test_photocurrent_falls_with_the_offset_and_the_coarse_cells_tell_the_side():
+    model = SensorModel(current_noise=0.0)
+    assert read_photocurrent(0.0, 1000.0, 100.0, 0.0, model) == pytest.approx(30.0 + 0.271 * (1000.0 + 50.0))
+    assert read_photocurrent(60.0, 1000.0, 100.0, 0.0, model) == pytest.approx(30.0 + 0.271 * (500.0 + 50.0))
+    assert read_photocurrent(95.0, 1000.0, 100.0, 0.0, model) == pytest.approx(30.0 + 0.271 * 50.0)
+    assert coarse_side(-40.0, 800.0, model) == -1 and coarse_side(40.0, 800.0, model) == 1
+    assert coarse_side(40.0, 50.0, model) == 0  # too little direct light to find the sun
 
 
 @pytest.mark.parametrize("kwargs, message", [({"diffuse_share": 1.5}, "diffuse_share"),

@@ -59,11 +59,16 @@ def test_hybrid_beats_both_single_strategies_with_p95_within_half_a_degree(mixed
 @pytest.mark.parametrize("site", list(MIXED))
 def test_astronomical_carries_the_bias_and_hybrid_removes_most_of_it(mixed_runs, site):
     astro = mixed_runs[(site, "astronomical")].summary["tracking_error_deg"]["mean"]
-    nocal = mixed_runs[(site, "hybrid-nocal")].summary["tracking_error_deg"]["mean"]
     hybrid = mixed_runs[(site, "hybrid")].summary["tracking_error_deg"]["mean"]
-    assert astro < -0.25  # clock behind, encoder off, axis turned: the open loop trails
-    assert abs(hybrid) < 0.35 * abs(astro)
-    assert abs(nocal) > abs(hybrid)  # without calibration the cloudy hours keep the bias
+    assert astro < -0.2  # clock behind, encoder off, axis turned: the open loop trails
+    bias = mixed_runs[(site, "hybrid")].config.imperfections.sensor_bias
+    assert abs(hybrid - bias) < 0.1  # what is left: the sensor's mounting bias and the drive's sawtooth
+    def cloudy_hours_rms(strategy):
+        log = mixed_runs[(site, strategy)].log
+        cloudy = (log["mode"] == "astronomical") & (log["dni"] > 0) & log["target_true"].notna()
+        return float(np.sqrt(np.mean(log.loc[cloudy, "error"] ** 2)))
+
+    assert cloudy_hours_rms("hybrid-nocal") > 1.3 * cloudy_hours_rms("hybrid")  # calibration carries over clouds
 
 
 def test_sensor_only_loses_time_under_cloud(mixed_runs):
@@ -134,32 +139,14 @@ def test_filterpy_reference_and_fast_kalman_give_the_same_run():
     assert fast.summary == reference.summary
 
 
-def test_bulk_nights_match_step_by_step():
-    from hybridtrack.control import run_controller
-    from hybridtrack.simulation import simulate as run
-
+@pytest.mark.parametrize("strategy", ["hybrid", "astronomical"])
+def test_bulk_nights_match_step_by_step(strategy):
     frame = synthetic("lanzhou", "2021-03-19", "2021-03-21", weather="mixed", seed=6, gusts_per_day=1)
-    captured = {}
-
-    def spy(inputs, config, drives, **kw):
-        captured["args"] = (inputs, config, drives, kw)
-        return run_controller(inputs, config, drives, **kw)
-
-    import hybridtrack.simulation as module
-
-    original = module.run_controller
-    module.run_controller = spy
-    try:
-        run(frame, "lanzhou")
-    finally:
-        module.run_controller = original
-    inputs, config, drives, kw = captured["args"]
-    kw = {k: v for k, v in kw.items() if k != "progress"}
-    bulk = run_controller(inputs, config, drives, bulk_nights=True, **kw)
-    steps = run_controller(inputs, config, drives, bulk_nights=False, **kw)
-    for name in ("mode", "sensor_status", "target", "angle", "reading", "calibration", "moves", "travel"):
-        np.testing.assert_array_equal(getattr(bulk, name), getattr(steps, name))
-    assert bulk.events == steps.events
+    bulk = simulate(frame, "lanzhou", strategy=strategy, bulk_nights=True)
+    steps = simulate(frame, "lanzhou", strategy=strategy, bulk_nights=False)
+    pd.testing.assert_frame_equal(bulk.log, steps.log)
+    pd.testing.assert_frame_equal(bulk.events, steps.events)
+    assert bulk.summary == steps.summary
 
 
 def test_intermittent_drive_error_is_bounded_by_deadband_and_sun_motion():

@@ -18,10 +18,11 @@ import numpy as np
 from ..drive import Drive
 from .calibration import Calibrator
 from .config import ControllerConfig
+from .disagreement import DisagreementMonitor
 from .encoder import EncoderMonitor
 from .mountfit import MountEstimator
-from .modes import (ASTRONOMICAL, FAULT, FAULTY, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR, SENSOR_STATUS,
-                    SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
+from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR,
+                    SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
 from .sensing import SensorGate
@@ -115,6 +116,9 @@ class Controller:
         self.mount_at: tuple = (-1, -1)
         self.mount: list = []
         self.fit_row = ([], [])
+        self.disagreement = DisagreementMonitor()
+        self.checkpoint: dict | None = None
+        self.distrusted = False  # the sensor disagreed with the calibrated model: not trusted until tomorrow
         if memory:
             self._recall(memory)
         self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
@@ -189,7 +193,9 @@ class Controller:
         for a in range(self.axes):
             per_axis["target"][a][i:j] = [self._night_target(a)] * count
             per_axis["reading"][a][i:j] = [reading[a]] * count
-            per_axis["calibration"][a][i:j] = [self._correction(i, a)] * count
+            offset = self.calibrators[a].offset
+            per_axis["calibration"][a][i:j] = [offset] * count if self.fit is None else \
+                (self._mount_corrections(i, j)[:, a] + offset).tolist()
             per_axis["sun"][a][i:j] = [math.nan] * count
         if self.fit is not None:
             for k, (value, std) in enumerate(zip(self.fit.theta, self.fit.std())):
@@ -224,6 +230,7 @@ class Controller:
         if self.mode == STOW_NIGHT:
             for gate in self.gates:
                 gate.forget()
+            self.distrusted = False
         return moves
 
     def _daylight(self, t: float, intensity: float) -> bool:
@@ -296,6 +303,8 @@ class Controller:
         trusted = config.calibrates and self._trusts_sensor(sky, obs)
         for a, gate in enumerate(self.gates):
             verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a])
+            if verdict == OK and self.distrusted:
+                verdict = IMPLAUSIBLE
             if verdict == OK:
                 verdict = self._offer(i, a, dt, reading[a] + obs.offset[a], trusted)
             valid[a] = verdict == OK
@@ -328,8 +337,12 @@ class Controller:
             return offset
         if self.mount_at != (i, self.fit.updates):
             self.mount_at = (i, self.fit.updates)
-            self.mount = (self.jacobian[i] @ self.theta).tolist()
+            self.mount = self._mount_corrections(i, i + 1)[0].tolist()
         return self.mount[a] + offset
+
+    def _mount_corrections(self, i: int, j: int) -> np.ndarray:
+        """The fitted mount's correction of scans `i` to `j` - 1, (j - i, axes)."""
+        return self.jacobian[i:j] @ self.theta
 
     def _offer(self, i: int, a: int, dt: float, z: float, trusted: bool) -> int:
         """Offer the sensor's sun angle on axis `a` to the gate, and let a trusted one calibrate."""
@@ -355,9 +368,27 @@ class Controller:
             w = self.weight[i, a]
             self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w)
             self.theta = self.fit.theta
+            if self._disagrees(i):
+                return
         mount = self._correction(i, a) - self.calibrators[a].offset
         residual = self._turn(a, self.gates[a].filter.angle - m0 - mount)
         self.calibrators[a].learn(dt, residual, self._turn(a, m0 - m1), bound)
+
+    def _disagrees(self, i: int) -> bool:
+        """Watch the fit's innovations; on a persistent disagreement roll the calibration back."""
+        normalised, size = self.fit.last_innovation
+        if self.disagreement.calm:
+            self.checkpoint = self.memory()
+        if not self.disagreement.add(normalised, size):
+            return False
+        mean, count = self.disagreement.mean_residual(), self.disagreement.run
+        if self.checkpoint is not None:
+            self._recall(self.checkpoint)
+        self.disagreement.reset()
+        self.distrusted = True
+        self._alarm(i, f"sensor and calibrated model disagree: mean residual {mean:+.3f}° over {count} readings; "
+                       "calibration rolled back, sensor not trusted until tomorrow")
+        return True
 
     def memory(self) -> dict:
         """What this controller would carry into a next run: its mount fit and offsets."""

@@ -1,0 +1,191 @@
+"""What the classifier is worth: every policy over a seeded set of days, on the same world.
+
+Each day (site × season × weather × seed × collector) is one synthetic frame; every policy runs
+on it with the same world (mount, clock, sensor errors and noise draws) and the same drive.
+The policies that bracket the classifier:
+
+* ``hybrid-always`` removes it (the sensor is tracked whenever it reads valid);
+* ``hybrid-oracle`` replaces it with the truth (the frame's own sky label);
+* ``hybrid`` is the fuzzy switch between them. The share of the RMS gap between the first two
+  that the hybrid recovers is what the classifier is worth.
+
+Beside them: ``hybrid-nocal`` (no calibration), ``astronomical`` (open loop as installed),
+``astronomical-commissioned`` (open loop after a commissioning fit) and ``sensor`` (closed loop
+as sold). Per run the table also says why a closed loop lost: the DNI-weighted share of
+tracking time spent on a sensor that read valid while pointing more than 0.5° off the sun (cloud
+pull) and the share spent searching or without a valid reading (a lost sun).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .control import STRATEGIES
+from .errors import HybridtrackError
+
+__all__ = ["AblationPlan", "AblationResult", "ablate", "SEASONS", "SITE_YEARS"]
+
+#: The typical days of each season (month-day) and the year each site's days are taken from.
+SEASONS = {"spring": "03-20", "summer": "06-21", "autumn": "09-23", "winter": "12-21"}
+SITE_YEARS = {"lanzhou": 2021, "nanjing": 2013}
+#: Pointing errors above this while the sensor reads valid count as the sensor being pulled.
+PULL_THRESHOLD = 0.5
+
+
+@dataclass(frozen=True)
+class AblationPlan:
+    """Which days and policies to run: every combination of the fields.
+
+    The default is 2 sites × 4 seasons × 5 seeds of mixed skies (40 days) on two collectors.
+    """
+
+    sites: tuple[str, ...] = ("lanzhou", "nanjing")
+    seasons: tuple[str, ...] = tuple(SEASONS)
+    weather: tuple[str, ...] = ("mixed",)
+    seeds: tuple[int, ...] = (1, 2, 3, 4, 5)
+    collectors: tuple[str, ...] = ("trough-ns", "fresnel")
+    policies: tuple[str, ...] = STRATEGIES
+
+    def __post_init__(self) -> None:
+        from .collectors import KINDS
+        from .sky import DAY_TYPES
+
+        checks = [("seasons", self.seasons, tuple(SEASONS)), ("weather", self.weather, (*DAY_TYPES, "mixed")),
+                  ("collectors", self.collectors, KINDS), ("policies", self.policies, STRATEGIES)]
+        for name, values, known in checks:
+            for value in values:
+                if value not in known:
+                    raise HybridtrackError(f"ablate: unknown {name[:-1] if name != 'weather' else name} "
+                                           f"{value!r}; choose from {', '.join(known)}")
+        for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
+            if not getattr(self, name):
+                raise HybridtrackError(f"ablate: no {name} to run")
+
+    def days(self) -> list[dict]:
+        """One dict per day: site, date, weather, seed, collector."""
+        from . import sites as known_sites
+
+        out = []
+        for site in self.sites:
+            known_sites.get(site)
+            year = SITE_YEARS.get(site, 2021)
+            for season in self.seasons:
+                for weather in self.weather:
+                    for seed in self.seeds:
+                        for collector in self.collectors:
+                            out.append({"site": site, "season": season, "date": f"{year}-{SEASONS[season]}",
+                                        "weather": weather, "seed": int(seed), "collector": collector})
+        return out
+
+
+def _day(day: dict, policies: tuple[str, ...], config) -> list[dict]:
+    """Every policy on one day; a row each."""
+    from .simulation import SimulationConfig, simulate
+    from .sky import synthetic
+
+    frame = synthetic(day["site"], day["date"], weather=day["weather"], seed=day["seed"])
+    base = dataclasses.replace(config or SimulationConfig(), seed=day["seed"])
+    rows = []
+    for policy in policies:
+        result = simulate(frame, day["site"], collector=day["collector"], strategy=policy, config=base)
+        rows.append({**day, "policy": policy, **_metrics(result)})
+    return rows
+
+
+def _metrics(result) -> dict:
+    """The headline numbers of a run and why a closed loop lost."""
+    summary, log = result.summary, result.log
+    error = summary["tracking_error_deg"]
+    beam = np.nan_to_num(log["dni"].to_numpy(float))
+    tracking = log["mode"].isin(["sensor", "astronomical", "search"]).to_numpy() & (beam > 0)
+    weight = beam * tracking
+    total = weight.sum()
+    on_sensor = (log["mode"] == "sensor").to_numpy()
+    pulled = on_sensor & log["sensor_valid"].to_numpy() & (np.abs(log["error"].to_numpy()) > PULL_THRESHOLD)
+    lost = (log["mode"] == "search").to_numpy() | (on_sensor & ~log["sensor_valid"].to_numpy())
+    share = (lambda mask: float((weight * mask).sum() / total)) if total > 0 else (lambda mask: float("nan"))
+    return {"rms": error["rms"], "p95": error["p95"], "energy": summary["energy_capture"],
+            "sensor_share": summary["mode_share"]["sensor"], "pulled_share": share(pulled),
+            "lost_share": share(lost)}
+
+
+def _interval(values: np.ndarray, rng: np.random.Generator, draws: int = 2000) -> tuple[float, float]:
+    """A 95 % bootstrap interval of the mean."""
+    values = values[np.isfinite(values)]
+    if len(values) < 2:
+        return float("nan"), float("nan")
+    means = rng.choice(values, size=(draws, len(values)), replace=True).mean(axis=1)
+    return float(np.percentile(means, 2.5)), float(np.percentile(means, 97.5))
+
+
+@dataclass
+class AblationResult:
+    """Every run (`runs`, one row per day and policy) and the table per policy (`table`)."""
+
+    runs: pd.DataFrame
+    plan: AblationPlan = field(default_factory=AblationPlan)
+
+    @property
+    def table(self) -> pd.DataFrame:
+        """Per policy: mean, 95 % interval of the mean and worst of RMS, p95 and energy capture."""
+        rng = np.random.default_rng(0)
+        rows = {}
+        for policy, runs in self.runs.groupby("policy", sort=False):
+            row = {}
+            for metric, worst in (("rms", np.max), ("p95", np.max), ("energy", np.min)):
+                values = runs[metric].to_numpy(float)
+                low, high = _interval(values, rng)
+                row.update({f"{metric} mean": np.nanmean(values), f"{metric} 95% low": low,
+                            f"{metric} 95% high": high, f"{metric} worst": worst(values)})
+            row["pulled share"] = runs["pulled_share"].mean()
+            row["lost share"] = runs["lost_share"].mean()
+            rows[policy] = row
+        return pd.DataFrame(rows).T
+
+    def gap_recovered(self) -> float:
+        """Share of the mean-RMS gap between ``hybrid-always`` and ``hybrid-oracle`` the hybrid recovers."""
+        mean = self.runs.groupby("policy")["rms"].mean()
+        if not {"hybrid", "hybrid-always", "hybrid-oracle"} <= set(mean.index):
+            return float("nan")
+        gap = mean["hybrid-always"] - mean["hybrid-oracle"]
+        return float((mean["hybrid-always"] - mean["hybrid"]) / gap) if gap != 0 else float("nan")
+
+    def __repr__(self) -> str:
+        days = len(self.runs) // max(self.runs["policy"].nunique(), 1)
+        return (f"AblationResult({days} day-runs × {self.runs['policy'].nunique()} policies; "
+                f"hybrid recovers {self.gap_recovered():.0%} of the always→oracle RMS gap)\n"
+                + self.table.to_string(float_format=lambda v: f"{v:.4f}"))
+
+    def _repr_html_(self) -> str:
+        return (f"<p>hybrid recovers <b>{self.gap_recovered():.0%}</b> of the always→oracle RMS gap</p>"
+                + self.table.to_html(float_format=lambda v: f"{v:.4f}"))
+
+    def plot(self):
+        """RMS and energy capture of every day, per policy (a matplotlib Figure)."""
+        from .report import plot_ablation
+
+        return plot_ablation(self)
+
+
+def ablate(plan: AblationPlan | None = None, *, config=None, progress=None) -> AblationResult:
+    """Run every policy of `plan` on every day of it.
+
+    Parameters
+    ----------
+    plan : AblationPlan, optional
+    config : SimulationConfig, optional
+        The world, controller and drive every policy shares (its seed is replaced by each day's).
+    progress : callable, optional
+        Called with 1 after each day.
+    """
+    plan = plan or AblationPlan()
+    rows = []
+    for day in plan.days():
+        rows.extend(_day(day, plan.policies, config))
+        if progress is not None:
+            progress(1)
+    return AblationResult(pd.DataFrame(rows), plan)

@@ -1,0 +1,63 @@
+"""Does the sensor still agree with the calibrated model? A two-sided CUSUM on the fit's
+normalised innovations, with a checkpoint of the calibration to roll back to.
+
+A healthy sensor's residuals against the calibrated model are zero-mean with the spread the
+fit predicts. A sensor that drifts, or takes on a bias, or a mount that shifts, leaves a run of
+residuals of one sign: Page's CUSUM accumulates them, less an allowance `ALLOWANCE` per reading,
+and raises the alarm above `THRESHOLD` (Page 1954; Montgomery 2009, §9.1). While both sums
+are at zero the calibration is checkpointed; on an alarm the calibration goes back to the last
+checkpoint, so what the disagreeing readings taught it is undone.
+
+References
+----------
+Page, E. S. (1954). Continuous inspection schemes. *Biometrika* 41(1/2), 100-115.
+doi:10.1093/biomet/41.1-2.100
+
+Montgomery, D. C. (2009). *Introduction to Statistical Quality Control*, 6th ed. Wiley.
+"""
+
+from __future__ import annotations
+
+__all__ = ["DisagreementMonitor", "ALLOWANCE", "THRESHOLD"]
+
+#: Half the shift (in standard deviations) the CUSUM is tuned to see at once.
+ALLOWANCE = 0.5
+#: The sum that raises the alarm; with k = 0.5 a healthy sensor takes on the order of a thousand
+#: fit readings (five-minute apart) to reach it by chance.
+THRESHOLD = 8.0
+
+
+class DisagreementMonitor:
+    """Two-sided CUSUM of normalised innovations; remembers the mean residual of the current run."""
+
+    __slots__ = ("high", "low", "run", "run_sum")
+
+    def __init__(self):
+        self.high = self.low = 0.0
+        self.run = 0
+        self.run_sum = 0.0
+
+    @property
+    def calm(self) -> bool:
+        """Both sums at zero: a moment to checkpoint the calibration."""
+        return self.high == 0.0 and self.low == 0.0
+
+    def add(self, normalised: float, residual: float) -> bool:
+        """Take one innovation (in its standard deviations) and its size (degrees); True on an alarm."""
+        self.high = max(0.0, self.high + normalised - ALLOWANCE)
+        self.low = max(0.0, self.low - normalised - ALLOWANCE)
+        if self.calm:
+            self.run, self.run_sum = 0, 0.0
+        else:
+            self.run += 1
+            self.run_sum += residual
+        return self.high > THRESHOLD or self.low > THRESHOLD
+
+    def mean_residual(self) -> float:
+        """The mean residual (degrees) over the run of readings that led to the alarm."""
+        return self.run_sum / self.run if self.run else 0.0
+
+    def reset(self) -> None:
+        """Start afresh."""
+        self.high = self.low = 0.0
+        self.run, self.run_sum = 0, 0.0
