@@ -28,7 +28,7 @@ Two signals come from one sensor head on the collector:
   DHI, so a pull appears only where the frame's light says a cloud is near the sun. The
   reading's noise grows as the light in view falls (an amplifier's noise against a smaller
   signal). It is valid only with enough light in view: the sensor's own "sun present" output,
-  not the DNI, which it cannot know. A coarse, wide-angle stage tells the side the sun is on.
+  not the DNI, which it cannot know. A coarse, wide-angle stage tells roughly where the sun is.
 
 References
 ----------
@@ -51,7 +51,7 @@ import pandas as pd
 from .errors import HybridtrackError
 
 __all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "SensorScene", "sensor_scene", "read_pointing",
-           "read_photocurrent", "coarse_side"]
+           "read_photocurrent", "coarse_offset"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
@@ -81,6 +81,9 @@ class SensorModel:
     coarse_field_of_view : float
         Half-angle of the wide-angle acquisition cells, degrees: commercial trackers' coarse
         cells look east and west down to the horizon, so the sun is found from any angle.
+    coarse_accuracy : float
+        Degrees, 1σ of the acquisition cells' estimate of the sun's offset (the ratio of two
+        cosine cells facing either way, good to a few degrees).
     noise : float
         Standard deviation of the measured pointing offset at 1000 W/m² in view, degrees;
         it grows as 1000 W/m² over the light in view.
@@ -106,6 +109,7 @@ class SensorModel:
     coarse_field_of_view: float = 90.0
     noise: float = 0.03
     bias: float = 0.0
+    coarse_accuracy: float = 2.0
     patch_distance: tuple[float, float] = (2.0, 6.0)
     view_share: float = 0.8
 
@@ -334,8 +338,8 @@ def read_photocurrent(offset: float, beam: float, diffuse: float, noise: float, 
     return max(current + model.current_noise * noise, 0.0)
 
 
-def coarse_side(offset: float, beam: float, model: SensorModel) -> int:
-    """The acquisition cells' answer: the side the sun is on (-1 or +1), or 0 if they see no sun."""
+def coarse_offset(offset: float, beam: float, noise: float, model: SensorModel) -> float:
+    """The acquisition cells' estimate of the sun's offset, degrees (NaN if they see no sun)."""
     if beam >= model.direct_threshold and abs(offset) <= model.coarse_field_of_view:
-        return 1 if offset > 0 else -1
-    return 0
+        return offset + model.coarse_accuracy * noise
+    return math.nan

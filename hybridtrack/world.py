@@ -36,7 +36,7 @@ from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
 from .mounting import mount_targets, mounting_rotation
-from .sensor import RECORDED_COLUMN, SensorModel, coarse_side, read_photocurrent, read_pointing, sensor_scene
+from .sensor import RECORDED_COLUMN, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
 from .sun import solar_position
 
 __all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
@@ -152,6 +152,7 @@ class World:
         self._truth = [np.nan_to_num(self.truth[:, a]).tolist() for a in range(self.axes)]
         self._noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
         self._current_noise = rng.standard_normal(self.n).tolist()
+        self._coarse_noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
         recorded = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
         self._recorded_current = recorded.tolist() if recorded is not None else None
         self.frame_dni = frame["dni"].to_numpy(float)
@@ -246,7 +247,7 @@ class World:
         obs.i, obs.t, obs.wind = i, self._minutes[i], self._wind[i]
         for a in range(self.axes):
             obs.encoder[a] = self._encoder(a, i)
-            obs.coarse[a] = coarse_side(offsets[a], beam[i], self.sensor)
+            obs.coarse[a] = coarse_offset(offsets[a], beam[i], self._coarse_noise[a][i], self.sensor)
         worst = max(abs(o) for o in offsets)
         obs.intensity = self._recorded_current[i] if self._recorded_current is not None else \
             read_photocurrent(worst, beam[i], diffuse[i], self._current_noise[i], self.sensor)

@@ -93,7 +93,7 @@ def test_the_controller_stays_in_limits_stows_on_gusts_and_moves_only_past_the_d
     for i in range(len(wind)):  # a perfect plant: the encoder reads the angle, the sensor what it is given
         obs.i, obs.t, obs.wind, obs.intensity, obs.true_sky = i, float(i), wind[i], intensity[i], 0
         obs.encoder[0], obs.offset[0], obs.valid = angle, offset[i], bool(valid[i])
-        obs.coarse[0] = 0 if np.isnan(offset[i]) else int(np.sign(offset[i]) or 1)
+        obs.coarse[0] = offset[i]
         angle = min(max(angle + controller.step(obs)[0], drive.limits[0]), drive.limits[1])
         angles.append(angle)
     out = controller.outputs()

@@ -6,7 +6,7 @@ import pytest
 
 from hybridtrack import HybridtrackError
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
-from hybridtrack.sensor import SensorModel, coarse_side, read_photocurrent, read_pointing, sensor_view
+from hybridtrack.sensor import SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_view
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import solar_position
 
@@ -86,13 +86,14 @@ def test_too_little_light_in_view_is_no_reading():
     assert not valid
 
 
-def test_photocurrent_falls_with_the_offset_and_the_coarse_cells_tell_the_side():
+def test_photocurrent_falls_with_the_offset_and_the_coarse_cells_find_the_sun():
     model = SensorModel(current_noise=0.0)
     assert read_photocurrent(0.0, 1000.0, 100.0, 0.0, model) == pytest.approx(30.0 + 0.271 * (1000.0 + 50.0))
     assert read_photocurrent(60.0, 1000.0, 100.0, 0.0, model) == pytest.approx(30.0 + 0.271 * (500.0 + 50.0))
     assert read_photocurrent(95.0, 1000.0, 100.0, 0.0, model) == pytest.approx(30.0 + 0.271 * 50.0)
-    assert coarse_side(-40.0, 800.0, model) == -1 and coarse_side(40.0, 800.0, model) == 1
-    assert coarse_side(40.0, 50.0, model) == 0  # too little direct light to find the sun
+    assert coarse_offset(-40.0, 800.0, 0.5, model) == pytest.approx(-40.0 + 0.5 * model.coarse_accuracy)
+    assert np.isnan(coarse_offset(40.0, 50.0, 0.0, model))  # too little direct light to find the sun
+    assert np.isnan(coarse_offset(95.0, 800.0, 0.0, model))  # behind the cells
 
 
 @pytest.mark.parametrize("kwargs, message", [({"diffuse_share": 1.5}, "diffuse_share"),

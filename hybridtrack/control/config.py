@@ -60,22 +60,25 @@ class ControllerConfig:
         Scans a jumped encoder reading must persist before it is believed.
     calibration_max_rate : float
         Degrees per minute: calibration learns only while the model's target moves no faster.
-    search_speed : float
-        Degrees per minute of the sensor-only acquisition; commercial sensor trackers acquire at
-        their drive's speed (30°/min here).
     coast : str
         Sensor-only strategy: how long to keep moving at the filtered rate through a gap in
-        the sensor's signal before holding still.
+        the sensor's signal before holding still. Passing clouds last minutes to tens of minutes;
+        commercial trackers' cloud modes coast through such spells and hold under overcast.
     dusk_current : float
         mA: the sensor-only tracker sleeps once its photocurrent has stayed below this for
         30 minutes, and wakes when it rises above it (5 mA over the 30 mA dark current, about
         20 W/m² of light: civil twilight).
     lead : bool
-        Aim half a deadband ahead of the sun, in its direction of motion. ``False`` is the
-        published field practice (aim at the sun).
+        Aim ahead of the sun by its rate times half the expected time to the next move, at most
+        half the deadband (`hybridtrack.control.controller._lead`), so the intermittent drive's
+        sawtooth is centred on the sun. ``False`` is the published field practice (aim at it).
     sensor_noise : float
         Degrees, 1σ: the sensor's datasheet accuracy at full sun, the Kalman filter's R. The
         default is half the < 0.1° accuracy quoted for commercial fine sun sensors.
+    disagreement : float
+        Degrees: a persistent residual between the sensor and the calibrated model at least this
+        large is a sensor (or mount) fault; a smaller one is the model's own misfit. Half the
+        0.5° whole-system error that trough fields are built to.
     kalman : {"fast", "filterpy"}
         ``filterpy`` runs filterpy's KalmanFilter, the reference; ``fast`` the same
         equations in plain floats (a test keeps them equal).
@@ -98,11 +101,11 @@ class ControllerConfig:
     sensor_plausibility: float = 2.0
     stuck_scans: int = 3
     encoder_confirm: int = 3
-    search_speed: float = 30.0
-    coast: str = "10min"
+    coast: str = "30min"
     dusk_current: float = 35.0
     lead: bool = True
     sensor_noise: float = 0.05
+    disagreement: float = 0.25
     kalman: str = "fast"
 
     def __post_init__(self) -> None:
@@ -122,7 +125,7 @@ class ControllerConfig:
             except ValueError:
                 raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive duration") from None
         for name in ("wind_stow", "wind_release", "min_altitude", "process_noise", "gate", "calibration_max_rate",
-                     "sensor_plausibility", "search_speed", "sensor_noise", "dusk_current"):
+                     "sensor_plausibility", "sensor_noise", "dusk_current", "disagreement"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise HybridtrackError(f"controller: {name} must be a finite number, got {value!r}")
@@ -133,16 +136,19 @@ class ControllerConfig:
             raise HybridtrackError("controller: working_hours needs a start and an end")
         for clock in self.working_hours:
             parse_clock(clock)
-        if not (0 < self.process_noise <= 10 and 0 < self.gate <= 100 and 0 < self.search_speed <= 600
-                and 0 < self.calibration_max_rate <= 100 and 0 < self.sensor_noise <= 5):
-            raise HybridtrackError("controller: process_noise (0-10], gate (0-100], search_speed (0-600], "
-                                   "calibration_max_rate (0-100] and sensor_noise (0-5] are out of range")
+        if not (0 < self.process_noise <= 10 and 0 < self.gate <= 100 and 0 < self.calibration_max_rate <= 100
+                and 0 < self.sensor_noise <= 5):
+            raise HybridtrackError("controller: process_noise (0-10], gate (0-100], calibration_max_rate (0-100] "
+                                   "and sensor_noise (0-5] are out of range")
         if not -10 <= self.min_altitude <= 30:
             raise HybridtrackError(f"controller: min_altitude {self.min_altitude} is outside -10 to 30 degrees")
         for name, least in (("reacquire", 1), ("stuck_scans", 2), ("encoder_confirm", 1)):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and least <= value <= 10_000):
                 raise HybridtrackError(f"controller: {name} must be a whole number of at least {least}, got {value!r}")
+        if not 0 < self.disagreement <= self.sensor_plausibility:
+            raise HybridtrackError(f"controller: disagreement {self.disagreement} must be positive and at most "
+                                   f"sensor_plausibility {self.sensor_plausibility}")
         if not 0 < self.sensor_plausibility <= 45:
             raise HybridtrackError("controller: sensor_plausibility must be within (0, 45] degrees")
 

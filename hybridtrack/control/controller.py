@@ -67,6 +67,21 @@ class ControllerOutputs:
     events: list
 
 
+def _lead(rate: float, period: float, deadband: float) -> float:
+    """How far ahead of the sun to aim, degrees: half the sun's motion until the next move.
+
+    With the sun moving `rate` °/min and a scan every `period` minutes, the drive moves every
+    k = ceil(deadband / (|rate| · period)) scans; aiming rate · period · (k - 1) / 2 ahead centres
+    the error the scans see on the sun. Bounded by half the deadband; no lead when the drive moves
+    every scan anyway.
+    """
+    step = abs(rate) * period
+    if not step > 0:
+        return 0.0
+    scans = math.ceil(deadband / step - 1e-9)
+    return math.copysign(min(step * (scans - 1) / 2.0, deadband / 2.0), rate)
+
+
 class Controller:
     """A tracking controller for one collector of one or two axes.
 
@@ -379,7 +394,7 @@ class Controller:
         normalised, size = self.fit.last_innovation
         if self.disagreement.calm:
             self.checkpoint = self.memory()
-        if not self.disagreement.add(normalised, size):
+        if not self.disagreement.add(normalised, size, self.config.disagreement):
             return False
         mean, count = self.disagreement.mean_residual(), self.disagreement.run
         if self.checkpoint is not None:
@@ -443,7 +458,7 @@ class Controller:
 
     def _target(self, i: int, a: int, t: float, dt: float, reading: float, valid: bool, obs: Observation) -> float:
         mode, gate, drive = self.mode, self.gates[a], self.drives[a]
-        half_band = drive.deadband / 2.0 if self.config.lead else 0.0
+        lead = self.config.lead
         if mode == STOW_WIND:
             return drive.stow
         if mode == STOW_NIGHT:
@@ -451,18 +466,18 @@ class Controller:
         if mode == SENSOR:
             coasting = not valid and t - self.invalid_since <= self.coast_for
             if gate.ready and (valid or not self.config.sensor_only or coasting):
-                return gate.filter.angle + math.copysign(half_band, gate.filter.rate)
+                return gate.filter.angle + (_lead(gate.filter.rate, dt, drive.deadband) if lead else 0.0)
             return reading  # hold
         if mode == SEARCH:
-            side = obs.coarse[a]
-            return reading + side * self.config.search_speed * dt if side else reading
+            rough = obs.coarse[a]  # the drive's speed limits the step; a scan later the cells look again
+            return reading if math.isnan(rough) else reading + rough
         m = self.model[a][i]
         if math.isnan(m):
             return drive.stow
         target = m + self._correction(i, a)
         previous = self.model[a][i - 1] if i else math.nan
-        if half_band and not math.isnan(previous) and m != previous:
-            target += math.copysign(half_band, self._turn(a, m - previous))
+        if lead and not math.isnan(previous) and dt > 0:
+            target += _lead(self._turn(a, m - previous) / dt, dt, drive.deadband)
         if self.circular[a]:  # the nearest way to the same direction, within the limits
             target = reading + self._turn(a, target - reading)
             low, high = drive.limits

@@ -4,9 +4,13 @@ normalised innovations, with a checkpoint of the calibration to roll back to.
 A healthy sensor's residuals against the calibrated model are zero-mean with the spread the
 fit predicts. A sensor that drifts, or takes on a bias, or a mount that shifts, leaves a run of
 residuals of one sign: Page's CUSUM accumulates them, less an allowance `ALLOWANCE` per reading,
-and raises the alarm above `THRESHOLD` (Page 1954; Montgomery 2009, §9.1). While both sums
-are at zero the calibration is checkpointed; on an alarm the calibration goes back to the last
-checkpoint, so what the disagreeing readings taught it is undone.
+and flags a disagreement above `THRESHOLD` (Page 1954; Montgomery 2009, §9.1). The model the
+residuals are judged against leaves out small time-of-day terms (the clock's drift, the site's
+coordinates, the linearisation), so a flagged run is an alarm only if its mean residual is also
+at least the controller's `disagreement` limit; a smaller one is model misfit, and the sums
+start again. While both sums are at zero the calibration is checkpointed; on an alarm the
+calibration goes back to the last checkpoint, so what the disagreeing readings taught it is
+undone.
 
 References
 ----------
@@ -42,16 +46,22 @@ class DisagreementMonitor:
         """Both sums at zero: a moment to checkpoint the calibration."""
         return self.high == 0.0 and self.low == 0.0
 
-    def add(self, normalised: float, residual: float) -> bool:
-        """Take one innovation (in its standard deviations) and its size (degrees); True on an alarm."""
+    def add(self, normalised: float, residual: float, limit: float) -> bool:
+        """Take one innovation (in its standard deviations) and its size (degrees); True on an alarm:
+        a run the CUSUM flags whose mean residual is at least `limit` degrees."""
         self.high = max(0.0, self.high + normalised - ALLOWANCE)
         self.low = max(0.0, self.low - normalised - ALLOWANCE)
         if self.calm:
             self.run, self.run_sum = 0, 0.0
-        else:
-            self.run += 1
-            self.run_sum += residual
-        return self.high > THRESHOLD or self.low > THRESHOLD
+            return False
+        self.run += 1
+        self.run_sum += residual
+        if self.high <= THRESHOLD and self.low <= THRESHOLD:
+            return False
+        if abs(self.mean_residual()) >= limit:
+            return True
+        self.reset()  # flagged but small: model misfit, not a fault
+        return False
 
     def mean_residual(self) -> float:
         """The mean residual (degrees) over the run of readings that led to the alarm."""

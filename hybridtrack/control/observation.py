@@ -20,9 +20,9 @@ class Observation:
         The sun sensor's pointing offset per axis, degrees; NaN when it gives none.
     valid : bool
         The sensor's own "sun present" output: enough light on its fine cells.
-    coarse : list of int
-        The wide-angle acquisition cells: -1 or +1, the side the light comes from, per axis;
-        0 when they see no sun.
+    coarse : list of float
+        The wide-angle acquisition cells' rough estimate of the sun's offset per axis, degrees;
+        NaN when they see no sun.
     intensity : float
         The sensor's photocurrent, mA.
     wind : float
@@ -40,7 +40,7 @@ class Observation:
         self.encoder = [0.0] * axes
         self.offset = [float("nan")] * axes
         self.valid = False
-        self.coarse = [0] * axes
+        self.coarse = [float("nan")] * axes
         self.intensity = float("nan")
         self.wind = 0.0
         self.true_sky = -1

@@ -33,14 +33,14 @@ class SensorGate:
         self.gate2 = gate * gate
         self.reacquire = reacquire
 
-    def judge(self, measured: float, valid: bool, coarse: int) -> int:
+    def judge(self, measured: float, valid: bool, coarse: float) -> int:
         """The status of a raw reading before it meets the model and the filter."""
         self.repeats = self.repeats + 1 if measured == self.last_measured else 0
         self.last_measured = measured
         if self.repeats >= self.stuck_scans - 1:
             return STUCK
         if not valid:
-            return OUT_OF_VIEW if coarse else LOW_LIGHT
+            return LOW_LIGHT if math.isnan(coarse) else OUT_OF_VIEW
         if math.isnan(measured) or abs(measured) > 90.0:
             return INVALID
         return OK

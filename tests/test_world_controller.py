@@ -1,0 +1,148 @@
+"""The world apart from the controller: what each side may see, the sensor's physics under cloud,
+the baselines, and what the classifier is worth."""
+
+import ast
+import gc
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import hybridtrack.control as control
+from hybridtrack import simulate, sites
+from hybridtrack.collectors import Collector
+from hybridtrack.control import Controller, ControllerConfig, make_plan
+from hybridtrack.control.plan import east_park
+from hybridtrack.control.skywatch import ClassifierTable
+from hybridtrack.fuzzy import FuzzyWeatherClassifier
+from hybridtrack.sensor import SensorModel, sensor_scene
+from hybridtrack.simulation import SimulationConfig, _drives
+from hybridtrack.sky import synthetic
+from hybridtrack.sun import solar_position
+from hybridtrack.world import Imperfections, World
+
+WORLD_MODULES = {"world", "sky", "sensor", "simulation", "commissioning", "io", "metrics", "ablation"}
+
+
+def test_the_controller_package_imports_nothing_of_the_world():
+    for path in Path(control.__file__).parent.glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level >= 2:
+                assert (node.module or "").split(".")[0] not in WORLD_MODULES, f"{path.name} imports ..{node.module}"
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                assert not node.module.startswith("hybridtrack."), path.name
+
+
+def reachable(root, limit=200_000):
+    """Every object reachable from `root` through references, up to `limit` objects."""
+    seen, stack = {id(root)}, [root]
+    while stack and len(seen) < limit:
+        for child in gc.get_referents(stack.pop()):
+            if id(child) not in seen and not isinstance(child, type):
+                seen.add(id(child))
+                stack.append(child)
+                yield child
+
+
+def test_the_controller_cannot_reach_the_worlds_state():
+    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=1)
+    site, collector, config = sites.get("lanzhou"), Collector("trough-ns"), SimulationConfig()
+    drives = _drives(collector, config.drive)
+    world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
+    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
+    controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), 20.0, east_park(collector))
+    forbidden = (World, Imperfections, pd.DataFrame, SensorModel)
+    assert not any(isinstance(thing, forbidden) for thing in reachable(controller))
+    assert not any(thing is world.truth for thing in reachable(controller))
+
+
+def test_the_kalman_filter_takes_its_noise_from_the_controllers_datasheet_not_the_world():
+    frame = synthetic("nanjing", "2013-06-21 08:00", "2013-06-21 10:00", weather="sunny", seed=1)
+    quiet = SimulationConfig(imperfections=Imperfections(sensor_noise=0.001))
+    loud = SimulationConfig(imperfections=Imperfections(sensor_noise=0.3))
+    for config in (quiet, loud):
+        drives = _drives(Collector("trough-ns"), config.drive)
+        plan = make_plan(frame.index, np.arange(len(frame), dtype=float), sites.get("nanjing"),
+                         Collector("trough-ns"), config.controller)
+        controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), 20.0, [90.0])
+        expected = config.controller.sensor_noise ** 2 + drives[0].resolution ** 2 / 12.0
+        assert controller.gates[0].filter.r == pytest.approx(expected)
+
+
+def test_the_classifier_table_matches_the_exact_engine():
+    clf = FuzzyWeatherClassifier()
+    table = ClassifierTable(clf)
+    rng = np.random.default_rng(0)
+    intensity, variation = rng.uniform(0, 350, 3000), rng.uniform(0, 200, 3000)
+    exact = clf.score(intensity, variation)
+    tabled = np.array([table.score(i, v) for i, v in zip(intensity, variation)])
+    assert np.max(np.abs(tabled - exact)) < 0.05  # score units on the 0-30 output (0.034 measured)
+    labels = clf.label(exact)
+    coded = np.array([control.SKY_CODES[table.code(s)] for s in tabled])
+    edges = np.array([10.0, 20.0])
+    clear_of_edges = np.min(np.abs(exact[:, None] - edges), axis=1) > 0.05
+    assert (coded[clear_of_edges] == labels[clear_of_edges]).all()
+
+
+def scene(weather, seed=2, site="lanzhou", date="2021-06-21"):
+    frame = synthetic(site, date, weather=weather, seed=seed)
+    position = solar_position(frame.index, sites.get(site), "spa")
+    return frame, position, sensor_scene(frame, position, SensorModel(), clear_dni=frame["dni_clear"],
+                                         clear_dhi=frame["dhi_clear"], rng=np.random.default_rng(seed))
+
+
+def test_a_bright_patch_appears_only_where_the_frames_own_light_says_cloud():
+    frame, position, light = scene("overcast")
+    up = position["altitude"].to_numpy() > 10
+    assert np.all(light.patch[up] <= light.aureole[up] * 1e9)  # defined everywhere
+    frame, position, clear = scene("sunny")
+    cloud_light = np.clip(frame["dhi"] - frame["dhi_clear"], 0, None).to_numpy()
+    assert np.all(clear.patch[cloud_light == 0] == 0)
+    frame, position, broken = scene("cloudy")
+    assert broken.patch[up].max() > 20.0  # W/m² of bright cloud near the sun
+    assert np.corrcoef(broken.patch[up], np.clip(frame["dhi"] - frame["dhi_clear"], 0, None)[up])[0, 1] > 0.5
+
+
+def test_the_patch_moves_continuously_and_flips_side_at_cloud_edges():
+    frame, position, light = scene("cloudy")
+    offset = light.patch_offset
+    low, high = SensorModel().patch_distance
+    # a flip of side is smoothed over 2 minutes: at most (1 - e^-0.5) of the full 2 * high swing a minute
+    assert np.max(np.abs(np.diff(offset, axis=0))) < (1 - np.exp(-0.5)) * 2 * high + 1.0
+    distance = np.hypot(offset[:, 0], offset[:, 1])
+    assert distance.max() <= high + 1e-9
+    again = scene("cloudy")[2]
+    np.testing.assert_array_equal(again.patch_offset, offset)  # seeded
+
+
+@pytest.mark.parametrize("site, date", [("lanzhou", "2021-06-21"), ("nanjing", "2013-12-22")])
+def test_clear_sky_sensor_tracking_p95_is_within_0_3_degrees(site, date):
+    frame = synthetic(site, date, weather="sunny", seed=4)
+    for strategy in ("sensor", "hybrid-always"):
+        assert simulate(frame, site, strategy=strategy).summary["tracking_error_deg"]["p95"] <= 0.3
+
+
+@pytest.mark.parametrize("site, date", [("lanzhou", "2021-06-21"), ("nanjing", "2013-12-22")])
+def test_the_fair_sensor_tracker_beats_the_uncommissioned_open_loop_on_sunny_days(site, date):
+    frame = synthetic(site, date, weather="sunny", seed=5)
+    sensor = simulate(frame, site, strategy="sensor").summary
+    astronomical = simulate(frame, site, strategy="astronomical").summary
+    assert sensor["energy_capture"] >= astronomical["energy_capture"]
+    assert sensor["tracking_error_deg"]["rms"] < 0.3  # built as sold: no zenith parking, no slow search
+
+
+def test_on_mixed_days_a_closed_loop_loses_and_the_log_says_why():
+    from hybridtrack.ablation import AblationPlan, ablate
+
+    plan = AblationPlan(sites=("lanzhou", "nanjing"), seasons=("summer", "winter"), seeds=(3,),
+                        collectors=("trough-ns",), policies=("hybrid", "hybrid-always", "sensor"))
+    runs = ablate(plan).runs
+    mean = runs.groupby("policy")[["rms", "energy", "pull_loss_share", "lost_sun_loss_share"]].mean()
+    assert mean.loc["sensor", "rms"] > mean.loc["hybrid", "rms"]
+    assert mean.loc["sensor", "energy"] < mean.loc["hybrid", "energy"]
+    # tracking the sensor whenever it reads valid loses its energy to cloud pull, not to a lost sun
+    assert mean.loc["hybrid-always", "pull_loss_share"] > 3 * mean.loc["hybrid-always", "lost_sun_loss_share"]
+    assert mean.loc["hybrid-always", "rms"] > mean.loc["hybrid", "rms"]
+    # the sensor-only tracker loses to both: pulled while it sees cloud, held while it sees nothing
+    assert (runs.loc[runs["policy"] == "sensor", ["pull_loss_share", "lost_sun_loss_share"]] > 0.05).all().all()
