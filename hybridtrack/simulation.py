@@ -266,7 +266,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     clf = classifier or FuzzyWeatherClassifier(FuzzyConfig.default())
     window = pd.Timedelta(config.sensor.window) / pd.Timedelta(minutes=1)
     controller = Controller(config.controller, drives, plan, clf, window, east_park(collector), memory)
-    _run(world, controller, config.controller.wind_stow, progress, bulk_nights and not faults)
+    _run(world, controller, progress, bulk_nights and not faults)
     out = controller.outputs()
     index = frame.index
     log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config.sensor))
@@ -277,7 +277,16 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                         sun_up=world.altitude > 0,
                         incidence=incidence_cosine(world.altitude, world.azimuth, collector))
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
+    summary["wind_data"] = _wind_data(frame)
     return Result(log, summary, events, site, collector, config, controller.memory())
+
+
+def _wind_data(frame: pd.DataFrame) -> str:
+    """``measured``, ``partly missing`` or ``missing``: never calm by default."""
+    if "wind_speed" not in frame.columns:
+        return "missing"
+    present = np.isfinite(frame["wind_speed"].to_numpy(float))
+    return "measured" if present.all() else ("missing" if not present.any() else "partly missing")
 
 
 def _history(site, collector, config, start, classifier, warm_start):
@@ -307,11 +316,13 @@ def _calibration_summary(mount: MountEstimate | None, fitted: dict | None, out, 
     return {name: round(float(v), 5) for name, v in zip(names, [*values, *mount.encoder_offset])}
 
 
-def _run(world: World, controller: Controller, wind_stow: float, progress, bulk_nights: bool) -> None:
+def _run(world: World, controller: Controller, progress, bulk_nights: bool) -> None:
     """Step world and controller together: the world observes, the controller decides, the world moves."""
     n = world.n
     obs = Observation(world.axes)
-    wind_ok = np.concatenate([[0], np.cumsum(~(world.wind <= wind_stow))])
+    guard = controller.wind
+    gusts = (world.wind > guard.stow_above) | (np.isnan(world.wind) & guard.stow_when_missing)
+    wind_ok = np.concatenate([[0], np.cumsum(gusts)])
     i = reported = 0
     while i < n:
         if progress is not None and i - reported >= 8192:

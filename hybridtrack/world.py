@@ -156,7 +156,7 @@ class World:
         recorded = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
         self._recorded_current = recorded.tolist() if recorded is not None else None
         self.frame_dni = frame["dni"].to_numpy(float)
-        self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.zeros(self.n)
+        self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
         self._wind = self.wind.tolist()
         self._sky = self._true_sky(frame)
         self.minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
 import pandas as pd
 
 from .. import sites
@@ -124,10 +125,24 @@ def _replay_frame(args: argparse.Namespace):
     return site, frame
 
 
+def replay_config(args: argparse.Namespace, frame):
+    """The run's config for a recorded file: a file with no wind at all is tracked through, not
+    stowed all day (``wind_missing = "track"``), unless the config chose otherwise; said aloud."""
+    import dataclasses
+
+    config = simulation_config(args)
+    has_wind = "wind_speed" in frame.columns and np.isfinite(frame["wind_speed"].to_numpy(float)).any()
+    if not has_wind and not args.config:
+        print("wind: MISSING in this file; replayed as tracking through (controller.wind_missing = 'track'), "
+              "not as calm")
+        config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, wind_missing="track"))
+    return config
+
+
 @command("replay", "run a tracker over a recorded weather file", _replay_arguments)
 def _replay(args: argparse.Namespace) -> int:
     site, frame = _replay_frame(args)
-    result = _run(frame, site, args, args.strategy, simulation_config(args))
+    result = _run(frame, site, args, args.strategy, replay_config(args, frame))
     _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, {args.strategy}")
     return 0
 
@@ -148,7 +163,7 @@ def _compare(args: argparse.Namespace) -> int:
         raise HybridtrackError("give a recorded FILE, or --date for synthetic days")
     if args.file is not None:
         site, frame = _replay_frame(args)
-        config = simulation_config(args)
+        config = replay_config(args, frame)
     else:
         site = site_from_arguments(args)
         frame = synthetic_frame(args, site)

@@ -38,6 +38,11 @@ class ControllerConfig:
     wind_stow, wind_release : float
         m/s: stow above `wind_stow`; resume once at or below `wind_release` for `wind_hold`.
     wind_hold : str
+    wind_missing : {"stow", "track"}
+        What a missing anemometer reading means. ``stow`` (the default, a live controller's
+        safe choice) treats it as a gust; ``track`` goes on tracking, for replaying a recorded
+        file that has no wind at all (``hybridtrack replay`` chooses it then, and says so). In
+        both cases the run reports the wind as missing, never as calm.
     working_hours : tuple of str
         Local clock times the controller works between.
     min_altitude : float
@@ -90,6 +95,7 @@ class ControllerConfig:
     wind_stow: float = 17.2
     wind_release: float = 12.0
     wind_hold: str = "10min"
+    wind_missing: str = "stow"
     working_hours: tuple[str, str] = ("05:00", "20:00")
     min_altitude: float = 0.0
     calibration_tau: str = "30min"
@@ -116,6 +122,8 @@ class ControllerConfig:
             raise HybridtrackError(f"unknown strategy {self.strategy!r}; choose from {', '.join(STRATEGIES)}")
         if self.sun_model not in ("plc", "spa"):
             raise HybridtrackError(f"unknown sun model {self.sun_model!r}; choose 'plc' or 'spa'")
+        if self.wind_missing not in ("stow", "track"):
+            raise HybridtrackError(f"controller: wind_missing {self.wind_missing!r}; choose 'stow' or 'track'")
         if self.kalman not in ("fast", "filterpy"):
             raise HybridtrackError(f"unknown Kalman engine {self.kalman!r}; choose 'fast' or 'filterpy'")
         for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast"):

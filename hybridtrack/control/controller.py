@@ -38,6 +38,10 @@ DUSK_MINUTES = 30.0
 #: Minutes between the readings the mount fit takes: readings a minute apart are correlated
 #: through the filter and the sun has hardly moved, so more would add time, not information.
 FIT_EVERY = 5.0
+#: Minutes a sensor that disagreed with the calibrated model is not trusted; then it is judged again.
+DISTRUST_MINUTES = 60.0
+#: Fit readings (an hour at one every five minutes) before the sensor is judged against the fit.
+SETTLE_UPDATES = 12
 #: The policies that decide on the fuzzy classifier's sky.
 CLASSIFYING = ("hybrid", "hybrid-nocal")
 
@@ -115,7 +119,7 @@ class Controller:
         resolution = [d.resolution for d in drives]
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.encoders = [EncoderMonitor(r, config.encoder_confirm) for r in resolution]
-        self.wind = WindGuard(config.wind_stow, config.wind_release, config.minutes("wind_hold"))
+        self.wind = WindGuard(config.wind_stow, config.wind_release, config.minutes("wind_hold"), config.wind_missing)
         self.sky = SkyWatch(ClassifierTable(classifier), window_minutes)
         variance = [config.sensor_noise**2 + r * r / 12.0 for r in resolution]
         self.gates = [SensorGate(config.kalman, config.process_noise, v, config.stuck_scans, config.gate,
@@ -133,7 +137,7 @@ class Controller:
         self.fit_row = ([], [])
         self.disagreement = DisagreementMonitor()
         self.checkpoint: dict | None = None
-        self.distrusted = False  # the sensor disagreed with the calibrated model: not trusted until tomorrow
+        self.distrusted_until = -math.inf  # the sensor disagreed with the calibrated model: not trusted till then
         if memory:
             self._recall(memory)
         self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
@@ -245,7 +249,6 @@ class Controller:
         if self.mode == STOW_NIGHT:
             for gate in self.gates:
                 gate.forget()
-            self.distrusted = False
         return moves
 
     def _daylight(self, t: float, intensity: float) -> bool:
@@ -318,7 +321,7 @@ class Controller:
         trusted = config.calibrates and self._trusts_sensor(sky, obs)
         for a, gate in enumerate(self.gates):
             verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a])
-            if verdict == OK and self.distrusted:
+            if verdict == OK and obs.t < self.distrusted_until:
                 verdict = IMPLAUSIBLE
             if verdict == OK:
                 verdict = self._offer(i, a, dt, reading[a] + obs.offset[a], trusted)
@@ -380,29 +383,42 @@ class Controller:
             self.fitted_at[a] = t
             self.fit.forget(t - self.fit_since)
             self.fit_since = t
+            miss, spread = self._against_checkpoint(i, a, z, m0)
             w = self.weight[i, a]
             self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w)
             self.theta = self.fit.theta
-            if self._disagrees(i):
+            if self._disagrees(i, miss, spread):
                 return
         mount = self._correction(i, a) - self.calibrators[a].offset
         residual = self._turn(a, self.gates[a].filter.angle - m0 - mount)
         self.calibrators[a].learn(dt, residual, self._turn(a, m0 - m1), bound)
 
-    def _disagrees(self, i: int) -> bool:
-        """Watch the fit's innovations; on a persistent disagreement roll the calibration back."""
-        normalised, size = self.fit.last_innovation
+    def _against_checkpoint(self, i: int, a: int, z: float, m0: float) -> tuple[float, float]:
+        """The sensor's sun angle less the mount as fitted at the last checkpoint, and the spread that
+        difference should have: the sensor's noise and the checkpoint's own uncertainty. A calibration
+        that follows a drifting sensor must not hide the drift; the residual offset is left out, as
+        it follows the time of day and a checkpoint's offset belongs to another hour."""
+        fit = self.checkpoint if self.checkpoint is not None else {"theta": self.theta, "p": self.fit.p}
+        row = self.jacobian[i, a]
+        miss = self._turn(a, z - m0 - float(row @ fit["theta"]))
+        return miss, math.sqrt(self.fit.r + float(row @ fit["p"] @ row))
+
+    def _disagrees(self, i: int, miss: float, spread: float) -> bool:
+        """Watch the sensor against the checkpointed calibration (`miss`, degrees, with its expected
+        `spread`); on a persistent disagreement roll the calibration back and distrust the sensor."""
+        if self.fit.updates < SETTLE_UPDATES:  # a fit still finding its feet is not evidence against the sensor
+            return False
         if self.disagreement.calm:
             self.checkpoint = self.memory()
-        if not self.disagreement.add(normalised, size, self.config.disagreement):
+        if not self.disagreement.add(miss / spread, miss, self.config.disagreement):
             return False
         mean, count = self.disagreement.mean_residual(), self.disagreement.run
         if self.checkpoint is not None:
             self._recall(self.checkpoint)
         self.disagreement.reset()
-        self.distrusted = True
+        self.distrusted_until = self.previous_t + DISTRUST_MINUTES
         self._alarm(i, f"sensor and calibrated model disagree: mean residual {mean:+.3f}° over {count} readings; "
-                       "calibration rolled back, sensor not trusted until tomorrow")
+                       f"calibration rolled back, sensor not trusted for {DISTRUST_MINUTES:.0f} min")
         return True
 
     def memory(self) -> dict:

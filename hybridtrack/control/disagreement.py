@@ -26,6 +26,9 @@ __all__ = ["DisagreementMonitor", "ALLOWANCE", "THRESHOLD"]
 
 #: Half the shift (in standard deviations) the CUSUM is tuned to see at once.
 ALLOWANCE = 0.5
+#: Readings in a flagged run before it can be an alarm (half an hour of fit readings): a few large
+#: residuals are a passing cloud's pull, not a fault.
+MIN_RUN = 6
 #: The sum that raises the alarm; with k = 0.5 a healthy sensor takes on the order of a thousand
 #: fit readings (five-minute apart) to reach it by chance.
 THRESHOLD = 8.0
@@ -56,7 +59,7 @@ class DisagreementMonitor:
             return False
         self.run += 1
         self.run_sum += residual
-        if self.high <= THRESHOLD and self.low <= THRESHOLD:
+        if (self.high <= THRESHOLD and self.low <= THRESHOLD) or self.run < MIN_RUN:
             return False
         if abs(self.mean_residual()) >= limit:
             return True

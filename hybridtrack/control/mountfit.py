@@ -116,7 +116,6 @@ class MountEstimator:
         self.updates = 0
         self.axis_frozen = True
         self.condition = math.inf
-        self.last_innovation = (0.0, 0.0)
 
     def predict(self, row) -> float:
         """The correction the fitted mount makes to a computed target: row · theta."""
@@ -146,7 +145,6 @@ class MountEstimator:
             gain[:2] = 0.0
         bound = self.clip * math.sqrt(s)
         innovation = residual - float(row @ self.theta)
-        self.last_innovation = (innovation / math.sqrt(s), innovation)
         error = max(-bound, min(bound, innovation))
         self.theta = self.theta + gain * error
         a = np.eye(self.n) - np.outer(gain, row)  # Joseph form, right for any gain
