@@ -12,7 +12,8 @@ def test_check_prints_the_validation_summary(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "3 rows read, 2 rows out, step 1min" in out
     assert "semicolon-separated, decimal ','" in out and "dni <- 'Direct Normal'" in out
-    assert "duplicated stamps: count 1, lines 6" in out and "negative values clipped to 0: dhi count 1" in out
+    assert "dropped (repeated stamps, the first kept): count 1, lines 6" in out
+    assert "clipped to 0 (negative irradiance): dhi count 1, lines 5, lowest -4.0" in out
 
 
 def test_check_a_shipped_record(capsys):

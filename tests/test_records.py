@@ -29,7 +29,8 @@ def test_semicolons_decimal_commas_header_block_and_units(tmp_path):
     assert list(frame.columns) == ["ghi", "dni", "dhi", "wind_speed"]
     assert frame["ghi"].iloc[0] == pytest.approx(900.5) and frame["wind_speed"].iloc[0] == pytest.approx(10.0)
     report = frame.attrs["validation"]
-    assert report["header_lines_skipped"] == 3 and report["separator"] == "semicolon" and report["decimal"] == ","
+    assert report["skipped"]["notes before the header"] == [1, 2]
+    assert report["separator"] == "semicolon" and report["decimal"] == ","
     assert frame.index[0] == pd.Timestamp("2021-06-21 12:00", tz="Asia/Shanghai")
 
 
@@ -61,7 +62,7 @@ def test_dst_fall_back_and_spring_forward(tmp_path):
     frame = read_weather(path, tz="America/New_York")
     dropped = frame.attrs["validation"]["dst_dropped"]
     assert dropped["count"] == 2 and dropped["lines"] == [6, 7] and len(frame) == 7
-    assert "DST: dropped" in validation_report(frame)
+    assert "dropped (DST: stamps that do not exist): count 2, lines 6, 7" in validation_report(frame)
 
 
 def test_missing_dni_by_closure_or_decomposition(tmp_path):
@@ -74,15 +75,21 @@ def test_missing_dni_by_closure_or_decomposition(tmp_path):
     closure = read_weather(path, site="nanjing")
     from hybridtrack.sun import solar_position
 
-    cos_z = np.cos(np.radians(solar_position(closure.index, "nanjing")["apparent_zenith"]))
+    # pvlib documents the true (not refraction-corrected) zenith for closure, erbs and dirint
+    zenith = solar_position(closure.index, "nanjing")["zenith"]
+    cos_z = np.cos(np.radians(zenith))
     np.testing.assert_allclose(closure["dni"] * cos_z + closure["dhi"], ghi, rtol=1e-9)
     assert closure.attrs["dni_source"].startswith("closure")
     path = write(tmp_path, "g.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "ghi": ghi})
                  .to_csv(index=False))
     erbs = read_weather(path, site="nanjing")
     assert erbs.attrs["dni_source"].startswith("erbs") and (erbs["dni"] > 0).all() and (erbs["dhi"] > 0).all()
+    expected = pvlib.irradiance.erbs(pd.Series(ghi, index=times), zenith.to_numpy(), times)
+    np.testing.assert_allclose(erbs["dni"], expected["dni"], rtol=1e-12)
     dirint = read_weather(path, site="nanjing", decomposition="dirint")
     assert dirint.attrs["dni_source"].startswith("dirint")
+    np.testing.assert_allclose(dirint["dni"], pvlib.irradiance.dirint(pd.Series(ghi, index=times), zenith.to_numpy(),
+                                                                      times).fillna(0.0), rtol=1e-12)
 
 
 def test_five_minute_data_is_interpolated_to_the_control_step(tmp_path):
@@ -121,8 +128,9 @@ def test_pvlib_formats_go_through_pvlib(tmp_path):
         read_weather(write(tmp_path, "bad.epw", "not an epw\n"), format="epw")
 
 
-EPW_HEADER = ("LOCATION,Nanjing,JS,CHN,SYN,582380,31.93,118.90,8.0,7.1\nDESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\n"
-              "GROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,test\nCOMMENTS 2,test\n"
+EPW_HEADER = ("LOCATION,Nanjing,JS,CHN,SYN,582380,31.93,118.90,8.0,7.1\nDESIGN CONDITIONS,0\n"
+              "TYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n"
+              "COMMENTS 1,test\nCOMMENTS 2,test\n"
               "DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n")
 
 
@@ -156,7 +164,8 @@ def test_the_shipped_records_regenerate_byte_for_byte():
     (None, {}, "no such file"),
     ("", {}, "the file is empty"),
     (b"\x89PNG\r\n\x1a\n\x00\x00binary", {}, "looks binary"),
-    ("time,ghi\n2021-06-21 12:00,9\u00e900\n".encode("latin-1"), {"tz": "UTC"}, "line 2: not UTF-8"),
+    ("time,ghi\n2021-06-21 12:00,9\u00e900\n".encode("latin-1"), {"tz": "UTC"},
+     "line 2, column 'ghi': '9\u00e900' is not"),
     ("a,b\n1,2\n3,4\n", {}, "no time column found"),
     ("time,pressure\n2021-06-21 12:00,1000\n2021-06-21 12:01,1000\n", {"tz": "UTC"}, "no irradiance column"),
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,lots\n", {"tz": "UTC"}, "line 3, column 'ghi': 'lots' is not"),
@@ -164,7 +173,8 @@ def test_the_shipped_records_regenerate_byte_for_byte():
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "UTC", "columns": {"dni": "Beam"}},
      "no column 'Beam' \\(mapped to dni\\); columns are time, ghi"),
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "Mars/Base"}, "unknown time zone 'Mars/Base'"),
-    ("time,ghi\n2021-06-21 12:00,9000\n2021-06-21 12:01,9100\n", {"tz": "UTC"}, "100% of values are outside.*wrong unit"),
+    ("time,ghi\n2021-06-21 12:00,9000\n2021-06-21 12:01,9100\n", {"tz": "UTC"},
+     "100% of values are outside.*wrong unit"),
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "UTC", "units": {"ghi": "furlongs"}},
      "unknown unit 'furlongs'"),
     ("time,ghi\n2021-06-21 12:00,900\n", {"tz": "UTC"}, "fewer than two distinct time stamps"),
