@@ -159,8 +159,10 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             why = f"at most {top:g} over {hours:.0f} hours"
         if suspicious:
             header = report.get("columns", {}).get(name, name)
-            raise HybridtrackError(f"{path}: column {header!r}: {name} is {why}; the values look like kW/m² read as "
-                                   f"W/m²: give the unit (--units {name}=kW/m2)")
+            line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(frame[name].to_numpy(float))))
+            where = f"line {line[0]}, " if line else ""
+            raise HybridtrackError(f"{path}: {where}column {header!r}: {name} is {why}; the values look like kW/m² "
+                                   f"read as W/m²: give the unit (--units {name}=kW/m2)")
 
 
 def refuse_repairs(path: Path, report: dict) -> None:

@@ -33,20 +33,22 @@ UNNAMED = ""
 #: Usual header names of each column, lower-cased, after brackets and statistics suffixes are removed.
 ALIASES = {
     "time": ("time", "timestamp", "datetime", "date_time", "date time", "date/time", "time stamp", "tmstamp",
-             "utc", "local time", "time_utc", "epoch", "unix time", "unixtime", UNNAMED, "unnamed: 0", "index"),
+             "utc", "local time", "time_utc", "epoch", "unix time", "unixtime", UNNAMED, "unnamed: 0", "index",
+             "zeit", "zeitstempel", "datum/zeit", "horodatage", "date heure", "fecha hora", "fecha y hora"),
     "date": ("date", "day", "date (mm/dd/yyyy)", "yyyy-mm-dd", "datum", "fecha"),
     "clock": ("time", "hour", "clock", "hh:mm", "time (hh:mm)", "mst", "pst", "lst", "est", "cst", "uhrzeit", "hora"),
     "ghi": ("ghi", "global", "global horizontal", "global_horizontal", "global horizontal irradiance",
-            "global irradiance", "glo", "gh", "ghi_wm2", "slrw", "sr", "sw_in", "swdown", "global_irradiance",
-            "global_horiz", "ghi_pyr", "g_h"),
+            "global irradiance", "glo", "gh", "ghi_wm2", "slrw", "sw_in", "swdown", "global_irradiance",
+            "global_horiz", "ghi_pyr", "g_h", "dw_solar"),
     "dni": ("dni", "direct normal", "direct_normal", "direct normal irradiance", "direct", "beam", "dn", "dni_wm2",
-            "direct_normal_irradiance", "dni_pyr", "direct normal (pyrheliometer)", "b_n"),
+            "direct_normal_irradiance", "dni_pyr", "b_n", "direct_n"),
     "dhi": ("dhi", "diffuse", "diffuse horizontal", "diffuse_horizontal", "diffuse horizontal irradiance", "dif",
-            "dhi_wm2", "diffuse_horizontal_irradiance", "diffuse horizontal (shaded)", "d_h"),
-    "wind_speed": ("wind_speed", "wind speed", "windspeed", "wind", "ws", "wspd", "ws_ms", "ws_kph", "ws_mph",
-                   "wind_ms", "u", "avg wind speed", "wind speed avg", "wsp"),
+            "dhi_wm2", "diffuse_horizontal_irradiance", "d_h"),
+    "wind_speed": ("wind_speed", "wind speed", "windspeed", "windgeschwindigkeit", "vitesse du vent",
+                   "wind", "ws", "wspd", "ws_ms", "wind_ms", "avg wind speed", "wind speed avg", "wsp"),
     "temp_air": ("temp_air", "air temperature", "temperature", "temp", "tair", "t_air", "ta", "airtc", "airtk",
-                 "air_temp", "tamb", "t_amb", "ambient temperature", "dry bulb", "drybulb", "temp_c", "t2m"),
+                 "air_temp", "tamb", "t_amb", "ambient temperature", "dry bulb", "drybulb", "temp_c", "t2m",
+                 "dry bulb temp", "tower dry bulb temp", "temperatur", "température", "temperatura", "lufttemperatur"),
     "photocurrent": ("photocurrent", "photocurrent_ma", "intensity", "intensity_ma", "sensor current"),
 }
 
@@ -67,7 +69,8 @@ def split_header(header: str) -> tuple[str, str | None, str | None]:
             unit = inner
         elif inner:
             note = inner if note is None else f"{note}; {inner}"
-    name = _BRACKETS.sub(" ", header).strip().lower()
+    name = re.sub(r"\s*@.*$", "", _BRACKETS.sub(" ", header)).strip().lower()  # 'Wind Speed @ 6ft'
+    name = re.sub(r"\s+", " ", name)
     if name == UNNAMED or name.startswith("unnamed:"):
         return (UNNAMED if header.strip().lower() in (UNNAMED, "unnamed: 0") else name), unit, note
     return _SUFFIX.sub("", name), unit, note

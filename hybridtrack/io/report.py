@@ -44,7 +44,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
     if "format" in report:
         lines.append(f"  format: {report['format'].upper()} (through pvlib), read as {report.get('read_as', '?')}")
     else:
-        lines.append(f"  table: {report.get('table', 'table')}, {report.get('separator', '?')}-separated, decimal "
+        kind = "" if report.get("table", "table") == "table" else f"{report['table']}, "
+        lines.append(f"  table: {kind}{report.get('separator', '?')}-separated, decimal "
                      f"'{report.get('decimal', '.')}', read as {report.get('read_as', '?')}")
         for what, numbers in report.get("skipped", {}).items():
             lines.append(f"  skipped {what}: {len(numbers)} line{'s' if len(numbers) > 1 else ''} "

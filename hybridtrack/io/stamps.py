@@ -68,7 +68,7 @@ def _day_month_order(column: _Column, parts: pd.DataFrame, dayfirst: bool | None
     """Whether the column's dates are day-first, and why (see the module's notes)."""
     first, second = parts[0].astype(int).to_numpy(), parts[2].astype(int).to_numpy()
     if dayfirst is not None:
-        return dayfirst, "as told (--dayfirst)" if dayfirst else "as told (--monthfirst)"
+        return dayfirst, ("day-first" if dayfirst else "month-first") + " as given (a flag or the column's name)"
     day_first, month_first = np.flatnonzero(first > 12), np.flatnonzero(second > 12)
     if len(day_first) and len(month_first):
         column.refuse(int(month_first[0]), f"reads month-first, but line {int(column.lines[day_first[0]])} reads "
@@ -218,5 +218,6 @@ def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *,
     if site_tz is not None:
         return _localise(column, index, site_tz, f"naive stamps read as the site's local time ({site_tz}); give "
                                                  "the file's zone if it is another (--tz)", report)
-    raise HybridtrackError(f"{path}: column {header!r} has naive time stamps (no UTC offset); give the time zone "
-                           "they were logged in (tz=..., --tz Asia/Shanghai), or a site")
+    raise HybridtrackError(f"{path}: line {int(lines[0])}, column {header!r}: naive time stamps (no UTC offset, e.g. "
+                           f"{column.text.iloc[0]!r}); give the time zone they were logged in (tz=..., --tz "
+                           "Asia/Shanghai), or a site")

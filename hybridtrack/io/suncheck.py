@@ -95,6 +95,14 @@ def _offset_text(frame: pd.DataFrame, shift: pd.Timedelta) -> str:
     return f"UTC{sign}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"
 
 
+def _fits(frame: pd.DataFrame, site, shift: pd.Timedelta) -> str:
+    offset = frame.index[len(frame) // 2].utcoffset() - shift
+    fits = f"the light fits the sun at {site.name} shifted by {_signed(shift)}"
+    if abs(offset) > pd.Timedelta(hours=14):
+        return fits + ", beyond any time zone: is the file from another site?"
+    return fits + f", i.e. stamps in {_offset_text(frame, shift)}"
+
+
 def _signed(shift: pd.Timedelta) -> str:
     return ("+" if shift >= pd.Timedelta(0) else "-") + span(abs(shift)) if shift != pd.Timedelta(0) else "0"
 
@@ -122,8 +130,7 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
         line = first_lines(frame, np.arange(len(frame)) == row)
         where = f"line {line[0]}, " if line else ""
         value = float(frame[name].iloc[row])
-        fits = (f"the light fits the sun at {site.name} shifted by {_signed(shift)}, i.e. stamps in "
-                f"{_offset_text(frame, shift)}" if offset_wrong else "no shift of the sun explains it")
+        fits = _fits(frame, site, shift) if offset_wrong else "no shift of the sun explains it"
         what = (f"{night.sum()} of {lit} lit rows have {name} while the sun is down, the first {value:g} W/m² at "
                 f"{frame.index[row]}" if night.any() else
                 f"the daily light curve is offset from the sun, e.g. {value:g} W/m² at {frame.index[row]}")

@@ -41,7 +41,8 @@ def normalise_unit(text: str) -> str:
     unit = re.sub(r"^(k?w)m-2$", r"\1/m2", unit)
     unit = re.sub(r"^(k?w)/m-2$", r"\1/m2", unit)
     unit = re.sub(r"^(deg(rees?)?|°)_?([cfk])$", r"\3", unit)
-    unit = {"kelvin": "k", "celsius": "c", "m/sec": "m/s", "mps": "m/s", "km/hr": "km/h"}.get(unit, unit)
+    unit = {"kelvin": "k", "celsius": "c", "m/sec": "m/s", "mps": "m/s",
+            "meters/second": "m/s", "metres/second": "m/s", "km/hr": "km/h"}.get(unit, unit)
     return unit
 
 

@@ -56,6 +56,9 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
         text = pd.Series(cells(mapping["date"])).str.strip() + " " + pd.Series(cells(mapping["clock"])).str.strip()
         header = f"{mapping['date']} + {mapping['clock']}"
         zone = CLOCK_ZONES.get(split_header(mapping["clock"])[0])
+        written = mapping["date"].lower().replace(" ", "")  # 'DATE (MM/DD/YYYY)' says its order
+        if dayfirst is None and ("mm/dd" in written or "dd/mm" in written):
+            dayfirst = "dd/mm" in written
     else:
         text, header, zone = pd.Series(cells(mapping["time"])), mapping["time"], None
     return parse_stamps(path, header, text, table.lines, tz=tz, site_tz=site.tz if site is not None else None,
@@ -117,8 +120,8 @@ def _site_from_meta(meta: dict):
 
     try:
         return custom(float(meta["latitude"]), float(meta["longitude"]), "UTC",
-                      float(meta.get("altitude", 0.0) or 0.0),
-                      name=str(meta.get("Name", meta.get("City", meta.get("city", "file")))).strip('"'))
+                      float(meta.get("altitude", meta.get("elevation", 0.0)) or 0.0),
+                      name=str(meta.get("Name", meta.get("City", meta.get("name", "file")))).strip('" '))
     except (HybridtrackError, TypeError, ValueError):
         return None
 
