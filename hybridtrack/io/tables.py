@@ -96,7 +96,9 @@ def _choose_separator(path: Path, kept: list[tuple[int, str]]) -> tuple[int, str
         for position, (_, line) in enumerate(kept):
             fields = _split(line, sep)
             if len(fields) == width and any(re.search(r"[A-Za-z]", f) for f in fields):
-                below = [len(_split(x, sep)) for _, x in kept[position + 1:]]
+                rest = kept[position + 1:]
+                sample = rest[::max(1, len(rest) // 500)]  # enough lines to judge, in big files too
+                below = [len(_split(x, sep)) for _, x in sample]
                 share = below.count(width) / max(len(below), 1)
                 if best is None or (share, width) > best[0]:
                     best = ((share, width), position, sep)
@@ -105,6 +107,10 @@ def _choose_separator(path: Path, kept: list[tuple[int, str]]) -> tuple[int, str
         raise HybridtrackError(f"{path}: no table found: no header row of named columns separated by comma, "
                                "semicolon, tab or bar")
     return best[1], best[2]
+
+
+def rows_with_values(body: list[tuple[int, str]], sep: str) -> bool:
+    return any(any(f.strip() for f in _split(line, sep)) for _, line in body)
 
 
 def locate_table(path: Path, text: str) -> Table:
@@ -128,11 +134,13 @@ def locate_table(path: Path, text: str) -> Table:
         meta.append(_split(body[0][1], sep))
         skipped.setdefault("units and processing rows", []).append(body[0][0])
         body = body[1:]
-    if not body:
+    if not body or not rows_with_values(body, sep):
         raise HybridtrackError(f"{path}: the table has a header but no rows")
     rows, numbers = [], []
-    for number, line in body:
-        fields = _split(line, sep)
+    for (number, _), fields in zip(body, csv.reader([line for _, line in body], delimiter=sep)):
+        if not any(f.strip() for f in fields):  # ';;;;': a row the logger left empty
+            skipped.setdefault("empty rows", []).append(number)
+            continue
         if len(fields) > len(headers):
             if all(not f.strip() for f in fields[len(headers):]):
                 fields = fields[:len(headers)]

@@ -132,8 +132,8 @@ def _wind(frame: pd.DataFrame, attrs: dict, report: dict) -> pd.DataFrame:
         attrs["wind_data"] = "measured"
         return frame
     attrs["wind_data"] = "missing"
-    report["wind_missing"] = ("no wind column in the file" if "wind_speed" not in frame
-                              else "the wind column holds no readable value")
+    why = "no wind column in the file" if "wind_speed" not in frame else "the wind column holds no readable value"
+    report["wind_missing"] = f"{why}; wind_speed is NaN (attrs['wind_data'] = 'missing'), never taken as calm"
     frame = frame.copy()
     frame["wind_speed"] = np.nan
     return frame
@@ -217,7 +217,8 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
 
         from ..sun import solar_position
 
-        clear = pvlib.clearsky.haurwitz(solar_position(frame.index, site)["apparent_zenith"])["ghi"].to_numpy(float)
+        zenith = solar_position(frame.index, site, model="plc")["apparent_zenith"]  # a magnitude check: PLC is ample
+        clear = pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float)
         check_magnitude(path, frame, report, clear)
         sun_check(path, frame, site, report, lenient=lenient)
     else:
