@@ -30,6 +30,7 @@ from make_records import truth  # noqa: E402
 
 SHANGHAI = "Asia/Shanghai"
 GOLDEN = sites.custom(39.742, -105.18, "Etc/GMT+7", 1829.0, name="golden")
+EUGENE = sites.custom(44.0467, -123.0743, "Etc/GMT+8", 150.0, name="eugene")
 ALL = ["ghi", "dni", "dhi", "wind_speed", "temp_air"]
 PVLIB_DATA = Path(os.path.dirname(pvlib.__file__)) / "data"
 
@@ -105,6 +106,7 @@ CASES = [
     ("NREL MIDC at the wrong site", "midc-bms.csv", {"site": "lanzhou"},
      refused("line 5, column 'Direct Normal [W/m^2]'", "while the sun is down", "shifted by")),
     ("NOAA SURFRAD", "surfrad-bon.dat", {}, {"pvlib": "surfrad"}),
+    ("University of Oregon SRML", "srml-eugene.tsv", {"site": EUGENE}, {"pvlib": "srml"}),
     ("--units with an unknown name", "plain.csv", {"tz": SHANGHAI, "units": {"wind": "km/h"}},
      refused("unknown column name 'wind' in --units")),
     ("one column mapped twice", "plain.csv", {"tz": SHANGHAI, "columns": {"ghi": "GHI", "dni": "GHI"}},
@@ -184,8 +186,9 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
 
 def check_pvlib(frame: pd.DataFrame, path: Path, fmt: str) -> None:
     reader = {"epw": lambda p: pvlib.iotools.read_epw(p, coerce_year=2019),
-              "surfrad": pvlib.iotools.read_surfrad}[fmt]
-    data = reader(str(path))[0]
+              "surfrad": pvlib.iotools.read_surfrad, "srml": pvlib.iotools.read_srml}[fmt]
+    data = reader(str(path))
+    data = data[0] if isinstance(data, tuple) else data.rename(columns=lambda c: c.removesuffix("_0"))
     pd.testing.assert_index_equal(frame.index.tz_convert("UTC"), data.index.tz_convert("UTC"), check_names=False)
     for name in ALL:
         np.testing.assert_allclose(frame[name], data[name].astype(float), rtol=1e-12, err_msg=name)

@@ -2,7 +2,8 @@
 
 `detect_format` looks at a file's first lines: ``LOCATION,`` (EPW), a TMY3 station line
 followed by ``Date (MM/DD/YYYY),Time (HH:MM)``, a TMY2 station line (WBAN, city, state, zone,
-latitude and longitude in degrees and minutes), a SURFRAD station and coordinates block, or a
+latitude and longitude in degrees and minutes), an SRML header (station, year, then element
+numbers each followed by a 0 flag column, tab-separated), a SURFRAD station and coordinates block, or a
 BSRN station-to-archive record (``*C0100`` ...). Anything else is read as a table, which covers
 NREL MIDC's CSV (``DATE (MM/DD/YYYY),MST,...``) by its names.
 
@@ -43,11 +44,12 @@ PVLIB_NAMES = {
 }
 
 _TMY2_FIRST = re.compile(r"^\s*\d{5}\s+\S.*\s+-?\d{1,2}\s+[NS]\s+\d+\s+\d+\s+[EW]\s+\d+\s+\d+\s+-?\d+\s*$")
+_SRML_FIRST = re.compile(r"^\d{5}\t(19|20)\d{2}(\t\d{3,4}\t0)+\s*$")
 _SURFRAD_SECOND = re.compile(r"^\s*-?\d+\.\d+\s+-?\d+\.\d+\s+\d+\s+m\s+version", re.I)
 
 
 def detect_format(text: str) -> str:
-    """``'epw'``, ``'tmy3'``, ``'tmy2'``, ``'surfrad'``, ``'bsrn'`` or ``'csv'``, from the first lines."""
+    """``'epw'``, ``'tmy3'``, ``'tmy2'``, ``'srml'``, ``'surfrad'``, ``'bsrn'`` or ``'csv'``, from the first lines."""
     lines = text.lstrip("\ufeff").splitlines()[:3] + ["", ""]
     first, second = lines[0], lines[1]
     if first.upper().startswith("LOCATION,"):
@@ -56,6 +58,8 @@ def detect_format(text: str) -> str:
         return "tmy3"
     if _TMY2_FIRST.match(first):
         return "tmy2"
+    if _SRML_FIRST.match(first):
+        return "srml"
     if _SURFRAD_SECOND.match(second):
         return "surfrad"
     if re.match(r"^\*[CU]\d{4}", first):

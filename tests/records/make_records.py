@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-SHANGHAI, MST = "Asia/Shanghai", "Etc/GMT+7"
+SHANGHAI, MST, PST = "Asia/Shanghai", "Etc/GMT+7", "Etc/GMT+8"
 WEATHER = ["ghi", "dni", "dhi", "wind_speed", "temp_air"]
 
 
@@ -29,10 +29,12 @@ def make_truths() -> None:  # pragma: no cover - run once; the truths are commit
 
     golden = sites.custom(39.742, -105.18, MST, 1829.0, name="golden")
     bondville = sites.custom(40.05, -88.37, "UTC", 213.0, name="bondville")
+    eugene = sites.custom(44.0467, -123.0743, PST, 150.0, name="eugene")
     specs = {"lanzhou-day": ("lanzhou", "2021-06-05 05:00", "2021-06-05 21:00", "10min", "sunny"),
              "lanzhou-days": ("lanzhou", "2021-06-05", "2021-06-14", "1h", "mixed"),
              "golden-day": (golden, "2021-06-05 05:00", "2021-06-05 20:00", "10min", "sunny"),
-             "bondville-day": (bondville, "2021-06-05", "2021-06-05", "10min", "sunny")}
+             "bondville-day": (bondville, "2021-06-05", "2021-06-05", "10min", "sunny"),
+             "eugene-day": (eugene, "2021-06-05 04:00", "2021-06-05 21:00", "10min", "sunny")}
     for name, (site, start, end, freq, weather) in specs.items():
         frame = synthetic(site, start, end, weather=weather, freq=freq, seed=3)[WEATHER]
         frame = frame.round({"ghi": 1, "dni": 1, "dhi": 1, "wind_speed": 2, "temp_air": 1})
@@ -262,6 +264,20 @@ def surfrad() -> str:
     return "Bondville\n   40.05  -88.37  213 m version   1\n" + "\n".join(rows) + "\n"
 
 
+def srml() -> str:
+    """A University of Oregon SRML archival file: tabs, element numbers, day of year, interval-end HHMM in PST."""
+    day = truth("eugene-day")
+    local = day.index.tz_convert(PST) + pd.Timedelta(minutes=10)  # stamped at the interval's end
+    head = "94255\t2021\t1000\t0\t2010\t0\t3000\t0\t9300\t0\t9210\t0"
+    rows = []
+    for stamp, row in zip(local, day.itertuples()):
+        clock = 2400 if stamp.hour == 0 and stamp.minute == 0 else stamp.hour * 100 + stamp.minute
+        values = (row.ghi, row.dni, row.dhi, row.temp_air, row.wind_speed)
+        rows.append("\t".join([str((stamp - pd.Timedelta(minutes=1)).day_of_year), str(clock)]
+                              + [f"{v:g}\t11" for v in values]))
+    return "\n".join([head] + rows) + "\n"
+
+
 def naive_no_zone() -> str:
     return pandas_index_naive()
 
@@ -292,7 +308,7 @@ FILES = {
     "logger.csv.gz": _packed_gzip, "logger.zip": _packed_zip, "excel-unicode.txt": excel_unicode,
     "latin1.csv": latin1, "utf8-bom.csv": utf8_bom, "comments-anywhere.csv": comments_anywhere, "messy.csv": messy,
     "ghi-only.csv": ghi_only, "lanzhou.epw": epw, "midc-bms.csv": midc, "surfrad-bon.dat": surfrad,
-    "naive-no-zone.csv": naive_no_zone,
+    "naive-no-zone.csv": naive_no_zone, "srml-eugene.tsv": srml,
 }
 
 
