@@ -46,3 +46,24 @@ def test_sky_prints_the_day_and_writes_csv_and_plot(tmp_path, capsys):
     frame = pd.read_csv(out, index_col="time")
     assert {"ghi", "dni", "dhi", "wind_speed", "temp_air", "sky", "intensity_ma", "variation_ma"} <= set(frame.columns)
     assert len(frame) == 2 * 1440 and png.stat().st_size > 30_000
+
+
+def test_the_report_gives_the_dates_and_every_change_with_where(capsys):
+    """A messy file at a 5-minute step: each kind of change is listed with its count and file lines."""
+    assert main(["check", "tests/records/messy.csv", "--site", "lanzhou", "--freq", "5min", "--map", "dhi=DHI"]) == 0
+    out = capsys.readouterr().out
+    assert "98 rows read, 193 rows out, step 10min" in out
+    assert "dates: 2021-06-05 05:00:00+08:00 to 2021-06-05 21:00:00+08:00" in out
+    assert "renamed: 'DHI' -> dhi, 'GHI' -> ghi, 'DNI' -> dni" in out
+    assert "sorted (stamps out of order): count 1, lines 33" in out
+    assert "dropped (repeated stamps, the first kept): count 1, lines 82" in out
+    assert "clipped to 0 (negative irradiance): ghi count 1, lines 3, lowest -2.5" in out
+    assert "resampled: linear in time from 10min to 5min" in out and "(rows 193, interpolated 96, empty 0)" in out
+    assert "NaN kept: dni 1" in out
+
+
+def test_ghi_alone_lists_the_filled_components(capsys):
+    assert main(["check", "tests/records/ghi-only.csv", "--site", "lanzhou"]) == 0
+    out = capsys.readouterr().out
+    assert "filled: dni count 97, how erbs decomposition of GHI (pvlib.irradiance.erbs, true zenith)" in out
+    assert "wind: MISSING: no wind column in the file" in out

@@ -134,6 +134,10 @@ def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
         report["nan"] = nan
     frame = frame.copy()
     _limits(path, frame, report)
+    light = [name for name in (*IRRADIANCE, "photocurrent") if name in frame]
+    if light and all(frame[name].isna().all() for name in light):
+        header = report.get("columns", {}).get(light[0], light[0])
+        raise HybridtrackError(f"{path}: column {header!r}: no readable value in any irradiance column")
     return frame
 
 

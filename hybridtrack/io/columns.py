@@ -109,10 +109,11 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
                                    "one column holds one quantity")
         mapping[name] = found
     taken = set(mapping.values())
+    unnamed_last = sorted(headers, key=lambda h: h.strip().lower() in (UNNAMED, "unnamed: 0"))
     for name in ("time", *WEATHER_COLUMNS):
         if name in mapping:
             continue
-        header = next((h for h in headers if h not in taken and _matches(h, name)), None)
+        header = next((h for h in unnamed_last if h not in taken and _matches(h, name)), None)
         if header is not None:
             mapping[name] = header
             taken.add(header)

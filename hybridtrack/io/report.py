@@ -31,7 +31,7 @@ _CHANGES = {
 
 def _describe(value) -> str:
     if isinstance(value, dict):
-        return ", ".join(f"{k} {_describe(v)}" for k, v in value.items())
+        return ", ".join(f"{k} {_describe(v)}" for k, v in value.items() if k != "action")
     if isinstance(value, list):
         return ", ".join(map(str, value))
     return str(value)

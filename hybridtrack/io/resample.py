@@ -6,7 +6,8 @@ gap longer than three native steps is resampled on its own, so a gap stays a gap
 
 * a step at least as long as the data's: the mean of the readings in each step, labelled at
   its start;
-* a shorter step (or irregular data): linear interpolation in time, never across a gap.
+* a shorter step (or irregular data): linear interpolation in time, never across a gap; a
+  stamp the data has keeps its value, NaN included (a flagged value is never filled).
 
 The report counts the rows made, the values interpolated and those left empty.
 """
@@ -69,6 +70,8 @@ def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -
         union = frame[columns].reindex(frame.index.union(grid))
         limit = max(int(3 * native / target), 1)
         out = union.interpolate(method="time", limit=limit, limit_area="inside").reindex(grid)
+        kept = grid.intersection(frame.index)
+        out.loc[kept, columns] = frame.loc[kept, columns]  # a NaN the data had stays NaN: no silent fill
         method = f"linear in time from {span(native)} to {span(target)}, gaps over {span(3 * native)} left empty"
         new = ~grid.isin(frame.index)
         counts = {"rows": int(len(out)), "interpolated": int((new & out[columns].notna().any(axis=1)).sum())}
