@@ -185,3 +185,40 @@ def test_bad_files_give_one_clear_line(tmp_path, content, kwargs, message):
     with pytest.raises(HybridtrackError, match=message) as error:
         read_weather(path, **kwargs)
     assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "data").glob("*-*.csv")))
+def test_the_shipped_days_follow_their_sites_sun_and_pass_the_magnitude_check(name):
+    frame = read_weather(ROOT / "data" / name, site=name.split("-")[0])
+    assert frame.attrs["validation"]["sun_check"].startswith("light follows the sun")
+
+
+def _shifted_record(tmp_path, seed, weather, shift):
+    """A synthetic Lanzhou day at 1 min written with its stamps moved by `shift` (a wrong clock)."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-21", weather=weather, seed=seed)
+    stamps = (frame.index + pd.Timedelta(shift)).tz_convert("Asia/Shanghai")
+    path = tmp_path / f"{weather}-{seed}.csv"
+    pd.DataFrame({"time": stamps.strftime("%Y-%m-%d %H:%M"), "ghi": frame["ghi"].round(1),
+                  "dni": frame["dni"].round(1), "dhi": frame["dhi"].round(1)}).to_csv(path, index=False)
+    return path
+
+
+@pytest.mark.parametrize("seed, weather", [(1, "mixed"), (2, "mixed"), (3, "cloudy"), (4, "overcast"),
+                                           (5, "sunny")])
+def test_the_sun_check_passes_true_clocks_under_any_sky_and_half_an_hour_off(tmp_path, seed, weather):
+    for shift in ("0min", "30min", "-30min"):
+        frame = read_weather(_shifted_record(tmp_path, seed, weather, shift), site="lanzhou")
+        assert frame.attrs["validation"]["sun_check"].startswith("light follows the sun"), (shift, weather)
+
+
+@pytest.mark.parametrize("shift, fits", [("1h", "shifted by -1h, i.e. stamps in UTC+09:00"),
+                                         ("-2h", "shifted by +2h, i.e. stamps in UTC+06:00")])
+def test_the_sun_check_refuses_a_clock_an_hour_or_more_off_and_names_the_offset(tmp_path, shift, fits):
+    path = _shifted_record(tmp_path, 1, "mixed", shift)
+    with pytest.raises(HybridtrackError, match=fits.replace("+", r"\+")):
+        read_weather(path, site="lanzhou")
+    frame = read_weather(path, site="lanzhou", lenient=True)
+    assert frame.attrs["validation"]["sun_check"].startswith("WARNING")
+    assert "verdict: usable" in validation_report(frame)

@@ -144,26 +144,29 @@ def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
 def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None) -> None:
     """Refuse irradiance a thousand times too small: kW/m² read as W/m².
 
-    With the site's clear-sky GHI (`clear_ghi`, W/m², on the frame's stamps) a column whose
-    largest value is under 2 % of the clear sky's largest, while the clear sky reaches 300 W/m²,
-    is refused: an overcast day still lets through 10 % or more. Without a site, a column that
-    never exceeds 1.5 over at least six hours is refused the same way.
+    In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
+    tens of W/m² while the sun is well up. So GHI (or DHI) whose largest value is above 0 and at
+    most 1.5 is refused when the site's clear sky (`clear_ghi`, W/m², on the frame's stamps)
+    reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
+    judged so only in a file without GHI and DHI, since an overcast day has none.
     """
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
-    for name in IRRADIANCE:
-        if name not in frame or not np.isfinite(frame[name].to_numpy(float)).any():
+    judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
+    for name in judged:
+        values = frame[name].to_numpy(float)
+        if not np.isfinite(values).any():
             continue
-        top = float(np.nanmax(frame[name].to_numpy(float)))
+        top = float(np.nanmax(values))
         if clear_ghi is not None:
             reference = float(np.nanmax(clear_ghi)) if len(clear_ghi) else 0.0
-            suspicious = reference >= 300.0 and top < 0.02 * reference
+            suspicious = reference >= 300.0 and 0.0 < top <= 1.5
             why = f"at most {top:g} while the clear sky reaches {reference:.0f} W/m²"
         else:
             suspicious = hours >= 6.0 and 0.0 < top <= 1.5
             why = f"at most {top:g} over {hours:.0f} hours"
         if suspicious:
             header = report.get("columns", {}).get(name, name)
-            line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(frame[name].to_numpy(float))))
+            line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
             where = f"line {line[0]}, " if line else ""
             raise HybridtrackError(f"{path}: {where}column {header!r}: {name} is {why}; the values look like kW/m² "
                                    f"read as W/m²: give the unit (--units {name}=kW/m2)")

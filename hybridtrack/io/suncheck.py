@@ -3,14 +3,15 @@
 A logger whose clock runs in UTC but is declared local (or a file from another site) puts
 daylight at night. Two tests, on the measured light before any gap is filled:
 
-* **Light at night**: direct (or, without DNI, global) irradiance above `LIGHT` W/m² while
-  the sun is below the horizon at the stamp and one step either side of it (so that averages
-  labelled at a step's start or end are not caught).
+* **Light at night**: direct (or, without any, global) irradiance above `LIGHT` W/m² while
+  the sun is below the horizon at the stamp and the tolerance (below) either side of it, so
+  that averages labelled at a step's start or end, or a clock a few minutes off, are not caught.
 * **Offset of the daily light curve**: the shift of the computed sun's up/down pattern that
-  best matches the file's light/dark pattern (the fewest ten-minute bins where one says day and
-  the other night), searched over ±14 hours. Daylight gives diffuse light under any cloud, so
-  the edges of the day are found on overcast days too; with DNI alone only the light-at-night
-  side counts, and the smallest shift that explains it is named.
+  best matches the file's global light/dark pattern (the fewest ten-minute bins where one says
+  day and the other night), searched over ±14 hours; of equally good shifts, none if it is
+  among them, else the middle one. Daylight gives diffuse light under any cloud, so the edges
+  of the day are found on overcast days too. With DNI alone only the light-at-night side
+  counts, and the smallest shift that explains it is named.
 
 A shift beyond `max(45 min, step)`, or light at night in more than 2 % of the lit rows (and
 more than 3 rows), refuses the file, naming the first such row, the shift that fits and the
@@ -70,18 +71,21 @@ def _best_shift(site, grid: pd.DatetimeIndex, light: np.ndarray, symmetric: bool
             wrong = wrong | (~lit & sun)
         scores[k] = wrong.mean() if len(wrong) else 0.0
     best = np.flatnonzero(scores <= scores.min() + 1e-12) - reach
-    chosen = int(best[np.argmin(np.abs(best))])  # of equally good shifts, the smallest
+    if best.min() <= 0 <= best.max() or not symmetric:
+        chosen = int(best[np.argmin(np.abs(best))])  # the data do not tell a shift apart from none
+    else:
+        chosen = int(round(float(np.median(best))))  # the middle of the equally good shifts
     return chosen * BIN, float(scores[chosen + reach])
 
 
-def _night_light(site, frame: pd.DataFrame, name: str, step: pd.Timedelta) -> np.ndarray:
-    """Rows with light while the sun is down at the stamp and a step either side."""
+def _night_light(site, frame: pd.DataFrame, name: str, window: pd.Timedelta) -> np.ndarray:
+    """Rows with light while the sun is down at the stamp and `window` either side."""
     values = frame[name].to_numpy(float)
     lit = np.isfinite(values) & (values > LIGHT)
     if not lit.any():
         return lit
     index = frame.index[lit]
-    altitude = np.max([_sun_up(site, index + sign * step) for sign in (-1, 0, 1)], axis=0)
+    altitude = np.max([_sun_up(site, index + sign * window) for sign in (-1, 0, 1)], axis=0)
     night = np.zeros(len(frame), bool)
     night[np.flatnonzero(lit)[altitude < 0.0]] = True
     return night
@@ -107,41 +111,49 @@ def _signed(shift: pd.Timedelta) -> str:
     return ("+" if shift >= pd.Timedelta(0) else "-") + span(abs(shift)) if shift != pd.Timedelta(0) else "0"
 
 
+def _mismatch(path: Path, frame: pd.DataFrame, site, name: str, header: str, night: np.ndarray,
+              shift: pd.Timedelta | None, lenient: bool) -> str:
+    """The one-line message: the first row of light at night (or the brightest), and the shift that fits."""
+    values = frame[name].to_numpy(float)
+    row = int(np.flatnonzero(night)[0]) if night.any() else int(np.nanargmax(values))
+    line = first_lines(frame, np.arange(len(frame)) == row)
+    where = f"line {line[0]}, " if line else ""
+    lit = int((values > LIGHT).sum())
+    if night.any():
+        what = (f"{night.sum()} of {lit} lit rows have {name} while the sun is down, the first {values[row]:g} W/m² "
+                f"at {frame.index[row]}")
+    else:
+        what = f"the daily light curve is offset from the sun, e.g. {values[row]:g} W/m² at {frame.index[row]}"
+    fits = _fits(frame, site, shift) if shift is not None else "no shift of the sun explains it"
+    ask = "" if lenient else ", or --lenient to read it anyway"
+    return (f"{path}: {where}column {header!r}: {what}; {fits}{'' if fits.endswith('?') else '.'} Give the file's "
+            f"time zone (--tz) or the right site{ask}")
+
+
 def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: bool = False) -> None:
     """Refuse (or, `lenient`, warn about) light that does not follow the site's sun.
 
     The result goes into ``report["sun_check"]``; see the module's notes for the tests.
     """
-    name = "dni" if "dni" in frame and np.isfinite(frame["dni"].to_numpy(float)).any() else "ghi"
-    if name not in frame or not (frame[name].to_numpy(float) > LIGHT).any():
+    lit_in = [c for c in ("dni", "ghi", "dhi") if c in frame and (frame[c].to_numpy(float) > LIGHT).any()]
+    if not lit_in:
         report["sun_check"] = "not done (no light in the file)"
         return
-    step = pd.Timedelta(report.get("step", "1min"))
-    grid, light = _binned(frame, name)
-    shift, disagree = _best_shift(site, grid, light, symmetric=name == "ghi")
-    night = _night_light(site, frame, name, step)
-    lit = int((frame[name].to_numpy(float) > LIGHT).sum())
+    name = lit_in[0]  # direct light where there is some: it is the surest sign of the sun
+    curve = "ghi" if "ghi" in lit_in else name  # global light has the day's edges under any sky
+    tolerance = max(pd.Timedelta(minutes=45), pd.Timedelta(report.get("step", "1min")))
+    shift, disagree = _best_shift(site, *_binned(frame, curve), symmetric=curve != "dni")
+    night = _night_light(site, frame, name, tolerance)
     header = report.get("columns", {}).get(name, name)
-    tolerance = max(pd.Timedelta(minutes=45), step)
     offset_wrong = abs(shift) > tolerance
-    many_at_night = night.sum() > max(3, 0.02 * lit)
-    if offset_wrong or many_at_night:
-        row = int(np.flatnonzero(night)[0]) if night.any() else int(np.nanargmax(frame[name].to_numpy(float)))
-        line = first_lines(frame, np.arange(len(frame)) == row)
-        where = f"line {line[0]}, " if line else ""
-        value = float(frame[name].iloc[row])
-        fits = _fits(frame, site, shift) if offset_wrong else "no shift of the sun explains it"
-        what = (f"{night.sum()} of {lit} lit rows have {name} while the sun is down, the first {value:g} W/m² at "
-                f"{frame.index[row]}" if night.any() else
-                f"the daily light curve is offset from the sun, e.g. {value:g} W/m² at {frame.index[row]}")
-        message = (f"{path}: {where}column {header!r}: {what}; {fits}. Give the file's time zone (--tz) or the "
-                   "right site" + ("" if lenient else ", or --lenient to read it anyway"))
+    if offset_wrong or night.sum() > max(3, 0.02 * (frame[name].to_numpy(float) > LIGHT).sum()):
+        message = _mismatch(path, frame, site, name, header, night, shift if offset_wrong else None, lenient)
         if not lenient:
             raise HybridtrackError(message)
         report["sun_check"] = "WARNING: " + message.split(": ", 1)[1]
         return
-    result = f"light follows the sun at {site.name} (best shift {_signed(shift)}, {disagree:.1%} of bins disagree)"
     if night.any():
         report["light_at_night"] = {"count": int(night.sum()), "lines": first_lines(frame, night),
                                     "column": header, "action": "kept"}
-    report["sun_check"] = result
+    report["sun_check"] = (f"light follows the sun at {site.name} (best shift {_signed(shift)}, {disagree:.1%} of "
+                           "bins disagree)")
