@@ -222,3 +222,22 @@ def test_the_sun_check_refuses_a_clock_an_hour_or_more_off_and_names_the_offset(
     frame = read_weather(path, site="lanzhou", lenient=True)
     assert frame.attrs["validation"]["sun_check"].startswith("WARNING")
     assert "verdict: usable" in validation_report(frame)
+
+
+def test_excels_separator_line_is_obeyed(tmp_path):
+    path = write(tmp_path, "excel.csv", "sep=;\nZeit;GHI;DNI;DHI\n2021-06-21T12:00+08:00;900,5;800;100\n"
+                 "2021-06-21T12:01+08:00;901;801;101\n")
+    frame = read_weather(path)
+    assert frame["ghi"].tolist() == [900.5, 901.0] and "sep=;" in frame.attrs["validation"]["table"]
+
+
+def test_midc_through_pvlib_maps_its_names(tmp_path):
+    from hybridtrack import sites
+
+    path = ROOT / "tests" / "records" / "midc-bms.csv"
+    golden = sites.custom(39.742, -105.18, "Etc/GMT+7", 1829.0)
+    frame = read_weather(path, format="midc", site=golden)
+    reference = pvlib.iotools.read_midc(str(path))
+    np.testing.assert_array_equal(frame["dni"], reference["Direct Normal [W/m^2]"].astype(float))
+    np.testing.assert_array_equal(frame["temp_air"], reference["Tower Dry Bulb Temp [deg C]"].astype(float))
+    assert frame.attrs["validation"]["format"] == "midc"

@@ -63,6 +63,8 @@ REFUSALS = [
      ["--tz", "UTC", "--format", "epw", "--map", "ghi=x"], ["--map and --units apply to tables"]),
     ("a resample step of 1 ns over a day", PLAIN, {"tz": "UTC", "freq": "1ns"}, ["--tz", "UTC", "--freq", "1ns"],
      ["would make over 50 million rows"]),
+    ("most stamps repeat (a date without its clock)", "date,ghi\n2021-06-05,10\n2021-06-05,500\n2021-06-05,700\n",
+     {"tz": "UTC"}, ["--tz", "UTC"], ["line 3: 2 of 3 stamps repeat an earlier one", "clock column"]),
     ("negative wind beyond an offset (strict)", PLAIN.replace(",2.0\n", ",-0.2\n", 1), {"tz": "UTC", "strict": True},
      ["--tz", "UTC", "--strict"], ["line 2, column 'wind_speed': a negative wind reading (strict)"]),
 ]

@@ -72,6 +72,10 @@ def _order(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
                               "action": "sorted by time"}
         frame = frame.sort_index(kind="stable")
     duplicated = frame.index.duplicated(keep="first")
+    if duplicated.sum() > 0.5 * len(frame):
+        lines = first_lines(frame, duplicated)
+        raise HybridtrackError(f"{path}: line {lines[0] if lines else '?'}: {duplicated.sum()} of {len(frame)} stamps "
+                               "repeat an earlier one; is part of the time (a clock column) missing? map it with --map")
     if duplicated.any():
         report["duplicates"] = {"count": int(duplicated.sum()), "lines": first_lines(frame, duplicated),
                                 "action": "dropped, the first of each kept"}

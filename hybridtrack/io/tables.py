@@ -109,6 +109,12 @@ def _choose_separator(path: Path, kept: list[tuple[int, str]]) -> tuple[int, str
     return best[1], best[2]
 
 
+def _header_after_hint(path: Path, kept: list[tuple[int, str]], sep: str) -> tuple[int, str, str]:
+    if len(kept) < 2:
+        raise HybridtrackError(f"{path}: no table found after the 'sep={sep}' line")
+    return 0, sep, f"table with Excel's 'sep={sep}' line"
+
+
 def rows_with_values(body: list[tuple[int, str]], sep: str) -> bool:
     return any(any(f.strip() for f in _split(line, sep)) for _, line in body)
 
@@ -120,7 +126,11 @@ def locate_table(path: Path, text: str) -> Table:
         raise HybridtrackError(f"{path}: no table found (fewer than two lines of data)")
     first = _split(kept[0][1], ",")
     kind = "table"
-    if first and first[0].strip().upper() == "TOA5":
+    hint = re.fullmatch(r"\s*sep=(.)\s*", kept[0][1])  # Excel's separator line
+    if hint and hint.group(1) in _SEPARATORS:
+        kept = kept[1:]
+        position, sep, kind = _header_after_hint(path, kept, hint.group(1))
+    elif first and first[0].strip().upper() == "TOA5":
         if len(kept) < 5:
             raise HybridtrackError(f"{path}: a TOA5 file needs its four header lines and data")
         position, sep, kind = 1, ",", f"Campbell TOA5 ({', '.join(c for c in first[1:3] if c)})"
