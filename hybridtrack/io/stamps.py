@@ -86,6 +86,8 @@ def _day_month_order(column: _Column, parts: pd.DataFrame, dayfirst: bool | None
 
 def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
     """Dates in ``d/m/y`` or ``m/d/y`` form rewritten as ``yyyy-mm-dd``, decided for the whole column."""
+    if not column.text.str.contains(r"^\d{1,2}[./-]\d{1,2}[./-]\d", regex=True).any():
+        return column.text  # year first (ISO) or another form the parser reads whole
     parts = column.text.str.extract(_DMY)
     matched = parts[0].notna().to_numpy()
     if not matched.any():
@@ -131,12 +133,13 @@ def _epoch(column: _Column, report: dict) -> pd.DatetimeIndex:
     return pd.DatetimeIndex(pd.to_datetime(column.text.astype(float), unit="s", utc=True))
 
 
-def _with_offsets(column: _Column, index: pd.DatetimeIndex, text: pd.Series, tz: str | None, report: dict):
-    has_offset = text.str.contains(_OFFSET)
+def _with_offsets(column: _Column, index: pd.DatetimeIndex, text: pd.Series, has_offset: pd.Series, tz: str | None,
+                  report: dict):
     if not has_offset.all():
         column.refuse(int(np.flatnonzero(~has_offset.to_numpy())[0]), "has no UTC offset, but other stamps in "
                                                                        "the column have one")
-    offsets = text.str.extract(r"([+-]\d{2}:?\d{2}|Z)$")[0].str.replace("Z", "+00:00")
+    endings = pd.Series(text.str.slice(-6).unique())  # a few distinct endings, however long the file
+    offsets = endings.str.extract(r"([+-]\d{2}:?\d{2}|Z)$")[0].str.replace("Z", "+00:00")
     if tz is not None:
         report["time"] = f"stamps with UTC offsets, converted to {tz}"
         return index.tz_convert(tz)
@@ -204,11 +207,13 @@ def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *,
     if len(clock_only):
         column.refuse(int(clock_only[0]), "has no date; stamps need the date (add a date column, or write "
                                           "'2021-06-21 12:00')")
-    iso = _to_iso(column, dayfirst, report).str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
+    iso = _to_iso(column, dayfirst, report)
+    if iso.str.endswith(("UTC", "GMT")).any():
+        iso = iso.str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
     has_offset = iso.str.contains(_OFFSET)
     index = _parse(column, iso, utc=bool(has_offset.any()))
     if has_offset.any():
-        return _with_offsets(column, index, iso, tz, report), np.ones(len(index), bool)
+        return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)
     if tz is not None:
         return _localise(column, index, tz, f"naive stamps localised to {tz}", report)
     if clock_zone is not None:

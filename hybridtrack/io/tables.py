@@ -115,6 +115,25 @@ def _header_after_hint(path: Path, kept: list[tuple[int, str]], sep: str) -> tup
     return 0, sep, f"table with Excel's 'sep={sep}' line"
 
 
+def _rows(path: Path, body: list[tuple[int, str]], sep: str, width: int, header_line: int,
+          skipped: dict) -> tuple[list[list[str]], list[int]]:
+    """The rows' fields, each `width` long, and their file lines; empty rows skipped, long rows refused."""
+    empty = [not line.strip(sep + ' \t"') for _, line in body]  # ';;;;': a row the logger left empty
+    if any(empty):
+        skipped["empty rows"] = [number for (number, _), blank in zip(body, empty) if blank]
+        body = [entry for entry, blank in zip(body, empty) if not blank]
+    rows = list(csv.reader([line for _, line in body], delimiter=sep))
+    numbers = [number for number, _ in body]
+    for i, fields in enumerate(rows):
+        if len(fields) == width:
+            continue
+        if len(fields) > width and any(f.strip() for f in fields[width:]):
+            raise HybridtrackError(f"{path}: line {numbers[i]}: {len(fields)} fields, but the header on line "
+                                   f"{header_line} names {width}")
+        rows[i] = fields[:width] + [""] * (width - len(fields))
+    return rows, numbers
+
+
 def rows_with_values(body: list[tuple[int, str]], sep: str) -> bool:
     return any(any(f.strip() for f in _split(line, sep)) for _, line in body)
 
@@ -146,19 +165,7 @@ def locate_table(path: Path, text: str) -> Table:
         body = body[1:]
     if not body or not rows_with_values(body, sep):
         raise HybridtrackError(f"{path}: the table has a header but no rows")
-    rows, numbers = [], []
-    for (number, _), fields in zip(body, csv.reader([line for _, line in body], delimiter=sep)):
-        if not any(f.strip() for f in fields):  # ';;;;': a row the logger left empty
-            skipped.setdefault("empty rows", []).append(number)
-            continue
-        if len(fields) > len(headers):
-            if all(not f.strip() for f in fields[len(headers):]):
-                fields = fields[:len(headers)]
-            else:
-                raise HybridtrackError(f"{path}: line {number}: {len(fields)} fields, but the header on line "
-                                       f"{kept[position][0]} names {len(headers)}")
-        rows.append(fields + [""] * (len(headers) - len(fields)))
-        numbers.append(number)
+    rows, numbers = _rows(path, body, sep, len(headers), kept[position][0], skipped)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
     decimal = "," if sep == ";" and any(re.fullmatch(r"[-+]?\d*,\d+", f.strip()) for r in rows for f in r) else "."
     return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind)
