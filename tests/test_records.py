@@ -241,3 +241,17 @@ def test_midc_through_pvlib_maps_its_names(tmp_path):
     np.testing.assert_array_equal(frame["dni"], reference["Direct Normal [W/m^2]"].astype(float))
     np.testing.assert_array_equal(frame["temp_air"], reference["Tower Dry Bulb Temp [deg C]"].astype(float))
     assert frame.attrs["validation"]["format"] == "midc"
+
+
+def test_the_fast_number_path_matches_the_careful_one(tmp_path):
+    """Clean columns are parsed in one numpy call; a column with a missing-value word goes cell by cell."""
+    cells = ["1.5", "-0.25", "1e400", "inf", "nan", "  3 ", "+2", "1e-3", "850"]
+    stamps = pd.date_range("2021-06-21 12:00", periods=len(cells), freq="1min").strftime("%Y-%m-%dT%H:%M+08:00")
+    fast = write(tmp_path, "fast.csv", "time,ghi\n" + "".join(f"{t},{c}\n" for t, c in zip(stamps, cells)))
+    careful = write(tmp_path, "careful.csv", "time,ghi\n" + "".join(f"{t},{c}\n" for t, c in zip(stamps, cells))
+                    + "2021-06-21T12:09+08:00,N/A\n")
+    reference = np.array([float(c) for c in cells])  # Python's own float() is the reference
+    reference[~((reference >= -50) & (reference <= 1500))] = np.nan  # inf and 1e400 are impossible
+    reference[reference < 0] = 0.0  # a small negative irradiance is clipped
+    np.testing.assert_array_equal(read_weather(fast, site="lanzhou")["ghi"].to_numpy(), reference)
+    np.testing.assert_array_equal(read_weather(careful, site="lanzhou")["ghi"].to_numpy()[:-1], reference)

@@ -74,6 +74,28 @@ def fill_components(path: Path, frame: pd.DataFrame, site, decomposition: str, a
 
     Needs the site for the sun's position; a file with neither GHI nor two components is
     refused.
+
+    Parameters
+    ----------
+    path : Path
+        The file, for messages.
+    frame : pandas.DataFrame
+        A weather frame with one or two of ``ghi``, ``dni``, ``dhi`` (W/m²).
+    site : Site or None
+    decomposition : {"erbs", "dirint"}
+        The model for GHI alone.
+    attrs, report : dict
+        Get ``{name}_source`` and the ``filled`` counts.
+
+    Returns
+    -------
+    pandas.DataFrame
+
+    References
+    ----------
+    Erbs, Klein & Duffie (1982), Solar Energy 28(4) 293-302, doi:10.1016/0038-092X(82)90302-4;
+    Perez, Ineichen, Maxwell, Seals & Zelenka (1992), ASHRAE Transactions 98(1) 354-369 (DIRINT);
+    Holmgren, Hansen & Mikofski (2018), JOSS 3(29) 884, doi:10.21105/joss.00884 (pvlib).
     """
     if decomposition not in DECOMPOSITIONS:
         raise HybridtrackError(f"unknown decomposition {decomposition!r}; choose 'erbs' or 'dirint'")
