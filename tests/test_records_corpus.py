@@ -108,6 +108,7 @@ CASES = [
              "beyond any time zone: is the file from another site? Give")),
     ("NOAA SURFRAD", "surfrad-bon.dat", {}, {"pvlib": "surfrad"}),
     ("University of Oregon SRML", "srml-eugene.tsv", {"site": EUGENE}, {"pvlib": "srml"}),
+    ("BSRN station-to-archive", "bsrn-bon.dat", {}, {"pvlib": "bsrn"}),
     ("--units with an unknown name", "plain.csv", {"tz": SHANGHAI, "units": {"wind": "km/h"}},
      refused("unknown column name 'wind' in --units")),
     ("one column mapped twice", "plain.csv", {"tz": SHANGHAI, "columns": {"ghi": "GHI", "dni": "GHI"}},
@@ -187,13 +188,18 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
 
 def check_pvlib(frame: pd.DataFrame, path: Path, fmt: str) -> None:
     reader = {"epw": lambda p: pvlib.iotools.read_epw(p, coerce_year=2019),
-              "surfrad": pvlib.iotools.read_surfrad, "srml": pvlib.iotools.read_srml}[fmt]
+              "surfrad": pvlib.iotools.read_surfrad, "srml": pvlib.iotools.read_srml,
+              "bsrn": pvlib.iotools.read_bsrn}[fmt]
     data = reader(str(path))
     data = data[0] if isinstance(data, tuple) else data.rename(columns=lambda c: c.removesuffix("_0"))
     pd.testing.assert_index_equal(frame.index.tz_convert("UTC"), data.index.tz_convert("UTC"), check_names=False)
     for name in ALL:
-        np.testing.assert_allclose(frame[name], data[name].astype(float), rtol=1e-12, err_msg=name)
+        if name in data:
+            np.testing.assert_allclose(frame[name], data[name].astype(float), rtol=1e-12, err_msg=name)
+        else:  # BSRN's basic record holds no wind: missing, never calm
+            assert frame[name].isna().all() and frame.attrs["wind_data"] == "missing"
     assert frame.attrs["validation"]["format"] == fmt
+    assert frame.attrs["validation"]["sun_check"].startswith("light follows the sun")
 
 
 def check_interpolated(frame: pd.DataFrame, name: str) -> None:

@@ -126,7 +126,7 @@ def _site_from_meta(meta: dict):
     try:
         return custom(float(meta["latitude"]), float(meta["longitude"]), "UTC",
                       float(meta.get("altitude", meta.get("elevation", 0.0)) or 0.0),
-                      name=str(meta.get("Name", meta.get("City", meta.get("name", "file")))).strip('" '))
+                      name=str(meta.get("Name", meta.get("City", meta.get("name", "the file's site")))).strip('" '))
     except (HybridtrackError, TypeError, ValueError):
         return None
 

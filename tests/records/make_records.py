@@ -278,6 +278,24 @@ def srml() -> str:
     return "\n".join([head] + rows) + "\n"
 
 
+def bsrn() -> str:
+    """A BSRN station-to-archive file: logical records *U0001, *U0004 (station, coordinates) and *U0100,
+    two fixed-width lines per step (GHI and DNI; DHI, long-wave, temperature, humidity, pressure), UTC."""
+    day = truth("bondville-day")
+    head = ["*U0001", " 31  6 2021   1", "*U0004", " -1 -1 -1", "  1  1", "Bondville, Illinois, USA",
+            "217 333 0000        217 333 0000", "0.0.0.0        bsrn@example.org",
+            "  130.05   91.63  213 72531", " -1 -1 -1", "   0   0  90   0 180   0 270   0", "*U0100"]
+    rows = []
+    for stamp, row in zip(day.index, day.itertuples()):
+        minute = stamp.hour * 60 + stamp.minute
+        first = (f"{stamp.day:3d} {minute:5d} {row.ghi:6.1f}{0.0:6.1f}{row.ghi:5.0f}{row.ghi:5.0f}"
+                 f"{row.dni:7.1f}{0.0:6.1f}{row.dni:5.0f}{row.dni:5.0f}")
+        second = (f"{'':3} {'':5} {row.dhi:6.1f}{0.0:6.1f}{row.dhi:5.0f}{row.dhi:5.0f}{350.0:7.1f}{0.0:6.1f}"
+                  f"{340:5d}{360:5d}{row.temp_air:9.1f}{50.0:6.1f}{990:5d}")
+        rows += [first, second]
+    return "\n".join(head + rows) + "\n"
+
+
 def naive_no_zone() -> str:
     return pandas_index_naive()
 
@@ -308,7 +326,7 @@ FILES = {
     "logger.csv.gz": _packed_gzip, "logger.zip": _packed_zip, "excel-unicode.txt": excel_unicode,
     "latin1.csv": latin1, "utf8-bom.csv": utf8_bom, "comments-anywhere.csv": comments_anywhere, "messy.csv": messy,
     "ghi-only.csv": ghi_only, "lanzhou.epw": epw, "midc-bms.csv": midc, "surfrad-bon.dat": surfrad,
-    "naive-no-zone.csv": naive_no_zone, "srml-eugene.tsv": srml,
+    "naive-no-zone.csv": naive_no_zone, "srml-eugene.tsv": srml, "bsrn-bon.dat": bsrn,
 }
 
 
