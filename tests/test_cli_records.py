@@ -67,3 +67,24 @@ def test_ghi_alone_lists_the_filled_components(capsys):
     out = capsys.readouterr().out
     assert "filled: dni count 97, how erbs decomposition of GHI (pvlib.irradiance.erbs, true zenith)" in out
     assert "wind: MISSING: no wind column in the file" in out
+
+
+def test_a_utc_logger_replays_at_a_built_in_site_with_tz_utc(tmp_path, capsys):
+    """The file's zone is not the site's: refused without --tz (the sun check), right with it."""
+    import json
+
+    record = "tests/records/utc-declared-local.csv"
+    assert main(["replay", record, "--site", "lanzhou"]) == 2
+    assert "stamps in UTC+00:00" in capsys.readouterr().err
+    out = tmp_path / "run"
+    assert main(["replay", record, "--site", "lanzhou", "--tz", "UTC", "--perfect", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "naive stamps localised to UTC" in printed and "light follows the sun at lanzhou" in printed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["energy_capture"] > 0.9
+    by_coordinates = tmp_path / "run2"
+    assert main(["replay", record, "--lat", "36.1055556", "--lon", "103.726389", "--altitude", "1520", "--tz", "UTC",
+                 "--site-tz", "Asia/Shanghai", "--perfect", "--out", str(by_coordinates)]) == 0
+    capsys.readouterr()
+    again = json.loads((by_coordinates / "summary.json").read_text())
+    assert again["energy_capture"] == pytest.approx(summary["energy_capture"], abs=1e-3)
