@@ -61,6 +61,8 @@ REFUSALS = [
      ["--tz", "UTC", "--units", "wind_speed=furlongs/fortnight"], ["--units: unknown unit 'furlongs/fortnight'"]),
     ("--map on a pvlib format", PLAIN, {"tz": "UTC", "format": "epw", "columns": {"ghi": "x"}},
      ["--tz", "UTC", "--format", "epw", "--map", "ghi=x"], ["--map and --units apply to tables"]),
+    ("a resample step of nan", PLAIN, {"tz": "UTC", "freq": "nan"}, ["--tz", "UTC", "--freq", "nan"],
+     ["step 'nan' is not a duration"]),
     ("a resample step of 1 ns over a day", PLAIN, {"tz": "UTC", "freq": "1ns"}, ["--tz", "UTC", "--freq", "1ns"],
      ["would make over 50 million rows"]),
     ("most stamps repeat (a date without its clock)", "date,ghi\n2021-06-05,10\n2021-06-05,500\n2021-06-05,700\n",

@@ -51,6 +51,8 @@ def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -
     native = pd.Timedelta(int(np.median(steps)), "ns")
     regular = bool(np.all(steps % native.value == 0))  # whole steps, gaps allowed
     target = parse_freq(freq) if freq is not None else native
+    if pd.isna(target):
+        raise HybridtrackError(f"step {freq!r} is not a duration such as '1min' or '10s'")
     if regular and target == native:
         attrs["resampling"] = f"none (regular {span(native)} steps)"
         return frame
