@@ -58,7 +58,8 @@ def span(delta) -> str:
     """A duration in its largest whole unit: ``5min``, ``1h``, ``30s``, ``2d``."""
     delta = pd.Timedelta(delta)
     for unit, size in (("d", pd.Timedelta(days=1)), ("h", pd.Timedelta(hours=1)), ("min", pd.Timedelta(minutes=1)),
-                       ("s", pd.Timedelta(seconds=1))):
+                       ("s", pd.Timedelta(seconds=1)), ("ms", pd.Timedelta(milliseconds=1)),
+                       ("us", pd.Timedelta(microseconds=1)), ("ns", pd.Timedelta(nanoseconds=1))):
         if delta >= size and delta % size == pd.Timedelta(0):
             return f"{delta // size}{unit}"
     return str(delta)

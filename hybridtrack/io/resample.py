@@ -56,10 +56,10 @@ def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -
     if regular and target == native:
         attrs["resampling"] = f"none (regular {span(native)} steps)"
         return frame
-    span_days = (frame.index[-1] - frame.index[0]) / pd.Timedelta(days=1)
-    if span_days / (target / pd.Timedelta(days=1)) > 50_000_000:
-        raise HybridtrackError(f"resampling {span_days:.0f} days to {span(target)} would make over 50 million rows; "
-                               "choose a longer step")
+    rows = (frame.index[-1] - frame.index[0]) / target
+    if rows > 50_000_000:
+        raise HybridtrackError(f"resampling {span(frame.index[-1] - frame.index[0])} of data to {span(target)} steps "
+                               f"would make {rows:,.0f} rows (over 50 million); choose a longer step")
     columns = [c for c in frame.columns if c in WEATHER_COLUMNS]
     grid, origin = _grid(frame.index, native, target)
     if target >= native:
