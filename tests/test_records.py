@@ -255,3 +255,22 @@ def test_the_fast_number_path_matches_the_careful_one(tmp_path):
     reference[reference < 0] = 0.0  # a small negative irradiance is clipped
     np.testing.assert_array_equal(read_weather(fast, site="lanzhou")["ghi"].to_numpy(), reference)
     np.testing.assert_array_equal(read_weather(careful, site="lanzhou")["ghi"].to_numpy()[:-1], reference)
+
+
+def test_packed_station_files_go_through_pvlib_decoded(tmp_path):
+    """An EPW gzipped, and EnergyPlus's zip of .epw, .stat and .ddy, read like the plain EPW."""
+    import gzip
+    import zipfile
+
+    epw = (ROOT / "tests" / "records" / "lanzhou.epw").read_text()
+    plain = read_weather(ROOT / "tests" / "records" / "lanzhou.epw")
+    packed = write(tmp_path, "lanzhou.epw.gz", gzip.compress(epw.encode()))
+    bundle = tmp_path / "CHN_GS_Lanzhou.zip"
+    with zipfile.ZipFile(bundle, "w") as archive:
+        archive.writestr("CHN_GS_Lanzhou.epw", epw)
+        archive.writestr("CHN_GS_Lanzhou.stat", "statistics")
+        archive.writestr("CHN_GS_Lanzhou.ddy", "design days")
+    for path in (packed, bundle):
+        frame = read_weather(path)
+        pd.testing.assert_frame_equal(frame, plain, check_like=True)
+        assert frame.attrs["validation"]["format"] == "epw"

@@ -15,7 +15,10 @@ from pathlib import Path
 
 from ..errors import HybridtrackError
 
-__all__ = ["read_bytes", "unpack", "decode", "file_text", "read_text", "read_toml", "write_toml"]
+__all__ = ["read_bytes", "unpack", "decode", "file_text", "read_text", "read_toml", "write_toml", "WEATHER_SUFFIXES"]
+
+#: In a zip of several files, the one weather file among them is read (EnergyPlus ships .epw with .stat, .ddy).
+WEATHER_SUFFIXES = (".epw", ".csv", ".tm2", ".tmy", ".dat", ".tsv", ".txt")
 
 
 def read_bytes(path: Path, what: str = "file") -> bytes:
@@ -43,6 +46,9 @@ def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
         try:
             with zipfile.ZipFile(io.BytesIO(raw)) as archive:
                 members = [m for m in archive.infolist() if not m.is_dir() and not m.filename.startswith("__MACOSX")]
+                weather = [m for m in members if m.filename.lower().endswith(WEATHER_SUFFIXES)]
+                if len(members) > 1 and len(weather) == 1:  # EnergyPlus zips: .epw with .stat and .ddy
+                    members = weather
                 if len(members) != 1:
                     names = ", ".join(m.filename for m in members) or "nothing"
                     raise HybridtrackError(f"{path}: a zip archive must hold exactly one file; it holds {names}")

@@ -67,7 +67,7 @@ def detect_format(text: str) -> str:
     return "csv"
 
 
-def _call(path: Path, fmt: str):
+def _call(path: Path, fmt: str, shown: Path | None = None):
     import pvlib
 
     reader = getattr(pvlib.iotools, PVLIB_FORMATS[fmt])
@@ -76,7 +76,7 @@ def _call(path: Path, fmt: str):
         result = reader(str(path), **options)
     except Exception as exc:  # pvlib raises many kinds; the user needs one line
         detail = str(exc).splitlines()[0] if str(exc) else ""
-        raise HybridtrackError(f"{path}: pvlib could not read it as {fmt.upper()}: {type(exc).__name__}: "
+        raise HybridtrackError(f"{shown or path}: pvlib could not read it as {fmt.upper()}: {type(exc).__name__}: "
                                f"{detail}") from None
     data, meta = result if isinstance(result, tuple) else (result, {})
     return data, dict(meta) if isinstance(meta, Mapping) else {}
@@ -126,11 +126,28 @@ def _map(path: Path, fmt: str, data: pd.DataFrame, report: dict) -> pd.DataFrame
     return frame
 
 
-def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict) -> tuple[pd.DataFrame, dict]:
-    """A pvlib format's data as a frame with the frame's names, and its metadata (site, zone)."""
+def _plain_copy(path: Path, text: str, folder: str) -> Path:
+    """The decoded text in a UTF-8 file pvlib can open (for packed or UTF-16 sources)."""
+    copy = Path(folder) / path.name.removesuffix(".gz").removesuffix(".zip")
+    copy.write_text(text, encoding="utf-8")
+    return copy
+
+
+def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict, text: str | None = None,
+               encoding: str = "UTF-8") -> tuple[pd.DataFrame, dict]:
+    """A pvlib format's data as a frame with the frame's names, and its metadata (site, zone).
+
+    A packed or non-UTF-8 file is handed to pvlib as a decoded copy (`text`).
+    """
+    import tempfile
+
     if fmt not in PVLIB_FORMATS:
         raise HybridtrackError(f"unknown format {fmt!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
-    data, meta = _call(path, fmt)
+    if text is not None and encoding != "UTF-8":
+        with tempfile.TemporaryDirectory() as folder:
+            data, meta = _call(_plain_copy(path, text, folder), fmt, shown=path)
+    else:
+        data, meta = _call(path, fmt)
     if len(data) == 0:
         raise HybridtrackError(f"{path}: pvlib read it as {fmt.upper()}, but it holds no rows")
     frame = _map(path, fmt, data, report)

@@ -206,7 +206,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         if columns or units:
             raise HybridtrackError(f"{path}: --map and --units apply to tables; a {fmt.upper()} file names its own "
                                    "columns and units")
-        frame, meta = read_pvlib(path, fmt, tz, report)
+        frame, meta = read_pvlib(path, fmt, tz, report, text, encoding)
         report["rows_read"] = int(len(frame))
     else:
         raise HybridtrackError(f"unknown format {format!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
