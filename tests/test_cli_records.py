@@ -12,7 +12,8 @@ def test_check_prints_the_validation_summary(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "3 rows read, 2 rows out, step 1min" in out
     assert "semicolon-separated, decimal ','" in out and "dni <- 'Direct Normal'" in out
-    assert "duplicated stamps: count 1, lines 6" in out and "negative values clipped to 0: dhi count 1" in out
+    assert "dropped (repeated stamps, the first kept): count 1, lines 6" in out
+    assert "clipped to 0 (negative irradiance): dhi count 1, lines 5, lowest -4.0" in out
 
 
 def test_check_a_shipped_record(capsys):
@@ -45,3 +46,45 @@ def test_sky_prints_the_day_and_writes_csv_and_plot(tmp_path, capsys):
     frame = pd.read_csv(out, index_col="time")
     assert {"ghi", "dni", "dhi", "wind_speed", "temp_air", "sky", "intensity_ma", "variation_ma"} <= set(frame.columns)
     assert len(frame) == 2 * 1440 and png.stat().st_size > 30_000
+
+
+def test_the_report_gives_the_dates_and_every_change_with_where(capsys):
+    """A messy file at a 5-minute step: each kind of change is listed with its count and file lines."""
+    assert main(["check", "tests/records/messy.csv", "--site", "lanzhou", "--freq", "5min", "--map", "dhi=DHI"]) == 0
+    out = capsys.readouterr().out
+    assert "98 rows read, 193 rows out, step 10min" in out
+    assert "dates: 2021-06-05 05:00:00+08:00 to 2021-06-05 21:00:00+08:00" in out
+    assert "renamed: 'DHI' -> dhi, 'GHI' -> ghi, 'DNI' -> dni" in out
+    assert "sorted (stamps out of order): count 1, lines 33" in out
+    assert "dropped (repeated stamps, the first kept): count 1, lines 82" in out
+    assert "clipped to 0 (negative irradiance): ghi count 1, lines 3, lowest -2.5" in out
+    assert "resampled: linear in time from 10min to 5min" in out and "(rows 193, interpolated 96, empty 0)" in out
+    assert "NaN kept: dni 1" in out
+
+
+def test_ghi_alone_lists_the_filled_components(capsys):
+    assert main(["check", "tests/records/ghi-only.csv", "--site", "lanzhou"]) == 0
+    out = capsys.readouterr().out
+    assert "filled: dni count 97, how erbs decomposition of GHI (pvlib.irradiance.erbs, true zenith)" in out
+    assert "wind: MISSING: no wind column in the file" in out
+
+
+def test_a_utc_logger_replays_at_a_built_in_site_with_tz_utc(tmp_path, capsys):
+    """The file's zone is not the site's: refused without --tz (the sun check), right with it."""
+    import json
+
+    record = "tests/records/utc-declared-local.csv"
+    assert main(["replay", record, "--site", "lanzhou"]) == 2
+    assert "stamps in UTC+00:00" in capsys.readouterr().err
+    out = tmp_path / "run"
+    assert main(["replay", record, "--site", "lanzhou", "--tz", "UTC", "--perfect", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "naive stamps localised to UTC" in printed and "light follows the sun at lanzhou" in printed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["energy_capture"] > 0.9
+    by_coordinates = tmp_path / "run2"
+    assert main(["replay", record, "--lat", "36.1055556", "--lon", "103.726389", "--altitude", "1520", "--tz", "UTC",
+                 "--site-tz", "Asia/Shanghai", "--perfect", "--out", str(by_coordinates)]) == 0
+    capsys.readouterr()
+    again = json.loads((by_coordinates / "summary.json").read_text())
+    assert again["energy_capture"] == pytest.approx(summary["energy_capture"], abs=1e-3)

@@ -214,7 +214,7 @@ def test_replaying_a_file_across_a_dst_change(tmp_path, capsys):
     local = frame.index.tz_convert("America/Denver").tz_localize(None)
     path = tmp_path / "denver.csv"
     pd.DataFrame({"time": local.strftime("%Y-%m-%d %H:%M"), "ghi": frame["ghi"].round(1), "dni": frame["dni"].round(1),
-                  "dhi": frame["dhi"].round(1)}).to_csv(path, index=False)
+                  "dhi": frame["dhi"].round(1), "wind_speed": frame["wind_speed"].round(2)}).to_csv(path, index=False)
     out = tmp_path / "out"
     assert main(["replay", str(path), "--lat", "39.74", "--lon", "-104.99", "--tz", "America/Denver", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
@@ -237,7 +237,7 @@ def test_a_replay_interrupted_by_a_bad_stretch_reports_it_and_carries_on(tmp_pat
     out = tmp_path / "out"
     assert main(["replay", str(path), "--site", "nanjing", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "unreadable values (NaN): ghi count 20, lines 702, 703, 704, 705, 706" in printed
+    assert "set to NaN (unreadable text): ghi count 20, lines 702, 703, 704, 705, 706" in printed
     import json
 
     summary = json.loads((out / "summary.json").read_text())

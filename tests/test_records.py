@@ -29,7 +29,8 @@ def test_semicolons_decimal_commas_header_block_and_units(tmp_path):
     assert list(frame.columns) == ["ghi", "dni", "dhi", "wind_speed"]
     assert frame["ghi"].iloc[0] == pytest.approx(900.5) and frame["wind_speed"].iloc[0] == pytest.approx(10.0)
     report = frame.attrs["validation"]
-    assert report["header_lines_skipped"] == 3 and report["separator"] == "semicolon" and report["decimal"] == ","
+    assert report["skipped"]["notes before the header"] == [1, 2]
+    assert report["separator"] == "semicolon" and report["decimal"] == ","
     assert frame.index[0] == pd.Timestamp("2021-06-21 12:00", tz="Asia/Shanghai")
 
 
@@ -61,7 +62,7 @@ def test_dst_fall_back_and_spring_forward(tmp_path):
     frame = read_weather(path, tz="America/New_York")
     dropped = frame.attrs["validation"]["dst_dropped"]
     assert dropped["count"] == 2 and dropped["lines"] == [6, 7] and len(frame) == 7
-    assert "DST: dropped" in validation_report(frame)
+    assert "dropped (DST: stamps that do not exist): count 2, lines 6, 7" in validation_report(frame)
 
 
 def test_missing_dni_by_closure_or_decomposition(tmp_path):
@@ -74,15 +75,21 @@ def test_missing_dni_by_closure_or_decomposition(tmp_path):
     closure = read_weather(path, site="nanjing")
     from hybridtrack.sun import solar_position
 
-    cos_z = np.cos(np.radians(solar_position(closure.index, "nanjing")["apparent_zenith"]))
+    # pvlib documents the true (not refraction-corrected) zenith for closure, erbs and dirint
+    zenith = solar_position(closure.index, "nanjing")["zenith"]
+    cos_z = np.cos(np.radians(zenith))
     np.testing.assert_allclose(closure["dni"] * cos_z + closure["dhi"], ghi, rtol=1e-9)
     assert closure.attrs["dni_source"].startswith("closure")
     path = write(tmp_path, "g.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "ghi": ghi})
                  .to_csv(index=False))
     erbs = read_weather(path, site="nanjing")
     assert erbs.attrs["dni_source"].startswith("erbs") and (erbs["dni"] > 0).all() and (erbs["dhi"] > 0).all()
+    expected = pvlib.irradiance.erbs(pd.Series(ghi, index=times), zenith.to_numpy(), times)
+    np.testing.assert_allclose(erbs["dni"], expected["dni"], rtol=1e-12)
     dirint = read_weather(path, site="nanjing", decomposition="dirint")
     assert dirint.attrs["dni_source"].startswith("dirint")
+    np.testing.assert_allclose(dirint["dni"], pvlib.irradiance.dirint(pd.Series(ghi, index=times), zenith.to_numpy(),
+                                                                      times).fillna(0.0), rtol=1e-12)
 
 
 def test_five_minute_data_is_interpolated_to_the_control_step(tmp_path):
@@ -121,8 +128,9 @@ def test_pvlib_formats_go_through_pvlib(tmp_path):
         read_weather(write(tmp_path, "bad.epw", "not an epw\n"), format="epw")
 
 
-EPW_HEADER = ("LOCATION,Nanjing,JS,CHN,SYN,582380,31.93,118.90,8.0,7.1\nDESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\n"
-              "GROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,test\nCOMMENTS 2,test\n"
+EPW_HEADER = ("LOCATION,Nanjing,JS,CHN,SYN,582380,31.93,118.90,8.0,7.1\nDESIGN CONDITIONS,0\n"
+              "TYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n"
+              "COMMENTS 1,test\nCOMMENTS 2,test\n"
               "DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n")
 
 
@@ -156,7 +164,8 @@ def test_the_shipped_records_regenerate_byte_for_byte():
     (None, {}, "no such file"),
     ("", {}, "the file is empty"),
     (b"\x89PNG\r\n\x1a\n\x00\x00binary", {}, "looks binary"),
-    ("time,ghi\n2021-06-21 12:00,9\u00e900\n".encode("latin-1"), {"tz": "UTC"}, "line 2: not UTF-8"),
+    ("time,ghi\n2021-06-21 12:00,9\u00e900\n".encode("latin-1"), {"tz": "UTC"},
+     "line 2, column 'ghi': '9\u00e900' is not"),
     ("a,b\n1,2\n3,4\n", {}, "no time column found"),
     ("time,pressure\n2021-06-21 12:00,1000\n2021-06-21 12:01,1000\n", {"tz": "UTC"}, "no irradiance column"),
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,lots\n", {"tz": "UTC"}, "line 3, column 'ghi': 'lots' is not"),
@@ -164,7 +173,8 @@ def test_the_shipped_records_regenerate_byte_for_byte():
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "UTC", "columns": {"dni": "Beam"}},
      "no column 'Beam' \\(mapped to dni\\); columns are time, ghi"),
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "Mars/Base"}, "unknown time zone 'Mars/Base'"),
-    ("time,ghi\n2021-06-21 12:00,9000\n2021-06-21 12:01,9100\n", {"tz": "UTC"}, "100% of values are outside.*wrong unit"),
+    ("time,ghi\n2021-06-21 12:00,9000\n2021-06-21 12:01,9100\n", {"tz": "UTC"},
+     "100% of values are outside.*wrong unit"),
     ("time,ghi\n2021-06-21 12:00,900\n2021-06-21 12:01,900\n", {"tz": "UTC", "units": {"ghi": "furlongs"}},
      "unknown unit 'furlongs'"),
     ("time,ghi\n2021-06-21 12:00,900\n", {"tz": "UTC"}, "fewer than two distinct time stamps"),
@@ -175,3 +185,92 @@ def test_bad_files_give_one_clear_line(tmp_path, content, kwargs, message):
     with pytest.raises(HybridtrackError, match=message) as error:
         read_weather(path, **kwargs)
     assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "data").glob("*-*.csv")))
+def test_the_shipped_days_follow_their_sites_sun_and_pass_the_magnitude_check(name):
+    frame = read_weather(ROOT / "data" / name, site=name.split("-")[0])
+    assert frame.attrs["validation"]["sun_check"].startswith("light follows the sun")
+
+
+def _shifted_record(tmp_path, seed, weather, shift):
+    """A synthetic Lanzhou day at 1 min written with its stamps moved by `shift` (a wrong clock)."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-21", weather=weather, seed=seed)
+    stamps = (frame.index + pd.Timedelta(shift)).tz_convert("Asia/Shanghai")
+    path = tmp_path / f"{weather}-{seed}.csv"
+    pd.DataFrame({"time": stamps.strftime("%Y-%m-%d %H:%M"), "ghi": frame["ghi"].round(1),
+                  "dni": frame["dni"].round(1), "dhi": frame["dhi"].round(1)}).to_csv(path, index=False)
+    return path
+
+
+@pytest.mark.parametrize("seed, weather", [(1, "mixed"), (2, "mixed"), (3, "cloudy"), (4, "overcast"),
+                                           (5, "sunny")])
+def test_the_sun_check_passes_true_clocks_under_any_sky_and_half_an_hour_off(tmp_path, seed, weather):
+    for shift in ("0min", "30min", "-30min"):
+        frame = read_weather(_shifted_record(tmp_path, seed, weather, shift), site="lanzhou")
+        assert frame.attrs["validation"]["sun_check"].startswith("light follows the sun"), (shift, weather)
+
+
+@pytest.mark.parametrize("shift, fits", [("1h", "shifted by -1h, i.e. stamps in UTC+09:00"),
+                                         ("-2h", "shifted by +2h, i.e. stamps in UTC+06:00")])
+def test_the_sun_check_refuses_a_clock_an_hour_or_more_off_and_names_the_offset(tmp_path, shift, fits):
+    path = _shifted_record(tmp_path, 1, "mixed", shift)
+    with pytest.raises(HybridtrackError, match=fits.replace("+", r"\+")):
+        read_weather(path, site="lanzhou")
+    frame = read_weather(path, site="lanzhou", lenient=True)
+    assert frame.attrs["validation"]["sun_check"].startswith("WARNING")
+    assert "verdict: usable" in validation_report(frame)
+
+
+def test_excels_separator_line_is_obeyed(tmp_path):
+    path = write(tmp_path, "excel.csv", "sep=;\nZeit;GHI;DNI;DHI\n2021-06-21T12:00+08:00;900,5;800;100\n"
+                 "2021-06-21T12:01+08:00;901;801;101\n")
+    frame = read_weather(path)
+    assert frame["ghi"].tolist() == [900.5, 901.0] and "sep=;" in frame.attrs["validation"]["table"]
+
+
+def test_midc_through_pvlib_maps_its_names(tmp_path):
+    from hybridtrack import sites
+
+    path = ROOT / "tests" / "records" / "midc-bms.csv"
+    golden = sites.custom(39.742, -105.18, "Etc/GMT+7", 1829.0)
+    frame = read_weather(path, format="midc", site=golden)
+    reference = pvlib.iotools.read_midc(str(path))
+    np.testing.assert_array_equal(frame["dni"], reference["Direct Normal [W/m^2]"].astype(float))
+    np.testing.assert_array_equal(frame["temp_air"], reference["Tower Dry Bulb Temp [deg C]"].astype(float))
+    assert frame.attrs["validation"]["format"] == "midc"
+
+
+def test_the_fast_number_path_matches_the_careful_one(tmp_path):
+    """Clean columns are parsed in one numpy call; a column with a missing-value word goes cell by cell."""
+    cells = ["1.5", "-0.25", "1e400", "inf", "nan", "  3 ", "+2", "1e-3", "850"]
+    stamps = pd.date_range("2021-06-21 12:00", periods=len(cells), freq="1min").strftime("%Y-%m-%dT%H:%M+08:00")
+    fast = write(tmp_path, "fast.csv", "time,ghi\n" + "".join(f"{t},{c}\n" for t, c in zip(stamps, cells)))
+    careful = write(tmp_path, "careful.csv", "time,ghi\n" + "".join(f"{t},{c}\n" for t, c in zip(stamps, cells))
+                    + "2021-06-21T12:09+08:00,N/A\n")
+    reference = np.array([float(c) for c in cells])  # Python's own float() is the reference
+    reference[~((reference >= -50) & (reference <= 1500))] = np.nan  # inf and 1e400 are impossible
+    reference[reference < 0] = 0.0  # a small negative irradiance is clipped
+    np.testing.assert_array_equal(read_weather(fast, site="lanzhou")["ghi"].to_numpy(), reference)
+    np.testing.assert_array_equal(read_weather(careful, site="lanzhou")["ghi"].to_numpy()[:-1], reference)
+
+
+def test_packed_station_files_go_through_pvlib_decoded(tmp_path):
+    """An EPW gzipped, and EnergyPlus's zip of .epw, .stat and .ddy, read like the plain EPW."""
+    import gzip
+    import zipfile
+
+    epw = (ROOT / "tests" / "records" / "lanzhou.epw").read_text()
+    plain = read_weather(ROOT / "tests" / "records" / "lanzhou.epw")
+    packed = write(tmp_path, "lanzhou.epw.gz", gzip.compress(epw.encode()))
+    bundle = tmp_path / "CHN_GS_Lanzhou.zip"
+    with zipfile.ZipFile(bundle, "w") as archive:
+        archive.writestr("CHN_GS_Lanzhou.epw", epw)
+        archive.writestr("CHN_GS_Lanzhou.stat", "statistics")
+        archive.writestr("CHN_GS_Lanzhou.ddy", "design days")
+    for path in (packed, bundle):
+        frame = read_weather(path)
+        pd.testing.assert_frame_equal(frame, plain, check_like=True)
+        assert frame.attrs["validation"]["format"] == "epw"

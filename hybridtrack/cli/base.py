@@ -26,30 +26,58 @@ def command(name: str, help: str, arguments: Callable[[argparse.ArgumentParser],
     return register
 
 
-def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None = None) -> None:
-    """``--site NAME`` or ``--lat --lon --tz [--altitude]``."""
+def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None = None, record: bool = False) -> None:
+    """``--site NAME`` or ``--lat --lon --tz [--altitude]``.
+
+    With `record` (commands that read a file) ``--tz`` is the file's time zone, which may differ
+    from the site's: ``--site lanzhou --tz UTC`` reads a UTC logger at Lanzhou. With
+    ``--lat/--lon`` the site's clock is ``--site-tz``, or else the same ``--tz``.
+    """
     group = parser.add_argument_group("site", f"a built-in site ({', '.join(sites.names())}) or coordinates")
     group.add_argument("--site", default=None, help=f"built-in site name{f' (default {default})' if default else ''}")
     group.add_argument("--lat", type=float, help="latitude, degrees north")
     group.add_argument("--lon", type=float, help="longitude, degrees east")
-    group.add_argument("--tz", help="IANA time zone of the local clock, e.g. Asia/Shanghai")
+    if record:
+        group.add_argument("--tz", help="IANA time zone of the file's naive stamps (or to convert stamps with "
+                                        "offsets to), e.g. UTC; with --lat/--lon also the site's clock")
+        group.add_argument("--site-tz", help="with --lat/--lon: the site's clock when it differs from the file's --tz")
+    else:
+        group.add_argument("--tz", help="IANA time zone of the local clock, e.g. Asia/Shanghai")
     group.add_argument("--altitude", type=float, default=0.0, help="metres above sea level (with --lat/--lon)")
-    parser.set_defaults(_default_site=default)
+    parser.set_defaults(_default_site=default, _record_site=record)
 
 
-def site_from_arguments(args: argparse.Namespace) -> sites.Site:
-    """The site the user named, or the one given by coordinates."""
-    coordinates = (args.lat, args.lon, args.tz)
+def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True) -> sites.Site | None:
+    """The site the user named, or the one given by coordinates.
+
+    For commands that read a file (`add_site_arguments` with ``record=True``) ``--tz`` is the
+    file's zone and goes with ``--site`` too; a site by coordinates takes ``--site-tz`` or
+    ``--tz`` as its clock. With `clock_required` false (``check``, which only needs the sun)
+    coordinates without a zone get UTC, and no site at all gives None.
+    """
+    record = getattr(args, "_record_site", False)
+    site_tz = getattr(args, "site_tz", None) if record else None
     if args.site is not None:
-        if any(value is not None for value in coordinates):
-            raise HybridtrackError("give either --site or --lat/--lon/--tz, not both")
+        given = (args.lat, args.lon, site_tz) if record else (args.lat, args.lon, args.tz)
+        if any(value is not None for value in given):
+            raise HybridtrackError("give either --site or --lat/--lon" + ("/--site-tz" if record else "/--tz")
+                                   + ", not both")
         return sites.get(args.site)
-    if all(value is not None for value in coordinates):
-        return sites.custom(args.lat, args.lon, args.tz, args.altitude)
-    if any(value is not None for value in coordinates):
-        raise HybridtrackError("--lat, --lon and --tz go together; one of them is missing")
+    clock = (site_tz or args.tz) if record else args.tz
+    if args.lat is not None and args.lon is not None:
+        if clock is None and (clock_required or not record):
+            raise HybridtrackError("--lat and --lon need the site's clock: --tz ZONE" + (" (or --site-tz)" if record
+                                                                                          else ""))
+        return sites.custom(args.lat, args.lon, clock or "UTC", args.altitude)
+    if args.lat is not None or args.lon is not None or (args.tz is not None and not record):
+        together = "--lat, --lon" + ("" if record else " and --tz")
+        raise HybridtrackError(f"{together} go together; one of them is missing")
+    if site_tz is not None:
+        raise HybridtrackError("--site-tz goes with --lat/--lon")
     if args._default_site:
         return sites.get(args._default_site)
+    if not clock_required:
+        return None
     raise HybridtrackError("no site: give --site NAME or --lat LAT --lon LON --tz TZ")
 
 
@@ -75,37 +103,48 @@ def collector_from_arguments(args: argparse.Namespace):
 
 
 def parse_mapping(pairs, flag: str) -> dict[str, str]:
-    mapping = {}
+    """``["dni=Direct Normal", "time="]`` -> a dict; ``time=`` (empty) names an unnamed column."""
+    mapping: dict[str, str] = {}
     for pair in pairs or []:
         name, sep, value = pair.partition("=")
-        if not sep or not name.strip() or not value.strip():
+        name = name.strip()
+        if not sep or not name or (not value.strip() and not (flag == "--map" and name == "time")):
             raise HybridtrackError(f"{flag} takes NAME=VALUE, got {pair!r}")
-        mapping[name.strip()] = value.strip()
+        if name in mapping:
+            raise HybridtrackError(f"{flag} names {name} twice ({mapping[name]!r} and {value.strip()!r})")
+        mapping[name] = value.strip()
     return mapping
 
 
 def add_record_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--map``, ``--units``, ``--format``, ``--freq`` and ``--decomposition`` for recorded files."""
+    """``--map``, ``--units``, ``--format``, date order, ``--decomposition``, ``--strict`` and ``--lenient``."""
     group = parser.add_argument_group("recorded file")
     group.add_argument("--map", action="append", metavar="NAME=COLUMN",
                        help="which file column holds ghi, dni, dhi, wind_speed, temp_air, photocurrent or time "
-                            "(repeatable), e.g. --map dni='Direct Normal'")
+                            "(repeatable), e.g. --map dni='Direct Normal'; --map time= names an unnamed first column")
     group.add_argument("--units", action="append", metavar="NAME=UNIT", help="unit of a column, e.g. --units ghi=kW/m2")
-    group.add_argument("--format", default="csv",
-                       help="csv (default), epw, tmy3, midc, srml, bsrn, surfrad, crn, solrad")
+    group.add_argument("--format", default=None,
+                       help="csv, epw, tmy3, tmy2, midc, srml, bsrn, surfrad, crn, solrad (default: from the content)")
+    order = group.add_mutually_exclusive_group()
+    order.add_argument("--dayfirst", dest="dayfirst", action="store_const", const=True, default=None,
+                       help="dates like 05/06/2021 are day first (5 June)")
+    order.add_argument("--monthfirst", dest="dayfirst", action="store_const", const=False,
+                       help="dates like 05/06/2021 are month first (6 May)")
     group.add_argument("--decomposition", choices=("erbs", "dirint"), default="erbs",
                        help="how DNI and DHI are split from GHI alone (default erbs)")
     group.add_argument("--strict", action="store_true",
                        help="refuse the file at the first thing the checks would repair (default: repair and report)")
+    group.add_argument("--lenient", action="store_true",
+                       help="warn instead of refusing when the light does not follow the site's sun")
 
 
 def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | None = None):
-    """`read_weather` with the flags of `add_record_arguments`."""
+    """`read_weather` with the flags of `add_record_arguments` (``--tz`` is the file's zone)."""
     from ..io import read_weather
 
     return read_weather(path, columns=parse_mapping(args.map, "--map"), tz=args.tz, format=args.format, site=site,
                         units=parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition,
-                        strict=args.strict)
+                        strict=args.strict, dayfirst=args.dayfirst, lenient=args.lenient)
 
 
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
@@ -134,9 +173,10 @@ def simulation_config(args: argparse.Namespace, seed: int | None = None):
     return config
 
 
-def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: bool = True) -> None:
-    """Site, dates, weather, step, seed and gusts of synthetic days."""
-    add_site_arguments(parser)
+def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: bool = True,
+                            record: bool = False) -> None:
+    """Site, dates, weather, step, seed and gusts of synthetic days (`record`: a file may be read too)."""
+    add_site_arguments(parser, record=record)
     parser.add_argument("--date", required=date_required, help="first local date, YYYY-MM-DD")
     parser.add_argument("--days", type=int, default=1, help="number of days (default 1)")
     parser.add_argument("--weather", default="mixed",

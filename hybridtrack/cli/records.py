@@ -8,6 +8,7 @@ import pandas as pd
 
 from .base import (
     add_record_arguments,
+    add_site_arguments,
     add_synthetic_arguments,
     command,
     read_record,
@@ -18,19 +19,41 @@ from .base import (
 
 def _check_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="recorded weather file")
+    add_site_arguments(parser, record=True)
     add_record_arguments(parser)
-    parser.add_argument("--tz", help="time zone of naive stamps, e.g. Asia/Shanghai")
-    parser.add_argument("--site", help="site, to derive missing irradiance components")
     parser.add_argument("--freq", help="resample to this step, e.g. 1min")
+    parser.add_argument("--out", metavar="FILE", help="write the checked (cleaned) frame as CSV")
 
 
-@command("check", "read a recorded weather file and print its validation summary", _check_arguments)
+@command("check", "read a recorded weather file and print its validation summary; with a site (--site or "
+                  "--lat/--lon) also check it against the sun", _check_arguments)
 def _check(args: argparse.Namespace) -> int:
     from ..io import validation_report
 
-    frame = read_record(args, args.file, site=args.site, freq=args.freq)
+    site = site_from_arguments(args, clock_required=False)
+    frame = read_record(args, args.file, site=site, freq=args.freq)
     print(validation_report(frame))
+    if args.out:
+        write_frame(frame, args.out)
+        print(f"wrote {len(frame)} rows to {args.out}")
     return 0
+
+
+def write_frame(frame: pd.DataFrame, path: str) -> None:
+    """A weather frame as CSV: ISO stamps with their UTC offset, which `read_weather` reads back."""
+    from pathlib import Path
+
+    from ..errors import HybridtrackError
+
+    target = Path(path)
+    if target.is_dir():
+        raise HybridtrackError(f"{path}: is a folder; --out takes a file name")
+    out = frame.copy()
+    out.index = out.index.strftime("%Y-%m-%dT%H:%M:%S%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2", regex=True)
+    try:
+        out.to_csv(target, index_label="time", float_format="%.6g")
+    except OSError as exc:
+        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
 
 
 def _sky_arguments(parser: argparse.ArgumentParser) -> None:

@@ -110,7 +110,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
 def _replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="recorded weather file (CSV or a pvlib format)")
-    add_site_arguments(parser)
+    add_site_arguments(parser, record=True)
     add_record_arguments(parser)
     parser.add_argument("--step", default="1min", help="control step the record is resampled to (default 1min)")
     add_run_arguments(parser)
@@ -149,7 +149,7 @@ def _replay(args: argparse.Namespace) -> int:
 
 def _compare_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", nargs="?", help="recorded weather file to replay (else synthetic days from --date)")
-    add_synthetic_arguments(parser, date_required=False)
+    add_synthetic_arguments(parser, date_required=False, record=True)
     add_record_arguments(parser)
     parser.add_argument("--step", default="1min", help="control step a record is resampled to (default 1min)")
     add_run_arguments(parser)
@@ -165,6 +165,8 @@ def _compare(args: argparse.Namespace) -> int:
         site, frame = _replay_frame(args)
         config = replay_config(args, frame)
     else:
+        if args.site is not None and args.tz is not None:
+            raise HybridtrackError("--tz is a recorded file's time zone; synthetic days at --site keep its clock")
         site = site_from_arguments(args)
         frame = synthetic_frame(args, site)
         config = simulation_config(args, args.seed)

@@ -1,0 +1,190 @@
+"""Validation: order, duplicates, gaps, impossible values, offsets, and each repair counted.
+
+Every repair is recorded in the validation report with its count and the first file lines
+it touched (`first_lines`), and `refuse_repairs` turns the first one into an error in strict
+mode. The limits and their reasons:
+
+* Irradiance below -50 W/m² or above 1500 (GHI), 1400 (DNI), 1000 (DHI) W/m² cannot be
+  measured at the Earth's surface: the solar constant is 1361 W/m² (Kopp & Lean 2011,
+  doi:10.1029/2010GL045777) and the BSRN "physically possible" limits of Long & Shi (2008,
+  doi:10.2174/1874282300802010023) are of this size. Small negative irradiance (down to
+  -50 W/m²) is a thermopile's night offset: clipped to 0.
+* Wind below -0.5 m/s or above 75 m/s: a cup or sonic anemometer's zero offset gives small
+  negative readings in calm air (a few tenths of m/s), which are calm, so clipped to 0; 75 m/s
+  is above any recorded surface gust outside tornadoes.
+* Air temperature outside -90..65 °C: beyond the records of the surface (-89.2 °C at Vostok;
+  56.7 °C in Death Valley).
+* Non-finite values (``inf``, ``1e400``) are impossible everywhere.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .columns import IRRADIANCE, WEATHER_COLUMNS
+from .units import FRAME_UNITS
+
+__all__ = ["LIMITS", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude", "refuse_repairs"]
+
+#: Physically possible range of each column; outside it a value is flagged (NaN).
+LIMITS = {"ghi": (-50.0, 1500.0), "dni": (-50.0, 1400.0), "dhi": (-50.0, 1000.0), "wind_speed": (-0.5, 75.0),
+          "temp_air": (-90.0, 65.0), "photocurrent": (0.0, 10_000.0)}
+
+#: m/s: negative wind down to this is an anemometer's zero offset in calm air, read as 0.
+CALM_OFFSET = -0.5
+
+_HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "temp_air": "K", "photocurrent": "A"}
+
+#: What each repair did, for strict mode's refusal.
+REPAIRS = {
+    "unreadable": "text in a numeric column", "dst_dropped": "a time stamp that does not exist in the time zone",
+    "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",
+    "impossible": "a physically impossible value", "negative_clipped": "a negative irradiance",
+    "calm_clipped": "a negative wind reading",
+}
+
+
+def first_lines(frame: pd.DataFrame, mask) -> list[int]:
+    """The file lines of the first five rows in `mask` (resampled rows have none)."""
+    lines = frame["_line"].to_numpy()[np.asarray(mask, bool)]
+    return [int(v) for v in lines[np.isfinite(lines)][:5]]
+
+
+def span(delta) -> str:
+    """A duration in its largest whole unit: ``5min``, ``1h``, ``30s``, ``2d``."""
+    delta = pd.Timedelta(delta)
+    for unit, size in (("d", pd.Timedelta(days=1)), ("h", pd.Timedelta(hours=1)), ("min", pd.Timedelta(minutes=1)),
+                       ("s", pd.Timedelta(seconds=1)), ("ms", pd.Timedelta(milliseconds=1)),
+                       ("us", pd.Timedelta(microseconds=1)), ("ns", pd.Timedelta(nanoseconds=1))):
+        if delta >= size and delta % size == pd.Timedelta(0):
+            return f"{delta // size}{unit}"
+    return str(delta)
+
+
+def _order(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
+    if not frame.index.is_monotonic_increasing:
+        disorder = np.flatnonzero(np.diff(frame.index.as_unit("ns").asi8) < 0) + 1
+        report["unsorted"] = {"count": int(len(disorder)),
+                              "lines": first_lines(frame, np.isin(np.arange(len(frame)), disorder)),
+                              "action": "sorted by time"}
+        frame = frame.sort_index(kind="stable")
+    duplicated = frame.index.duplicated(keep="first")
+    if duplicated.sum() > 0.5 * len(frame):
+        lines = first_lines(frame, duplicated)
+        raise HybridtrackError(f"{path}: line {lines[0] if lines else '?'}: {duplicated.sum()} of {len(frame)} stamps "
+                               "repeat an earlier one; is part of the time (a clock column) missing? map it with --map")
+    if duplicated.any():
+        report["duplicates"] = {"count": int(duplicated.sum()), "lines": first_lines(frame, duplicated),
+                                "action": "dropped, the first of each kept"}
+        frame = frame[~duplicated]
+    if len(frame) < 2:
+        raise HybridtrackError(f"{path}: fewer than two distinct time stamps; nothing to replay")
+    return frame
+
+
+def _gaps(frame: pd.DataFrame, report: dict) -> None:
+    steps = np.diff(frame.index.as_unit("ns").asi8)
+    step = int(np.median(steps))
+    gap_at = np.flatnonzero(steps > 1.5 * step)
+    report["step"] = span(pd.Timedelta(step, "ns"))
+    if len(gap_at):
+        report["gaps"] = {"count": int(len(gap_at)), "longest": span(pd.Timedelta(int(steps[gap_at].max()), "ns")),
+                          "first_after_lines": first_lines(frame, np.isin(np.arange(len(frame)), gap_at))}
+
+
+def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
+    clipped, calm, impossible = {}, {}, {}
+    for name, (low, high) in LIMITS.items():
+        if name not in frame:
+            continue
+        values = frame[name].to_numpy(float)
+        present = ~np.isnan(values)
+        bad = present & ~((values >= low) & (values <= high))  # inf and 1e400 included
+        if present.sum() and bad.sum() > 0.5 * present.sum():
+            raise HybridtrackError(
+                f"{path}: column {report.get('columns', {}).get(name, name)!r}: {bad.sum() / present.sum():.0%} of "
+                f"values are outside {low:g}..{high:g} ({FRAME_UNITS[name]}); wrong unit? give it, e.g. "
+                f"--units {name}={_HINT[name]}")
+        if bad.any():
+            first = values[bad][0]
+            impossible[name] = {"count": int(bad.sum()), "lines": first_lines(frame, bad),
+                                "first": float(first) if np.isfinite(first) else str(first), "action": "set to NaN"}
+            values = np.where(bad, np.nan, values)
+        negative = ~np.isnan(values) & (values < 0)
+        if negative.any() and name in (*IRRADIANCE, "wind_speed"):
+            entry = {"count": int(negative.sum()), "lines": first_lines(frame, negative),
+                     "lowest": float(values[negative].min())}
+            (calm if name == "wind_speed" else clipped)[name] = entry
+            values = np.where(negative, 0.0, values)
+        frame[name] = values
+    for key, entry in (("negative_clipped", clipped), ("calm_clipped", calm), ("impossible", impossible)):
+        if entry:
+            report[key] = entry
+
+
+def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
+    """`frame` sorted, without repeated stamps, with impossible values flagged and offsets clipped.
+
+    Each repair is counted in `report`; gaps and NaN are reported, not changed.
+    """
+    frame = _order(path, frame, report)
+    _gaps(frame, report)
+    nan = {name: int(frame[name].isna().sum()) for name in WEATHER_COLUMNS
+           if name in frame and frame[name].isna().any()}
+    if nan:
+        report["nan"] = nan
+    frame = frame.copy()
+    _limits(path, frame, report)
+    light = [name for name in (*IRRADIANCE, "photocurrent") if name in frame]
+    if light and all(frame[name].isna().all() for name in light):
+        header = report.get("columns", {}).get(light[0], light[0])
+        raise HybridtrackError(f"{path}: column {header!r}: no readable value in any irradiance column")
+    return frame
+
+
+def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None) -> None:
+    """Refuse irradiance a thousand times too small: kW/m² read as W/m².
+
+    In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
+    tens of W/m² while the sun is well up. So GHI (or DHI) whose largest value is above 0 and at
+    most 1.5 is refused when the site's clear sky (`clear_ghi`, W/m², on the frame's stamps)
+    reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
+    judged so only in a file without GHI and DHI, since an overcast day has none.
+    """
+    hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
+    judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
+    for name in judged:
+        values = frame[name].to_numpy(float)
+        if not np.isfinite(values).any():
+            continue
+        top = float(np.nanmax(values))
+        if clear_ghi is not None:
+            reference = float(np.nanmax(clear_ghi)) if len(clear_ghi) else 0.0
+            suspicious = reference >= 300.0 and 0.0 < top <= 1.5
+            why = f"at most {top:g} while the clear sky reaches {reference:.0f} W/m²"
+        else:
+            suspicious = hours >= 6.0 and 0.0 < top <= 1.5
+            why = f"at most {top:g} over {hours:.0f} hours"
+        if suspicious:
+            header = report.get("columns", {}).get(name, name)
+            line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
+            where = f"line {line[0]}, " if line else ""
+            raise HybridtrackError(f"{path}: {where}column {header!r}: {name} is {why}; the values look like kW/m² "
+                                   f"read as W/m²: give the unit (--units {name}=kW/m2)")
+
+
+def refuse_repairs(path: Path, report: dict) -> None:
+    """In strict mode, the first thing the checks would have repaired is an error."""
+    for key, what in REPAIRS.items():
+        if key not in report:
+            continue
+        entry = report[key]
+        if "lines" in entry:
+            raise HybridtrackError(f"{path}: line {entry['lines'][0]}: {what} (strict)")
+        column, detail = next(iter(entry.items()))
+        header = report.get("columns", {}).get(column, column)
+        raise HybridtrackError(f"{path}: line {detail['lines'][0]}, column {header!r}: {what} (strict)")

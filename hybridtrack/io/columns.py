@@ -1,0 +1,146 @@
+"""Column names: which of a file's columns holds each quantity.
+
+A header is split into its name and a bracketed part (``'GHI [kW/m2]'``); the bracketed part
+is a unit when it spells one (`units.any_known_unit`), else a note (``'(vent/cor)'``) that is
+reported and otherwise ignored. The name is compared, lower-cased, with `ALIASES` after a
+logger's statistics suffix (``_Avg``, ``_Smp``, ``_S_WVT`` ...) is removed, so ``GHI_Avg`` and
+``WS_ms_S_WVT`` are found. The user's mapping (``--map NAME=COLUMN``) comes first and may name
+any column; it is refused when it names an unknown quantity, a missing column, or one column
+for two quantities. docs/records.md lists the aliases.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+
+from ..errors import HybridtrackError
+from .units import any_known_unit
+
+__all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "split_header", "resolve_columns",
+           "check_names"]
+
+#: The columns of a weather frame, in order.
+WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent")
+IRRADIANCE = ("ghi", "dni", "dhi")
+
+#: A column of true sky labels (e.g. in synthetic records), kept as text for scoring.
+LABEL_COLUMN = "sky"
+
+#: The name of a column without a header (pandas writes its index so); ``--map time=`` names it.
+UNNAMED = ""
+
+#: Usual header names of each column, lower-cased, after brackets and statistics suffixes are removed.
+ALIASES = {
+    "time": ("time", "timestamp", "datetime", "date_time", "date time", "date/time", "time stamp", "tmstamp",
+             "utc", "local time", "time_utc", "epoch", "unix time", "unixtime", UNNAMED, "unnamed: 0", "index",
+             "zeit", "zeitstempel", "datum/zeit", "horodatage", "date heure", "fecha hora", "fecha y hora"),
+    "date": ("date", "day", "date (mm/dd/yyyy)", "yyyy-mm-dd", "datum", "fecha"),
+    "clock": ("time", "hour", "clock", "hh:mm", "time (hh:mm)", "mst", "pst", "lst", "est", "cst", "uhrzeit", "hora"),
+    "ghi": ("ghi", "global", "global horizontal", "global_horizontal", "global horizontal irradiance",
+            "global irradiance", "glo", "gh", "ghi_wm2", "slrw", "sw_in", "swdown", "global_irradiance",
+            "global_horiz", "ghi_pyr", "g_h", "dw_solar"),
+    "dni": ("dni", "direct normal", "direct_normal", "direct normal irradiance", "direct", "beam", "dn", "dni_wm2",
+            "direct_normal_irradiance", "dni_pyr", "b_n", "direct_n"),
+    "dhi": ("dhi", "diffuse", "diffuse horizontal", "diffuse_horizontal", "diffuse horizontal irradiance", "dif",
+            "dhi_wm2", "diffuse_horizontal_irradiance", "d_h"),
+    "wind_speed": ("wind_speed", "wind speed", "windspeed", "windgeschwindigkeit", "vitesse du vent",
+                   "wind", "ws", "wspd", "ws_ms", "wind_ms", "avg wind speed", "wind speed avg", "wsp"),
+    "temp_air": ("temp_air", "air temperature", "temperature", "temp", "tair", "t_air", "ta", "airtc", "airtk",
+                 "air_temp", "tamb", "t_amb", "ambient temperature", "dry bulb", "drybulb", "temp_c", "t2m",
+                 "dry bulb temp", "tower dry bulb temp", "temperatur", "température", "temperatura", "lufttemperatur"),
+    "photocurrent": ("photocurrent", "photocurrent_ma", "intensity", "intensity_ma", "sensor current"),
+}
+
+#: Statistics suffixes loggers append to a measurement's name (Campbell: _Avg, _Smp, _S_WVT ...).
+_SUFFIX = re.compile(r"(_(avg|mean|smp|sample|s_wvt|wvt|wvc|std|tot))+$")
+_BRACKETS = re.compile(r"\s*[\[(]([^\])]*)[\])]\s*")
+
+
+def split_header(header: str) -> tuple[str, str | None, str | None]:
+    """``'GHI [kW/m2]'`` -> (``'ghi'``, ``'kW/m2'``, None); ``'DNI (vent/cor)'`` -> (``'dni'``, None, ``'vent/cor'``).
+
+    The name is lower-cased, stripped of brackets and of a logger's statistics suffix.
+    """
+    unit = note = None
+    for match in _BRACKETS.finditer(header):
+        inner = match.group(1).strip()
+        if unit is None and any_known_unit(inner):
+            unit = inner
+        elif inner:
+            note = inner if note is None else f"{note}; {inner}"
+    name = re.sub(r"\s*@.*$", "", _BRACKETS.sub(" ", header)).strip().lower()  # 'Wind Speed @ 6ft'
+    name = re.sub(r"\s+", " ", name)
+    if name == UNNAMED or name.startswith("unnamed:"):
+        return (UNNAMED if header.strip().lower() in (UNNAMED, "unnamed: 0") else name), unit, note
+    return _SUFFIX.sub("", name), unit, note
+
+
+def check_names(mapping: Mapping[str, str], flag: str) -> None:
+    """Refuse a mapping that names an unknown quantity (``--units beam=...``)."""
+    allowed = ("time", *WEATHER_COLUMNS) if flag == "--map" else WEATHER_COLUMNS
+    for name in mapping:
+        if name not in allowed:
+            raise HybridtrackError(f"unknown column name {name!r} in {flag}; use {', '.join(allowed)}")
+
+
+def _matches(header: str, name: str) -> bool:
+    base = split_header(header)[0]
+    return base in ALIASES[name] or (name == "time" and header.strip().lower() in ALIASES["time"])
+
+
+def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] | None) -> dict[str, str]:
+    """Quantity -> file header, from the user's mapping first, then `ALIASES`.
+
+    The result may hold ``date`` and ``clock`` instead of ``time`` when the file keeps them in
+    two columns.
+    """
+    columns = dict(columns or {})
+    check_names(columns, "--map")
+    mapping: dict[str, str] = {}
+    for name, header in columns.items():
+        found = _find(headers, header)
+        if found is None:
+            shown = ", ".join(repr(h) if not h.strip() else h for h in headers)
+            raise HybridtrackError(f"{where}: no column {header!r} (mapped to {name}); columns are {shown}")
+        twice = next((other for other, taken in mapping.items() if taken == found), None)
+        if twice is not None:
+            raise HybridtrackError(f"{where}: column {found!r} is mapped to both {twice} and {name}; "
+                                   "one column holds one quantity")
+        mapping[name] = found
+    taken = set(mapping.values())
+    unnamed_last = sorted(headers, key=lambda h: h.strip().lower() in (UNNAMED, "unnamed: 0"))
+    for name in ("time", *WEATHER_COLUMNS):
+        if name in mapping:
+            continue
+        header = next((h for h in unnamed_last if h not in taken and _matches(h, name)), None)
+        if header is not None:
+            mapping[name] = header
+            taken.add(header)
+    if "time" not in mapping or split_header(mapping["time"])[0] in ALIASES["clock"] and "time" not in columns:
+        _date_and_clock(headers, taken, mapping)
+    return mapping
+
+
+def _find(headers: list[str], wanted: str) -> str | None:
+    """The header the user meant: exact, then stripped and case-insensitive; '' or 'Unnamed: 0' is the unnamed one."""
+    if wanted in headers:
+        return wanted
+    key = wanted.strip().lower()
+    if key in (UNNAMED, "unnamed: 0"):
+        return next((h for h in headers if h.strip().lower() in (UNNAMED, "unnamed: 0")), None)
+    return next((h for h in headers if h.strip().lower() == key), None)
+
+
+def _date_and_clock(headers: list[str], taken: set, mapping: dict[str, str]) -> None:
+    """Separate ``date`` and ``time`` columns: both are kept for the stamps to combine."""
+    date = next((h for h in headers if h not in taken and split_header(h)[0] in ALIASES["date"]), None)
+    if date is None:
+        return
+    clock = mapping.get("time") or next((h for h in headers if h not in taken
+                                         and split_header(h)[0] in ALIASES["clock"]), None)
+    mapping.pop("time", None)
+    if clock is None:
+        mapping["time"] = date  # one column named 'date' may hold whole stamps
+    else:
+        mapping["date"], mapping["clock"] = date, clock

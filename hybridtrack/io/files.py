@@ -1,0 +1,145 @@
+"""Files and encodings: the bytes of a file, unpacked (``.gz``, ``.zip``) and decoded to text.
+
+Text is decoded as UTF-8 (with or without a byte-order mark), UTF-16 (with a byte-order mark,
+or without one when every other byte is NUL, as Windows tools write it), and otherwise as
+Windows-1252 / Latin-1, the encoding of older loggers' degree signs. The encoding used is
+returned so that the validation report can say it.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import zipfile
+from pathlib import Path
+
+from ..errors import HybridtrackError
+
+__all__ = ["read_bytes", "unpack", "decode", "file_text", "read_text", "read_toml", "write_toml", "WEATHER_SUFFIXES"]
+
+#: In a zip of several files, the one weather file among them is read (EnergyPlus ships .epw with .stat, .ddy).
+WEATHER_SUFFIXES = (".epw", ".csv", ".tm2", ".tmy", ".dat", ".tsv", ".txt")
+
+
+def read_bytes(path: Path, what: str = "file") -> bytes:
+    """The raw bytes of `path`, or one clear error: missing, a folder, not readable."""
+    try:
+        return Path(path).read_bytes()
+    except FileNotFoundError:
+        raise HybridtrackError(f"{path}: no such {what}") from None
+    except IsADirectoryError:
+        raise HybridtrackError(f"{path}: is a folder, not a {what}") from None
+    except PermissionError:
+        raise HybridtrackError(f"{path}: not readable (permission denied)") from None
+    except OSError as exc:
+        raise HybridtrackError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+
+
+def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
+    """The content of a gzip or zip file (by its magic bytes), and how it was packed."""
+    if raw[:2] == b"\x1f\x8b":
+        try:
+            return gzip.decompress(raw), "gzip"
+        except (OSError, EOFError, gzip.BadGzipFile) as exc:
+            raise HybridtrackError(f"{path}: a damaged gzip file ({exc})") from None
+    if raw[:4] == b"PK\x03\x04":
+        try:
+            with zipfile.ZipFile(io.BytesIO(raw)) as archive:
+                members = [m for m in archive.infolist() if not m.is_dir() and not m.filename.startswith("__MACOSX")]
+                weather = [m for m in members if m.filename.lower().endswith(WEATHER_SUFFIXES)]
+                if len(members) > 1 and len(weather) == 1:  # EnergyPlus zips: .epw with .stat and .ddy
+                    members = weather
+                if len(members) != 1:
+                    names = ", ".join(m.filename for m in members) or "nothing"
+                    raise HybridtrackError(f"{path}: a zip archive must hold exactly one file; it holds {names}")
+                return archive.read(members[0]), f"zip member {members[0].filename}"
+        except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, NotImplementedError) as exc:
+            raise HybridtrackError(f"{path}: a damaged or unsupported zip file ({exc})") from None
+    return raw, None
+
+
+def _looks_utf16(raw: bytes) -> str | None:
+    """'utf-16-le' or 'utf-16-be' for BOM-less UTF-16 text (NUL in every other byte), else None."""
+    sample = raw[:4096]
+    if len(sample) < 4:
+        return None
+    even, odd = sample[0::2], sample[1::2]
+    if odd.count(0) > 0.9 * len(odd) and even.count(0) < 0.1 * len(even):
+        return "utf-16-le"
+    if even.count(0) > 0.9 * len(even) and odd.count(0) < 0.1 * len(odd):
+        return "utf-16-be"
+    return None
+
+
+def decode(path: Path, raw: bytes) -> tuple[str, str]:
+    """Text and the encoding it was read in; binary data is refused."""
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        encoding = "utf-16"
+    else:
+        encoding = _looks_utf16(raw) or ""
+    if encoding:
+        try:
+            return raw.decode(encoding).lstrip("\ufeff"), encoding.upper()
+        except UnicodeDecodeError as exc:
+            raise HybridtrackError(f"{path}: not valid UTF-16 text (byte {exc.start})") from None
+    if b"\x00" in raw[:4096]:
+        raise HybridtrackError(f"{path}: looks binary, not a text table")
+    try:
+        return raw.decode("utf-8-sig"), "UTF-8"
+    except UnicodeDecodeError:
+        pass
+    try:
+        return raw.decode("cp1252"), "Windows-1252"
+    except UnicodeDecodeError:
+        return raw.decode("latin-1"), "Latin-1"
+
+
+def file_text(path, what: str = "file") -> tuple[str, str]:
+    """The text of a (possibly packed) file and a note of how it was read, e.g. ``'gzip, UTF-16'``."""
+    path = Path(path)
+    raw, packing = unpack(path, read_bytes(path, what))
+    text, encoding = decode(path, raw)
+    if not text.strip():
+        raise HybridtrackError(f"{path}: the file is empty")
+    return text, ", ".join(part for part in (packing, encoding) if part)
+
+
+def read_text(path) -> str:
+    """A text file's contents, or one clear error: missing, a folder, binary, empty.
+
+    Packed (gzip, zip) and UTF-16 or Latin-1 files are read too (see `decode`).
+    """
+    return file_text(path)[0]
+
+
+def _tomllib():
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+    return tomllib
+
+
+def read_toml(path, what: str = "config") -> dict:
+    """A TOML file as a dict, or one clear error naming the file (missing, not UTF-8, bad TOML)."""
+    tomllib = _tomllib()
+    path = Path(path)
+    raw = read_bytes(path, f"{what} file")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise HybridtrackError(f"{path}: not valid TOML: {exc}") from None
+
+
+def write_toml(data: dict, path) -> Path:
+    """Write a dict as TOML, creating folders; `read_toml` reads it back equal."""
+    import tomli_w
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(tomli_w.dumps(data), encoding="utf-8")
+    return path

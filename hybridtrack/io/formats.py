@@ -1,0 +1,165 @@
+"""pvlib's weather formats: recognised by their content, read by `pvlib.iotools`, names mapped.
+
+`detect_format` looks at a file's first lines: ``LOCATION,`` (EPW), a TMY3 station line
+followed by ``Date (MM/DD/YYYY),Time (HH:MM)``, a TMY2 station line (WBAN, city, state, zone,
+latitude and longitude in degrees and minutes), an SRML header (station, year, then element
+numbers each followed by a 0 flag column, tab-separated), a SURFRAD station and coordinates block, or a
+BSRN station-to-archive record (``*C0100`` ...). Anything else is read as a table, which covers
+NREL MIDC's CSV (``DATE (MM/DD/YYYY),MST,...``) by its names.
+
+Whatever pvlib returns, its columns are mapped to the frame's through the same alias table as
+a CSV's (`columns.ALIASES`), plus pvlib's own names per format, with the format's units (TMY2
+gives tenths of °C and m/s); a file from which no irradiance column can be mapped is refused,
+so "clean" always means readable. Typical-year files (EPW, TMY3, TMY2) take one year, 2019,
+since their months come from different years.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .columns import IRRADIANCE, WEATHER_COLUMNS, resolve_columns
+
+__all__ = ["PVLIB_FORMATS", "TYPICAL_YEAR", "detect_format", "read_pvlib"]
+
+#: Formats read through pvlib.iotools.
+PVLIB_FORMATS = {"epw": "read_epw", "tmy3": "read_tmy3", "tmy2": "read_tmy2", "midc": "read_midc",
+                 "srml": "read_srml", "bsrn": "read_bsrn", "surfrad": "read_surfrad", "crn": "read_crn",
+                 "solrad": "read_solrad"}
+#: Typical-year formats: their months come from different years, so one year is coerced.
+TYPICAL_YEAR_FORMATS = ("epw", "tmy3", "tmy2")
+TYPICAL_YEAR = 2019  # any year that is not a leap year
+
+#: pvlib's names in each format that the alias table does not already know, and their scale.
+PVLIB_NAMES = {
+    "tmy2": {"GHI": ("ghi", 1.0), "DNI": ("dni", 1.0), "DHI": ("dhi", 1.0), "DryBulb": ("temp_air", 0.1),
+             "Wspd": ("wind_speed", 0.1)},
+    "midc": {},
+}
+
+_TMY2_FIRST = re.compile(r"^\s*\d{5}\s+\S.*\s+-?\d{1,2}\s+[NS]\s+\d+\s+\d+\s+[EW]\s+\d+\s+\d+\s+-?\d+\s*$")
+_SRML_FIRST = re.compile(r"^\d{5}\t(19|20)\d{2}(\t\d{3,4}\t0)+\s*$")
+_SURFRAD_SECOND = re.compile(r"^\s*-?\d+\.\d+\s+-?\d+\.\d+\s+\d+\s+m\s+version", re.I)
+
+
+def detect_format(text: str) -> str:
+    """``'epw'``, ``'tmy3'``, ``'tmy2'``, ``'srml'``, ``'surfrad'``, ``'bsrn'`` or ``'csv'``, from the first lines."""
+    lines = text.lstrip("\ufeff").splitlines()[:3] + ["", ""]
+    first, second = lines[0], lines[1]
+    if first.upper().startswith("LOCATION,"):
+        return "epw"
+    if second.startswith("Date (MM/DD/YYYY),Time (HH:MM)"):
+        return "tmy3"
+    if _TMY2_FIRST.match(first):
+        return "tmy2"
+    if _SRML_FIRST.match(first):
+        return "srml"
+    if _SURFRAD_SECOND.match(second):
+        return "surfrad"
+    if re.match(r"^\*[CU]\d{4}", first):
+        return "bsrn"
+    return "csv"
+
+
+def _call(path: Path, fmt: str, shown: Path | None = None):
+    import pvlib
+
+    reader = getattr(pvlib.iotools, PVLIB_FORMATS[fmt])
+    options = {"coerce_year": TYPICAL_YEAR} if fmt in ("epw", "tmy3") else {}
+    try:
+        result = reader(str(path), **options)
+    except Exception as exc:  # pvlib raises many kinds; the user needs one line
+        detail = str(exc).splitlines()[0] if str(exc) else ""
+        raise HybridtrackError(f"{shown or path}: pvlib could not read it as {fmt.upper()}: {type(exc).__name__}: "
+                               f"{detail}") from None
+    data, meta = result if isinstance(result, tuple) else (result, {})
+    return data, dict(meta) if isinstance(meta, Mapping) else {}
+
+
+def _coerce_year(index: pd.DatetimeIndex) -> pd.DatetimeIndex:
+    """TMY2 stamps in one year, as pvlib does for EPW and TMY3."""
+    naive = index.tz_localize(None)
+    moved = pd.to_datetime({"year": TYPICAL_YEAR, "month": naive.month, "day": naive.day, "hour": naive.hour,
+                            "minute": naive.minute})
+    return pd.DatetimeIndex(moved).tz_localize(index.tz)
+
+
+def _map(path: Path, fmt: str, data: pd.DataFrame, report: dict) -> pd.DataFrame:
+    """The frame's columns from pvlib's: its own names, then the alias table (units in brackets)."""
+    from .units import to_frame_units
+    from .columns import split_header
+
+    frame = pd.DataFrame(index=pd.DatetimeIndex(data.index))
+    mapping, notes = {}, {}
+    for header, (name, scale) in PVLIB_NAMES.get(fmt, {}).items():
+        if header in data.columns and name not in mapping:
+            frame[name] = pd.to_numeric(data[header], errors="coerce").to_numpy(float) * scale
+            mapping[name] = header
+            if scale != 1.0:
+                notes[name] = f"{header} x {scale:g}"
+    headers = [str(c) for c in data.columns if not str(c).lower().endswith(("flag", "_flag", "source", "uncert"))]
+    headers = [re.sub(r"_\d+$", "", h) if fmt == "srml" else h for h in headers]  # SRML: ghi_0, dni_1 ...
+    by_alias = resolve_columns(str(path), headers, {})
+    originals = {re.sub(r"_\d+$", "", str(c)) if fmt == "srml" else str(c): c for c in data.columns}
+    for name in WEATHER_COLUMNS:
+        if name in mapping or name not in by_alias:
+            continue
+        header = by_alias[name]
+        values = pd.to_numeric(data[originals[header]], errors="coerce").to_numpy(float)
+        values, note = to_frame_units(values, name, split_header(header)[1], f"{path}: column {header!r}")
+        frame[name] = values
+        mapping[name] = header
+        if note:
+            notes[name] = note
+    if not any(name in frame for name in IRRADIANCE):
+        raise HybridtrackError(f"{path}: pvlib read it as {fmt.upper()}, but no irradiance column (ghi, dni, dhi) "
+                               f"is among its columns: {', '.join(map(str, data.columns))}")
+    report["columns"] = mapping
+    if notes:
+        report["units_converted"] = notes
+    return frame
+
+
+def _plain_copy(path: Path, text: str, folder: str) -> Path:
+    """The decoded text in a UTF-8 file pvlib can open (for packed or UTF-16 sources)."""
+    copy = Path(folder) / path.name.removesuffix(".gz").removesuffix(".zip")
+    copy.write_text(text, encoding="utf-8")
+    return copy
+
+
+def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict, text: str | None = None,
+               encoding: str = "UTF-8") -> tuple[pd.DataFrame, dict]:
+    """A pvlib format's data as a frame with the frame's names, and its metadata (site, zone).
+
+    A packed or non-UTF-8 file is handed to pvlib as a decoded copy (`text`).
+    """
+    import tempfile
+
+    if fmt not in PVLIB_FORMATS:
+        raise HybridtrackError(f"unknown format {fmt!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
+    if text is not None and encoding != "UTF-8":
+        with tempfile.TemporaryDirectory() as folder:
+            data, meta = _call(_plain_copy(path, text, folder), fmt, shown=path)
+    else:
+        data, meta = _call(path, fmt)
+    if len(data) == 0:
+        raise HybridtrackError(f"{path}: pvlib read it as {fmt.upper()}, but it holds no rows")
+    frame = _map(path, fmt, data, report)
+    if fmt == "tmy2":
+        frame.index = _coerce_year(frame.index)
+    if frame.index.tz is None:
+        if tz is None:
+            raise HybridtrackError(f"{path}: the {fmt.upper()} stamps carry no time zone; give one (tz=..., --tz)")
+        frame.index = frame.index.tz_localize(tz, ambiguous="infer", nonexistent="shift_forward")
+    elif tz is not None:
+        frame.index = frame.index.tz_convert(tz)
+    typical = f", one year ({TYPICAL_YEAR}) for a typical-year file" if fmt in TYPICAL_YEAR_FORMATS else ""
+    report.update(format=fmt, time=f"from the {fmt.upper()} file ({frame.index.tz}){typical}")
+    frame["_line"] = np.arange(1, len(frame) + 1, dtype=float)
+    return frame, meta

@@ -1,0 +1,95 @@
+"""The validation report: what was read, from where, and every change made to the data.
+
+`validation_report` prints ``frame.attrs["validation"]`` as short lines: the source, rows in
+and out, the date range, how the table and its stamps were read, the columns, findings (gaps,
+NaN, light at night, the sun check) and then each change with its count and the first file
+lines it touched: renamed, converted, sorted, dropped, set to NaN, clipped, filled,
+interpolated, resampled.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+__all__ = ["validation_report", "ISSUES"]
+
+#: Report keys that make the verdict "usable, with issues" rather than "clean".
+ISSUES = ("unreadable", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
+          "impossible", "light_at_night", "wind_missing")
+
+_FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
+             "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING"}
+
+_CHANGES = {
+    "units_converted": "converted", "unreadable": "set to NaN (unreadable text)",
+    "dst_dropped": "dropped (DST: stamps that do not exist)", "unsorted": "sorted (stamps out of order)",
+    "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
+    "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",
+    "filled": "filled",
+}
+
+
+def _describe(value) -> str:
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_describe(v)}" for k, v in value.items() if k != "action")
+    if isinstance(value, list):
+        return ", ".join(map(str, value))
+    return str(value)
+
+
+def _head(report: dict, frame: pd.DataFrame) -> list[str]:
+    lines = [f"{report.get('source', 'frame')}: {report.get('rows_read', len(frame))} rows read, "
+             f"{report.get('rows_out', len(frame))} rows out, step {report.get('step', '?')}",
+             f"  dates: {report.get('date_range', '?')}"]
+    if "format" in report:
+        lines.append(f"  format: {report['format'].upper()} (through pvlib), read as {report.get('read_as', '?')}")
+    else:
+        kind = "" if report.get("table", "table") == "table" else f"{report['table']}, "
+        lines.append(f"  table: {kind}{report.get('separator', '?')}-separated, decimal "
+                     f"'{report.get('decimal', '.')}', read as {report.get('read_as', '?')}")
+        for what, numbers in report.get("skipped", {}).items():
+            lines.append(f"  skipped {what}: {len(numbers)} line{'s' if len(numbers) > 1 else ''} "
+                         f"({_describe(numbers[:5])}{', ...' if len(numbers) > 5 else ''})")
+    lines.append("  columns: " + ", ".join(f"{k} <- {v!r}" for k, v in report.get("columns", {}).items()))
+    if "header_notes" in report:
+        lines.append(f"  header notes (not units, ignored): {_describe(report['header_notes'])}")
+    lines.append(f"  time: {report.get('time', '?')}" + (f"; dates {report['date_order']}" if "date_order" in report
+                                                         else ""))
+    if "sun_check" in report:
+        lines.append(f"  sun check: {report['sun_check']}")
+    return lines
+
+
+def _changes(report: dict) -> list[str]:
+    lines = []
+    renamed = {k: v for k, v in report.get("columns", {}).items() if v != k}
+    if renamed:
+        lines.append("    renamed: " + ", ".join(f"{v!r} -> {k}" for k, v in renamed.items()))
+    for key, label in _CHANGES.items():
+        if key in report:
+            lines.append(f"    {label}: {_describe(report[key])}")
+    if "resampled" in report:
+        entry = report["resampled"]
+        counts = ", ".join(f"{k} {v}" for k, v in entry.items() if k != "method")
+        lines.append(f"    resampled: {entry['method']} ({counts})")
+    return lines
+
+
+def validation_report(frame: pd.DataFrame) -> str:
+    """The validation summary of a frame from `read_weather`, as short readable lines."""
+    report = frame.attrs.get("validation", {})
+    lines = _head(report, frame)
+    for key, label in _FINDINGS.items():
+        if key in report:
+            lines.append(f"  {label}: {_describe(report[key])}")
+    if frame.attrs.get("wind_data") == "missing" and "wind_missing" not in report:
+        lines.append("  wind: MISSING")
+    changes = _changes(report)
+    lines.append("  changes: " + ("none" if not changes else f"{len(changes)}"))
+    lines.extend(changes)
+    issues = [k for k in ISSUES if k in report]
+    warning = str(report.get("sun_check", "")).startswith("WARNING")
+    kinds = f"{len(issues) + warning} kind{'s' if len(issues) + warning > 1 else ''}"
+    lines.append("  verdict: " + ("clean" if not issues and not warning else f"usable, with {kinds} of issue noted "
+                                                                              "above"))
+    return "\n".join(lines)

@@ -1,0 +1,91 @@
+"""Resampling to the control step, for any step (also one that does not divide a day).
+
+The grid starts at local midnight of the first day and runs in whole steps from there, so a
+7-minute grid continues across midnight instead of restarting. Each stretch of data without a
+gap longer than three native steps is resampled on its own, so a gap stays a gap:
+
+* a step at least as long as the data's: the mean of the readings in each step, labelled at
+  its start;
+* a shorter step (or irregular data): linear interpolation in time, never across a gap; a
+  stamp the data has keeps its value, NaN included (a flagged value is never filled).
+
+The report counts the rows made, the values interpolated and those left empty.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .checks import span
+from .columns import LABEL_COLUMN, WEATHER_COLUMNS
+
+__all__ = ["resample"]
+
+
+def _segments(index: pd.DatetimeIndex, longest: pd.Timedelta) -> list[tuple[pd.Timestamp, pd.Timestamp]]:
+    """(first, last) stamp of each stretch of data without a gap longer than `longest`."""
+    steps = np.diff(index.as_unit("ns").asi8)
+    breaks = np.flatnonzero(steps > longest.value)
+    starts = np.concatenate([[0], breaks + 1])
+    ends = np.concatenate([breaks, [len(index) - 1]])
+    return [(index[a], index[b]) for a, b in zip(starts, ends)]
+
+
+def _grid(index: pd.DatetimeIndex, native: pd.Timedelta, target: pd.Timedelta) -> tuple[pd.DatetimeIndex, pd.Timestamp]:
+    origin = index[0].normalize() if index.tz is None else index[0].tz_convert(index.tz).normalize()
+    parts = []
+    for first, last in _segments(index, 3 * native):
+        start = origin + ((first - origin) // target) * target
+        parts.append(pd.date_range(start, last, freq=target))
+    grid = parts[0].append(parts[1:]) if len(parts) > 1 else parts[0]
+    return grid[~grid.duplicated()], origin
+
+
+def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -> pd.DataFrame:
+    """`frame` on a regular grid of step `freq` (its own median step if None); see the module's notes."""
+    from ..times import parse_freq
+
+    steps = np.diff(frame.index.as_unit("ns").asi8)
+    native = pd.Timedelta(int(np.median(steps)), "ns")
+    regular = bool(np.all(steps % native.value == 0))  # whole steps, gaps allowed
+    target = parse_freq(freq) if freq is not None else native
+    if pd.isna(target):
+        raise HybridtrackError(f"step {freq!r} is not a duration such as '1min' or '10s'")
+    if regular and target == native:
+        attrs["resampling"] = f"none (regular {span(native)} steps)"
+        return frame
+    rows = (frame.index[-1] - frame.index[0]) / target
+    if rows > 50_000_000:
+        raise HybridtrackError(f"resampling {span(frame.index[-1] - frame.index[0])} of data to {span(target)} steps "
+                               f"would make {rows:,.0f} rows (over 50 million); choose a longer step")
+    columns = [c for c in frame.columns if c in WEATHER_COLUMNS]
+    grid, origin = _grid(frame.index, native, target)
+    if target >= native:
+        binned = frame[columns].resample(target, label="left", closed="left", origin=origin).mean()
+        out = binned.reindex(grid)
+        method = f"mean over each {span(target)} step"
+        made = out[columns].notna().any(axis=1)
+        counts = {"rows": int(len(out)), "averaged": int(made.sum())}
+    else:
+        union = frame[columns].reindex(frame.index.union(grid))
+        limit = max(int(3 * native / target), 1)
+        out = union.interpolate(method="time", limit=limit, limit_area="inside").reindex(grid)
+        kept = grid.intersection(frame.index)
+        out.loc[kept, columns] = frame.loc[kept, columns]  # a NaN the data had stays NaN: no silent fill
+        method = f"linear in time from {span(native)} to {span(target)}, gaps over {span(3 * native)} left empty"
+        new = ~grid.isin(frame.index)
+        counts = {"rows": int(len(out)), "interpolated": int((new & out[columns].notna().any(axis=1)).sum())}
+    if not regular:
+        method = f"irregular stamps (median step {span(native)}): " + method
+    empty = out[columns].isna().all(axis=1)
+    if empty.all():
+        raise HybridtrackError(f"resampling to {span(target)} left no values; check the step (--freq/--step)")
+    counts["empty"] = int(empty.sum())
+    if LABEL_COLUMN in frame.columns:
+        out[LABEL_COLUMN] = frame[LABEL_COLUMN].reindex(out.index, method="ffill")
+    attrs["resampling"] = method
+    report["resampled"] = {"method": method, **counts}
+    out["_line"] = np.nan
+    return out

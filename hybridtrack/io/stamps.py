@@ -1,0 +1,228 @@
+"""Time stamps: text (or epoch seconds, or a date and a clock column) to a tz-aware index.
+
+Decided for the whole column, never cell by cell:
+
+* **Day or month first.** ``dd/mm/yyyy`` and ``mm/dd/yyyy`` are told apart by a first number
+  above 12 (then the day comes first) or a second one above 12 (the month first). A column
+  with both is refused; a column with neither is refused and the user asked
+  (``dayfirst=True``/``False``, ``--dayfirst``/``--monthfirst``), except dotted dates
+  (``05.06.2021``), which are day-first wherever they are written.
+* **Epoch seconds**: a column of 9- or 10-digit numbers is seconds since 1970-01-01 UTC.
+* **Stamps without a date** (``12:00``) are refused: the date cannot be guessed.
+* **The file's zone**: stamps with UTC offsets (``+08:00``, ``Z``, `` UTC``) keep them, or are
+  converted to `tz`; naive stamps are in `tz`, or in the zone a clock column's name gives
+  (``MST``, as NREL's MIDC files write), or else in the site's own zone, which the report
+  says and the sun check tests. Without any of these, naive stamps are refused.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+
+__all__ = ["parse_stamps", "fixed_zone", "CLOCK_ZONES"]
+
+#: Zones named by a clock column's header: US standard times (no daylight saving), as MIDC writes.
+CLOCK_ZONES = {"mst": "-07:00", "pst": "-08:00", "cst": "-06:00", "est": "-05:00", "ast": "-04:00", "hst": "-10:00",
+               "akst": "-09:00", "utc": "+00:00", "gmt": "+00:00"}
+
+_DMY = re.compile(r"^(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?=$|[ T])(.*)$")
+_CLOCK_ONLY = re.compile(r"^\d{1,2}:\d{2}(:\d{2}(\.\d+)?)?$")
+_EPOCH = re.compile(r"^\d{9,10}(\.\d+)?$")
+_OFFSET = re.compile(r"\d(?:\s*[+-]\d{2}:?\d{2}|Z)$")
+
+
+def fixed_zone(offset: str) -> dt.timezone:
+    """``'+08:00'`` or ``'+0800'`` -> a fixed-offset time zone."""
+    sign = -1 if offset.startswith("-") else 1
+    digits = offset[1:].replace(":", "")
+    hours, minutes = int(digits[:2]), int(digits[2:4] or 0)
+    if hours > 14 or minutes >= 60:
+        raise HybridtrackError(f"UTC offset {offset!r} is not a real one (beyond ±14:00)")
+    return dt.timezone(sign * dt.timedelta(hours=hours, minutes=minutes))
+
+
+class _Column:
+    """The stamps' text with where each came from, for messages."""
+
+    def __init__(self, path: Path, header: str, text: pd.Series, lines: np.ndarray):
+        self.path, self.header, self.text, self.lines = path, header, text.reset_index(drop=True), lines
+
+    def refuse(self, row: int, problem: str):
+        raise HybridtrackError(f"{self.path}: line {int(self.lines[row])}, column {self.header!r}: "
+                               f"{self.text.iloc[row]!r} {problem}")
+
+
+def _two_digit_year(year: str) -> int:
+    value = int(year)
+    return value if len(year) == 4 else value + (2000 if value < 70 else 1900)
+
+
+def _day_month_order(column: _Column, parts: pd.DataFrame, dayfirst: bool | None) -> tuple[bool, str]:
+    """Whether the column's dates are day-first, and why (see the module's notes)."""
+    first, second = parts[0].astype(int).to_numpy(), parts[2].astype(int).to_numpy()
+    if dayfirst is not None:
+        return dayfirst, ("day-first" if dayfirst else "month-first") + " as given (a flag or the column's name)"
+    day_first, month_first = np.flatnonzero(first > 12), np.flatnonzero(second > 12)
+    if len(day_first) and len(month_first):
+        column.refuse(int(month_first[0]), f"reads month-first, but line {int(column.lines[day_first[0]])} reads "
+                                           "day-first; the column mixes both")
+    if len(day_first):
+        return True, f"day-first (a first number above 12 on line {int(column.lines[day_first[0]])})"
+    if len(month_first):
+        return False, f"month-first (a second number above 12 on line {int(column.lines[month_first[0]])})"
+    if (parts[1] == ".").all():
+        return True, "day-first (dotted dates)"
+    column.refuse(0, "could be day-first or month-first, and no date in the column tells; give --dayfirst or "
+                     "--monthfirst (dayfirst=True/False)")
+    raise AssertionError  # unreachable: refuse raises
+
+
+def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
+    """Dates in ``d/m/y`` or ``m/d/y`` form rewritten as ``yyyy-mm-dd``, decided for the whole column."""
+    if not column.text.str.contains(r"^\d{1,2}[./-]\d{1,2}[./-]\d", regex=True).any():
+        return column.text  # year first (ISO) or another form the parser reads whole
+    parts = column.text.str.extract(_DMY)
+    matched = parts[0].notna().to_numpy()
+    if not matched.any():
+        return column.text
+    if not matched.all():
+        column.refuse(int(np.flatnonzero(~matched)[0]), f"is not written like the column's other dates "
+                                                        f"({column.text.iloc[int(np.flatnonzero(matched)[0])]!r})")
+    is_dayfirst, why = _day_month_order(column, parts, dayfirst)
+    day, month = (parts[0], parts[2]) if is_dayfirst else (parts[2], parts[0])
+    years = parts[3].map(_two_digit_year)
+    report["date_order"] = why
+    return (years.astype(str) + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + parts[4]).str.strip()
+
+
+def _parse(column: _Column, text: pd.Series, utc: bool) -> pd.DatetimeIndex:
+    for fmt in ("ISO8601", "mixed"):
+        try:
+            parsed = pd.to_datetime(text, utc=utc, format=fmt)
+            break
+        except (ValueError, TypeError, OverflowError) as exc:
+            error = exc
+    else:
+        for row, value in enumerate(text):
+            try:
+                if pd.isna(pd.to_datetime(value, format="mixed", utc=utc)):
+                    column.refuse(row, "is not a time stamp")
+            except (ValueError, TypeError, OverflowError):
+                column.refuse(row, "is not a time stamp")
+        raise HybridtrackError(f"{column.path}: column {column.header!r}: the stamps cannot be read together "
+                               f"({str(error).splitlines()[0]})")
+    if parsed.isna().any():
+        column.refuse(int(np.flatnonzero(parsed.isna().to_numpy())[0]), "is not a time stamp")
+    index = pd.DatetimeIndex(parsed)
+    years = np.asarray(index.year)
+    odd = np.flatnonzero((years < 1900) | (years > 2200))
+    if len(odd):  # '-0.5' or '1,5' parse as dates in year 0; no logger recorded then
+        column.refuse(int(odd[0]), "is not a plausible time stamp (outside 1900-2200)")
+    return index
+
+
+def _epoch(column: _Column, report: dict) -> pd.DatetimeIndex:
+    report["time"] = "epoch seconds (since 1970-01-01 UTC)"
+    return pd.DatetimeIndex(pd.to_datetime(column.text.astype(float), unit="s", utc=True))
+
+
+def _with_offsets(column: _Column, index: pd.DatetimeIndex, text: pd.Series, has_offset: pd.Series, tz: str | None,
+                  report: dict):
+    if not has_offset.all():
+        column.refuse(int(np.flatnonzero(~has_offset.to_numpy())[0]), "has no UTC offset, but other stamps in "
+                                                                       "the column have one")
+    endings = pd.Series(text.str.slice(-6).unique())  # a few distinct endings, however long the file
+    offsets = endings.str.extract(r"([+-]\d{2}:?\d{2}|Z)$")[0].str.replace("Z", "+00:00")
+    if tz is not None:
+        report["time"] = f"stamps with UTC offsets, converted to {tz}"
+        return index.tz_convert(tz)
+    if offsets.nunique() == 1:
+        try:
+            zone = fixed_zone(offsets.iloc[0])
+        except HybridtrackError as exc:
+            column.refuse(0, str(exc))
+        report["time"] = f"stamps with UTC offset {offsets.iloc[0]}, kept"
+        return index.tz_convert(zone)
+    report["time"] = f"stamps with {offsets.nunique()} different UTC offsets, kept as UTC (give a time zone to convert)"
+    return index
+
+
+def _localise(column: _Column, index: pd.DatetimeIndex, tz, how: str, report: dict):
+    try:
+        local = index.tz_localize(tz, ambiguous="infer", nonexistent="NaT")
+        resolved = "repeated DST stamps resolved by their order"
+    except (ValueError, TypeError):  # the order cannot tell the repeated hour apart
+        local = index.tz_localize(tz, ambiguous="NaT", nonexistent="NaT")
+        resolved = "ambiguous DST stamps dropped (their order did not resolve them)"
+    keep = ~np.asarray(local.isna())
+    report["time"] = how
+    dropped = np.flatnonzero(~keep)
+    if len(dropped):
+        report["dst_dropped"] = {"count": int(len(dropped)), "lines": [int(v) for v in column.lines[dropped][:5]],
+                                 "why": "stamps that do not exist in the time zone (spring-forward gap) "
+                                        "or could not be resolved"}
+    ambiguous = int(index.tz_localize(tz, ambiguous="NaT", nonexistent="shift_forward").isna().sum())
+    if ambiguous:
+        report["dst_repeated"] = {"count": ambiguous, "resolution": resolved}
+    return local, keep
+
+
+def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *, tz: str | None,
+                 site_tz: str | None = None, clock_zone: str | None = None, dayfirst: bool | None = None,
+                 report: dict) -> tuple[pd.DatetimeIndex, np.ndarray]:
+    """The column's stamps as a tz-aware index, and which rows to keep (DST gaps dropped).
+
+    Parameters
+    ----------
+    path, header, lines
+        For messages: the file, the column (or ``'date + time'``) and each row's file line.
+    text : pandas.Series of str
+        The stamps as written.
+    tz : str, optional
+        The file's time zone: naive stamps are in it, stamps with offsets are converted to it.
+    site_tz : str, optional
+        The site's zone, taken for naive stamps when nothing else says (and reported so).
+    clock_zone : str, optional
+        A UTC offset named by the clock column's header (``'-07:00'`` for ``MST``).
+    dayfirst : bool, optional
+        Whether ``a/b/yyyy`` dates are day-first; None decides from the column.
+    report : dict
+        The validation report, which gets ``time`` (and ``date_order``, ``dst_*``).
+    """
+    column = _Column(path, header, text.astype(str).str.strip(), lines)
+    empty = np.flatnonzero((column.text == "").to_numpy())
+    if len(empty):
+        column.refuse(int(empty[0]), "is an empty time stamp")
+    if column.text.str.fullmatch(_EPOCH).all():
+        index = _epoch(column, report)
+        return (index.tz_convert(tz) if tz else index), np.ones(len(index), bool)
+    clock_only = np.flatnonzero(column.text.str.fullmatch(_CLOCK_ONLY).to_numpy())
+    if len(clock_only):
+        column.refuse(int(clock_only[0]), "has no date; stamps need the date (add a date column, or write "
+                                          "'2021-06-21 12:00')")
+    iso = _to_iso(column, dayfirst, report)
+    if iso.str.endswith(("UTC", "GMT")).any():
+        iso = iso.str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
+    has_offset = iso.str.contains(_OFFSET)
+    index = _parse(column, iso, utc=bool(has_offset.any()))
+    if has_offset.any():
+        return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)
+    if tz is not None:
+        return _localise(column, index, tz, f"naive stamps localised to {tz}", report)
+    if clock_zone is not None:
+        zone = fixed_zone(clock_zone)
+        report["time"] = f"naive stamps in UTC{clock_zone}, as the clock column's name says"
+        return index.tz_localize(zone), np.ones(len(index), bool)
+    if site_tz is not None:
+        return _localise(column, index, site_tz, f"naive stamps read as the site's local time ({site_tz}); give "
+                                                 "the file's zone if it is another (--tz)", report)
+    raise HybridtrackError(f"{path}: line {int(lines[0])}, column {header!r}: naive time stamps (no UTC offset, e.g. "
+                           f"{column.text.iloc[0]!r}); give the time zone they were logged in (tz=..., --tz "
+                           "Asia/Shanghai), or a site")

@@ -1,0 +1,159 @@
+"""The sun check: does the file's light rise and set with the site's computed sun?
+
+A logger whose clock runs in UTC but is declared local (or a file from another site) puts
+daylight at night. Two tests, on the measured light before any gap is filled:
+
+* **Light at night**: direct (or, without any, global) irradiance above `LIGHT` W/m² while
+  the sun is below the horizon at the stamp and the tolerance (below) either side of it, so
+  that averages labelled at a step's start or end, or a clock a few minutes off, are not caught.
+* **Offset of the daily light curve**: the shift of the computed sun's up/down pattern that
+  best matches the file's global light/dark pattern (the fewest ten-minute bins where one says
+  day and the other night), searched over ±14 hours; of equally good shifts, none if it is
+  among them, else the middle one. Daylight gives diffuse light under any cloud, so the edges
+  of the day are found on overcast days too. With DNI alone only the light-at-night side
+  counts, and the smallest shift that explains it is named.
+
+A shift beyond `max(45 min, step)`, or light at night in more than 2 % of the lit rows (and
+more than 3 rows), refuses the file, naming the first such row, the shift that fits and the
+UTC offset the stamps would then have. With ``lenient=True`` it is a warning in the report.
+A few rows of light at night are reported and kept.
+
+The sun is computed with the project's PLC model (`hybridtrack.sun`), well within a minute of
+SPA, which is far finer than the ten-minute bins.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .checks import first_lines, span
+
+__all__ = ["sun_check", "LIGHT", "BIN"]
+
+#: W/m²: light a sensor cannot read with the sun below the horizon (twilight gives a few W/m²).
+LIGHT = 20.0
+#: The resolution of the offset search.
+BIN = pd.Timedelta(minutes=10)
+_SEARCH = pd.Timedelta(hours=14)
+
+
+def _sun_up(site, times: pd.DatetimeIndex) -> np.ndarray:
+    from ..sun import solar_position
+
+    return solar_position(times, site, model="plc")["apparent_altitude"].to_numpy(float)
+
+
+def _binned(frame: pd.DataFrame, name: str) -> tuple[pd.DatetimeIndex, np.ndarray]:
+    """Mean light in ten-minute bins over the file (NaN where the file has none)."""
+    utc = frame[name].tz_convert("UTC") if frame.index.tz is not None else frame[name]
+    means = utc.groupby(utc.index.floor(BIN)).mean()
+    grid = pd.date_range(means.index[0], means.index[-1], freq=BIN)
+    return grid, means.reindex(grid).to_numpy(float)
+
+
+def _best_shift(site, grid: pd.DatetimeIndex, light: np.ndarray, symmetric: bool) -> tuple[pd.Timedelta, float]:
+    """The shift of the sun that matches the light best, and the share of bins that then disagree."""
+    reach = int(_SEARCH / BIN)
+    wide = pd.date_range(grid[0] - reach * BIN, grid[-1] + reach * BIN, freq=BIN)
+    up = _sun_up(site, wide) > 0.0
+    known = np.isfinite(light)
+    lit = light[known] > LIGHT
+    where = np.flatnonzero(known)
+    scores = np.empty(2 * reach + 1)
+    for k, shift in enumerate(range(-reach, reach + 1)):
+        sun = up[where + reach + shift]
+        wrong = lit & ~sun
+        if symmetric:
+            wrong = wrong | (~lit & sun)
+        scores[k] = wrong.mean() if len(wrong) else 0.0
+    best = np.flatnonzero(scores <= scores.min() + 1e-12) - reach
+    if best.min() <= 0 <= best.max() or not symmetric:
+        chosen = int(best[np.argmin(np.abs(best))])  # the data do not tell a shift apart from none
+    else:
+        chosen = int(round(float(np.median(best))))  # the middle of the equally good shifts
+    return chosen * BIN, float(scores[chosen + reach])
+
+
+def _night_light(site, frame: pd.DataFrame, name: str, window: pd.Timedelta) -> np.ndarray:
+    """Rows with light while the sun is down at the stamp and `window` either side."""
+    values = frame[name].to_numpy(float)
+    lit = np.isfinite(values) & (values > LIGHT)
+    if not lit.any():
+        return lit
+    index = frame.index[lit]
+    altitude = np.max([_sun_up(site, index + sign * window) for sign in (-1, 0, 1)], axis=0)
+    night = np.zeros(len(frame), bool)
+    night[np.flatnonzero(lit)[altitude < 0.0]] = True
+    return night
+
+
+def _offset_text(frame: pd.DataFrame, shift: pd.Timedelta) -> str:
+    """The UTC offset the stamps would have if the light is right: theirs minus the shift."""
+    offset = frame.index[len(frame) // 2].utcoffset() - shift
+    minutes = int(round(offset / pd.Timedelta(minutes=1)))
+    sign = "+" if minutes >= 0 else "-"
+    return f"UTC{sign}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"
+
+
+def _fits(frame: pd.DataFrame, site, shift: pd.Timedelta) -> str:
+    offset = frame.index[len(frame) // 2].utcoffset() - shift
+    fits = f"the light fits the sun at {site.name} shifted by {_signed(shift)}"
+    if abs(offset) > pd.Timedelta(hours=14):
+        return fits + ", beyond any time zone: is the file from another site?"
+    return fits + f", i.e. stamps in {_offset_text(frame, shift)}"
+
+
+def _signed(shift: pd.Timedelta) -> str:
+    return ("+" if shift >= pd.Timedelta(0) else "-") + span(abs(shift)) if shift != pd.Timedelta(0) else "0"
+
+
+def _mismatch(path: Path, frame: pd.DataFrame, site, name: str, header: str, night: np.ndarray,
+              shift: pd.Timedelta | None, lenient: bool) -> str:
+    """The one-line message: the first row of light at night (or the brightest), and the shift that fits."""
+    values = frame[name].to_numpy(float)
+    row = int(np.flatnonzero(night)[0]) if night.any() else int(np.nanargmax(values))
+    line = first_lines(frame, np.arange(len(frame)) == row)
+    where = f"line {line[0]}, " if line else ""
+    lit = int((values > LIGHT).sum())
+    if night.any():
+        what = (f"{night.sum()} of {lit} lit rows have {name} while the sun is down, the first {values[row]:g} W/m² "
+                f"at {frame.index[row]}")
+    else:
+        what = f"the daily light curve is offset from the sun, e.g. {values[row]:g} W/m² at {frame.index[row]}"
+    fits = _fits(frame, site, shift) if shift is not None else "no shift of the sun explains it"
+    ask = "" if lenient else ", or --lenient to read it anyway"
+    return (f"{path}: {where}column {header!r}: {what}; {fits}{'' if fits.endswith('?') else '.'} Give the file's "
+            f"time zone (--tz) or the right site{ask}")
+
+
+def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: bool = False) -> None:
+    """Refuse (or, `lenient`, warn about) light that does not follow the site's sun.
+
+    The result goes into ``report["sun_check"]``; see the module's notes for the tests.
+    """
+    lit_in = [c for c in ("dni", "ghi", "dhi") if c in frame and (frame[c].to_numpy(float) > LIGHT).any()]
+    if not lit_in:
+        report["sun_check"] = "not done (no light in the file)"
+        return
+    name = lit_in[0]  # direct light where there is some: it is the surest sign of the sun
+    curve = "ghi" if "ghi" in lit_in else name  # global light has the day's edges under any sky
+    tolerance = max(pd.Timedelta(minutes=45), pd.Timedelta(report.get("step", "1min")))
+    shift, disagree = _best_shift(site, *_binned(frame, curve), symmetric=curve != "dni")
+    night = _night_light(site, frame, name, tolerance)
+    header = report.get("columns", {}).get(name, name)
+    offset_wrong = abs(shift) > tolerance
+    if offset_wrong or night.sum() > max(3, 0.02 * (frame[name].to_numpy(float) > LIGHT).sum()):
+        message = _mismatch(path, frame, site, name, header, night, shift if offset_wrong else None, lenient)
+        if not lenient:
+            raise HybridtrackError(message)
+        report["sun_check"] = "WARNING: " + message.split(": ", 1)[1]
+        return
+    if night.any():
+        report["light_at_night"] = {"count": int(night.sum()), "lines": first_lines(frame, night),
+                                    "column": header, "action": "kept"}
+    report["sun_check"] = (f"light follows the sun at {site.name} (best shift {_signed(shift)}, {disagree:.1%} of "
+                           "bins disagree)")

@@ -1,0 +1,221 @@
+"""Tables and headers: where a file's table starts, its separator, header, units row and rows.
+
+A weather table is found in text that may carry, before or inside it:
+
+* a block of notes before the header (station, logger, anything);
+* comment lines starting with ``#``, anywhere, skipped with their line numbers kept;
+* a Campbell Scientific TOA5 header: an environment line (``"TOA5",station,logger,...``),
+  the field names, a units row and a processing row (``Smp``, ``Avg``);
+* a units row under the header in other loggers' files;
+* a comma, semicolon, tab or bar separator (sniffed on the data's own lines), and decimal
+  commas with semicolons anywhere in the table.
+
+Line numbers in every message are the file's own, 1-based, as an editor shows them.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .files import file_text
+
+__all__ = ["Table", "locate_table", "read_table", "numeric_columns", "MISSING"]
+
+#: Cell texts that mean "no value" (Campbell writes NAN, spreadsheets #N/A).
+MISSING = ("", "nan", "na", "n/a", "#n/a", "-", "null", "none", "--")
+
+_SEPARATORS = {",": "comma", ";": "semicolon", "\t": "tab", "|": "bar"}
+_NUMBER = re.compile(r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|[-+]?inf(inity)?", re.I)
+
+
+@dataclass
+class Table:
+    """A located table: its header, rows (as text) and the file line of each row."""
+
+    headers: list[str]
+    rows: list[list[str]]
+    lines: np.ndarray
+    separator: str
+    decimal: str
+    units: dict[str, str] = field(default_factory=dict)
+    notes: dict[str, str] = field(default_factory=dict)
+    skipped: dict[str, list[int]] = field(default_factory=dict)
+    kind: str = "table"
+
+
+def _split(line: str, sep: str) -> list[str]:
+    return next(csv.reader([line], delimiter=sep))
+
+
+def _kept_lines(text: str) -> tuple[list[tuple[int, str]], list[int]]:
+    """(line number, text) of every line that is not blank or a ``#`` comment, and the comment lines."""
+    kept, comments = [], []
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            comments.append(number)
+            continue
+        kept.append((number, line))
+    return kept, comments
+
+
+def _is_number(cell: str) -> bool:
+    return bool(_NUMBER.fullmatch(cell.strip()))
+
+
+def _meta_row(fields: list[str]) -> bool:
+    """A units or processing row: no cell is a number and the first cell has no digit (no stamp)."""
+    cells = [f.strip() for f in fields]
+    return not any(_is_number(c) for c in cells if c) and not re.search(r"\d", cells[0] if cells else "")
+
+
+def _choose_separator(path: Path, kept: list[tuple[int, str]]) -> tuple[int, str]:
+    """Index (into `kept`) of the header and the separator.
+
+    For each separator the data's usual field count is read off the last lines; the header is
+    the first line with that many fields of which one has letters. The separator that splits
+    the rows below its header most consistently (then widest) wins.
+    """
+    tail = [line for _, line in kept[-30:]]
+    best = None
+    for sep in _SEPARATORS:
+        counts = [len(_split(line, sep)) for line in tail]
+        width = max(set(counts), key=counts.count)
+        if width < 2:
+            continue
+        for position, (_, line) in enumerate(kept):
+            fields = _split(line, sep)
+            if len(fields) == width and any(re.search(r"[A-Za-z]", f) for f in fields):
+                rest = kept[position + 1:]
+                sample = rest[::max(1, len(rest) // 500)]  # enough lines to judge, in big files too
+                below = [len(_split(x, sep)) for _, x in sample]
+                share = below.count(width) / max(len(below), 1)
+                if best is None or (share, width) > best[0]:
+                    best = ((share, width), position, sep)
+                break
+    if best is None:
+        raise HybridtrackError(f"{path}: no table found: no header row of named columns separated by comma, "
+                               "semicolon, tab or bar")
+    return best[1], best[2]
+
+
+def _header_after_hint(path: Path, kept: list[tuple[int, str]], sep: str) -> tuple[int, str, str]:
+    if len(kept) < 2:
+        raise HybridtrackError(f"{path}: no table found after the 'sep={sep}' line")
+    return 0, sep, f"table with Excel's 'sep={sep}' line"
+
+
+def _rows(path: Path, body: list[tuple[int, str]], sep: str, width: int, header_line: int,
+          skipped: dict) -> tuple[list[list[str]], list[int]]:
+    """The rows' fields, each `width` long, and their file lines; empty rows skipped, long rows refused."""
+    empty = [not line.strip(sep + ' \t"') for _, line in body]  # ';;;;': a row the logger left empty
+    if any(empty):
+        skipped["empty rows"] = [number for (number, _), blank in zip(body, empty) if blank]
+        body = [entry for entry, blank in zip(body, empty) if not blank]
+    rows = list(csv.reader([line for _, line in body], delimiter=sep))
+    numbers = [number for number, _ in body]
+    for i, fields in enumerate(rows):
+        if len(fields) == width:
+            continue
+        if len(fields) > width and any(f.strip() for f in fields[width:]):
+            raise HybridtrackError(f"{path}: line {numbers[i]}: {len(fields)} fields, but the header on line "
+                                   f"{header_line} names {width}")
+        rows[i] = fields[:width] + [""] * (width - len(fields))
+    return rows, numbers
+
+
+def rows_with_values(body: list[tuple[int, str]], sep: str) -> bool:
+    return any(any(f.strip() for f in _split(line, sep)) for _, line in body)
+
+
+def locate_table(path: Path, text: str) -> Table:
+    """The weather table in `text` (see the module's notes)."""
+    kept, comments = _kept_lines(text)
+    if len(kept) < 2:
+        raise HybridtrackError(f"{path}: no table found (fewer than two lines of data)")
+    first = _split(kept[0][1], ",")
+    kind = "table"
+    hint = re.fullmatch(r"\s*sep=(.)\s*", kept[0][1])  # Excel's separator line
+    if hint and hint.group(1) in _SEPARATORS:
+        kept = kept[1:]
+        position, sep, kind = _header_after_hint(path, kept, hint.group(1))
+    elif first and first[0].strip().upper() == "TOA5":
+        if len(kept) < 5:
+            raise HybridtrackError(f"{path}: a TOA5 file needs its four header lines and data")
+        position, sep, kind = 1, ",", f"Campbell TOA5 ({', '.join(c for c in first[1:3] if c)})"
+    else:
+        position, sep = _choose_separator(path, kept)
+    headers = [h.strip() for h in _split(kept[position][1], sep)]
+    skipped = {"notes before the header": [n for n, _ in kept[:position]], "comments": comments}
+    body = kept[position + 1:]
+    meta = []
+    while body and len(meta) < 2 and _meta_row(_split(body[0][1], sep)):
+        meta.append(_split(body[0][1], sep))
+        skipped.setdefault("units and processing rows", []).append(body[0][0])
+        body = body[1:]
+    if not body or not rows_with_values(body, sep):
+        raise HybridtrackError(f"{path}: the table has a header but no rows")
+    rows, numbers = _rows(path, body, sep, len(headers), kept[position][0], skipped)
+    units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
+    decimal = "," if sep == ";" and any(re.fullmatch(r"[-+]?\d*,\d+", f.strip()) for r in rows for f in r) else "."
+    return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind)
+
+
+def read_table(path) -> pd.DataFrame:
+    """A small table from CSV (comma, semicolon or tab) or TOML (``[[case]]`` rows).
+
+    Lines starting with ``#`` in a CSV are comments. Column names are stripped and lowered.
+    """
+    from .files import _tomllib
+
+    path = Path(path)
+    text = file_text(path)[0]
+    if path.suffix.lower() == ".toml":
+        tomllib = _tomllib()
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise HybridtrackError(f"{path}: not valid TOML: {exc}") from None
+        rows = data.get("case", data.get("cases"))
+        if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+            raise HybridtrackError(f"{path}: expected an array of [[case]] tables")
+        frame = pd.DataFrame(rows)
+    else:
+        try:
+            frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", skipinitialspace=True)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as exc:
+            raise HybridtrackError(f"{path}: cannot read as CSV: {str(exc).splitlines()[0]}") from None
+    frame.columns = [str(c).strip().lower() for c in frame.columns]
+    if frame.empty:
+        raise HybridtrackError(f"{path}: the table has no rows")
+    frame.attrs["source"] = str(path)
+    return frame
+
+
+def numeric_columns(frame: pd.DataFrame, columns, where: str) -> pd.DataFrame:
+    """`frame` with `columns` (those present) as floats; text in one names its row and column.
+
+    Row numbers count the header as row 1, as a spreadsheet shows them.
+    """
+    frame = frame.copy()
+    for column in columns:
+        if column not in frame.columns:
+            continue
+        values = pd.to_numeric(frame[column], errors="coerce")
+        bad = (values.isna() & frame[column].notna()).to_numpy()
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise HybridtrackError(f"{where}: row {row + 2}, column {column!r}: {frame[column].iloc[row]!r} "
+                                   "is not a number")
+        frame[column] = values.astype(float)
+    return frame

@@ -1,0 +1,242 @@
+"""`read_weather`: a recorded weather file to a checked weather frame, every change counted.
+
+The steps, each in its own module: the file's bytes and encoding (`files`), the table and its
+header (`tables`) or a pvlib format (`formats`), the columns (`columns`) and their units
+(`units`), the stamps (`stamps`), the checks (`checks`), the sun check (`suncheck`), the
+missing components (`gapfill`) and the step (`resample`). docs/records.md says what each accepts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .checks import check_frame, check_magnitude, refuse_repairs
+from .columns import IRRADIANCE, LABEL_COLUMN, WEATHER_COLUMNS, check_names, resolve_columns, split_header
+from .files import file_text
+from .formats import PVLIB_FORMATS, detect_format, read_pvlib
+from .gapfill import fill_components
+from .resample import resample
+from .stamps import CLOCK_ZONES, parse_stamps
+from .tables import MISSING, Table, locate_table
+from .units import to_frame_units
+
+__all__ = ["read_weather"]
+
+_SEPARATOR_NAMES = {",": "comma", ";": "semicolon", "\t": "tab", "|": "bar"}
+
+
+def _numbers(path: Path, table: Table, header: str, column: list[str], decimal: str, strict: bool,
+             report: dict, name: str) -> np.ndarray:
+    """A column's text as floats; a few unreadable cells become NaN (counted), many are refused."""
+    if decimal == ".":
+        try:  # the common case, fast: every cell a number ('nan', 'inf' and '1e400' included)
+            return np.array(column, dtype=float)
+        except ValueError:
+            pass
+    strings = pd.Series(column, dtype=str).str.strip()
+    missing = strings.str.lower().isin(MISSING)
+    if decimal == ",":
+        strings = strings.str.replace(",", ".", regex=False)
+    values = pd.to_numeric(strings.where(~missing), errors="coerce")
+    bad = (values.isna() & ~missing).to_numpy()
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        where = f"{path}: line {table.lines[row]}, column {header!r}: {column[row]!r} is not a number"
+        filled = int((~missing).sum())
+        if strict or bad.sum() * 2 >= max(filled, 1):
+            raise HybridtrackError(where if strict else f"{where} (nor are {bad.sum()} of its {filled} values)")
+        report.setdefault("unreadable", {})[name] = {"count": int(bad.sum()),
+                                                     "lines": [int(v) for v in table.lines[bad][:5]],
+                                                     "first": str(column[row]), "action": "set to NaN"}
+    return values.to_numpy(float)
+
+
+def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, report):
+    if "date" in mapping:
+        text = pd.Series(cells(mapping["date"])).str.strip() + " " + pd.Series(cells(mapping["clock"])).str.strip()
+        header = f"{mapping['date']} + {mapping['clock']}"
+        zone = CLOCK_ZONES.get(split_header(mapping["clock"])[0])
+        written = mapping["date"].lower().replace(" ", "")  # 'DATE (MM/DD/YYYY)' says its order
+        if dayfirst is None and ("mm/dd" in written or "dd/mm" in written):
+            dayfirst = "dd/mm" in written
+    else:
+        text, header, zone = pd.Series(cells(mapping["time"])), mapping["time"], None
+    return parse_stamps(path, header, text, table.lines, tz=tz, site_tz=site.tz if site is not None else None,
+                        clock_zone=zone, dayfirst=dayfirst, report=report)
+
+
+def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict, report) -> pd.DataFrame:
+    table = locate_table(path, text)
+    position = {h: i for i, h in enumerate(table.headers)}
+    repeated = sorted({h for h in table.headers if table.headers.count(h) > 1})
+    if repeated:
+        raise HybridtrackError(f"{path}: column {repeated[0]!r} appears more than once in the header; rename one")
+
+    def cells(header):
+        return [row[position[header]] for row in table.rows]
+
+    mapping = resolve_columns(str(path), table.headers, columns)
+    report.update(rows_read=len(table.rows), table=table.kind, separator=_SEPARATOR_NAMES[table.separator],
+                  decimal=table.decimal,
+                  skipped={k: v for k, v in table.skipped.items() if v},
+                  columns={k: v for k, v in mapping.items() if k in WEATHER_COLUMNS})
+    if "time" not in mapping and "date" not in mapping:
+        raise HybridtrackError(f"{path}: no time column found; name it with columns={{'time': ...}} "
+                               f"(--map time=COLUMN, or --map time= for an unnamed first column); columns are "
+                               f"{', '.join(repr(h) if not h else h for h in table.headers)}")
+    if not any(name in mapping for name in (*IRRADIANCE, "photocurrent")):
+        raise HybridtrackError(f"{path}: no irradiance column found (ghi, dni, dhi); map one, e.g. --map "
+                               f"dni=COLUMN; columns are {', '.join(table.headers)}")
+    index, keep = _stamps(path, table, mapping, cells, tz, site, dayfirst, report)
+    frame = pd.DataFrame(index=index)
+    conversions, notes = {}, {}
+    for name in WEATHER_COLUMNS:
+        if name not in mapping:
+            continue
+        header = mapping[name]
+        values = _numbers(path, table, header, cells(header), table.decimal, strict, report, name)
+        _, header_unit, note = split_header(header)
+        if note:
+            notes[header] = note
+        unit = (units or {}).get(name) or header_unit or table.units.get(header) or None
+        where = "--units" if (units or {}).get(name) else f"{path}: column {header!r}"
+        values, converted = to_frame_units(values, name, unit, where)
+        if converted:
+            conversions[name] = converted
+        frame[name] = values
+    if conversions:
+        report["units_converted"] = conversions
+    if notes:
+        report["header_notes"] = notes
+    label = next((h for h in table.headers if split_header(h)[0] == LABEL_COLUMN), None)
+    if label is not None:
+        frame[LABEL_COLUMN] = pd.Series(cells(label)).str.strip().str.lower().replace({"": np.nan}).to_numpy()
+    frame["_line"] = table.lines.astype(float)
+    return frame[keep]
+
+
+def _site_from_meta(meta: dict):
+    from ..sites import custom
+
+    try:
+        return custom(float(meta["latitude"]), float(meta["longitude"]), "UTC",
+                      float(meta.get("altitude", meta.get("elevation", 0.0)) or 0.0),
+                      name=str(meta.get("Name", meta.get("City", meta.get("name", "the file's site")))).strip('" '))
+    except (HybridtrackError, TypeError, ValueError):
+        return None
+
+
+def _wind(frame: pd.DataFrame, attrs: dict, report: dict) -> pd.DataFrame:
+    """Mark the wind measured or missing; a missing column is NaN, never a fabricated calm."""
+    if "wind_speed" in frame and np.isfinite(frame["wind_speed"].to_numpy(float)).any():
+        attrs["wind_data"] = "measured"
+        return frame
+    attrs["wind_data"] = "missing"
+    why = "no wind column in the file" if "wind_speed" not in frame else "the wind column holds no readable value"
+    report["wind_missing"] = f"{why}; wind_speed is NaN (attrs['wind_data'] = 'missing'), never taken as calm"
+    frame = frame.copy()
+    frame["wind_speed"] = np.nan
+    return frame
+
+
+def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | None = None, format: str | None = None,
+                 site=None, units: Mapping[str, str] | None = None, freq: str | None = None,
+                 decomposition: str = "erbs", strict: bool = False, dayfirst: bool | None = None,
+                 lenient: bool = False) -> pd.DataFrame:
+    """A recorded weather file as a checked weather frame.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV-like text (any separator, header block, comments, TOA5), or a pvlib format; packed
+        with gzip or zip, in UTF-8, UTF-16 or Latin-1.
+    columns : mapping, optional
+        Quantity to the file's column, e.g. ``{"dni": "Direct Normal", "time": ""}`` (``""``: the
+        unnamed first column pandas writes); names not given are found by `ALIASES`.
+    tz : str, optional
+        The file's time zone (IANA): naive stamps are in it, stamps with offsets are converted
+        to it. Separate from the site's zone.
+    format : str, optional
+        ``"csv"`` or one of pvlib's formats (epw, tmy3, tmy2, midc, srml, bsrn, surfrad, crn,
+        solrad); by default recognised from the content.
+    site : Site or str, optional
+        Used to derive missing components, for the sun and magnitude checks, and as the zone
+        of naive stamps when `tz` is not given.
+    units : mapping, optional
+        Quantity to unit, e.g. ``{"ghi": "kW/m2", "wind_speed": "km/h"}``.
+    freq : str, optional
+        Resample to this step (any step, e.g. ``"7min"``); irregular data is resampled to its
+        median step.
+    decomposition : {"erbs", "dirint"}
+        How DNI and DHI are split from GHI alone.
+    strict : bool
+        Refuse, rather than repair and report, anything the checks would repair.
+    dayfirst : bool, optional
+        Whether ``a/b/yyyy`` dates are day-first; None decides from the whole column.
+    lenient : bool
+        Warn, rather than refuse, when the light does not follow the site's sun.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns among ``ghi dni dhi wind_speed temp_air photocurrent`` (``wind_speed`` always,
+        NaN when the file has none) on a tz-aware index; ``attrs`` holds ``validation`` (see
+        `validation_report`), ``wind_data`` (``"measured"`` or ``"missing"``), the source of
+        each irradiance column and the resampling method.
+    """
+    from ..sites import get
+    from ..times import check_tz
+
+    path = Path(path)
+    if tz is not None:
+        check_tz(tz)
+    check_names(units or {}, "--units")
+    site = get(site) if site is not None else None
+    text, encoding = file_text(path)
+    fmt = str(format).lower() if format is not None else detect_format(text)
+    report: dict = {"source": str(path), "read_as": encoding}
+    if fmt == "csv":
+        frame, meta = _read_csv(path, text, columns, tz, units, site, dayfirst, strict, report), {}
+    elif fmt in PVLIB_FORMATS:
+        if columns or units:
+            raise HybridtrackError(f"{path}: --map and --units apply to tables; a {fmt.upper()} file names its own "
+                                   "columns and units")
+        frame, meta = read_pvlib(path, fmt, tz, report, text, encoding)
+        report["rows_read"] = int(len(frame))
+    else:
+        raise HybridtrackError(f"unknown format {format!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
+    if site is None and {"latitude", "longitude"} <= set(meta):
+        site = _site_from_meta(meta)
+    frame = check_frame(path, frame, report)
+    if strict:
+        refuse_repairs(path, report)
+    clear = None
+    if site is not None:
+        from .suncheck import sun_check
+        import pvlib
+
+        from ..sun import solar_position
+
+        zenith = solar_position(frame.index, site, model="plc")["apparent_zenith"]  # a magnitude check: PLC is ample
+        clear = pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float)
+        check_magnitude(path, frame, report, clear)
+        sun_check(path, frame, site, report, lenient=lenient)
+    else:
+        check_magnitude(path, frame, report, None)
+    attrs: dict = {}
+    frame = fill_components(path, frame, site, decomposition, attrs, report)
+    frame = resample(frame, freq, report, attrs)
+    frame = _wind(frame, attrs, report)
+    frame = frame[[c for c in (*WEATHER_COLUMNS, LABEL_COLUMN) if c in frame.columns]]
+    report["rows_out"] = int(len(frame))
+    report["date_range"] = f"{frame.index[0]} to {frame.index[-1]}"
+    attrs.update(source=str(path), validation=report)
+    if site is not None:
+        attrs["site"] = site.name
+    frame.attrs = attrs
+    return frame

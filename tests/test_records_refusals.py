@@ -1,0 +1,129 @@
+"""Each way a recorded file or its flags can be refused: one line from the API and the CLI alike.
+
+Every row makes the file, calls `read_weather` (which must raise HybridtrackError with one
+line) and `hybridtrack check` (exit status 2, one ``hybridtrack: error:`` line, no traceback),
+and both must name the problem and, for a file's content, its line and column.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import zipfile
+
+import pandas as pd
+import pytest
+
+from hybridtrack import HybridtrackError
+from hybridtrack.cli import main
+from hybridtrack.io import read_weather
+
+ROWS = "".join(f"2021-06-05 {h:02d}:00,{g},{d},{f},2.0\n" for h, g, d, f in
+               ((6, 40, 300, 20), (9, 600, 800, 90), (12, 950, 900, 100), (15, 700, 820, 95), (18, 200, 500, 60)))
+PLAIN = "time,ghi,dni,dhi,wind_speed\n" + ROWS
+
+
+def zipped(members: dict) -> bytes:
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        for name, text in members.items():
+            archive.writestr(name, text)
+    return buffer.getvalue()
+
+
+# (id, file content, read_weather keywords, CLI flags, message parts)
+REFUSALS = [
+    ("dates mixing day-first and month-first", "time,ghi\n13/06/2021 10:00,500\n06/14/2021 10:00,500\n",
+     {"tz": "UTC"}, ["--tz", "UTC"], ["line 3, column 'time'", "the column mixes both"]),
+    ("dates written two ways", "time,ghi\n05/06/2021 10:00,500\n2021-06-05 11:00,500\n", {"tz": "UTC"},
+     ["--tz", "UTC"], ["line 3, column 'time'", "is not written like the column's other dates"]),
+    ("an empty stamp", "time,ghi\n2021-06-05 10:00,500\n,500\n", {"tz": "UTC"}, ["--tz", "UTC"],
+     ["line 3, column 'time'", "empty time stamp"]),
+    ("stamps with and without offsets", "time,ghi\n2021-06-05T10:00+08:00,500\n2021-06-05T11:00,500\n", {}, [],
+     ["line 3, column 'time'", "has no UTC offset, but other stamps"]),
+    ("a row longer than the header", "time,ghi\n2021-06-05 10:00,500\n2021-06-05 11:00,500,7\n", {"tz": "UTC"},
+     ["--tz", "UTC"], ["line 3: 3 fields", "names 2"]),
+    ("a TOA5 file cut short", '"TOA5","x","CR1000"\n"TIMESTAMP","GHI_Avg"\n"TS","W/m^2"\n', {"tz": "UTC"},
+     ["--tz", "UTC"], ["a TOA5 file needs its four header lines and data"]),
+    ("an unknown unit in a units row", '"TOA5","x"\n"TIMESTAMP","GHI_Avg"\n"TS","furlongs"\n"","Avg"\n'
+     '"2021-06-05 10:00",500\n"2021-06-05 11:00",600\n', {"tz": "UTC"}, ["--tz", "UTC"],
+     ["column 'GHI_Avg'", "unknown unit 'furlongs' for ghi"]),
+    ("a zip of two files", zipped({"a.csv": PLAIN, "b.csv": PLAIN}), {"tz": "UTC"}, ["--tz", "UTC"],
+     ["a zip archive must hold exactly one file; it holds a.csv, b.csv"]),
+    ("a damaged gzip file", gzip.compress(PLAIN.encode())[:30], {"tz": "UTC"}, ["--tz", "UTC"],
+     ["a damaged gzip file"]),
+    ("light at midnight", PLAIN + "".join(
+        f"2021-06-05 {h:02d}:30,300,600,50,2.0\n" for h in (0, 1, 2, 3, 23)), {"site": "lanzhou"},
+     ["--site", "lanzhou"], ["line 7, column 'dni'", "of 10 lit rows have dni while the sun is down", "--lenient"]),
+    ("a unit for an unknown quantity", PLAIN, {"tz": "UTC", "units": {"pressure": "hPa"}},
+     ["--tz", "UTC", "--units", "pressure=hPa"], ["unknown column name 'pressure' in --units"]),
+    ("an unknown unit given", PLAIN, {"tz": "UTC", "units": {"wind_speed": "furlongs/fortnight"}},
+     ["--tz", "UTC", "--units", "wind_speed=furlongs/fortnight"], ["--units: unknown unit 'furlongs/fortnight'"]),
+    ("--map on a pvlib format", PLAIN, {"tz": "UTC", "format": "epw", "columns": {"ghi": "x"}},
+     ["--tz", "UTC", "--format", "epw", "--map", "ghi=x"], ["--map and --units apply to tables"]),
+    ("a resample step of nan", PLAIN, {"tz": "UTC", "freq": "nan"}, ["--tz", "UTC", "--freq", "nan"],
+     ["step 'nan' is not a duration"]),
+    ("a resample step of 1 ns over a day", PLAIN, {"tz": "UTC", "freq": "1ns"}, ["--tz", "UTC", "--freq", "1ns"],
+     ["resampling 12h of data to 1ns steps would make 43,200,000,000,000 rows (over 50 million)"]),
+    ("most stamps repeat (a date without its clock)", "date,ghi\n2021-06-05,10\n2021-06-05,500\n2021-06-05,700\n",
+     {"tz": "UTC"}, ["--tz", "UTC"], ["line 3: 2 of 3 stamps repeat an earlier one", "clock column"]),
+    ("negative wind beyond an offset (strict)", PLAIN.replace(",2.0\n", ",-0.2\n", 1), {"tz": "UTC", "strict": True},
+     ["--tz", "UTC", "--strict"], ["line 2, column 'wind_speed': a negative wind reading (strict)"]),
+]
+
+
+@pytest.mark.parametrize("content, kwargs, flags, parts", [r[1:] for r in REFUSALS], ids=[r[0] for r in REFUSALS])
+def test_each_refusal_is_one_line_from_the_api_and_the_cli(tmp_path, capsys, content, kwargs, flags, parts):
+    path = tmp_path / "record.csv"
+    path.write_bytes(content if isinstance(content, bytes) else content.encode("utf-8"))
+    with pytest.raises(HybridtrackError) as error:
+        read_weather(path, **kwargs)
+    message = str(error.value)
+    assert "\n" not in message and all(part in message for part in parts), message
+    assert main(["check", str(path), *flags]) == 2
+    err = capsys.readouterr().err
+    assert err == f"hybridtrack: error: {message}\n"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--map", "dni=Direct", "--map", "dni=Beam"], "--map names dni twice ('Direct' and 'Beam')"),
+    (["--site", "lanzhou", "--site-tz", "UTC"], "give either --site or --lat/--lon/--site-tz, not both"),
+    (["--lat", "36.1"], "--lat, --lon go together; one of them is missing"),
+    (["--site-tz", "UTC"], "--site-tz goes with --lat/--lon"),
+    (["--map", "time"], "--map takes NAME=VALUE, got 'time'"),
+    (["--units", "ghi="], "--units takes NAME=VALUE, got 'ghi='"),
+])
+def test_record_flags_refused_in_one_line(tmp_path, capsys, args, message):
+    path = tmp_path / "record.csv"
+    path.write_text(PLAIN)
+    assert main(["check", str(path), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and "Traceback" not in err
+
+
+def test_replay_needs_the_sites_clock_with_coordinates_and_compare_refuses_tz_for_synthetic_days(tmp_path, capsys):
+    path = tmp_path / "record.csv"
+    path.write_text(PLAIN)
+    assert main(["replay", str(path), "--lat", "36.1", "--lon", "103.7"]) == 2
+    assert "--lat and --lon need the site's clock: --tz ZONE (or --site-tz)" in capsys.readouterr().err
+    assert main(["compare", "--site", "lanzhou", "--tz", "UTC", "--date", "2021-06-21"]) == 2
+    assert "--tz is a recorded file's time zone" in capsys.readouterr().err
+
+
+def test_a_file_without_wind_is_never_calm_and_check_and_replay_say_so(tmp_path, capsys):
+    times = pd.date_range("2021-06-05 06:00", "2021-06-05 20:00", freq="10min")
+    path = tmp_path / "no-wind.csv"
+    pd.DataFrame({"time": times.strftime("%Y-%m-%d %H:%M"), "ghi": 500.0, "dni": 600.0, "dhi": 80.0}).to_csv(
+        path, index=False)
+    frame = read_weather(path, site="lanzhou")
+    assert frame.attrs["wind_data"] == "missing" and frame["wind_speed"].isna().all()
+    assert main(["check", str(path), "--site", "lanzhou"]) == 0
+    assert "wind: MISSING: no wind column in the file" in capsys.readouterr().out
+    assert main(["replay", str(path), "--site", "lanzhou", "--tz", "Asia/Shanghai", "--step", "10min"]) == 0
+    assert "wind: MISSING" in capsys.readouterr().out
+
+
+def test_site_flags_keep_their_meaning_for_commands_without_a_file(capsys):
+    assert main(["sun", "--site", "lanzhou", "--tz", "UTC", "--date", "2021-06-21"]) == 2
+    assert "give either --site or --lat/--lon/--tz, not both" in capsys.readouterr().err
+    assert main(["sun", "--lat", "36.1", "--lon", "103.7", "--tz", "Asia/Shanghai", "--date", "2021-06-21"]) == 0
