@@ -39,6 +39,7 @@ thresholds. Solar Energy 263, 111895. doi:10.1016/j.solener.2023.111895
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -116,7 +117,9 @@ def clearsky_detected(frame: pd.DataFrame, clear: pd.DataFrame) -> pd.Series:
     expected = _regular(clear["ghi"].astype(float))
     minutes = ghi.index.to_series().diff().median() / pd.Timedelta("1min")
     window = max(10.0, 3.0 * minutes)
-    detected = pvlib.clearsky.detect_clearsky(ghi.fillna(0.0), expected.fillna(0.0), window_length=window)
+    with warnings.catch_warnings():  # pvlib's own notes on its rescaling and on pandas' inferred_freq
+        warnings.simplefilter("ignore")
+        detected = pvlib.clearsky.detect_clearsky(ghi.fillna(0.0), expected.fillna(0.0), window_length=window)
     detected = pd.Series(np.asarray(detected, bool), index=ghi.index).where(ghi.notna())
     return detected.reindex(frame.index).rename("detect_clearsky")
 
@@ -263,6 +266,10 @@ def validate_sky(frame: pd.DataFrame, site: Site | str, *, sensor: SensorModel |
     for column in ("ghi", "dni", "dhi"):
         if column not in frame.columns:
             raise HybridtrackError(f"validating the sky needs measured ghi, dni and dhi; {column!r} is missing")
+        source = frame.attrs.get(f"{column}_source", "measured")
+        if source != "measured":
+            raise HybridtrackError(f"validating the sky needs measured ghi, dni and dhi; {column} is not measured "
+                                   f"({source})")
     if len(frame) < 3:
         raise HybridtrackError(f"validating the sky needs at least 3 samples, got {len(frame)}")
     clear = clear_sky(frame.index, site)
