@@ -193,11 +193,14 @@ class SkyValidation:
         return confusion(counted["sky"], counted[reference])
 
     def to_dict(self) -> dict:
-        """JSON-ready: overall figures, the days and the confusion matrix."""
+        """JSON-ready: overall figures, the days and the confusion matrix (NaN as None)."""
         days = self.days.reset_index()
         days["day"] = days["day"].astype(str)
-        return {"overall": self.overall, "days": days.to_dict(orient="records"),
-                "confusion": self.confusion().to_dict(), "min_altitude": self.min_altitude, "notes": self.notes}
+        days = days.astype(object).where(days.notna(), None)
+        overall = {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in self.overall.items()}
+        confusion = {ref: {k: int(n) for k, n in row.items()} for ref, row in self.confusion().to_dict("index").items()}
+        return {"overall": overall, "days": days.to_dict(orient="records"), "confusion": confusion,
+                "min_altitude": self.min_altitude, "notes": self.notes}
 
     def __str__(self) -> str:
         o = self.overall
@@ -272,6 +275,10 @@ def validate_sky(frame: pd.DataFrame, site: Site | str, *, sensor: SensorModel |
                                    f"({source})")
     if len(frame) < 3:
         raise HybridtrackError(f"validating the sky needs at least 3 samples, got {len(frame)}")
+    if not isinstance(frame.index, pd.DatetimeIndex) or frame.index.tz is None:
+        raise HybridtrackError("validating the sky needs a weather frame on a time-zone-aware DatetimeIndex")
+    if not (frame.index.is_monotonic_increasing and frame.index.is_unique):
+        raise HybridtrackError("validating the sky needs increasing, unique time stamps")
     clear = clear_sky(frame.index, site)
     samples = classify_sky(frame, site, sensor, config, classifier=classifier, clear=clear)
     ratio = beam_ratio(frame, clear)

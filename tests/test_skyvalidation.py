@@ -219,6 +219,34 @@ def test_confusion_counts_every_counted_sample():
     assert v.confusion().to_numpy().sum() == counted["beam_window_sky"].notna().sum()
 
 
+def test_the_scores_are_strict_json_even_with_empty_days():
+    import json
+
+    text = json.dumps(validation("payerne-2016-06-12-overcast.csv").to_dict(), allow_nan=False)
+    scores = json.loads(text)
+    assert scores["overall"]["sunny_precision"] is None  # nothing was called sunny
+    assert sum(sum(row.values()) for row in scores["confusion"].values()) > 2000
+
+
+@pytest.mark.parametrize("mangle, message", [
+    (lambda f: f.tz_localize(None), "time-zone-aware"),
+    (lambda f: f.iloc[::-1], "increasing, unique"),
+    (lambda f: pd.concat([f.iloc[:5], f.iloc[4:10]]), "increasing, unique"),
+    (lambda f: f.drop(columns="dni"), "'dni' is missing"),
+    (lambda f: f.iloc[:2], "at least 3 samples"),
+])
+def test_validate_sky_refuses_bad_frames(mangle, message):
+    frame, site = record("tucson-2018-10-18.csv")
+    with pytest.raises(HybridtrackError, match=message):
+        validate_sky(mangle(frame), site)
+
+
+def test_sky_inputs_refuse_a_naive_index():
+    frame, site = record("tucson-2018-10-18.csv")
+    with pytest.raises(HybridtrackError, match="time-zone-aware"):
+        sky_inputs(frame.tz_localize(None), site)
+
+
 def test_plot_day_is_a_figure_of_three_panels():
     from matplotlib.figure import Figure
 

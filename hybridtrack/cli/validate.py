@@ -58,7 +58,7 @@ def _validate(args: argparse.Namespace) -> int:
     print(result)
     if args.json:
         with open(args.json, "w") as handle:
-            json.dump(result.to_dict(), handle, indent=2, default=str)
+            json.dump(result.to_dict(), handle, indent=2, allow_nan=False)
         print(f"wrote {args.json}")
     if args.out:
         result.samples.to_csv(args.out, float_format="%.6g")
