@@ -9,15 +9,19 @@ trailing 20-minute window. Both tie it to one sensor, one climate and one sampli
   with ``I0`` the dark current and ``Ic`` the photocurrent the sensor model gives for
   pvlib's Ineichen clear sky with the Linke turbidity looked up for the site and month.
   ``k`` is capped at 1 (a sky brighter than the model's clear sky is clear) and put back
-  on the classifier's mA scale, ``lo + k (hi - lo)`` with the config's intensity
-  ``raw_range``, so one fuzzy config serves both modes: a clear sky reads as the top of
-  the published range whatever the sun's height, site or sensor.
+  on the classifier's mA scale, ``lo + (hi - lo) (k - k0) / (1 - k0)`` (clipped) with the
+  config's intensity ``raw_range`` and ``k0 = relative_floor``, so one fuzzy config serves
+  both modes: a clear sky reads as the top of the published range whatever the sun's
+  height, site or sensor, and overcast light (``k`` below ``k0``) as its bottom.
 * **Variation per unit time**: the readings are first averaged over a trailing
-  ``smoothing`` period (2 min by default), then the range (max - min) is taken over the
-  trailing ``window`` (20 min). Both are durations, not sample counts, so a record of
-  any step up to the smoothing is read at the same time resolution. In relative mode the
-  range is that of ``k``, with a swing of ``full_variation`` at the top of the
-  variation's ``raw_range``: the clear-sky morning ramp is not a variation.
+  ``smoothing`` period (1 min by default), then the range (max - min) is taken over the
+  trailing ``window`` (20 min). Both are durations, not sample counts: the variation is
+  the 20-minute range of 1-minute means, whatever the logger's step up to a minute (1 s,
+  10 s or 1 min read the same). A coarser record (5 min) cannot be refined; its labels
+  agree with those of the same sky at 1 min on about 90 % of samples (measured,
+  ``docs/sky-validation.md``). In relative mode the range is that of ``k``, with a swing
+  of ``full_variation`` at the top of the variation's ``raw_range``: the clear-sky
+  morning ramp is not a variation.
 * **Low sun**: below ``min_altitude`` the expected clear-sky light is small and the
   clear-sky model least certain, so the ratio is unstable and overcast diffuse light can
   read as a large share of it. There the absolute photocurrent is used instead
@@ -85,17 +89,24 @@ class SkyInputConfig:
     full_variation : float
         Relative mode: the swing of the clear-sky ratio (0-1) that reads as the top of the
         variation's ``raw_range``. The published ranges make it 180/270 = 0.67 of the
-        intensity span; 0.35 puts the sunny/cloudy boundary under steady bright light where
-        the beam ratio dips to about 0.7 (measured, ``docs/sky-validation.md``).
+        intensity span; 0.3 puts the sunny/cloudy boundary under bright light at a swing of
+        0.15, about where thin cloud takes the beam ratio below 0.7 (measured,
+        ``docs/sky-validation.md``).
+    relative_floor : float
+        Relative mode: the clear-sky ratio read as the bottom of the intensity ``raw_range``.
+        0.3: on real records 95 % of samples whose beam was hidden for the whole window read
+        below 0.27 (median 0.12), so overcast light is "weak" and the "medium" term's centre
+        lands at 0.65, in the thin-cloud range (median 0.64 for "cloudy").
     """
 
     mode: str = "relative"
     rules: str = "published"
     window: str = "20min"
-    smoothing: str | None = "2min"
+    smoothing: str | None = "1min"
     min_altitude: float = 5.0
     low_sun: str = "absolute"
-    full_variation: float = 0.35
+    full_variation: float = 0.3
+    relative_floor: float = 0.3
 
     def __post_init__(self) -> None:
         for name, allowed in (("mode", MODES), ("rules", RULES), ("low_sun", LOW_SUN)):
@@ -108,10 +119,11 @@ class SkyInputConfig:
                 or not math.isfinite(self.min_altitude) or not -5.0 <= self.min_altitude <= 45.0:
             raise HybridtrackError(f"sky inputs: min_altitude {self.min_altitude!r} must be a number of degrees "
                                    "within [-5, 45]")
-        if isinstance(self.full_variation, bool) or not isinstance(self.full_variation, (int, float)) \
-                or not math.isfinite(self.full_variation) or not 0.05 <= self.full_variation <= 2.0:
-            raise HybridtrackError(f"sky inputs: full_variation {self.full_variation!r} must be a number "
-                                   "within [0.05, 2]")
+        for name, low, high in (("full_variation", 0.05, 2.0), ("relative_floor", 0.0, 0.9)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or not low <= value <= high:
+                raise HybridtrackError(f"sky inputs: {name} {value!r} must be a number within [{low:g}, {high:g}]")
 
     @classmethod
     def published(cls) -> SkyInputConfig:
@@ -267,10 +279,10 @@ def sky_inputs(frame: pd.DataFrame, site: Site | str, sensor: SensorModel | None
     low = (clear["apparent_elevation"] < config.min_altitude).to_numpy() | ~(expected.to_numpy() > 0)
     # a sky brighter than the model's clear sky is clear: the excess is the model's error
     # (Linke turbidity looked up, not measured), and its ramp must not read as variation
-    ratio = ((current - sensor.dark_current) / expected.where(~low)).clip(upper=1.0)
-    relative = _smoothed(ratio, config.smoothing)
+    relative = ((absolute - sensor.dark_current) / expected.where(~low)).clip(upper=1.0)
     relative_variation = _range(relative, config.window)
-    intensity_input = lo + (hi - lo) * relative
+    floor = config.relative_floor
+    intensity_input = lo + (hi - lo) * ((relative - floor) / (1.0 - floor)).clip(0.0, 1.0)
     variation_input = vlo + (vhi - vlo) * relative_variation / config.full_variation
     fallback = (absolute, absolute_variation) if config.low_sun == "absolute" else (np.nan, np.nan)
     intensity_input = intensity_input.where(~low, fallback[0])
