@@ -314,7 +314,8 @@ def plot_day(validation: SkyValidation, day=None):
 
     days = validation.days
     if day is None:
-        day = days["beam_window"].idxmin()
+        scored = days["beam_window"].dropna()
+        day = scored.idxmin() if len(scored) else days.index[0]
     day = pd.Timestamp(str(day)).date()
     if day not in set(days.index):
         raise HybridtrackError(f"no day {day} in the validation; days are {', '.join(map(str, days.index))}")

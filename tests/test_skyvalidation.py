@@ -350,6 +350,11 @@ def test_validate_sky_published_flag(capsys):
     (["validate-sky", str(REAL / "tucson-2018-10-18.csv"), *PAYERNE, "--min-altitude", "nan"], "min_altitude nan"),
     (["validate-sky", str(REAL / "tucson-2018-10-18.csv"), *PAYERNE, "--plot", "x.png", "--day", "2001-01-01"],
      "no day 2001-01-01"),
+    (["validate-sky", str(REAL / "tucson-2018-10-18.csv"), *PAYERNE, "--day", "2018-10-18"], "give --plot PNG too"),
+    (["validate-sky", str(REAL / "eugene-2018-01-01.csv"), "--lat", "44.0467", "--lon", "-123.0743", "--tz",
+      "Etc/GMT+8", "--min-altitude", "30"], "no sample has the sun above 30 degrees"),
+    (["validate-sky", str(REAL / "tucson-2018-10-18.csv"), *PAYERNE, "--config", str(REAL / "stations.toml")],
+     "unknown key"),
 ])
 def test_validate_sky_bad_input(capsys, args, message):
     assert main(args) == 2

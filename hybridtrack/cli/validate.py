@@ -44,6 +44,8 @@ def _validate(args: argparse.Namespace) -> int:
     from ..skyvalidation import plot_day, validate_sky
     from .fuzzy import load_fuzzy_config
 
+    if args.day and not args.plot:
+        raise HybridtrackError("--day chooses the day to draw; give --plot PNG too")
     site = site_from_arguments(args)
     config = _sky_config(args)
     classifier = None
