@@ -1,0 +1,72 @@
+"""``validate-sky``: score the sky classifier on a recorded file against references from it."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import HybridtrackError
+from .base import add_record_arguments, add_site_arguments, command, read_record, site_from_arguments
+
+
+def _validate_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", help="recorded weather file with measured ghi, dni and dhi")
+    add_site_arguments(parser)
+    add_record_arguments(parser)
+    group = parser.add_argument_group("classifier")
+    group.add_argument("--config", help="sky inputs (TOML with a [sky] table); the measured-best default otherwise")
+    group.add_argument("--published", action="store_true",
+                       help="the published system: absolute mA, raw samples, the four published rules")
+    group.add_argument("--classifier", help="fuzzy config (.toml or .fis) overriding the rule table")
+    group.add_argument("--min-altitude", type=float, default=10.0,
+                       help="count samples with the sun above this many degrees (default 10)")
+    out = parser.add_argument_group("output")
+    out.add_argument("--plot", metavar="PNG", help="draw one day: beam ratio, classifier inputs and labels")
+    out.add_argument("--day", help="the day to draw, YYYY-MM-DD (default: the day that agrees least)")
+    out.add_argument("--json", metavar="FILE", help="also write the scores as JSON here")
+    out.add_argument("--out", metavar="CSV", help="write every sample's inputs, labels and references here")
+
+
+def _sky_config(args: argparse.Namespace):
+    from ..skyinputs import SkyInputConfig
+
+    if args.published and args.config:
+        raise HybridtrackError("give either --published or --config, not both")
+    if args.published:
+        return SkyInputConfig.published()
+    return SkyInputConfig.from_toml(args.config) if args.config else SkyInputConfig()
+
+
+@command("validate-sky", "score the sky classifier on a recorded file against beam-ratio and clear-sky references",
+         _validate_arguments)
+def _validate(args: argparse.Namespace) -> int:
+    import json
+
+    from ..skyvalidation import plot_day, validate_sky
+    from .fuzzy import load_fuzzy_config
+
+    if args.day and not args.plot:
+        raise HybridtrackError("--day chooses the day to draw; give --plot PNG too")
+    site = site_from_arguments(args)
+    config = _sky_config(args)
+    classifier = None
+    if args.classifier:
+        from ..fuzzy import FuzzyWeatherClassifier
+
+        classifier = FuzzyWeatherClassifier(load_fuzzy_config(args.classifier))
+    frame = read_record(args, args.file, site=site)
+    result = validate_sky(frame, site, config=config, classifier=classifier, min_altitude=args.min_altitude)
+    print(f"{args.file}: {site.name} ({site.latitude:g}, {site.longitude:g}), sky inputs: {config.mode} mode, "
+          f"{config.rules} rules")
+    print(result)
+    if args.json:
+        with open(args.json, "w") as handle:
+            json.dump(result.to_dict(), handle, indent=2, allow_nan=False)
+        print(f"wrote {args.json}")
+    if args.out:
+        result.samples.to_csv(args.out, float_format="%.6g")
+        print(f"wrote {args.out}")
+    if args.plot:
+        from ..report import save_figure
+
+        print(f"wrote {save_figure(plot_day(result, args.day), args.plot)}")
+    return 0
