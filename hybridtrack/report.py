@@ -1,4 +1,10 @@
-"""Plots and summaries a person would rather look at than read."""
+"""Plots and summaries a person would rather look at than read.
+
+Every picture is a `matplotlib.figure.Figure` made with the object API: nothing here imports
+pyplot or touches the global backend, so a notebook's own ``plt.plot`` cells keep working after
+the project's plots. A returned Figure shows in Jupyter once pyplot's inline backend is loaded,
+and `save_figure` writes it to a file.
+"""
 
 from __future__ import annotations
 
@@ -9,22 +15,18 @@ import pandas as pd
 __all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_compare", "save_figure", "SKY_COLOURS", "MODE_COLOURS"]
 
 
-def _pyplot():
-    import matplotlib
+def figure(**options):
+    """A new `matplotlib.figure.Figure`, not registered with pyplot (so nothing global changes)."""
+    from matplotlib.figure import Figure
 
-    if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return Figure(**options)
 
 
 def save_figure(fig, path) -> Path:
-    """Write a figure to `path` (PNG, SVG or PDF by suffix), creating folders, and close it."""
+    """Write a figure to `path` (PNG, SVG or PDF by suffix), creating folders."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120, bbox_inches="tight")
-    _pyplot().close(fig)
     return path
 
 
@@ -38,9 +40,9 @@ def plot_sun_path(position: pd.DataFrame, angles: pd.DataFrame, *, title: str = 
     angles : pandas.DataFrame
         From `hybridtrack.collectors.Collector.angles`.
     """
-    plt = _pyplot()
     panels = 3 if "rate" in angles else 2
-    fig, axes = plt.subplots(panels, 1, figsize=(10, 2.6 * panels + 0.6), sharex=True)
+    fig = figure(figsize=(10, 2.6 * panels + 0.6))
+    axes = fig.subplots(panels, 1, sharex=True)
     local = position.index.tz_localize(None)
     ax = axes[0]
     ax.plot(local, position["altitude"], label="altitude", color="tab:orange")
@@ -82,7 +84,8 @@ def plot_fuzzy_surface(classifier, *, points: int = 121, title: str | None = Non
 
     from .fuzzy.engine import sample_term
 
-    plt = _pyplot()
+    from matplotlib import colormaps
+
     config = classifier.config
     (a, b), out = config.inputs, config.output
     x = np.linspace(*a.universe, points)
@@ -90,11 +93,11 @@ def plot_fuzzy_surface(classifier, *, points: int = 121, title: str | None = Non
     gx, gy = np.meshgrid(x, y)
     score = classifier.score(gx.ravel(), gy.ravel(), raw=False).reshape(gx.shape)
 
-    fig = plt.figure(figsize=(13, 6.5), layout="constrained")
+    fig = figure(figsize=(13, 6.5), layout="constrained")
     grid = fig.add_gridspec(3, 2, width_ratios=[1.25, 1])
     ax = fig.add_subplot(grid[:, 0])
     edges = [band[1] for band in config.bands] + [config.bands[-1][2]]
-    colours = plt.get_cmap("RdYlBu_r")(np.linspace(0.1, 0.9, len(config.bands)))
+    colours = colormaps["RdYlBu_r"](np.linspace(0.1, 0.9, len(config.bands)))
     ax.set_facecolor("0.8")
     fill = ax.contourf(gx, gy, score, levels=np.linspace(out.universe[0], out.universe[1], 31), cmap="RdYlBu_r")
     lines = ax.contour(gx, gy, score, levels=edges[1:-1], colors="k", linewidths=1.2)
@@ -125,24 +128,106 @@ def plot_fuzzy_surface(classifier, *, points: int = 121, title: str | None = Non
     return fig
 
 
-SKY_COLOURS = {"sunny": "#f6c343", "cloudy": "#9db4c0", "overcast": "#5c6b73", "unknown": "#dddddd"}
+#: One colour per sky class, ``night`` (true sun down) included; none repeats a mode's colour.
+SKY_COLOURS = {"sunny": "#ffd60a", "cloudy": "#8ecae6", "overcast": "#6c757d", "unknown": "#ced4da",
+               "night": "#0d1b2a"}
+#: How a stretch without data is drawn: hatched white, never a sky or a mode.
+NO_DATA = {"facecolor": "white", "hatch": "////", "edgecolor": "#adb5bd", "label": "no data"}
+_MODE_PRESET = {"stow_night": "#4a4e69", "stow_wind": "#d62828", "astronomical": "#7b2cbf", "sensor": "#2a9d8f",
+                "search": "#f77f00", "fault": "#000000"}
+_SPARE_COLOURS = ("#ff006e", "#8ac926", "#00b4d8", "#b5838d", "#9c6644", "#e9c46a")
+#: The colours of the modes known when this module was written; plots use `mode_colours()`.
+MODE_COLOURS = dict(_MODE_PRESET)
 
 
-def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0, colours: dict | None = None) -> None:
-    """Shade the time axis by a categorical label (sky class or mode), one colour a label."""
-    colours = SKY_COLOURS if colours is None else colours
+def mode_colours() -> dict[str, str]:
+    """A distinct colour for every mode in `hybridtrack.control.MODES` (read when called)."""
+    from .control import MODES
+
+    spare = iter(_SPARE_COLOURS)
+    return {mode: _MODE_PRESET.get(mode) or next(spare, "#888888") for mode in MODES}
+
+
+def _step(index: pd.DatetimeIndex) -> pd.Timedelta:
+    """The regular step of an index (its median spacing)."""
+    return pd.Timedelta(pd.Series(index).diff().median()) if len(index) > 1 else pd.Timedelta(minutes=1)
+
+
+def _gaps(index: pd.DatetimeIndex) -> list[tuple[int, int]]:
+    """(last step before, first step after) of every gap longer than one and a half steps."""
     import numpy as np
 
+    if len(index) < 2:
+        return []
+    spacing = np.diff(index.asi8)
+    return [(int(i), int(i) + 1) for i in np.flatnonzero(spacing > 1.5 * _step(index).value)]
+
+
+def _broken(x, y, gaps):
+    """`x`, `y` with a NaN after each gap's first side, so a line is not drawn across it."""
+    import numpy as np
+
+    if not gaps:
+        return x, np.asarray(y, float)
+    cut = [g[1] for g in gaps]
+    xs = np.insert(np.asarray(x, dtype="datetime64[ns]"), cut, np.asarray(x, dtype="datetime64[ns]")[cut])
+    return xs, np.insert(np.asarray(y, float), cut, np.nan)
+
+
+def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0, colours: dict | None = None,
+                step=None) -> None:
+    """Shade the time axis by a categorical label (sky class or mode), one colour a label.
+
+    A run of one label ends at the next step or one step after its last, whichever is
+    earlier, so a gap in the data stays unshaded.
+    """
+    import numpy as np
+
+    colours = SKY_COLOURS if colours is None else colours
     values = np.asarray(labels, dtype=object)
     if len(values) == 0:
         return
+    step = step if step is not None else (times[1] - times[0] if len(times) > 1 else pd.Timedelta(minutes=1))
     change = np.flatnonzero(values[1:] != values[:-1]) + 1
     starts = np.concatenate([[0], change])
     ends = np.concatenate([change, [len(values)]])
-    step = (times[1] - times[0]) if len(times) > 1 else None
-    for a, b in zip(starts, ends):
-        right = times[b] if b < len(times) else times[-1] + step if step is not None else times[-1]
-        ax.axvspan(times[a], right, ymin=y0, ymax=y1, color=colours.get(values[a], "#cccccc"), lw=0)
+    for first, stop in zip(starts, ends):
+        for a, b in _contiguous(times, first, stop, step):
+            ax.axvspan(times[a], min(times[b - 1] + step, times[b]) if b < len(times) else times[b - 1] + step,
+                       ymin=y0, ymax=y1, color=colours.get(values[first], "#cccccc"), lw=0)
+
+
+def _contiguous(times, first: int, stop: int, step):
+    """Split steps ``first:stop`` where the spacing exceeds one and a half steps."""
+    import numpy as np
+
+    t = np.asarray(times[first:stop])
+    if np.issubdtype(t.dtype, np.datetime64):
+        spacing, limit = np.diff(t.astype("datetime64[ns]")).astype("int64"), 1.5 * pd.Timedelta(step).value
+    else:
+        spacing, limit = np.diff(t.astype(float)), 1.5 * float(step)
+    cuts = [first, *(first + 1 + np.flatnonzero(spacing > limit)), stop]
+    return list(zip(cuts[:-1], cuts[1:]))
+
+
+def _shade_gaps(ax, local, gaps) -> None:
+    for a, b in gaps:
+        ax.axvspan(local[a], local[b], **{k: v for k, v in NO_DATA.items() if k != "label"}, lw=0)
+
+
+def _legend(ax, colours: dict, title: str, *, extra=()) -> None:
+    """A legend of every band colour, beside the axis."""
+    from matplotlib.patches import Patch
+
+    handles = [Patch(color=c, label=k) for k, c in colours.items()] + list(extra)
+    ax.legend(handles=handles, title=title, loc="center left", bbox_to_anchor=(1.005, 0.5), fontsize="x-small",
+              title_fontsize="x-small", frameon=False, ncols=2 if len(handles) > 4 else 1)
+
+
+def _no_data_patch():
+    from matplotlib.patches import Patch
+
+    return Patch(**NO_DATA)
 
 
 def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = None):
@@ -161,11 +246,11 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
     from .fuzzy import FuzzyWeatherClassifier
     from .sites import get
 
-    plt = _pyplot()
     site = get(site)
     clf = classifier or FuzzyWeatherClassifier()
     local = frame.index.tz_convert(site.tz).tz_localize(None)
-    fig, axes = plt.subplots(4, 1, figsize=(12, 9), sharex=True, height_ratios=[3, 0.35, 2.2, 1.4])
+    fig = figure(figsize=(12, 9))
+    axes = fig.subplots(4, 1, sharex=True, height_ratios=[3, 0.35, 2.2, 1.4])
     ax = axes[0]
     for column, colour in (("ghi", "tab:orange"), ("dni", "tab:red"), ("dhi", "tab:blue")):
         ax.plot(local, frame[column], label=column.upper(), color=colour, lw=0.9)
@@ -201,61 +286,6 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
     return fig
 
 
-MODE_COLOURS = {"sensor": "#2a9d8f", "astronomical": "#e9c46a", "search": "#f4a261", "stow_wind": "#e76f51",
-                "stow_night": "#264653", "fault": "#9b2226"}
-
-
-def plot_run(result, *, title: str | None = None):
-    """A run on one time axis: irradiance, sky class, mode, target and actual angle, pointing error."""
-    import numpy as np
-    from matplotlib.patches import Patch
-
-    plt = _pyplot()
-    log = result.log
-    local = log.index.tz_convert(result.site.tz).tz_localize(None)
-    sun_up = np.isfinite(log["target_true"].to_numpy())
-    fig, axes = plt.subplots(5, 1, figsize=(12, 10), sharex=True, height_ratios=[2, 0.3, 0.3, 2.4, 1.8])
-    ax = axes[0]
-    ax.plot(local, log["dni"], color="tab:red", lw=0.9, label="DNI")
-    ax.set_ylabel("W/m²")
-    ax.legend(loc="upper left", fontsize="small")
-    summary = result.summary
-    err = summary["tracking_error_deg"]
-    ax.set_title(title or (f"{summary['site']} · {summary['collector']} · {summary['strategy']}: RMS "
-                           f"{err['rms'] if err['rms'] is not None else float('nan'):.3f}°, p95 "
-                           f"{err['p95'] if err['p95'] is not None else float('nan'):.3f}°, energy "
-                           f"{summary['energy_capture'] if summary['energy_capture'] is not None else float('nan'):.1%}"))
-    _label_band(axes[1], local, log["sky"].astype(str).to_numpy())
-    axes[1].set_yticks([])
-    axes[1].set_ylabel("sky", rotation=0, ha="right", va="center")
-    bands = axes[2]
-    _label_band(bands, local, log["mode"].astype(str).to_numpy(), colours=MODE_COLOURS)
-    bands.set_yticks([])
-    bands.set_ylabel("mode", rotation=0, ha="right", va="center")
-    bands.legend(handles=[Patch(color=c, label=m) for m, c in MODE_COLOURS.items()] +
-                 [Patch(color=c, label=f"sky {k}") for k, c in SKY_COLOURS.items() if k != "unknown"],
-                 loc="upper left", bbox_to_anchor=(0, -0.2), ncols=8, fontsize="x-small", frameon=False)
-    ax = axes[3]
-    ax.plot(local, log["target_true"], color="k", lw=0.8, label="true target")
-    ax.plot(local, log["angle"], color="tab:blue", lw=0.9, ls="--", label="actual angle")
-    ax.set_ylabel("angle (°)" if result.collector.single_axis else "elevation axis (°)")
-    ax.legend(loc="upper left", fontsize="small")
-    ax = axes[4]
-    error = log["error"].where(sun_up & log["mode"].isin(["sensor", "astronomical", "search"]))
-    ax.plot(local, error, color="tab:purple", lw=0.7)
-    for y in (-0.5, 0.5):
-        ax.axhline(y, color="tab:red", ls=":", lw=0.8)
-    ax.set_ylabel("pointing error (°)")
-    finite = np.abs(error.dropna())
-    if len(finite):
-        limit = max(1.0, min(float(finite.quantile(0.99)) * 1.3, 10.0))
-        ax.set_ylim(-limit if result.collector.single_axis else 0, limit)
-    ax.set_xlabel(f"local time ({result.site.tz})")
-    fig.autofmt_xdate()
-    fig.tight_layout()
-    return fig
-
-
 STRATEGY_COLOURS = {"hybrid": "#2a9d8f", "hybrid-nocal": "#8ab17d", "astronomical": "#e9c46a", "sensor": "#e76f51"}
 
 
@@ -269,10 +299,9 @@ def plot_compare(results: dict, *, title: str | None = None):
     """
     import numpy as np
 
-    plt = _pyplot()
     first = next(iter(results.values()))
     local = first.log.index.tz_convert(first.site.tz).tz_localize(None)
-    fig = plt.figure(figsize=(12, 9), layout="constrained")
+    fig = figure(figsize=(12, 9), layout="constrained")
     grid = fig.add_gridspec(4, 3, height_ratios=[1.4, 0.3, 2.6, 1.8])
     ax = fig.add_subplot(grid[0, :])
     ax.plot(local, first.log["dni"], color="tab:red", lw=0.8)
@@ -313,4 +342,455 @@ def plot_compare(results: dict, *, title: str | None = None):
     summary = first.summary
     fig.suptitle(title or f"{summary['site']} · {summary['collector']} · {summary['start'][:10]}"
                           f"{' to ' + summary['end'][:10] if summary['end'][:10] != summary['start'][:10] else ''}")
+    return fig
+
+
+# --- a run at a glance: text, HTML, daily table, pictures at any length ---------------------
+
+
+def run_title(result, *, day=None) -> str:
+    """``site · collector · strategy · first day to last day``."""
+    local = result.log.index.tz_convert(result.site.tz)
+    first, last = (local[0].date(), local[-1].date()) if day is None else (day, day)
+    span = f"{first}" if first == last else f"{first} to {last}"
+    return f"{result.site.name} · {result.collector.kind} · {result.summary['strategy']} · {span}"
+
+
+def _headline(summary: dict) -> list[tuple[str, str]]:
+    err = summary["tracking_error_deg"]
+
+    def fmt(value, spec):
+        return "-" if value is None else format(value, spec)
+
+    return [("pointing error (DNI-weighted)", f"RMS {fmt(err['rms'], '.3f')}°, p95 {fmt(err['p95'], '.3f')}°, "
+                                              f"max {fmt(err['max'], '.3f')}°"),
+            ("within 0.5°", fmt(summary["within_0_5_deg"], ".1%")),
+            ("energy capture", fmt(summary["energy_capture"], ".1%")),
+            ("drive", f"{summary['moves']:,} moves, {summary['travel_deg']:,.0f}° travelled"),
+            ("events", f"{summary['mode_switches']} mode switches ({summary.get('tracking_switches', '-')} between "
+                       f"tracking modes), {summary['stow_events']} wind stows, {summary['faults']} faults, "
+                       f"{summary['alarms']} alarms")]
+
+
+def _shares(shares: dict) -> str:
+    return ", ".join(f"{k} {v:.1%}" for k, v in sorted(shares.items(), key=lambda kv: -kv[1]) if v > 0)
+
+
+def _span(result) -> str:
+    local = result.log.index.tz_convert(result.site.tz)
+    return (f"{local[0]:%Y-%m-%d %H:%M} to {local[-1]:%Y-%m-%d %H:%M} ({result.site.tz}), {len(local):,} steps of "
+            f"{_step(local.tz_convert('UTC')).total_seconds() / 60:g} min")
+
+
+def describe(result, *, events: int = 3) -> str:
+    """A short text summary of a run (the repr of `hybridtrack.simulation.Result`)."""
+    s = result.summary
+    lines = [f"hybridtrack run: {run_title(result)}", f"  {_span(result)}"]
+    lines += [f"  {label}: {value}" for label, value in _headline(s)]
+    lines += [f"  modes: {_shares(s['mode_share'])}", f"  sky: {_shares(s['sky_share'])} (every step)"]
+    if len(result.events) and events:
+        lines.append(f"  last {min(events, len(result.events))} of {len(result.events)} events:")
+        for row in result.events.tail(events).itertuples(index=False):
+            lines.append(f"    {row[0].tz_convert(result.site.tz):%Y-%m-%d %H:%M} {row[1]} -> {row[2]} ({row[3]})")
+    return "\n".join(lines)
+
+
+def describe_html(result, *, events: int = 12) -> str:
+    """The run summary as HTML, for Jupyter (the `_repr_html_` of a Result)."""
+    from html import escape
+
+    s = result.summary
+    rows = [("run", run_title(result)), ("span", _span(result)), *_headline(s),
+            ("mode shares", _shares(s["mode_share"])), ("sky shares (every step)", _shares(s["sky_share"]))]
+    table = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td style='text-align:left'>{escape(v)}</td></tr>"
+                    for k, v in rows)
+    shown = result.events.head(events).assign(time=lambda e: e["time"].dt.tz_convert(result.site.tz)
+                                               .dt.strftime("%Y-%m-%d %H:%M"))
+    more = len(result.events) - len(shown)
+    event_html = shown.to_html(index=False, border=0) if len(shown) else "<p>no events</p>"
+    return (f"<div><strong>hybridtrack run</strong><table>{table}</table>"
+            f"<details><summary>{len(result.events)} events</summary>{event_html}"
+            f"{f'<p>… {more} more in result.events</p>' if more > 0 else ''}</details></div>")
+
+
+def _true_sun(result):
+    """Sun-up flags and the incidence cosine on a perfect aperture, at every step (SPA)."""
+    from .sun import solar_position
+    from .world import incidence_cosine
+
+    sun = solar_position(result.log.index, result.site, "spa")
+    altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    return altitude > 0, incidence_cosine(altitude, azimuth, result.collector)
+
+
+def daily(result) -> pd.DataFrame:
+    """One row per local day of a run, by the run summary's definitions (`hybridtrack.metrics.daily`)."""
+    from .metrics import daily as daily_table
+
+    sun_up, incidence = _true_sun(result)
+    return daily_table(result.log, collector=result.collector.kind, tz=result.site.tz, sun_up=sun_up,
+                       incidence=incidence)
+
+
+def plot_run(result, *, day=None, title: str | None = None):
+    """A run as one Figure: a timeline for up to three days (or one `day`), else an overview.
+
+    The timeline shows DNI, sky class (night as night), mode, target and actual angle, pointing
+    error (clipped and marked as clipped) and wind with its stow threshold, with gaps in the data
+    hatched. The overview of a longer run shows pointing error, mode and sky by hour and day,
+    the energy capture of each day and each day's highest wind against the stow threshold.
+    """
+    log = result.log
+    if day is not None:
+        local = log.index.tz_convert(result.site.tz)
+        wanted = pd.Timestamp(day).date()
+        mask = local.date == wanted
+        if not mask.any():
+            from .errors import HybridtrackError
+
+            raise HybridtrackError(f"the run has no step on {wanted}; it runs {local[0].date()} to {local[-1].date()}")
+        return _plot_timeline(result, log[mask], title or run_title(result, day=wanted))
+    days = (log.index[-1] - log.index[0]) / pd.Timedelta(days=1)
+    if days <= 3:
+        return _plot_timeline(result, log, title or run_title(result))
+    return _plot_overview(result, title or run_title(result))
+
+
+def _metrics_line(summary: dict) -> str:
+    err = summary["tracking_error_deg"]
+    parts = [f"RMS {err['rms']:.3f}°" if err["rms"] is not None else "no tracking error scored",
+             f"p95 {err['p95']:.3f}°" if err["p95"] is not None else "",
+             f"energy {summary['energy_capture']:.1%}" if summary["energy_capture"] is not None else ""]
+    return ", ".join(p for p in parts if p)
+
+
+def _error_limit(error) -> float:
+    import numpy as np
+
+    finite = np.abs(error[np.isfinite(error)])
+    return float(max(1.0, min(np.quantile(finite, 0.99) * 1.3, 10.0))) if finite.size else 1.0
+
+
+def _draw_clipped(ax, x, error, limit: float, *, signed: bool) -> None:
+    """Plot an error series clipped to ±`limit`, with the clipped steps marked and counted."""
+    import numpy as np
+
+    over = np.isfinite(error) & (np.abs(error) > limit)
+    ax.set_ylim(-limit * 1.08 if signed else 0, limit * 1.08)
+    if over.any():
+        xs = np.asarray(x)[over]
+        ax.scatter(xs, np.sign(error[over]) * limit if signed else np.full(over.sum(), limit), marker="^", s=14,
+                   color="tab:red", zorder=3)
+        ax.text(0.995, 0.96, f"clipped at ±{limit:g}°: {int(over.sum())} steps beyond (max {np.nanmax(np.abs(error)):.2f}°)",
+                transform=ax.transAxes, ha="right", va="top", fontsize="x-small", color="tab:red",
+                bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none"})
+
+
+def _plot_timeline(result, log: pd.DataFrame, title: str):
+    import numpy as np
+
+    from .metrics import TRACKING_MODES
+
+    tz = result.site.tz
+    local = log.index.tz_convert(tz).tz_localize(None)
+    gaps = _gaps(log.index)
+    step = _step(log.index)
+    sun_up = np.isfinite(log["target_true"].to_numpy())
+    fig = figure(figsize=(13, 11), layout="constrained")
+    axes = fig.subplots(6, 1, sharex=True, height_ratios=[1.6, 0.35, 0.35, 2.2, 1.8, 1.2])
+    ax = axes[0]
+    ax.plot(*_broken(local, log["dni"], gaps), color="tab:red", lw=0.9, label="DNI")
+    ax.set_ylabel("DNI (W/m²)")
+    ax.set_title(f"{title}\n{_metrics_line(result.summary)}" if len(log) == len(result.log) else title)
+    sky = log["sky"].astype(str).where(sun_up, "night").to_numpy()
+    _label_band(axes[1], local, sky, step=step)
+    _legend(axes[1], SKY_COLOURS, "sky", extra=[_no_data_patch()] if gaps else ())
+    modes = mode_colours()
+    _label_band(axes[2], local, log["mode"].astype(str).to_numpy(), colours=modes, step=step)
+    _legend(axes[2], modes, "mode")
+    for band, name in ((axes[1], "sky"), (axes[2], "mode")):
+        band.set_yticks([])
+        band.set_ylabel(name, rotation=0, ha="right", va="center")
+    ax = axes[3]
+    ax.plot(*_broken(local, log["target_true"], gaps), color="k", lw=0.8, label="true target")
+    ax.plot(*_broken(local, log["angle"], gaps), color="tab:blue", lw=0.9, ls="--", label="actual angle")
+    ax.set_ylabel("angle (°)" if result.collector.single_axis else "elevation axis (°)")
+    ax.legend(loc="upper left", fontsize="small")
+    ax = axes[4]
+    error = log["error"].where(sun_up & log["mode"].isin(TRACKING_MODES)).to_numpy(float)
+    limit = _error_limit(error)
+    ax.plot(*_broken(local, np.clip(error, -limit, limit), gaps), color="tab:purple", lw=0.7)
+    _draw_clipped(ax, local, error, limit, signed=result.collector.single_axis)
+    for y in (-0.5, 0.5):
+        ax.axhline(y, color="tab:red", ls=":", lw=0.8)
+    ax.set_ylabel("pointing error (°)\nwhile tracking")
+    ax = axes[5]
+    controller = result.config.controller
+    ax.plot(*_broken(local, log["wind_speed"], gaps), color="tab:gray", lw=0.8)
+    ax.axhline(controller.wind_stow, color="tab:red", ls="--", lw=1)
+    ax.axhline(controller.wind_release, color="tab:green", ls=":", lw=1)
+    ax.text(1.005, controller.wind_stow, f"stow > {controller.wind_stow:g}", transform=ax.get_yaxis_transform(),
+            color="tab:red", fontsize="x-small", va="center")
+    ax.text(1.005, controller.wind_release, f"release ≤ {controller.wind_release:g}",
+            transform=ax.get_yaxis_transform(), color="tab:green", fontsize="x-small", va="center")
+    ax.set_ylabel("wind (m/s)")
+    ax.set_ylim(0, max(controller.wind_stow * 1.15, float(np.nanmax(log["wind_speed"], initial=0)) * 1.05))
+    for ax in axes:
+        _shade_gaps(ax, local, gaps)
+    axes[-1].set_xlabel(f"local time ({tz})")
+    return fig
+
+
+def _by_hour_and_day(log: pd.DataFrame, tz, values, bins: int):
+    """Day number, time-of-day bin and the grid shape for every step."""
+    import numpy as np
+
+    local = log.index.tz_convert(tz)
+    dates = pd.DatetimeIndex(local.normalize().tz_localize(None))
+    first = dates[0]
+    day = np.asarray((dates - first).days, int)
+    minute = local.hour * 60 + local.minute + local.second / 60.0
+    slot = np.minimum((np.asarray(minute) * bins / 1440.0).astype(int), bins - 1)
+    return day, slot, (bins, int(day.max()) + 1), first
+
+
+def _category_grid(day, slot, shape, codes, count: int):
+    """The most frequent category of each (time-of-day, day) cell; -1 where there is no step."""
+    import numpy as np
+
+    counts = np.zeros((*shape, count), int)
+    np.add.at(counts, (slot, day, codes), 1)
+    grid = counts.argmax(axis=2)
+    grid[counts.sum(axis=2) == 0] = -1
+    return grid
+
+
+def _rgb(grid, colours: list[str]):
+    import numpy as np
+    from matplotlib.colors import to_rgb
+
+    palette = np.array([to_rgb(c) for c in colours] + [to_rgb("white")])
+    return palette[grid]  # -1 (no data) picks the white at the end
+
+
+def _plot_overview(result, title: str):
+    import numpy as np
+    from matplotlib import colormaps
+    from matplotlib.dates import AutoDateLocator, ConciseDateFormatter, date2num
+
+    from .metrics import TRACKING_MODES
+
+    log = result.log
+    tz = result.site.tz
+    table = daily(result)
+    step_minutes = max(_step(log.index).total_seconds() / 60.0, 1.0)
+    bins = int(min(144, 1440 / step_minutes))  # 10-minute cells, or the step if coarser
+    day, slot, shape, first = _by_hour_and_day(log, tz, None, bins)
+    sun_up = np.isfinite(log["target_true"].to_numpy())
+    extent = [date2num(first), date2num(first + pd.Timedelta(days=shape[1])), 0, 24]
+
+    fig = figure(figsize=(13, 13), layout="constrained")
+    axes = fig.subplots(5, 1, sharex=True, height_ratios=[2.2, 1.6, 1.6, 1.2, 1.0])
+    fig.suptitle(f"{title}\n{_metrics_line(result.summary)}")
+
+    # pointing error by hour and day, over a background of night / not tracking / no data
+    sky_names = list(SKY_COLOURS)
+    sky_codes = np.array([sky_names.index(v) for v in log["sky"].astype(str).where(sun_up, "night")])
+    sky_grid = _category_grid(day, slot, shape, sky_codes, len(sky_names))
+    background = np.where(sky_grid == sky_names.index("night"), 0, np.where(sky_grid < 0, -1, 1))
+    ax = axes[0]
+    ax.imshow(_rgb(background, [SKY_COLOURS["night"], "#e9ecef"]), aspect="auto", origin="lower", extent=extent,
+              interpolation="nearest")
+    tracking = (log["mode"].isin(TRACKING_MODES).to_numpy() & sun_up & (log["dni"].to_numpy() > 0)
+                & np.isfinite(log["error"].to_numpy()))
+    total = np.zeros(shape)
+    count = np.zeros(shape)
+    np.add.at(total, (slot[tracking], day[tracking]), np.abs(log["error"].to_numpy()[tracking]))
+    np.add.at(count, (slot[tracking], day[tracking]), 1)
+    mean_error = np.ma.masked_invalid(np.where(count > 0, total / np.maximum(count, 1), np.nan))
+    limit = float(np.quantile(mean_error.compressed(), 0.99)) if mean_error.count() else 1.0
+    image = ax.imshow(mean_error, aspect="auto", origin="lower", extent=extent, cmap=colormaps["viridis"],
+                      vmin=0, vmax=max(limit, 0.05), interpolation="nearest")
+    bar = fig.colorbar(image, ax=ax, extend="max" if mean_error.max() > limit else "neither", pad=0.01)
+    bar.set_label(f"mean |error| (°)\n{'clipped at ' + format(limit, '.2f') + '° (arrow)' if mean_error.max() > limit else ''}",
+                  fontsize="small")
+    ax.set_ylabel("pointing error\nhour of day")
+    _legend_strip(ax, {"night": SKY_COLOURS["night"], "not tracking": "#e9ecef"}, gaps=bool((background < 0).any()))
+
+    # mode and sky by hour and day
+    modes = mode_colours()
+    names = list(modes)
+    mode_codes = np.array([names.index(m) for m in log["mode"].astype(str)])
+    for ax, grid, colours, label in ((axes[1], _category_grid(day, slot, shape, mode_codes, len(names)), modes, "mode"),
+                                     (axes[2], sky_grid, SKY_COLOURS, "sky")):
+        ax.imshow(_rgb(grid, list(colours.values())), aspect="auto", origin="lower", extent=extent,
+                  interpolation="nearest")
+        ax.set_ylabel(f"{label}\nhour of day")
+        _legend(ax, colours, label, extra=[_no_data_patch()] if (grid < 0).any() else ())
+    for ax in axes[:3]:
+        ax.set_yticks([0, 6, 12, 18, 24])
+
+    # energy capture per day, and each day's highest wind
+    centres = date2num(pd.DatetimeIndex(table.index.astype(str)) + pd.Timedelta(hours=12))
+    ax = axes[3]
+    capture = table["energy_capture"].to_numpy(float)
+    ax.bar(centres, np.nan_to_num(capture), width=0.8, color="tab:orange")
+    low = max(0.0, float(np.nanmin(capture)) - 0.05) if np.isfinite(capture).any() else 0.0
+    ax.set_ylim(low, 1.0)
+    if low > 0:
+        ax.text(0.005, 0.04, f"axis starts at {low:.0%}", transform=ax.transAxes, fontsize="x-small", color="0.3")
+    ax.set_ylabel("energy capture\nper day")
+    ax = axes[4]
+    controller = result.config.controller
+    ax.bar(centres, table["max_wind"].to_numpy(float), width=0.8, color="tab:gray")
+    ax.axhline(controller.wind_stow, color="tab:red", ls="--", lw=1)
+    ax.text(1.005, controller.wind_stow, f"stow > {controller.wind_stow:g} m/s", transform=ax.get_yaxis_transform(),
+            color="tab:red", fontsize="x-small", va="center")
+    ax.set_ylabel("highest wind\nper day (m/s)")
+    locator = AutoDateLocator()
+    axes[-1].xaxis.set_major_locator(locator)
+    axes[-1].xaxis.set_major_formatter(ConciseDateFormatter(locator))
+    axes[-1].set_xlim(extent[0], extent[1])
+    axes[-1].set_xlabel(f"local date ({tz})")
+    return fig
+
+
+def _legend_strip(ax, colours: dict, *, gaps: bool) -> None:
+    from matplotlib.patches import Patch
+
+    handles = [Patch(color=c, label=k) for k, c in colours.items()] + ([_no_data_patch()] if gaps else [])
+    ax.legend(handles=handles, loc="upper left", fontsize="x-small", ncols=len(handles), framealpha=0.9)
+
+
+def plot_days(result, *, days: int = 14):
+    """One row per day (up to `days`): pointing error over a band of the mode, hours aligned."""
+    import numpy as np
+
+    from .metrics import TRACKING_MODES
+
+    log = result.log
+    local = log.index.tz_convert(result.site.tz)
+    dates = sorted(set(local.date))[:days]
+    modes = mode_colours()
+    fig = figure(figsize=(13, 1.3 * len(dates) + 1.2), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(len(dates), 1, sharex=True, sharey=True))
+    limit = 1.0
+    for ax, date in zip(axes, dates):
+        mask = local.date == date
+        part = log[mask]
+        hours = np.asarray(local[mask].hour + local[mask].minute / 60 + local[mask].second / 3600, float)
+        _label_band(ax, hours, part["mode"].astype(str).to_numpy(), colours=modes, step=_step(part.index).total_seconds() / 3600)
+        for patch in ax.patches:
+            patch.set_alpha(0.35)
+        up = np.isfinite(part["target_true"].to_numpy()) & part["mode"].isin(TRACKING_MODES).to_numpy()
+        error = np.where(up, part["error"].to_numpy(float), np.nan)
+        ax.plot(hours, np.clip(error, -limit, limit), color="k", lw=0.7)
+        over = np.isfinite(error) & (np.abs(error) > limit)
+        if over.any():
+            ax.scatter(hours[over], np.sign(error[over]) * limit, marker="^", s=10, color="tab:red", zorder=3)
+        ax.set_ylabel(f"{date:%m-%d}", rotation=0, ha="right", va="center")
+        ax.set_ylim(-limit * 1.1 if result.collector.single_axis else 0, limit * 1.1)
+    axes[0].set_title(f"{run_title(result)}: pointing error (°, clipped at ±{limit:g}°, red marks beyond) "
+                      "over the mode", fontsize="medium")
+    _legend(axes[0], modes, "mode")
+    axes[-1].set_xlim(0, 24)
+    axes[-1].set_xticks(range(0, 25, 3))
+    axes[-1].set_xlabel(f"hour of day ({result.site.tz})")
+    return fig
+
+
+# --- tuning: before/after surfaces and confusion matrices -----------------------------------
+
+
+def _labels_of(config, samples: pd.DataFrame):
+    """The true label of each sample: its ``weather``, else the band of its ``score``."""
+    from .fuzzy import FuzzyWeatherClassifier
+
+    if "weather" in samples.columns:
+        return samples["weather"].astype(str).str.strip().str.lower().to_numpy()
+    return FuzzyWeatherClassifier(config).label(samples["score"].to_numpy(float))
+
+
+def plot_tuning(before, after, samples: pd.DataFrame, *, points: int = 121):
+    """Decision surfaces of the starting and the tuned config side by side, the labelled readings on both.
+
+    Axes are raw readings (mA), extended past the labelled range so the extrapolation shows;
+    the labelled range is drawn as a dashed box.
+    """
+    import warnings
+
+    import numpy as np
+    from matplotlib import colormaps
+    from matplotlib.patches import Rectangle
+
+    from .fuzzy import FuzzyWeatherClassifier
+
+    labels = _labels_of(before, samples)
+    names = [band[0] for band in before.bands]
+    colours = dict(zip(names, colormaps["RdYlBu_r"](np.linspace(0.1, 0.9, len(names)))))
+    fig = figure(figsize=(13, 5.5), layout="constrained")
+    axes = fig.subplots(1, 2, sharey=True)
+    (a, b) = before.inputs
+    x = np.linspace(a.raw_range[0], max(a.raw_range[1], float(samples["intensity"].max())) * 1.1, points)
+    y = np.linspace(b.raw_range[0], max(b.raw_range[1], float(samples["variation"].max())) * 1.1, points)
+    gx, gy = np.meshgrid(x, y)
+    for ax, config, name in ((axes[0], before, "before"), (axes[1], after, "after")):
+        clf = FuzzyWeatherClassifier(config)
+        with warnings.catch_warnings():  # drawing the extrapolation on purpose
+            warnings.simplefilter("ignore")
+            score = clf.score(gx.ravel(), gy.ravel()).reshape(gx.shape)
+            predicted = clf.classify(samples["intensity"].to_numpy(float), samples["variation"].to_numpy(float))
+        ax.set_facecolor("0.8")
+        fill = ax.contourf(gx, gy, score, levels=np.linspace(*config.output.universe, 31), cmap="RdYlBu_r")
+        ax.contour(gx, gy, score, levels=[band[2] for band in config.bands[:-1]], colors="k", linewidths=1.2)
+        for label in names:
+            mine = labels == label
+            right = mine & (predicted == labels)
+            ax.scatter(samples["intensity"][right], samples["variation"][right], color=colours[label], edgecolor="k",
+                       s=28, label=f"{label} (right)")
+            ax.scatter(samples["intensity"][mine & ~right], samples["variation"][mine & ~right], color=colours[label],
+                       edgecolor="red", linewidth=1.8, marker="X", s=60, label=f"{label} (wrong)")
+        accuracy = float(np.mean(predicted == labels))
+        ax.set_title(f"{name}: {config.name}, training accuracy {accuracy:.1%}")
+        ax.set_xlabel(f"intensity ({a.unit})")
+        if after.labelled_range is not None:
+            (ilo, ihi), (vlo, vhi) = after.labelled_range
+            ax.add_patch(Rectangle((ilo, vlo), ihi - ilo, vhi - vlo, fill=False, ls="--", color="k", lw=1))
+    axes[0].set_ylabel(f"variation ({b.unit})")
+    axes[1].legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    fig.colorbar(fill, ax=axes, label="weather score", shrink=0.8)
+    fig.suptitle("decision surface before and after tuning (dashed: the labelled range; beyond it, extrapolation)")
+    return fig
+
+
+def plot_confusion(before, after, samples: pd.DataFrame):
+    """Confusion matrices (true label against the classifier's) of the starting and tuned configs."""
+    import warnings
+
+    import numpy as np
+
+    from .fuzzy import FuzzyWeatherClassifier
+    from .fuzzy.classifier import UNKNOWN
+
+    labels = _labels_of(before, samples)
+    names = [band[0] for band in before.bands]
+    predicted_names = names + [UNKNOWN]
+    fig = figure(figsize=(10, 4.5), layout="constrained")
+    axes = fig.subplots(1, 2)
+    for ax, config, name in ((axes[0], before, "before"), (axes[1], after, "after")):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            predicted = FuzzyWeatherClassifier(config).classify(samples["intensity"].to_numpy(float),
+                                                                samples["variation"].to_numpy(float))
+        matrix = np.array([[np.sum((labels == t) & (predicted == p)) for p in predicted_names] for t in names])
+        ax.imshow(matrix, cmap="Blues")
+        for (i, j), value in np.ndenumerate(matrix):
+            ax.text(j, i, str(value), ha="center", va="center",
+                    color="white" if value > matrix.max() / 2 else "black")
+        ax.set_xticks(range(len(predicted_names)), predicted_names)
+        ax.set_yticks(range(len(names)), names)
+        ax.set_xlabel("classified as")
+        ax.set_ylabel("labelled")
+        ax.set_title(f"{name}: {np.trace(matrix[:, :len(names)])} of {matrix.sum()} right")
+    fig.suptitle("confusion on the labelled readings (training set)")
     return fig
