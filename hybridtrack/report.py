@@ -11,15 +11,31 @@ from __future__ import annotations
 from pathlib import Path
 
 import pandas as pd
+from matplotlib.figure import Figure
 
-__all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_compare", "save_figure", "SKY_COLOURS", "MODE_COLOURS"]
+__all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_days", "plot_compare", "plot_rules",
+           "plot_tuning", "plot_confusion", "save_figure", "figure", "ReportFigure", "describe", "describe_html",
+           "daily", "explain_step", "StepExplanation", "mode_colours", "SKY_COLOURS", "MODE_COLOURS"]
 
 
-def figure(**options):
-    """A new `matplotlib.figure.Figure`, not registered with pyplot (so nothing global changes)."""
-    from matplotlib.figure import Figure
+class ReportFigure(Figure):
+    """A `matplotlib.figure.Figure` that shows itself in Jupyter as a PNG, whatever the backend.
 
-    return Figure(**options)
+    A Figure made without pyplot has no display hook until pyplot's inline backend has been
+    loaded; this one renders itself, so ``result.plot()`` shows in the first cell too.
+    """
+
+    def _repr_png_(self) -> bytes:
+        from io import BytesIO
+
+        buffer = BytesIO()
+        self.savefig(buffer, format="png", dpi=100, bbox_inches="tight")
+        return buffer.getvalue()
+
+
+def figure(**options) -> ReportFigure:
+    """A new Figure, not registered with pyplot (so nothing global changes)."""
+    return ReportFigure(**options)
 
 
 def save_figure(fig, path) -> Path:
@@ -481,7 +497,8 @@ def _draw_clipped(ax, x, error, limit: float, *, signed: bool) -> None:
         xs = np.asarray(x)[over]
         ax.scatter(xs, np.sign(error[over]) * limit if signed else np.full(over.sum(), limit), marker="^", s=14,
                    color="tab:red", zorder=3)
-        ax.text(0.995, 0.96, f"clipped at ±{limit:g}°: {int(over.sum())} steps beyond (max {np.nanmax(np.abs(error)):.2f}°)",
+        worst = np.nanmax(np.abs(error))
+        ax.text(0.995, 0.96, f"clipped at ±{limit:g}°: {int(over.sum())} steps beyond (max {worst:.2f}°)",
                 transform=ax.transAxes, ha="right", va="top", fontsize="x-small", color="tab:red",
                 bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none"})
 
@@ -612,7 +629,8 @@ def _plot_overview(result, title: str):
     image = ax.imshow(mean_error, aspect="auto", origin="lower", extent=extent, cmap=colormaps["viridis"],
                       vmin=0, vmax=max(limit, 0.05), interpolation="nearest")
     bar = fig.colorbar(image, ax=ax, extend="max" if mean_error.max() > limit else "neither", pad=0.01)
-    bar.set_label(f"mean |error| (°)\n{'clipped at ' + format(limit, '.2f') + '° (arrow)' if mean_error.max() > limit else ''}",
+    clipped = f"clipped at {limit:.2f}° (arrow)" if mean_error.max() > limit else ""
+    bar.set_label(f"mean |error| (°)\n{clipped}",
                   fontsize="small")
     ax.set_ylabel("pointing error\nhour of day")
     _legend_strip(ax, {"night": SKY_COLOURS["night"], "not tracking": "#e9ecef"}, gaps=bool((background < 0).any()))
@@ -634,7 +652,8 @@ def _plot_overview(result, title: str):
     centres = date2num(pd.DatetimeIndex(table.index.astype(str)) + pd.Timedelta(hours=12))
     ax = axes[3]
     capture = table["energy_capture"].to_numpy(float)
-    ax.bar(centres, np.nan_to_num(capture), width=0.8, color="tab:orange")
+    width = 0.8 if len(centres) <= 31 else 1.0  # touching bars for long runs: gaps between them would flicker
+    ax.bar(centres, np.nan_to_num(capture), width=width, color="tab:orange", linewidth=0)
     low = max(0.0, float(np.nanmin(capture)) - 0.05) if np.isfinite(capture).any() else 0.0
     ax.set_ylim(low, 1.0)
     if low > 0:
@@ -642,7 +661,7 @@ def _plot_overview(result, title: str):
     ax.set_ylabel("energy capture\nper day")
     ax = axes[4]
     controller = result.config.controller
-    ax.bar(centres, table["max_wind"].to_numpy(float), width=0.8, color="tab:gray")
+    ax.bar(centres, table["max_wind"].to_numpy(float), width=width, color="tab:gray", linewidth=0)
     ax.axhline(controller.wind_stow, color="tab:red", ls="--", lw=1)
     ax.text(1.005, controller.wind_stow, f"stow > {controller.wind_stow:g} m/s", transform=ax.get_yaxis_transform(),
             color="tab:red", fontsize="x-small", va="center")
@@ -679,7 +698,8 @@ def plot_days(result, *, days: int = 14):
         mask = local.date == date
         part = log[mask]
         hours = np.asarray(local[mask].hour + local[mask].minute / 60 + local[mask].second / 3600, float)
-        _label_band(ax, hours, part["mode"].astype(str).to_numpy(), colours=modes, step=_step(part.index).total_seconds() / 3600)
+        _label_band(ax, hours, part["mode"].astype(str).to_numpy(), colours=modes,
+                    step=_step(part.index).total_seconds() / 3600)
         for patch in ax.patches:
             patch.set_alpha(0.35)
         up = np.isfinite(part["target_true"].to_numpy()) & part["mode"].isin(TRACKING_MODES).to_numpy()
@@ -794,3 +814,123 @@ def plot_confusion(before, after, samples: pd.DataFrame):
         ax.set_title(f"{name}: {np.trace(matrix[:, :len(names)])} of {matrix.sum()} right")
     fig.suptitle("confusion on the labelled readings (training set)")
     return fig
+
+
+# --- the rule viewer, and why a run was in its mode at a step --------------------------------
+
+
+def plot_rules(classifier, intensity: float, variation: float, *, title: str | None = None):
+    """MATLAB's rule viewer for one reading: a row per rule, then the aggregate and its centroid.
+
+    Each rule's row shows its antecedent terms with the reading marked and the membership it
+    gives shaded, and its consequent term clipped at the rule's firing strength (min of the
+    memberships). The last row is the aggregate (max of the clipped consequents) with its
+    centroid, the crisp score.
+    """
+    import warnings
+
+    import numpy as np
+
+    from .fuzzy.engine import sample_term
+
+    config = classifier.config
+    with warnings.catch_warnings():  # the caller decides whether to warn about the labelled range
+        warnings.simplefilter("ignore")
+        explanation = classifier.explain(intensity, variation)
+    inputs, out = config.inputs, config.output
+    rules = explanation.rules
+    fig = figure(figsize=(11, 1.25 * (len(rules) + 1) + 1.2), layout="constrained")
+    axes = np.atleast_2d(fig.subplots(len(rules) + 1, len(inputs) + 1, sharex="col", sharey=True))
+    u_out = np.linspace(*out.universe, config.resolution[1])
+    aggregate = np.zeros_like(u_out)
+    for row, rule in enumerate(rules):
+        for col, (var, x) in enumerate(zip(inputs, explanation.normalised)):
+            ax = axes[row, col]
+            term_name = rule["when"].get(var.name)
+            if term_name is None:
+                ax.text(0.5, 0.5, "(any)", ha="center", va="center", transform=ax.transAxes, color="0.5")
+            else:
+                u = np.linspace(*var.universe, 401)
+                curve = sample_term(var.term(term_name), u)
+                degree = explanation.memberships[var.name][term_name]
+                ax.plot(u, curve, color="tab:blue", lw=1)
+                ax.fill_between(u, np.minimum(curve, degree), color="tab:blue", alpha=0.35)
+                ax.text(0.02, 0.8, f"{var.name} is {term_name}: {degree:.3f}", transform=ax.transAxes,
+                        fontsize="x-small")
+            ax.axvline(x, color="tab:red", lw=1)
+        ax = axes[row, -1]
+        curve = sample_term(out.term(rule["then"]), u_out)
+        clipped = np.minimum(curve, rule["firing"])
+        aggregate = np.maximum(aggregate, clipped)
+        ax.plot(u_out, curve, color="0.6", lw=0.8)
+        ax.fill_between(u_out, clipped, color="tab:orange", alpha=0.7)
+        ax.text(0.02, 0.8, f"-> {rule['then']}, fires {rule['firing']:.3f}", transform=ax.transAxes, fontsize="x-small")
+        axes[row, 0].set_ylabel(f"rule {rule['rule']}", rotation=0, ha="right", va="center")
+    for col in range(len(inputs)):
+        axes[-1, col].axis("off")
+    ax = axes[-1, -1]
+    ax.fill_between(u_out, aggregate, color="tab:orange", alpha=0.7)
+    if np.isfinite(explanation.score):
+        ax.axvline(explanation.score, color="k", lw=1.5)
+    for name, lo, hi in config.bands:
+        ax.axvspan(lo, hi, color=SKY_COLOURS.get(name, "#eeeeee"), alpha=0.25, lw=0)
+    ax.set_ylabel("aggregate", rotation=0, ha="right", va="center")
+    ax.set_xlabel(f"{out.name} score: centroid {explanation.score:.2f} -> {explanation.weather}")
+    for col, var in enumerate(inputs):
+        axes[0, col].set_title(f"{var.name} {getattr(explanation, var.name, x):g} {var.unit} "
+                               f"(normalised {explanation.normalised[col]:.2f})", fontsize="small")
+    axes[0, -1].set_title(f"{out.name} (clipped consequents)", fontsize="small")
+    axes[0, 0].set_ylim(0, 1.08)
+    fig.suptitle(title or f"rule viewer: {config.name}")
+    return fig
+
+
+def explain_step(result, time):
+    """Why the controller of `result` was in its mode at `time` (the step at or before it)."""
+    from .fuzzy import FuzzyWeatherClassifier
+
+    log = result.log
+    stamp = pd.Timestamp(time)
+    if stamp.tz is None:
+        stamp = stamp.tz_localize(result.site.tz)
+    position = log.index.get_indexer([stamp], method="pad")[0]
+    if position < 0:
+        from .errors import HybridtrackError
+
+        raise HybridtrackError(f"{stamp} is before the run, which starts at {log.index[0]}")
+    row = log.iloc[position]
+    events = result.events[result.events["time"] <= log.index[position]]
+    event = events.iloc[-1].to_dict() if len(events) else None
+    classifier = FuzzyWeatherClassifier()
+    return StepExplanation(log.index[position].tz_convert(result.site.tz), str(row["mode"]), str(row["sky"]),
+                           float(row["sky_score"]), str(row["sensor_status"]), float(row["wind_speed"]),
+                           float(row["dni"]), event, classifier.explain(row["intensity_ma"], row["variation_ma"]),
+                           classifier)
+
+
+class StepExplanation:
+    """One step of a run taken apart: mode, sky, sensor, the last event, and the fuzzy rules."""
+
+    def __init__(self, time, mode, sky, sky_score, sensor_status, wind_speed, dni, event, fuzzy, classifier):
+        self.time, self.mode, self.sky, self.sky_score = time, mode, sky, sky_score
+        self.sensor_status, self.wind_speed, self.dni = sensor_status, wind_speed, dni
+        self.event, self.fuzzy, self._classifier = event, fuzzy, classifier
+
+    def __str__(self) -> str:
+        since = (f"since {self.event['time'].tz_convert(self.time.tz):%Y-%m-%d %H:%M}: {self.event['from']} -> "
+                 f"{self.event['to']} because {self.event['reason']}" if self.event else "no mode change before it")
+        return "\n".join([
+            f"{self.time:%Y-%m-%d %H:%M:%S} mode {self.mode} ({since})",
+            f"  sky {self.sky} (score {self.sky_score:.2f}), sensor {self.sensor_status}, DNI {self.dni:.0f} W/m², "
+            f"wind {self.wind_speed:.1f} m/s",
+            f"  the classifier's rules for intensity {self.fuzzy.intensity:.1f} mA, "
+            f"variation {self.fuzzy.variation:.1f} mA:",
+            *("  " + line for line in str(self.fuzzy).splitlines()),
+        ])
+
+    __repr__ = __str__
+
+    def plot(self):
+        """The rule viewer for this step's readings."""
+        return plot_rules(self._classifier, self.fuzzy.intensity, self.fuzzy.variation,
+                          title=f"{self.time:%Y-%m-%d %H:%M}: mode {self.mode}, sky {self.sky}")

@@ -138,7 +138,8 @@ def read_samples(source) -> pd.DataFrame:
         frame, where = read_table(source), str(source)
     missing = [c for c in ("intensity", "variation") if c not in frame.columns]
     if missing:
-        raise HybridtrackError(f"{where}: missing column {missing[0]!r} (need intensity, variation and weather or score)")
+        raise HybridtrackError(f"{where}: missing column {missing[0]!r} "
+                               "(need intensity, variation and weather or score)")
     if "weather" not in frame.columns and "score" not in frame.columns:
         raise HybridtrackError(f"{where}: needs a 'weather' or a 'score' column to fit to")
     if frame.empty:
