@@ -46,8 +46,33 @@ def save_figure(fig, path) -> Path:
     return path
 
 
+#: Columns of `Collector.angles` in metres, drawn on their own axis (never beside degrees).
+LENGTH_COLUMNS = ("end_loss", "jack_1", "jack_2", "jack_3")
+
+
+def _continuous_azimuth(azimuth):
+    """Azimuths without the jump across north (0/360°), e.g. a southern-hemisphere noon.
+
+    Returns the values and whether they were unwrapped.
+    """
+    import numpy as np
+
+    values = np.asarray(azimuth, float)
+    finite = np.isfinite(values)
+    if finite.sum() < 2 or not (np.abs(np.diff(values[finite])) > 180).any():
+        return values, False
+    out = values.copy()
+    out[finite] = np.rad2deg(np.unwrap(np.deg2rad(values[finite])))
+    out -= 360.0 * np.round(np.nanmedian(out) / 360.0)  # centred on north: negative is west of it
+    return out, True
+
+
 def plot_sun_path(position: pd.DataFrame, angles: pd.DataFrame, *, title: str = ""):
     """Sun altitude/azimuth and the collector's target angles over a day, on one time axis.
+
+    Degrees and metres never share an axis: lengths (a Fresnel row's end loss, a heliostat's jack
+    heights) get their own panel. An azimuth that crosses north is drawn continuously (past 360°
+    or below 0°) and says so.
 
     Parameters
     ----------
@@ -56,8 +81,10 @@ def plot_sun_path(position: pd.DataFrame, angles: pd.DataFrame, *, title: str = 
     angles : pandas.DataFrame
         From `hybridtrack.collectors.Collector.angles`.
     """
-    panels = 3 if "rate" in angles else 2
-    fig = figure(figsize=(10, 2.6 * panels + 0.6))
+    degrees = [c for c in angles.columns if c not in LENGTH_COLUMNS and c != "rate"]
+    lengths = [c for c in angles.columns if c in LENGTH_COLUMNS]
+    panels = 2 + ("rate" in angles) + bool(lengths)
+    fig = figure(figsize=(10, 2.6 * panels + 0.6), layout="constrained")
     axes = fig.subplots(panels, 1, sharex=True)
     local = position.index.tz_localize(None)
     ax = axes[0]
@@ -65,21 +92,30 @@ def plot_sun_path(position: pd.DataFrame, angles: pd.DataFrame, *, title: str = 
     ax.set_ylabel("altitude (°)")
     ax.axhline(0, color="0.6", lw=0.8)
     twin = ax.twinx()
-    twin.plot(local, position["azimuth"], label="azimuth", color="tab:blue", ls="--")
+    azimuth, unwrapped = _continuous_azimuth(position["azimuth"])
+    twin.plot(local, azimuth, label="azimuth" + (" (continuous across north)" if unwrapped else ""),
+              color="tab:blue", ls="--")
     twin.set_ylabel("azimuth from north (°)")
     ax.legend(loc="upper left")
     twin.legend(loc="upper right")
     ax = axes[1]
-    for column in angles.columns.drop(["rate"], errors="ignore"):
-        ax.plot(local, angles[column], label=column)
-    ax.set_ylabel("target")
+    for column in degrees:
+        values, turned = _continuous_azimuth(angles[column]) if "azimuth" in column else (angles[column], False)
+        ax.plot(local, values, label=column + (" (continuous)" if turned else ""))
+    ax.set_ylabel("target (°)")
     ax.legend(loc="best", fontsize="small", ncols=2)
-    if panels == 3:
-        axes[2].plot(local, angles["rate"], color="tab:red")
-        axes[2].set_ylabel("rate (°/min)")
+    row = 2
+    if "rate" in angles:
+        axes[row].plot(local, angles["rate"], color="tab:red")
+        axes[row].set_ylabel("rate (°/min)")
+        row += 1
+    if lengths:
+        for column in lengths:
+            axes[row].plot(local, angles[column], label=column)
+        axes[row].set_ylabel("length (m)")
+        axes[row].legend(loc="best", fontsize="small", ncols=len(lengths))
     axes[-1].set_xlabel(f"local time ({position.index.tz})")
     fig.suptitle(title)
-    fig.autofmt_xdate()
     return fig
 
 
@@ -257,6 +293,7 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
     classifier : FuzzyWeatherClassifier, optional
         The published one by default.
     """
+    import numpy as np
     from matplotlib.patches import Patch
 
     from .fuzzy import FuzzyWeatherClassifier
@@ -278,8 +315,13 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
                  [:140])
     band = axes[1]
     predicted = clf.classify(frame["intensity_ma"].to_numpy(), frame["variation_ma"].to_numpy())
+    if "ghi_clear" in frame:  # night is night, not a sky class
+        predicted = np.where(frame["ghi_clear"].to_numpy() > 0, predicted, "night")
     if "sky" in frame:
-        _label_band(band, local, frame["sky"].astype(str).to_numpy(), y0=0.5, y1=1.0)
+        true_sky = frame["sky"].astype(str).to_numpy()
+        if "ghi_clear" in frame:
+            true_sky = np.where(frame["ghi_clear"].to_numpy() > 0, true_sky, "night")
+        _label_band(band, local, true_sky, y0=0.5, y1=1.0)
         band.text(1.005, 0.75, "true", transform=band.transAxes, va="center", fontsize="small")
     _label_band(band, local, predicted, y0=0.0, y1=0.5 if "sky" in frame else 1.0)
     band.text(1.005, 0.25, "fuzzy", transform=band.transAxes, va="center", fontsize="small")
@@ -323,9 +365,11 @@ def plot_compare(results: dict, *, title: str | None = None):
     ax.plot(local, first.log["dni"], color="tab:red", lw=0.8)
     ax.set_ylabel("DNI (W/m²)")
     band = fig.add_subplot(grid[1, :], sharex=ax)
-    _label_band(band, local, first.log["sky"].astype(str).to_numpy())
+    sun_up = np.isfinite(first.log["target_true"].to_numpy())
+    _label_band(band, local, first.log["sky"].astype(str).where(sun_up, "night").to_numpy())
     band.set_yticks([])
     band.set_ylabel("sky", rotation=0, ha="right", va="center")
+    _legend(band, SKY_COLOURS, "sky")
     err_ax = fig.add_subplot(grid[2, :], sharex=ax)
     for name, result in results.items():
         log = result.log

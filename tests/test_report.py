@@ -85,3 +85,22 @@ def test_the_rule_viewer_prints_each_rule_and_the_centroid(capsys, tmp_path):
     assert "rule 1: intensity is strong 0.048 AND variation is small 0.171 -> fires 0.048" in text
     assert "-> cloudy" in text and out.read_bytes()[:4] == b"\x89PNG"
     assert main(["rules", "--intensity", "nan", "--variation", "1"]) == 2
+
+
+def test_a_southern_sun_path_does_not_wrap_and_metres_get_their_own_axis():
+    import pandas as pd
+
+    from hybridtrack import sites
+    from hybridtrack.collectors import Collector
+    from hybridtrack.report import plot_sun_path
+    from hybridtrack.sun import solar_position
+
+    times = pd.date_range("2024-12-21 06:00", "2024-12-21 19:00", freq="10min", tz="Africa/Johannesburg")
+    position = solar_position(times, sites.custom(-33.9, 18.4, "Africa/Johannesburg"), "spa")
+    fig = plot_sun_path(position, Collector("heliostat").angles(position["altitude"], position["azimuth"]))
+    azimuth = fig.axes[-1].get_lines()[0].get_ydata()  # the twin axis holds the azimuth
+    assert np.max(np.abs(np.diff(azimuth))) < 30  # no jump across north
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert "length (m)" in labels and "target (°)" in labels
+    assert all(not line.get_label().startswith("jack") for ax in fig.axes if ax.get_ylabel() == "target (°)"
+               for line in ax.get_lines())
