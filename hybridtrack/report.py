@@ -473,23 +473,26 @@ def describe_html(result, *, events: int = 12) -> str:
             f"{f'<p>… {more} more in result.events</p>' if more > 0 else ''}</details></div>")
 
 
-def _true_sun(result):
-    """Sun-up flags and the incidence cosine on a perfect aperture, at every step (SPA)."""
+def _true_sun(result, index=None):
+    """Sun-up flags and the incidence cosine on a perfect aperture at every step (SPA)."""
     from .sun import solar_position
     from .world import incidence_cosine
 
-    sun = solar_position(result.log.index, result.site, "spa")
+    sun = solar_position(result.log.index if index is None else index, result.site, "spa")
     altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
     return altitude > 0, incidence_cosine(altitude, azimuth, result.collector)
 
 
-def daily(result) -> pd.DataFrame:
-    """One row per local day of a run, by the run summary's definitions (`hybridtrack.metrics.daily`)."""
+def daily(result, log: pd.DataFrame | None = None) -> pd.DataFrame:
+    """One row per local day of a run (or of part of its `log`), by the run summary's definitions.
+
+    See `hybridtrack.metrics.daily` for the columns.
+    """
     from .metrics import daily as daily_table
 
-    sun_up, incidence = _true_sun(result)
-    return daily_table(result.log, collector=result.collector.kind, tz=result.site.tz, sun_up=sun_up,
-                       incidence=incidence)
+    log = result.log if log is None else log
+    sun_up, incidence = _true_sun(result, log.index)
+    return daily_table(log, collector=result.collector.kind, tz=result.site.tz, sun_up=sun_up, incidence=incidence)
 
 
 def plot_run(result, *, day=None, title: str | None = None):
@@ -509,7 +512,13 @@ def plot_run(result, *, day=None, title: str | None = None):
             from .errors import HybridtrackError
 
             raise HybridtrackError(f"the run has no step on {wanted}; it runs {local[0].date()} to {local[-1].date()}")
-        return _plot_timeline(result, log[mask], title or run_title(result, day=wanted))
+        day_row = daily(result, log[mask]).iloc[0]
+        heading = title or (f"{run_title(result, day=wanted)}\n" + ", ".join(
+            text for text, value in ((f"RMS {day_row['rms']:.3f}°", day_row["rms"]),
+                                     (f"p95 {day_row['p95']:.3f}°", day_row["p95"]),
+                                     (f"energy {day_row['energy_capture']:.1%}", day_row["energy_capture"]))
+            if pd.notna(value)))
+        return _plot_timeline(result, log[mask], heading)
     days = (log.index[-1] - log.index[0]) / pd.Timedelta(days=1)
     if days <= 3:
         return _plot_timeline(result, log, title or run_title(result))

@@ -458,6 +458,15 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
         report. Every candidate must keep the physical constraints (`constraint_violations`);
         if the starting config breaks them, the fit moves towards keeping them and the report
         says which still fail.
+
+    References
+    ----------
+    .. [1] Storn, R. & Price, K. (1997). Differential evolution: a simple and efficient heuristic
+       for global optimization over continuous spaces. Journal of Global Optimization 11,
+       341-359. doi:10.1023/A:1008202821328 (through `scipy.optimize.differential_evolution`).
+    .. [2] Powell, M. J. D. (1964). An efficient method for finding the minimum of a function of
+       several variables without calculating derivatives. The Computer Journal 7(2), 155-162.
+       (DOI not verified here, so none is given; through `scipy.optimize.minimize`.)
     """
     config = config if config is not None else FuzzyConfig.default()
     samples = read_samples(samples)
