@@ -14,6 +14,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 __all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_days", "plot_compare", "plot_rules",
+           "Comparison",
            "plot_tuning", "plot_confusion", "save_figure", "figure", "ReportFigure", "describe", "describe_html",
            "daily", "explain_step", "StepExplanation", "mode_colours", "SKY_COLOURS", "MODE_COLOURS"]
 
@@ -947,10 +948,10 @@ def explain_step(result, time):
     if stamp.tz is None:
         stamp = stamp.tz_localize(result.site.tz)
     position = log.index.get_indexer([stamp], method="pad")[0]
-    if position < 0:
+    if position < 0 or stamp > log.index[-1] + _step(log.index):
         from .errors import HybridtrackError
 
-        raise HybridtrackError(f"{stamp} is before the run, which starts at {log.index[0]}")
+        raise HybridtrackError(f"{stamp} is outside the run, which runs {log.index[0]} to {log.index[-1]}")
     row = log.iloc[position]
     events = result.events[result.events["time"] <= log.index[position]]
     event = events.iloc[-1].to_dict() if len(events) else None
@@ -987,3 +988,57 @@ class StepExplanation:
         """The rule viewer for this step's readings."""
         return plot_rules(self._classifier, self.fuzzy.intensity, self.fuzzy.variation,
                           title=f"{self.time:%Y-%m-%d %H:%M}: mode {self.mode}, sky {self.sky}")
+
+
+# --- several runs on the same weather (compare, ablations) ----------------------------------
+
+
+class Comparison:
+    """Runs on the same weather side by side: a table, an HTML table, a Figure, a daily table.
+
+    Parameters
+    ----------
+    results : dict of str to Result
+        One `hybridtrack.simulation.Result` per strategy (or per variant of an ablation).
+    """
+
+    def __init__(self, results: dict):
+        if not results:
+            from .errors import HybridtrackError
+
+            raise HybridtrackError("a comparison needs at least one run")
+        self.results = dict(results)
+
+    def __getitem__(self, name):
+        return self.results[name]
+
+    def table(self) -> pd.DataFrame:
+        """Headline metrics, one column per run (the summary's own numbers)."""
+        rows = {}
+        for name, result in self.results.items():
+            s = result.summary
+            rows[name] = {"RMS (°)": s["tracking_error_deg"]["rms"], "p95 (°)": s["tracking_error_deg"]["p95"],
+                          "max (°)": s["tracking_error_deg"]["max"], "within 0.5°": s["within_0_5_deg"],
+                          "energy capture": s["energy_capture"], "moves": s["moves"],
+                          "mode switches": s["mode_switches"], "wind stows": s["stow_events"],
+                          **{f"mode {m}": v for m, v in s["mode_share"].items()}}
+        return pd.DataFrame(rows)
+
+    def __repr__(self) -> str:
+        first = next(iter(self.results.values()))
+        return f"hybridtrack comparison: {run_title(first)}\n{self.table().to_string(float_format='{:.4g}'.format)}"
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        first = next(iter(self.results.values()))
+        return (f"<div><strong>hybridtrack comparison</strong>: {escape(run_title(first))}"
+                f"{self.table().to_html(float_format='{:.4g}'.format, border=0)}</div>")
+
+    def plot(self):
+        """`plot_compare` of the runs."""
+        return plot_compare(self.results)
+
+    def daily(self) -> pd.DataFrame:
+        """Every run's daily table, stacked with the run's name as the outer index level."""
+        return pd.concat({name: daily(result) for name, result in self.results.items()}, names=["run", "date"])

@@ -104,3 +104,27 @@ def test_a_southern_sun_path_does_not_wrap_and_metres_get_their_own_axis():
     assert "length (m)" in labels and "target (°)" in labels
     assert all(not line.get_label().startswith("jack") for ax in fig.axes if ax.get_ylabel() == "target (°)"
                for line in ax.get_lines())
+
+
+def test_a_comparison_shows_each_run_by_its_own_summary(two_days):
+    import dataclasses
+
+    from hybridtrack.report import Comparison
+
+    other = dataclasses.replace(two_days, summary={**two_days.summary, "strategy": "other"})
+    both = Comparison({"hybrid": two_days, "other": other})
+    table = both.table()
+    assert list(table.columns) == ["hybrid", "other"]
+    assert table.loc["RMS (°)", "hybrid"] == two_days.summary["tracking_error_deg"]["rms"]
+    assert "hybridtrack comparison" in repr(both) and "<table" in both._repr_html_()
+    assert both.daily().index.names == ["run", "date"] and len(both.daily()) == 4
+    assert both.plot()._repr_png_()[:4] == b"\x89PNG"
+
+
+def test_explain_outside_the_run_is_an_error(two_days):
+    from hybridtrack import HybridtrackError
+
+    with pytest.raises(HybridtrackError, match="outside the run"):
+        two_days.explain("2021-06-25 12:00")
+    with pytest.raises(HybridtrackError, match="outside the run"):
+        two_days.explain("2021-06-20 12:00")
