@@ -955,7 +955,7 @@ def explain_step(result, time):
     row = log.iloc[position]
     events = result.events[result.events["time"] <= log.index[position]]
     event = events.iloc[-1].to_dict() if len(events) else None
-    classifier = FuzzyWeatherClassifier()
+    classifier = getattr(result, "classifier", None) or FuzzyWeatherClassifier()  # the run's, once it keeps one
     return StepExplanation(log.index[position].tz_convert(result.site.tz), str(row["mode"]), str(row["sky"]),
                            float(row["sky_score"]), str(row["sensor_status"]), float(row["wind_speed"]),
                            float(row["dni"]), event, classifier.explain(row["intensity_ma"], row["variation_ma"]),
