@@ -8,10 +8,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import hybridtrack
+from hybridtrack.io import read_weather
 from hybridtrack.report import plot_days, save_figure
 from hybridtrack.sky import synthetic
 
 OUT = Path(__file__).with_name("images")
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def main() -> None:
@@ -26,6 +28,8 @@ def main() -> None:
                                           seed=1, gusts_per_day=0.3), "lanzhou", collector="trough-ns")
     save_figure(year.plot(), OUT / "report-365day.png")
     save_figure(year.plot(day="2021-03-20"), OUT / "report-365day-one-day.png")
+    record = read_weather(DATA / "nanjing-2013-cloudy.csv", site="nanjing", freq="1min")
+    save_figure(hybridtrack.simulate(record, "nanjing").plot(), OUT / "report-4-typical-days.png")
     print(f"wrote the pictures to {OUT}")
 
 

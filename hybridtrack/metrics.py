@@ -167,7 +167,8 @@ def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidenc
     steps = _steps(log, collector, sun_up, incidence)
     local = log.index.tz_convert(tz)
     day = pd.Index(local.date, name="date")
-    minutes = np.diff(log.index.asi8, append=log.index.asi8[-1]) / 6e10
+    elapsed = np.asarray((log.index - log.index[0]) / pd.Timedelta(minutes=1), float)  # any index unit
+    minutes = np.diff(elapsed, append=elapsed[-1])
     if len(minutes) > 1:
         minutes[-1] = minutes[-2]
     minutes = np.minimum(minutes, np.median(minutes) if len(minutes) else 1.0)  # a gap is not time in a mode

@@ -212,7 +212,7 @@ def _gaps(index: pd.DatetimeIndex) -> list[tuple[int, int]]:
 
     if len(index) < 2:
         return []
-    spacing = np.diff(index.asi8)
+    spacing = np.diff(index.to_numpy(dtype="datetime64[ns]").astype("int64"))  # ns, whatever the index's unit
     return [(int(i), int(i) + 1) for i in np.flatnonzero(spacing > 1.5 * _step(index).value)]
 
 
@@ -612,17 +612,74 @@ def _plot_timeline(result, log: pd.DataFrame, title: str):
     return fig
 
 
-def _by_hour_and_day(log: pd.DataFrame, tz, values, bins: int):
-    """Day number, time-of-day bin and the grid shape for every step."""
-    import numpy as np
+class _DayAxis:
+    """The x axis of an overview: calendar days, or only the days with data when most are missing.
 
-    local = log.index.tz_convert(tz)
-    dates = pd.DatetimeIndex(local.normalize().tz_localize(None))
-    first = dates[0]
-    day = np.asarray((dates - first).days, int)
-    minute = local.hour * 60 + local.minute + local.second / 60.0
-    slot = np.minimum((np.asarray(minute) * bins / 1440.0).astype(int), bins - 1)
-    return day, slot, (bins, int(day.max()) + 1), first
+    A run over a few scattered days (four typical days of a year) would be slivers on a calendar
+    axis, so then each day with data gets one column and the gaps between are marked instead.
+    """
+
+    def __init__(self, index: pd.DatetimeIndex, tz):
+        import numpy as np
+
+        local = index.tz_convert(tz)
+        dates = pd.DatetimeIndex(local.normalize().tz_localize(None))
+        self.present = pd.DatetimeIndex(sorted(set(dates)))
+        span = (self.present[-1] - self.present[0]).days + 1
+        self.compact = len(self.present) < 0.8 * span
+        if self.compact:
+            self.day = np.searchsorted(self.present.to_numpy(dtype="datetime64[ns]"),
+                                       dates.to_numpy(dtype="datetime64[ns]"))
+            self.days = len(self.present)
+        else:
+            self.day = np.asarray((dates - self.present[0]).days, int)
+            self.days = span
+        minute = np.asarray(local.hour * 60 + local.minute + local.second / 60.0)
+        self.minute = minute
+
+    def slots(self, bins: int):
+        import numpy as np
+
+        return np.minimum((self.minute * bins / 1440.0).astype(int), bins - 1)
+
+    def extent(self) -> list[float]:
+        from matplotlib.dates import date2num
+
+        if self.compact:
+            return [0.0, float(self.days), 0.0, 24.0]
+        return [date2num(self.present[0]), date2num(self.present[0] + pd.Timedelta(days=self.days)), 0.0, 24.0]
+
+    def centres(self, dates) -> list[float]:
+        """x of the middle of each of `dates` (the daily table's index)."""
+        from matplotlib.dates import date2num
+
+        stamps = pd.DatetimeIndex(pd.Index(dates).astype(str))
+        if self.compact:
+            return [float(i) + 0.5 for i in self.present.get_indexer(stamps)]
+        return list(date2num(stamps + pd.Timedelta(hours=12)))
+
+    def decorate(self, axes) -> None:
+        """Date ticks on the last axis; in compact mode a marked gap between days that are not adjacent."""
+        from matplotlib.dates import AutoDateLocator, ConciseDateFormatter
+
+        extent = self.extent()
+        axes[-1].set_xlim(extent[0], extent[1])
+        if not self.compact:
+            locator = AutoDateLocator()
+            axes[-1].xaxis.set_major_locator(locator)
+            axes[-1].xaxis.set_major_formatter(ConciseDateFormatter(locator))
+            return
+        step = max(1, self.days // 16)
+        axes[-1].set_xticks([i + 0.5 for i in range(0, self.days, step)],
+                            [f"{d:%Y-%m-%d}" for d in self.present[::step]], rotation=30, ha="right")
+        for i in range(1, self.days):
+            missing = (self.present[i] - self.present[i - 1]).days - 1
+            if missing:
+                for ax in axes:
+                    ax.axvline(i, color="white", lw=3)
+                    ax.axvline(i, color="tab:red", lw=1, ls=(0, (2, 2)))
+                axes[0].text(i, 24.3, f"{missing} days without data", ha="center", va="bottom", fontsize="x-small",
+                             color="tab:red")
 
 
 def _category_grid(day, slot, shape, codes, count: int):
@@ -637,17 +694,26 @@ def _category_grid(day, slot, shape, codes, count: int):
 
 
 def _rgb(grid, colours: list[str]):
+    """RGBA image of a category grid; cells without data (-1) are transparent, so the hatch shows."""
     import numpy as np
-    from matplotlib.colors import to_rgb
+    from matplotlib.colors import to_rgba
 
-    palette = np.array([to_rgb(c) for c in colours] + [to_rgb("white")])
-    return palette[grid]  # -1 (no data) picks the white at the end
+    palette = np.array([to_rgba(c) for c in colours] + [(1.0, 1.0, 1.0, 0.0)])
+    return palette[grid]  # -1 (no data) picks the transparent colour at the end
+
+
+def _hatch_background(ax, extent) -> None:
+    """Hatch the whole axis behind its images: whatever no image covers reads as no data."""
+    from matplotlib.patches import Rectangle
+
+    x0, x1, y0, y1 = extent
+    ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, zorder=0, lw=0,
+                           **{k: v for k, v in NO_DATA.items() if k != "label"}))
 
 
 def _plot_overview(result, title: str):
     import numpy as np
     from matplotlib import colormaps
-    from matplotlib.dates import AutoDateLocator, ConciseDateFormatter, date2num
 
     from .metrics import TRACKING_MODES
 
@@ -656,9 +722,10 @@ def _plot_overview(result, title: str):
     table = daily(result)
     step_minutes = max(_step(log.index).total_seconds() / 60.0, 1.0)
     bins = int(min(144, 1440 / step_minutes))  # 10-minute cells, or the step if coarser
-    day, slot, shape, first = _by_hour_and_day(log, tz, None, bins)
+    days = _DayAxis(log.index, tz)
+    day, slot, shape = days.day, days.slots(bins), (bins, days.days)
     sun_up = np.isfinite(log["target_true"].to_numpy())
-    extent = [date2num(first), date2num(first + pd.Timedelta(days=shape[1])), 0, 24]
+    extent = days.extent()
 
     fig = figure(figsize=(13, 13), layout="constrained")
     axes = fig.subplots(5, 1, sharex=True, height_ratios=[2.2, 1.6, 1.6, 1.2, 1.0])
@@ -670,8 +737,9 @@ def _plot_overview(result, title: str):
     sky_grid = _category_grid(day, slot, shape, sky_codes, len(sky_names))
     background = np.where(sky_grid == sky_names.index("night"), 0, np.where(sky_grid < 0, -1, 1))
     ax = axes[0]
+    _hatch_background(ax, extent)
     ax.imshow(_rgb(background, [SKY_COLOURS["night"], "#e9ecef"]), aspect="auto", origin="lower", extent=extent,
-              interpolation="nearest")
+              interpolation="nearest", zorder=1)
     tracking = (log["mode"].isin(TRACKING_MODES).to_numpy() & sun_up & (log["dni"].to_numpy() > 0)
                 & np.isfinite(log["error"].to_numpy()))
     total = np.zeros(shape)
@@ -681,7 +749,7 @@ def _plot_overview(result, title: str):
     mean_error = np.ma.masked_invalid(np.where(count > 0, total / np.maximum(count, 1), np.nan))
     limit = float(np.quantile(mean_error.compressed(), 0.99)) if mean_error.count() else 1.0
     image = ax.imshow(mean_error, aspect="auto", origin="lower", extent=extent, cmap=colormaps["viridis"],
-                      vmin=0, vmax=max(limit, 0.05), interpolation="nearest")
+                      vmin=0, vmax=max(limit, 0.05), interpolation="nearest", zorder=2)
     bar = fig.colorbar(image, ax=ax, extend="max" if mean_error.max() > limit else "neither", pad=0.01)
     clipped = f"clipped at {limit:.2f}° (arrow)" if mean_error.max() > limit else ""
     bar.set_label(f"mean |error| (°)\n{clipped}",
@@ -695,15 +763,16 @@ def _plot_overview(result, title: str):
     mode_codes = np.array([names.index(m) for m in log["mode"].astype(str)])
     for ax, grid, colours, label in ((axes[1], _category_grid(day, slot, shape, mode_codes, len(names)), modes, "mode"),
                                      (axes[2], sky_grid, SKY_COLOURS, "sky")):
+        _hatch_background(ax, extent)
         ax.imshow(_rgb(grid, list(colours.values())), aspect="auto", origin="lower", extent=extent,
-                  interpolation="nearest")
+                  interpolation="nearest", zorder=1)
         ax.set_ylabel(f"{label}\nhour of day")
         _legend(ax, colours, label, extra=[_no_data_patch()] if (grid < 0).any() else ())
     for ax in axes[:3]:
         ax.set_yticks([0, 6, 12, 18, 24])
 
     # energy capture per day, and each day's highest wind
-    centres = date2num(pd.DatetimeIndex(table.index.astype(str)) + pd.Timedelta(hours=12))
+    centres = days.centres(table.index)
     ax = axes[3]
     capture = table["energy_capture"].to_numpy(float)
     width = 0.8 if len(centres) <= 31 else 1.0  # touching bars for long runs: gaps between them would flicker
@@ -720,11 +789,8 @@ def _plot_overview(result, title: str):
     ax.text(1.005, controller.wind_stow, f"stow > {controller.wind_stow:g} m/s", transform=ax.get_yaxis_transform(),
             color="tab:red", fontsize="x-small", va="center")
     ax.set_ylabel("highest wind\nper day (m/s)")
-    locator = AutoDateLocator()
-    axes[-1].xaxis.set_major_locator(locator)
-    axes[-1].xaxis.set_major_formatter(ConciseDateFormatter(locator))
-    axes[-1].set_xlim(extent[0], extent[1])
-    axes[-1].set_xlabel(f"local date ({tz})")
+    days.decorate(axes)
+    axes[-1].set_xlabel(f"local date ({tz})" + (", days with data only" if days.compact else ""))
     return fig
 
 

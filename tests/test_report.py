@@ -128,3 +128,16 @@ def test_explain_outside_the_run_is_an_error(two_days):
         two_days.explain("2021-06-25 12:00")
     with pytest.raises(HybridtrackError, match="outside the run"):
         two_days.explain("2021-06-20 12:00")
+
+
+def test_scattered_days_get_a_column_each_and_the_gap_is_marked():
+    import pandas as pd
+
+    frame = pd.concat([synthetic("nanjing", "2013-03-20", weather="sunny", seed=1, freq="10min"),
+                       synthetic("nanjing", "2013-06-21", weather="cloudy", seed=1, freq="10min")])
+    result = hybridtrack.simulate(frame, "nanjing")
+    fig = result.plot()
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert "92 days without data" in texts  # 2013-03-21 to 2013-06-20
+    assert [t.get_text() for t in fig.axes[4].get_xticklabels()] == ["2013-03-20", "2013-06-21"]
+    assert len(result.daily()) == 2
