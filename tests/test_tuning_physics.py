@@ -78,3 +78,9 @@ def test_classify_warns_on_one_line_outside_the_labelled_range(capsys):
     assert main(["classify", "--intensity", "30", "--variation", "0", "--config", str(TUNED)]) == 0
     err = capsys.readouterr().err
     assert err.startswith("hybridtrack: warning: 1 of 1 readings lie outside") and err.count("\n") == 1
+
+
+def test_progress_counts_every_fit():
+    calls = []
+    tune(None, LABELS, method="local", maxiter=3, restarts=0, folds=3, seeds=2, progress=calls.append)
+    assert calls == [1] * (1 + 3 + 1)

@@ -113,8 +113,12 @@ def _tune(args: argparse.Namespace) -> int:
         raise HybridtrackError(f"--folds must be 0 (none) or at least 2, got {args.folds}")
     start = load_fuzzy_config(args.config)
     samples = read_samples(args.labels)
-    tuned, report = tune(start, samples, method=args.method, margin=args.margin, seed=args.seed, folds=args.folds,
-                         seeds=args.seeds)
+    from tqdm import tqdm
+
+    fits = 1 + args.folds + max(args.seeds - 1, 0)
+    with tqdm(total=fits, unit="fit", desc="tuning", disable=fits < 2, leave=False, file=sys.stderr) as bar:
+        tuned, report = tune(start, samples, method=args.method, margin=args.margin, seed=args.seed,
+                             folds=args.folds, seeds=args.seeds, progress=bar.update)
     out = tuned.to_fis(args.out) if args.out.lower().endswith(".fis") else tuned.to_toml(args.out)
     print(report)
     for name, change in report.changed.items():

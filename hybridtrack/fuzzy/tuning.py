@@ -380,11 +380,13 @@ def _folds(samples: pd.DataFrame, folds: int, seed: int) -> np.ndarray:
     return fold
 
 
-def cross_validate(config: FuzzyConfig | None, samples, *, folds: int = 5, seed: int = 0, **options) -> dict:
+def cross_validate(config: FuzzyConfig | None, samples, *, folds: int = 5, seed: int = 0, progress=None,
+                   **options) -> dict:
     """k-fold cross-validated accuracy (and score RMSE) of tuning `config` to `samples`.
 
     Each fold is held out in turn, the config is tuned on the other readings (same options as
     `tune`), and the held-out readings are classified by that fit. Folds are stratified by label.
+    `progress`, if given, is called with 1 after each fold's fit.
 
     Returns
     -------
@@ -403,6 +405,8 @@ def cross_validate(config: FuzzyConfig | None, samples, *, folds: int = 5, seed:
     for k in range(folds):
         held = assignment == k
         fitted, _ = _fit(config, samples[~held], opts, seed)
+        if progress is not None:
+            progress(1)
         part = evaluate(fitted, samples[held], opts.margin)
         per_fold.append(part["accuracy"])
         scores[held] = FuzzyWeatherClassifier(fitted).score(samples["intensity"].to_numpy(float)[held],
@@ -422,7 +426,7 @@ def _centre_spread(fits: list[FuzzyConfig]) -> dict[str, float]:
 
 def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin: float = 0.5,
          maxiter: int = 60, popsize: int = 8, restarts: int = 8, seed: int = 0, folds: int = 0,
-         seeds: int = 1) -> tuple[FuzzyConfig, TuningReport]:
+         seeds: int = 1, progress=None) -> tuple[FuzzyConfig, TuningReport]:
     """Fit the input membership parameters of `config` to labelled readings.
 
     Parameters
@@ -450,6 +454,8 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
         With 2 or more, also report the `folds`-fold cross-validated accuracy (`cross_validate`).
     seeds : int
         With 2 or more, also fit from seeds ``seed + 1 ...`` and report the spread of the fits.
+    progress : callable, optional
+        Called with 1 after each of the ``1 + folds + seeds - 1`` fits (e.g. a tqdm bar's update).
 
     Returns
     -------
@@ -477,13 +483,19 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     if not 1 <= seeds <= 20:
         raise HybridtrackError(f"seeds must be between 1 and 20, got {seeds}")
     options = _Options(method, margin, maxiter, popsize, restarts)
-    cv = cross_validate(config, samples, folds=folds, seed=seed, **options.__dict__) if folds else {}
+    cv = cross_validate(config, samples, folds=folds, seed=seed, progress=progress, **options.__dict__) if folds \
+        else {}
     before = evaluate(config, samples, margin)
     fitted, evaluations = _fit(config, samples, options, seed)
+    step = progress if progress is not None else (lambda _: None)
+    step(1)
     span = labelled_range(samples)
     tuned = fitted.replace(name=f"{config.name}-tuned", labelled_range=span)
     after = evaluate(tuned.replace(labelled_range=None), samples, margin)
-    others = [_fit(config, samples, options, seed + k)[0] for k in range(1, seeds)]
+    others = []
+    for k in range(1, seeds):
+        others.append(_fit(config, samples, options, seed + k)[0])
+        step(1)
     seed_accuracy = {seed: after["accuracy"]}
     seed_accuracy.update({seed + k: evaluate(fit, samples, margin)["accuracy"] for k, fit in enumerate(others, 1)})
     changed = {}
