@@ -4,8 +4,8 @@ Each reading is what the sun sensor sees (`hybridtrack.sensor.sensor_view`) on a
 (`hybridtrack.sky.synthetic`), labelled with the synthetic day's true ``sky`` at that minute.
 Days: Lanzhou (2021) and Nanjing (2013), at a solstice and an equinox, one sunny, one cloudy, one
 overcast and one mixed day each. Readings are drawn while the clear-sky GHI is above 100 W/m²
-(the sensor's working day), 24 per class, by a seeded generator, so the file is reproduced byte
-for byte::
+(the sensor's working day), 24 per class, by a seeded generator, so the same synthetic skies and
+sensor model reproduce the file byte for byte::
 
     python examples/tuning/make_labels.py
 """
