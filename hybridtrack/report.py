@@ -465,8 +465,9 @@ def describe_html(result, *, events: int = 12) -> str:
             ("mode shares", _shares(s["mode_share"])), ("sky shares (every step)", _shares(s["sky_share"]))]
     table = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td style='text-align:left'>{escape(v)}</td></tr>"
                     for k, v in rows)
-    shown = result.events.head(events).assign(time=lambda e: e["time"].dt.tz_convert(result.site.tz)
-                                               .dt.strftime("%Y-%m-%d %H:%M"))
+    shown = result.events.head(events)
+    if len(shown):  # an empty frame's time column is not datetime-like
+        shown = shown.assign(time=[f"{t.tz_convert(result.site.tz):%Y-%m-%d %H:%M}" for t in shown["time"]])
     more = len(result.events) - len(shown)
     event_html = shown.to_html(index=False, border=0) if len(shown) else "<p>no events</p>"
     return (f"<div><strong>hybridtrack run</strong><table>{table}</table>"

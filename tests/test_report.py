@@ -141,3 +141,10 @@ def test_scattered_days_get_a_column_each_and_the_gap_is_marked():
     assert "92 days without data" in texts  # 2013-03-21 to 2013-06-20
     assert [t.get_text() for t in fig.axes[4].get_xticklabels()] == ["2013-03-20", "2013-06-21"]
     assert len(result.daily()) == 2
+
+
+def test_a_run_without_events_still_shows_itself():
+    frame = synthetic("delingha", "2018-06-21", weather="sunny", seed=2, freq="5min").iloc[:3]
+    result = hybridtrack.simulate(frame, "delingha", collector="trough-ew")  # three steps of night
+    assert "no events" in result._repr_html_() and "night 100.0%" in repr(result)
+    assert result.plot()._repr_png_()[:4] == b"\x89PNG" and len(result.daily()) == 1
