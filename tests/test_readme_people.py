@@ -27,8 +27,8 @@ def test_the_python_block_runs_on_a_run_of_that_day():
     import hybridtrack
     from hybridtrack.sky import synthetic
 
-    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=5, freq="5min")
-    namespace = {"result": hybridtrack.simulate(frame, "lanzhou", collector="fresnel")}
+    frame = synthetic("nanjing", "2013-12-22", weather="mixed", seed=3, freq="5min")  # the README's run, coarser
+    namespace = {"result": hybridtrack.simulate(frame, "nanjing", collector="trough-ns")}
     (block,) = section_blocks("python")
     for line in block.splitlines():
         code = line.split("#")[0].strip()
