@@ -183,6 +183,36 @@ class Result:
             written["report"] = save_figure(plot_run(self), folder / "report.png")
         return written
 
+    # -- for people (hybridtrack.report): a short repr, an HTML repr, pictures, a daily table --
+
+    def __repr__(self) -> str:
+        from .report import describe
+
+        return describe(self)
+
+    def _repr_html_(self) -> str:
+        from .report import describe_html
+
+        return describe_html(self)
+
+    def plot(self, *, day=None):
+        """The run as a `matplotlib.figure.Figure` (a timeline, or an overview of a long run)."""
+        from .report import plot_run
+
+        return plot_run(self, day=day)
+
+    def daily(self) -> pd.DataFrame:
+        """One row per local day: energy capture, RMS, p95, moves, stow minutes, sky shares."""
+        from .report import daily
+
+        return daily(self)
+
+    def explain(self, time):
+        """Why the controller was in its mode at `time`, with the fuzzy rules for that step."""
+        from .report import explain_step
+
+        return explain_step(self, time)
+
 
 def _has_parquet() -> bool:
     try:

@@ -49,12 +49,21 @@ class RuleCase:
     config_path: str | None = None
     source: str = ""
     row: int = 0
+    line: int | None = None
 
     @property
     def id(self) -> str:
-        """A readable test id: ``row2-246mA-27mA-sunny``."""
+        """A readable test id: ``line4-246mA-27mA-sunny`` (the file's line), else ``row2-...``."""
         expected = self.weather or f"score{self.score:g}"
-        return f"row{self.row}-{self.intensity:g}mA-{self.variation:g}mA-{expected}"
+        where = f"line{self.line}" if self.line else f"row{self.row}"
+        return f"{where}-{self.intensity:g}mA-{self.variation:g}mA-{expected}"
+
+    @property
+    def where(self) -> str:
+        """``file:line`` (or ``source row N``) of the case, for messages."""
+        if self.line:
+            return f"{self.source}:{self.line}"
+        return f"{self.source} row {self.row}" if self.source else f"row {self.row}"
 
     def classifier(self):
         """The classifier the case runs against (its file's config, else the published one)."""
@@ -72,10 +81,10 @@ class RuleCase:
             if not (abs(explanation.score - self.score) <= tolerance):
                 problems.append(f"expected score {self.score:g} ± {tolerance:g}, got {explanation.score:.4f}")
         if problems:
-            where = f"{self.source} row {self.row}: " if self.source else ""
+            config = self.config_path or "the published system (built in)"
             raise RuleCaseFailure(
-                f"{where}{'; '.join(problems)} for intensity {self.intensity:g} mA, variation {self.variation:g} mA\n"
-                f"{explanation}"
+                f"{self.where}: {'; '.join(problems)} for intensity {self.intensity:g} mA, "
+                f"variation {self.variation:g} mA\nconfig: {config}\n{explanation}"
             )
 
 
@@ -89,12 +98,6 @@ def _classifier(config_path: str | None):
         config = FuzzyConfig.from_toml(config_path) if config_path else FuzzyConfig.default()
         _CLASSIFIERS[config_path] = FuzzyWeatherClassifier(config)
     return _CLASSIFIERS[config_path]
-
-
-def _optional(value) -> float | None:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return None
-    return float(value)
 
 
 def _config_reference(path: Path) -> str | None:
@@ -111,24 +114,108 @@ def _config_reference(path: Path) -> str | None:
     return str((path.parent / reference).resolve()) if reference else None
 
 
+def _data_lines(path: Path, rows: int) -> list[int] | None:
+    """The file's line number (1-based) of each table row, or None if they cannot be matched."""
+    import re
+
+    from .io import read_text
+
+    text = read_text(path).splitlines()
+    if path.suffix.lower() == ".toml":
+        lines = [n for n, line in enumerate(text, 1) if re.match(r"\s*\[\[\s*cases?\s*\]\]", line)]
+    else:
+        lines = [n for n, line in enumerate(text, 1) if line.strip() and not line.strip().startswith("#")][1:]
+    return lines if len(lines) == rows else None
+
+
+class _Row:
+    """Reads one table row's values, naming the file and line of the first problem."""
+
+    def __init__(self, values: dict, where: str):
+        self.values, self.where = values, where
+
+    def fail(self, message: str):
+        from .errors import HybridtrackError
+
+        raise HybridtrackError(f"{self.where}: {message}")
+
+    def number(self, column: str, *, required: bool) -> float | None:
+        value = self.values.get(column)
+        if value is None or (isinstance(value, str) and not value.strip()) or (
+                isinstance(value, float) and math.isnan(value)):
+            if required:
+                self.fail(f"column {column!r} is empty")
+            return None
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"column {column!r}: {value!r} is not a number")
+        if not math.isfinite(number):
+            self.fail(f"column {column!r}: {value!r} is not a finite number")
+        return number
+
+    def label(self, column: str) -> str | None:
+        value = self.values.get(column)
+        if value is None or (isinstance(value, float) and math.isnan(value)) or not str(value).strip():
+            return None
+        return str(value).strip().lower()
+
+
+def _case(row: _Row, config, config_path, source: str, number: int, line: int | None) -> RuleCase:
+    """One checked case: numbers finite and inside the config's ranges, labels the config's own."""
+    readings = []
+    for var in config.inputs:
+        value = row.number(var.name, required=True)
+        lo, hi = var.raw_range
+        if not lo <= value <= hi:
+            row.fail(f"{var.name} {value:g} {var.unit} is outside the config's range {lo:g}-{hi:g} {var.unit} "
+                     "(the classifier would clip it to the edge; test the edge itself instead)")
+        readings.append(value)
+    weather = row.label("weather")
+    bands = [band[0] for band in config.bands]
+    if weather is not None and weather not in bands:
+        row.fail(f"unknown weather label {weather!r}; the config's labels are {', '.join(bands)}")
+    score, tolerance = row.number("score", required=False), row.number("tolerance", required=False)
+    lo, hi = config.output.universe
+    if score is not None and not lo <= score <= hi:
+        row.fail(f"score {score:g} is outside the output universe {lo:g}-{hi:g}")
+    if tolerance is not None and tolerance < 0:
+        row.fail(f"tolerance {tolerance:g} is negative")
+    if weather is None and score is None:
+        row.fail("neither a weather label nor a score to check")
+    return RuleCase(readings[0], readings[1], weather, score, tolerance, config_path, source, number, line)
+
+
 def load_cases(path) -> list[RuleCase]:
-    """Read a rule-table file (CSV or TOML) into `RuleCase` rows, checked."""
+    """Read a rule-table file (CSV or TOML) into `RuleCase` rows, checked against its config.
+
+    A problem in a row (text where a number belongs, a reading outside the config's raw range,
+    a label the config does not have, a negative tolerance) is a `HybridtrackError` naming the
+    file and line, never a silent clip.
+    """
     from .errors import HybridtrackError
-    from .fuzzy.tuning import read_samples
+    from .io import read_table
 
     path = Path(path)
-    frame = read_samples(path)
-    if "weather" not in frame.columns and "score" not in frame.columns:  # pragma: no cover - read_samples checks
-        raise HybridtrackError(f"{path}: needs a 'weather' or 'score' column")
+    frame = read_table(path)
+    for column in ("intensity", "variation"):
+        if column not in frame.columns:
+            raise HybridtrackError(f"{path}: missing column {column!r} (need intensity, variation and weather "
+                                   "or score)")
+    if "weather" not in frame.columns and "score" not in frame.columns:
+        raise HybridtrackError(f"{path}: needs a 'weather' or a 'score' column")
     config_path = _config_reference(path)
+    try:
+        config = _classifier(config_path).config
+    except HybridtrackError as exc:
+        raise HybridtrackError(f"{path}: its config: {exc}") from None
+    lines = _data_lines(path, len(frame))
+    first = 1 if path.suffix.lower() == ".toml" else 2
     cases = []
-    for number, row in enumerate(frame.to_dict("records"), start=2 if path.suffix.lower() != ".toml" else 1):
-        weather = row.get("weather")
-        weather = None if weather is None or (isinstance(weather, float) and math.isnan(weather)) \
-            else str(weather).strip().lower()
-        cases.append(RuleCase(float(row["intensity"]), float(row["variation"]), weather,
-                              _optional(row.get("score")), _optional(row.get("tolerance")),
-                              config_path, str(path), number))
+    for k, values in enumerate(frame.to_dict("records")):
+        line = lines[k] if lines else None
+        where = f"{path}:{line}" if line else f"{path}: row {k + first}"
+        cases.append(_case(_Row(values, where), config, config_path, str(path), k + first, line))
     return cases
 
 
@@ -205,4 +292,5 @@ class RuleCaseItem(pytest.Item):
         return super().repr_failure(excinfo)
 
     def reportinfo(self):
-        return self.path, self.case.row, f"rule-table row {self.case.row}: {self.case.id}"
+        line = self.case.line or self.case.row
+        return self.path, line - 1, f"rule table {self.case.where}: {self.case.id}"

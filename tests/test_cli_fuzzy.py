@@ -43,13 +43,16 @@ def test_tune_writes_a_config_that_loads(tmp_path, capsys):
     labels = tmp_path / "labels.csv"
     pd.DataFrame({"intensity": [246.0, 200.1, 200.1, 143.4, 100.0], "variation": [27.0, 84.6, 93.6, 45.0, 150.0],
                   "weather": ["sunny", "cloudy", "cloudy", "overcast", "cloudy"]}).to_csv(labels, index=False)
-    out, report = tmp_path / "tuned.toml", tmp_path / "report.json"
-    assert main(["tune", str(labels), "--out", str(out), "--method", "local", "--report", str(report)]) == 0
+    out, report = tmp_path / "tuned.toml", tmp_path / "report"
+    assert main(["tune", str(labels), "--out", str(out), "--method", "local", "--folds", "0", "--seeds", "1",
+                 "--report", str(report)]) == 0
     printed = capsys.readouterr().out
     assert "label accuracy" in printed and f"wrote {out}" in printed
     tuned = FuzzyConfig.from_toml(out)
     assert tuned.name == "published-tuned"
-    data = json.loads(report.read_text())
+    for picture in ("surfaces.png", "confusion.png"):
+        assert (report / picture).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    data = json.loads((report / "report.json").read_text())
     assert data["accuracy_after"] >= data["accuracy_before"] and data["accuracy_after"] == 1.0
 
 

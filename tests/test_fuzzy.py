@@ -281,9 +281,11 @@ def test_tuning_fits_a_table_of_target_scores_closely():
 
 def test_tuning_to_labels_reaches_full_accuracy_and_is_reproducible():
     table = target_table(40, seed=5)[["intensity", "variation", "weather"]]
-    first, report = tune(None, table, method="local")
+    # the hidden truth dips 0.56 score units as intensity rises, which tuning may not copy, so the
+    # local search alone gets stuck at 95 %; the population search finds a sound fit of every label
+    first, report = tune(None, table, maxiter=30, popsize=6)
     assert report.accuracy_after == 1.0 and report.accuracy_before < 1.0
-    second, _ = tune(None, table, method="local")
+    second, _ = tune(None, table, maxiter=30, popsize=6)
     assert first == second
 
 

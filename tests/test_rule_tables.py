@@ -20,8 +20,8 @@ def run_pytest(folder, *args):
 def test_the_example_rule_tables_pass_and_have_readable_ids():
     result = run_pytest(ROOT / "examples" / "rule_tables")
     assert result.returncode == 0, result.stdout + result.stderr
-    assert "test_site.rules.csv::row2-280mA-10mA-sunny PASSED" in result.stdout
-    assert "test_commissioning_readings[row4-143.4mA-45mA-overcast] PASSED" in result.stdout
+    assert "test_site.rules.csv::line4-280mA-10mA-sunny PASSED" in result.stdout
+    assert "test_commissioning_readings[line4-143.4mA-45mA-overcast] PASSED" in result.stdout
     assert "8 passed" in result.stdout
 
 
@@ -39,7 +39,7 @@ def test_a_broken_rule_table_is_a_collection_error_that_says_where(tmp_path):
     (tmp_path / "test_broken.rules.csv").write_text("intensity,variation,weather\nbright,27.0,sunny\n")
     result = run_pytest(tmp_path)
     assert result.returncode != 0
-    assert "row 2, column 'intensity': 'bright' is not a number" in result.stdout
+    assert "test_broken.rules.csv:2: column 'intensity': 'bright' is not a number" in result.stdout
 
 
 def test_toml_cases_read_config_and_scores():
@@ -60,3 +60,34 @@ def test_check_raises_a_rule_case_failure_with_the_explanation():
 def test_missing_rule_table_is_a_clear_error(tmp_path):
     with pytest.raises(HybridtrackError, match="no such file"):
         load_cases(tmp_path / "nope.csv")
+
+
+def test_a_failure_cites_the_file_line_and_the_config(tmp_path):
+    table = tmp_path / "test_lines.rules.csv"
+    table.write_text("# two comment lines\n# config: ../cfg.toml\nintensity,variation,weather\n"
+                     "246.0,27.0,sunny\n246.0,27.0,overcast\n")
+    (tmp_path.parent / "cfg.toml").write_text('name = "mine"\n')
+    result = run_pytest(tmp_path)
+    assert result.returncode == 1
+    assert "test_lines.rules.csv:5: expected overcast, got sunny" in result.stdout
+    assert f"config: {(tmp_path.parent / 'cfg.toml').resolve()}" in result.stdout
+    assert "test_lines.rules.csv::line5-246mA-27mA-overcast FAILED" in result.stdout
+
+
+@pytest.mark.parametrize("row, message", [
+    ("246.0,27.0,sunnny", "t.csv:3: unknown weather label 'sunnny'; the config's labels are overcast, cloudy, sunny"),
+    ("350.0,27.0,sunny", "t.csv:3: intensity 350 mA is outside the config's range 30-300 mA"),
+    ("246.0,-1,sunny", "t.csv:3: variation -1 mA is outside the config's range 0-180 mA"),
+    ("246.0,inf,sunny", "t.csv:3: column 'variation': inf is not a finite number"),
+])
+def test_bad_rows_are_errors_naming_file_and_line(tmp_path, row, message):
+    table = tmp_path / "t.csv"
+    table.write_text(f"intensity,variation,weather\n100,5,overcast\n{row}\n")
+    with pytest.raises(HybridtrackError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        load_cases(table)
+
+
+def test_toml_cases_carry_their_table_line():
+    cases = load_cases(ROOT / "tests" / "test_complete.rules.toml")
+    text = (ROOT / "tests" / "test_complete.rules.toml").read_text().splitlines()
+    assert all(text[case.line - 1].startswith("[[case]]") for case in cases)

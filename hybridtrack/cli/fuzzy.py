@@ -3,9 +3,29 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import sys
+import warnings
 
 from ..errors import HybridtrackError
 from .base import command
+
+
+@contextlib.contextmanager
+def tuned_config_warnings():
+    """Print a tuned config's `OutsideLabelsWarning` as one ``hybridtrack: warning:`` line each."""
+    from ..fuzzy.tuning import OutsideLabelsWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", OutsideLabelsWarning)
+        try:
+            yield
+        finally:
+            for warning in caught:
+                if issubclass(warning.category, OutsideLabelsWarning):
+                    print(f"hybridtrack: warning: {warning.message}", file=sys.stderr)
+                else:
+                    warnings.showwarning(warning.message, warning.category, warning.filename, warning.lineno)
 
 
 def load_fuzzy_config(path):
@@ -32,6 +52,11 @@ def _classify_arguments(parser: argparse.ArgumentParser) -> None:
 
 @command("classify", "classify sky readings with the fuzzy classifier", _classify_arguments)
 def _classify(args: argparse.Namespace) -> int:
+    with tuned_config_warnings():
+        return _classify_readings(args)
+
+
+def _classify_readings(args: argparse.Namespace) -> int:
     import json
 
     from ..fuzzy import FuzzyWeatherClassifier
@@ -69,25 +94,46 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
                         help="global: population search then Powell (default); local: Powell only")
     parser.add_argument("--margin", type=float, default=0.5, help="how far inside its band a label's score should sit")
     parser.add_argument("--seed", type=int, default=0, help="seed for reproducible fits (default 0)")
-    parser.add_argument("--report", help="also write the before/after report as JSON here")
+    parser.add_argument("--folds", type=int, default=5,
+                        help="k of the k-fold cross-validated accuracy (default 5; 0 skips it)")
+    parser.add_argument("--seeds", type=int, default=3,
+                        help="fit from this many seeds and report how far the fits spread (default 3; 1 skips it)")
+    parser.add_argument("--report", metavar="DIR",
+                        help="also write report.json, surfaces.png (before/after) and confusion.png here")
 
 
 @command("tune", "fit the classifier's membership functions to labelled readings", _tune_arguments)
 def _tune(args: argparse.Namespace) -> int:
     import json
+    from pathlib import Path
 
-    from ..fuzzy.tuning import tune
+    from ..fuzzy.tuning import read_samples, tune
 
-    tuned, report = tune(load_fuzzy_config(args.config), args.labels, method=args.method, margin=args.margin,
-                         seed=args.seed)
+    if args.folds == 1 or args.folds < 0:
+        raise HybridtrackError(f"--folds must be 0 (none) or at least 2, got {args.folds}")
+    start = load_fuzzy_config(args.config)
+    samples = read_samples(args.labels)
+    from tqdm import tqdm
+
+    fits = 1 + args.folds + max(args.seeds - 1, 0)
+    with tqdm(total=fits, unit="fit", desc="tuning", disable=fits < 2, leave=False, file=sys.stderr) as bar:
+        tuned, report = tune(start, samples, method=args.method, margin=args.margin, seed=args.seed,
+                             folds=args.folds, seeds=args.seeds, progress=bar.update)
     out = tuned.to_fis(args.out) if args.out.lower().endswith(".fis") else tuned.to_toml(args.out)
     print(report)
     for name, change in report.changed.items():
         print(f"  {name}: {change['before']} -> {change['after']}")
-    print(f"wrote {out}")
+    print(f"wrote {out}" + (" (a .fis file cannot keep the labelled range; use .toml to keep the warning)"
+                            if str(out).lower().endswith(".fis") else ""))
     if args.report:
-        with open(args.report, "w") as handle:
-            json.dump(report.to_dict(), handle, indent=2)
+        from ..report import plot_confusion, plot_tuning, save_figure
+
+        folder = Path(args.report)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2) + "\n")
+        surfaces = save_figure(plot_tuning(start, tuned, samples), folder / "surfaces.png")
+        confusion = save_figure(plot_confusion(start, tuned, samples), folder / "confusion.png")
+        print(f"wrote {folder / 'report.json'}, {surfaces}, {confusion}")
     return 0
 
 

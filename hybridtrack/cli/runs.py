@@ -49,10 +49,9 @@ def summary_table(summaries: dict[str, dict]) -> str:
             ("travel (°)", lambda s: f"{s['travel_deg']:,.0f}"),
             ("mode switches", lambda s: f"{s['mode_switches']}"),
             ("wind stow events", lambda s: f"{s['stow_events']}")]
-    rows += [(f"mode {m}", lambda s, m=m: _fmt(s["mode_share"][m], ".1%"))
-             for m in ("sensor", "astronomical", "search", "stow_wind", "stow_night")]
-    rows += [(f"sky {k} (sun up)", lambda s, k=k: _fmt(s["sky_share"][k], ".1%"))
-             for k in ("sunny", "cloudy", "overcast")]
+    first = next(iter(summaries.values()))  # shares of every step of the run (docs/metrics.md)
+    rows += [(f"mode {m}", lambda s, m=m: _fmt(s["mode_share"].get(m), ".1%")) for m in first["mode_share"]]
+    rows += [(f"sky {k}", lambda s, k=k: _fmt(s["sky_share"].get(k), ".1%")) for k in first["sky_share"]]
     table = pd.DataFrame({name: [pick(summary) for _, pick in rows] for name, summary in summaries.items()},
                          index=[label for label, _ in rows])
     return table.to_string()

@@ -87,6 +87,10 @@ class FuzzyWeatherClassifier:
         except (TypeError, ValueError) as exc:
             raise HybridtrackError(f"intensity and variation must be numbers of matching shape: {exc}") from None
         if raw:
+            if self.config.labelled_range is not None:  # a tuned config: say when it extrapolates
+                from .tuning import warn_outside_labels
+
+                warn_outside_labels(self.config, a, b)
             x = self.normalise(a, b)
         else:
             x = np.stack([np.clip(a, *self.config.inputs[0].universe), np.clip(b, *self.config.inputs[1].universe)],

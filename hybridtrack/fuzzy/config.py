@@ -224,6 +224,10 @@ class FuzzyConfig:
         Samples across (input universes, output universe); both engines evaluate the system
         on these samples, as scikit-fuzzy does.
     name : str
+    labelled_range : tuple of (low, high), optional
+        Set by tuning: the raw range of each input (in order) that the labelled readings
+        covered. A classifier warns when it is applied outside it
+        (`hybridtrack.fuzzy.tuning.OutsideLabelsWarning`). Written as ``[labelled_range]``.
     """
 
     inputs: tuple[Variable, ...] = field(default_factory=_default_inputs)
@@ -233,12 +237,15 @@ class FuzzyConfig:
                                                    ("sunny", 20.0, 30.0))
     resolution: tuple[int, int] = (1001, 3001)
     name: str = "published"
+    labelled_range: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inputs", tuple(self.inputs))
         object.__setattr__(self, "rules", tuple(self.rules))
         object.__setattr__(self, "bands", tuple((str(n), float(lo), float(hi)) for n, lo, hi in self.bands))
         object.__setattr__(self, "resolution", tuple(int(r) for r in self.resolution))
+        if self.labelled_range is not None:
+            object.__setattr__(self, "labelled_range", tuple((float(lo), float(hi)) for lo, hi in self.labelled_range))
         self.validate()
 
     # -- construction ------------------------------------------------------------------------
@@ -315,6 +322,10 @@ class FuzzyConfig:
         self._validate_bands()
         if any(r < 3 for r in self.resolution) or len(self.resolution) != 2:
             raise HybridtrackError(f"resolution needs two sample counts of at least 3, got {list(self.resolution)}")
+        if self.labelled_range is not None and (
+                len(self.labelled_range) != len(self.inputs)
+                or not all(math.isfinite(lo) and math.isfinite(hi) and lo <= hi for lo, hi in self.labelled_range)):
+            raise HybridtrackError(f"labelled_range needs a finite [low, high] for each input, got {self.labelled_range}")
 
     def _validate_bands(self) -> None:
         if not self.bands:
@@ -343,7 +354,7 @@ class FuzzyConfig:
         for var in self.inputs:
             inputs[var.name] = {"raw_range": list(var.raw_range), "unit": var.unit,
                                 "universe": list(var.universe), "terms": terms(var)}
-        return {
+        data = {
             "name": self.name,
             "resolution": {"input": self.resolution[0], "output": self.resolution[1]},
             "inputs": inputs,
@@ -351,12 +362,15 @@ class FuzzyConfig:
             "bands": {name: [low, high] for name, low, high in self.bands},
             "rules": [{**rule.conditions, self.output.name: rule.then} for rule in self.rules],
         }
+        if self.labelled_range is not None:
+            data["labelled_range"] = {var.name: list(pair) for var, pair in zip(self.inputs, self.labelled_range)}
+        return data
 
     @classmethod
     def from_dict(cls, data: Mapping, *, source: str = "config") -> FuzzyConfig:
         """Build and validate a config from the TOML layout; unknown keys are refused."""
         reader = _Reader(source)
-        data = reader.table(data, "", {"name", "resolution", "inputs", "output", "bands", "rules"})
+        data = reader.table(data, "", {"name", "resolution", "inputs", "output", "bands", "rules", "labelled_range"})
         default = cls()
         inputs = tuple(
             reader.variable(name, spec, f"inputs.{name}", is_input=True)
@@ -382,8 +396,14 @@ class FuzzyConfig:
         name = data.get("name", "custom")
         if not isinstance(name, str):
             raise HybridtrackError(f"{source}: name must be a string, got {name!r}")
+        labelled = None
+        if "labelled_range" in data:
+            spans = reader.table(data["labelled_range"], "labelled_range", {var.name for var in inputs})
+            labelled = tuple(reader.pair(spans[var.name], f"labelled_range.{var.name}") if var.name in spans
+                             else reader.fail("labelled_range", f"{var.name} is missing") for var in inputs)
         try:
-            return cls(inputs=inputs, output=output, rules=rules, bands=bands, resolution=resolution, name=name)
+            return cls(inputs=inputs, output=output, rules=rules, bands=bands, resolution=resolution, name=name,
+                       labelled_range=labelled)
         except HybridtrackError as exc:
             raise HybridtrackError(f"{source}: {exc}") from None
 
