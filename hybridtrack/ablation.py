@@ -98,7 +98,6 @@ def _day(day: dict, policies: tuple[str, ...], config) -> list[dict]:
 def _metrics(result) -> dict:
     """The headline numbers of a run and why a closed loop lost: shares of the energy it lost."""
     from .metrics import ACCEPTANCE_HALF_ANGLE, acceptance
-    from .mounting import incidence_cosine
 
     summary, log = result.summary, result.log
     error = summary["tracking_error_deg"]

@@ -1,6 +1,5 @@
 """The fuzzy weather classifier: published rows, engine parity, contracts, files and tuning."""
 
-import json
 
 import numpy as np
 import pandas as pd

@@ -8,7 +8,6 @@ import pandas as pd
 import pytest
 
 from hybridtrack import HybridtrackError, simulate
-from hybridtrack.collectors import Collector
 from hybridtrack.control import ControllerConfig
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
 from hybridtrack.simulation import LOG_COLUMNS, SimulationConfig

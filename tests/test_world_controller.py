@@ -12,7 +12,7 @@ import pytest
 import hybridtrack.control as control
 from hybridtrack import simulate, sites
 from hybridtrack.collectors import Collector
-from hybridtrack.control import Controller, ControllerConfig, make_plan
+from hybridtrack.control import Controller, make_plan
 from hybridtrack.control.plan import east_park
 from hybridtrack.control.skywatch import ClassifierTable
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
