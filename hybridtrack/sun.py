@@ -29,6 +29,9 @@ selectable.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Literal
 
 import numpy as np
@@ -41,6 +44,7 @@ from .times import clock_hours
 __all__ = [
     "solar_position",
     "spa_fast",
+    "reuse_positions",
     "SUN_MODELS",
     "SPA_FAST_ERROR",
     "altitude_azimuth",
@@ -331,6 +335,53 @@ def spa_fast(times, latitude: float, longitude: float, altitude: float = 0.0, pr
                         index=index)
 
 
+#: The answers `reuse_positions` keeps: (capacity, [(key, frame), ...] oldest first), or None outside it.
+_REUSE: ContextVar[tuple[int, list] | None] = ContextVar("hybridtrack_sun_reuse", default=None)
+
+
+@contextmanager
+def reuse_positions(entries: int = 8) -> Iterator[None]:
+    """Within this block, `solar_position` answers a request it has answered before from memory.
+
+    A request is answered from memory when it asks for the same model, site and options as an
+    earlier one and every one of its times was among that one's; the rows are the same numbers
+    the model gives (every model here computes each stamp on its own). Runs of many collectors
+    on one frame ask for the same sun again and again; this is how they share it without
+    passing it around. The memory holds the last `entries` answers, for this thread or task only.
+    """
+    token = _REUSE.set((max(int(entries), 1), []))
+    try:
+        yield
+    finally:
+        _REUSE.reset(token)
+
+
+def _remembered(key: tuple, index: pd.DatetimeIndex) -> pd.DataFrame | None:
+    capacity, memory = _REUSE.get() or (0, [])
+    for entry in memory:
+        if entry[0] != key:
+            continue
+        if entry[1].index.equals(index):
+            rows = entry[1]
+        else:
+            where = entry[1].index.get_indexer(index)
+            if (where < 0).any():
+                continue
+            rows = entry[1].iloc[where]
+        memory.remove(entry)
+        memory.append(entry)  # most recently used last
+        return rows.set_axis(index).copy()
+    return None
+
+
+def _remember(key: tuple, frame: pd.DataFrame) -> None:
+    capacity, memory = _REUSE.get() or (0, None)
+    if memory is None or not frame.index.is_unique:
+        return
+    memory.append((key, frame))
+    del memory[:-capacity]  # keep the newest
+
+
 def solar_position(
     times,
     site: Site | str,
@@ -370,6 +421,10 @@ def solar_position(
 
     site = get(site)
     index = _check_times(times)
+    key = (model, site, temperature) + ((declination, equation_of_time) if model == "plc" else ())
+    remembered = _remembered(key, index)
+    if remembered is not None:
+        return remembered
     pressure = float(pvlib.atmosphere.alt2pres(site.altitude))  # Pa
     if model in ("spa", "spa-fast"):
         arguments = dict(altitude=site.altitude, pressure=pressure, temperature=temperature)
@@ -397,7 +452,7 @@ def solar_position(
         apparent = altitude + refraction(altitude, pressure / 100.0, temperature)
     else:
         raise HybridtrackError(f"unknown sun model {model!r}; choose from {', '.join(SUN_MODELS)}")
-    return pd.DataFrame(
+    frame = pd.DataFrame(
         {
             "altitude": altitude,
             "apparent_altitude": apparent,
@@ -410,3 +465,5 @@ def solar_position(
         },
         index=index,
     )
+    _remember(key, frame)
+    return frame
