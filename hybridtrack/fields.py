@@ -65,7 +65,8 @@ class ImperfectionSpread:
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
-            if not isinstance(value, (int, float)) or isinstance(value, bool) or not (np.isfinite(value) and value >= 0):
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not number or not (np.isfinite(value) and value >= 0):
                 raise HybridtrackError(f"imperfection spread: {f.name} must be a finite number >= 0, got {value!r}")
 
     @classmethod
@@ -200,7 +201,8 @@ class TroughLoop:
     spread: ImperfectionSpread = field(default_factory=ImperfectionSpread)
 
     def __post_init__(self) -> None:
-        if isinstance(self.count, bool) or not isinstance(self.count, (int, np.integer)) or not 1 <= self.count <= 100_000:
+        whole = isinstance(self.count, (int, np.integer)) and not isinstance(self.count, bool)
+        if not whole or not 1 <= self.count <= 100_000:
             raise HybridtrackError(f"trough loop: count must be a whole number from 1 to 100000, got {self.count!r}")
         object.__setattr__(self, "collector_length",
                            _finite_number(self.collector_length, "collector length", positive=True))
@@ -452,7 +454,8 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     from .sun import reuse_positions, solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
-        raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, got {type(field).__name__}")
+        raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
+                               f"got {type(field).__name__}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise HybridtrackError(f"seed must be a whole number >= 0, got {seed!r}")
     site = sites.get(site)
