@@ -31,7 +31,7 @@ from .errors import HybridtrackError
 from .world import Imperfections, incidence_cosine
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
-           "FIELD_KINDS", "LOG_VARIABLES"]
+           "collector_columns", "FIELD_KINDS", "LOG_VARIABLES", "COLLECTOR_METRICS"]
 
 #: The per-collector log columns kept in `FieldResult.dataset` (collector × time).
 LOG_VARIABLES = ("target_true", "target", "angle", "error", "mode", "sky", "sensor_status", "intensity_ma",
@@ -274,6 +274,27 @@ class HeliostatField:
         object.__setattr__(self, "aim", tuple(float(v) for v in np.asarray(self.aim, float)))
         object.__setattr__(self, "aims", aims)
 
+    @classmethod
+    def rings(cls, count: int, *, first_radius: float = 60.0, spacing: float = 12.0,
+              aim: tuple[float, float, float] = (0.0, 0.0, 100.0), spread: ImperfectionSpread | None = None
+              ) -> HeliostatField:
+        """`count` heliostats on concentric rings round the tower's foot, `spacing` metres apart
+        along and between the rings, every other ring turned by half a place (a radial stagger)."""
+        whole = isinstance(count, (int, np.integer)) and not isinstance(count, bool)
+        if not whole or not 1 <= count <= 100_000:
+            raise HybridtrackError(f"heliostat count must be a whole number from 1 to 100000, got {count!r}")
+        first_radius = _finite_number(first_radius, "first ring radius", positive=True)
+        spacing = _finite_number(spacing, "heliostat spacing", positive=True)
+        placed, ring = [], 0
+        while sum(len(p) for p in placed) < count:
+            radius = first_radius + ring * spacing
+            places = max(int(2 * np.pi * radius / spacing), 1)
+            angle = 2 * np.pi * (np.arange(places) + 0.5 * (ring % 2)) / places
+            placed.append(np.column_stack([radius * np.sin(angle), radius * np.cos(angle)]))
+            ring += 1
+        spread = spread if spread is not None else ImperfectionSpread()
+        return cls(positions=np.concatenate(placed)[:count], aim=aim, spread=spread)
+
     @property
     def names(self) -> list[str]:
         return [f"H{i + 1}" for i in range(len(self.positions))]
@@ -349,10 +370,18 @@ class FieldResult:
             raise HybridtrackError(f"no collector metric {metric!r}; choose from {', '.join(self.collectors.columns)}")
         fig = Figure(figsize=(7, 6), layout="constrained")
         ax = fig.add_subplot()
-        values = pd.to_numeric(self.collectors[metric], errors="coerce")
-        marker = "^" if isinstance(self.field, HeliostatField) else "s"
-        points = ax.scatter(self.collectors["east"], self.collectors["north"], c=values, cmap="viridis", marker=marker,
-                            s=max(12.0, 4000.0 / max(len(values), 1) ** 0.8), edgecolors="0.3", linewidths=0.3)
+        values = pd.to_numeric(self.collectors[metric], errors="coerce").to_numpy(float)
+        segments = _segments(self.field)
+        if segments is None:  # heliostats: a marker per mirror
+            points = ax.scatter(self.collectors["east"], self.collectors["north"], c=values, cmap="viridis",
+                                marker="^", s=max(12.0, 4000.0 / len(values) ** 0.8), edgecolors="0.3",
+                                linewidths=0.3)
+        else:  # rows and troughs: a line of their length along their axis
+            from matplotlib.collections import LineCollection
+
+            points = LineCollection(segments, array=values, cmap="viridis", linewidths=max(2.0, 60.0 / len(values)))
+            ax.add_collection(points)
+            ax.autoscale_view()
         fig.colorbar(points, ax=ax, label=_METRIC_LABELS.get(metric, metric))
         if isinstance(self.field, HeliostatField):
             ax.plot(*self.field.aim[:2], marker="*", color="tab:red", markersize=14, ls="", label="aim point")
@@ -380,16 +409,37 @@ class FieldResult:
         return written
 
 
+def _segments(field) -> np.ndarray | None:
+    """Each row's or trough's ends (N, 2, 2) in (east, north), or None for heliostats."""
+    if isinstance(field, HeliostatField):
+        return None
+    length = field.row_length if isinstance(field, FresnelField) else field.collector_length
+    half = 0.5 * length * _along_axis(np.ones(1), field.axis_azimuth)[0, :2]
+    centres = field.positions[:, :2]
+    return np.stack([centres - half, centres + half], axis=1)
+
+
 _METRIC_LABELS = {"rms": "pointing error RMS (°)", "p95": "pointing error p95 (°)", "energy_capture": "energy capture",
                   "moves": "moves", "travel_deg": "travel (°)", "end_loss_share": "end loss (share of the row)"}
 
 
+#: The metrics each collector gets in `FieldResult.collectors` (after its position and imperfections).
+COLLECTOR_METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture", "moves", "travel_deg",
+                     "mode_switches", "stow_events", "faults")
+
+
+def collector_columns(field) -> list[str]:
+    """The columns `simulate_field` gives `field`'s collector table (what a field map can show)."""
+    columns = ["east", "north", "up"] + (["row_distance"] if isinstance(field, FresnelField) else [])
+    columns += [f.name for f in dataclasses.fields(Imperfections)] + list(COLLECTOR_METRICS) + ["offered"]
+    if isinstance(field, FresnelField) and field.axis_azimuth % 180.0 == 0.0:
+        columns += ["end_loss_m", "end_loss_share"]
+    return columns
+
+
 def _metrics(summary: dict) -> dict:
     error = summary["tracking_error_deg"]
-    return {"rms": error["rms"], "p95": error["p95"], "max": error["max"], "mean": error["mean"],
-            "within_0_5_deg": summary["within_0_5_deg"], "energy_capture": summary["energy_capture"],
-            "moves": summary["moves"], "travel_deg": summary["travel_deg"], "mode_switches": summary["mode_switches"],
-            "stow_events": summary["stow_events"], "faults": summary["faults"]}
+    return {name: error[name] if name in error else summary[name] for name in COLLECTOR_METRICS}
 
 
 def _offered(dni: np.ndarray, altitude: np.ndarray, azimuth: np.ndarray, collector: Collector) -> float:

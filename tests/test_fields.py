@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 
 from hybridtrack import HybridtrackError, simulate, simulate_field
 from hybridtrack.collectors import fresnel_angle, heliostat_normal, trough_angle
-from hybridtrack.fields import FresnelField, HeliostatField, ImperfectionSpread, TroughLoop
+from hybridtrack.fields import FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns
 from hybridtrack.simulation import SimulationConfig
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import altitude_azimuth, solar_position
@@ -124,11 +124,22 @@ def test_field_figures_weigh_each_collector_by_the_light_it_is_offered(day):
     assert result.summary["moves"] == table["moves"].sum()
     assert result.summary["rms_worst_collector"] == table["rms"].idxmax()
     assert result.dataset is None
+    assert list(table.columns) == collector_columns(HeliostatField())
+
+
+def test_heliostat_rings_are_spaced_and_staggered():
+    field = HeliostatField.rings(300, first_radius=50.0, spacing=10.0)
+    xy = field.positions[:, :2]
+    gaps = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1)) + np.diag(np.full(len(xy), np.inf))
+    assert len(xy) == 300 and gaps.min() >= 10.0 - 1e-9
+    radii = np.hypot(*xy.T)
+    assert radii.min() == pytest.approx(50.0) and set(np.round(radii, 6)) <= {50.0 + 10.0 * k for k in range(10)}
 
 
 def test_field_result_map_dataset_and_files(day, tmp_path):
     field = FresnelField(row_distances=[-5.0, 0.0, 5.0])
     result = simulate_field(day, "lanzhou", field, seed=0)
+    assert list(result.collectors.columns) == collector_columns(field)
     assert isinstance(result.plot_map("energy_capture"), Figure)
     with pytest.raises(HybridtrackError, match="no collector metric 'shine'"):
         result.plot_map("shine")
