@@ -22,7 +22,8 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
     add_synthetic_arguments(parser)
     group = parser.add_argument_group("field")
     group.add_argument("--rows", help="Fresnel: row distances from the receiver line, m, comma-separated "
-                                      "(default 20 rows, -9.5 to 9.5 every 1 m); write --rows=-4,0,4 when the first is negative")
+                                      "(default 20 rows, -9.5 to 9.5 every 1 m); write --rows=-4,0,4 when the first is "
+                                      "negative")
     group.add_argument("--receiver-height", type=float, default=10.0, help="Fresnel: receiver height, m (default 10)")
     group.add_argument("--row-length", type=float, default=100.0, help="Fresnel: row length, m (default 100)")
     group.add_argument("--count", type=int, default=12, help="trough: collectors in the loop (default 12); "
