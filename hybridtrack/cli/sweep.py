@@ -21,7 +21,10 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
 def _sweep(args: argparse.Namespace) -> int:
     from ..sweep import Sweep, pareto_front, run_sweep, save_sweep
 
+    from pathlib import Path
+
     sweep = Sweep.from_toml(args.file)
+    Path(args.out).mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails now, not after the runs
     runs = len(sweep.runs())
     print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
     table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
