@@ -16,8 +16,9 @@ from .base import (
 
 def _field_arguments(parser: argparse.ArgumentParser) -> None:
     from ..control import STRATEGIES
+    from ..fields import FIELD_KINDS
 
-    parser.add_argument("kind", choices=("fresnel", "trough", "heliostat"),
+    parser.add_argument("kind", choices=tuple(FIELD_KINDS),
                         help="a linear Fresnel field, a trough loop or a heliostat field")
     add_synthetic_arguments(parser)
     group = parser.add_argument_group("field")
