@@ -310,7 +310,11 @@ class HeliostatField:
     def normals(self, altitude, azimuth) -> np.ndarray:
         """Every mirror's nominal unit normal at every step (T, N, 3); NaN at night."""
         alt, az = _sun_columns(altitude, azimuth)
-        return heliostat_normal(alt, az, self.relative_aims)
+        up = alt[:, 0] >= 0.0  # at night every normal is NaN: compute the day only
+        normals = np.full((len(alt), len(self.positions), 3), np.nan)
+        if up.any():
+            normals[up] = heliostat_normal(alt[up], az[up], self.relative_aims)
+        return normals
 
     def targets(self, altitude, azimuth) -> np.ndarray:
         """Every mirror's nominal normal azimuth and elevation (T, N, 2), degrees."""
