@@ -534,20 +534,24 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                 if keep_log:
                     logs[name] = result.log
                 bar.update()
-    table = pd.DataFrame(rows, index=pd.Index(field.names, name="collector"))
-    position = field.positions
-    table.insert(0, "east", position[:, 0])
-    table.insert(1, "north", position[:, 1])
-    table.insert(2, "up", position[:, 2])
-    if isinstance(field, FresnelField):
-        table.insert(3, "row_distance", field.row_distances)
-        for column, values in _end_loss_columns(field, frame["dni"].to_numpy(float), truth["altitude"].to_numpy(),
-                                                truth["azimuth"].to_numpy()).items():
-            table[column] = values
+    table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
     dataset = _dataset(logs, table, field, site) if keep_log else None
     return FieldResult(table, summary, all_events, dataset, field, site)
+
+
+def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:
+    """The collectors' rows with their positions first and, for a Fresnel field, their end loss last."""
+    table = pd.DataFrame(rows, index=pd.Index(field.names, name="collector"))
+    for i, axis in enumerate(("east", "north", "up")):
+        table.insert(i, axis, field.positions[:, i])
+    if isinstance(field, FresnelField):
+        table.insert(3, "row_distance", field.row_distances)
+        altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
+        for column, values in _end_loss_columns(field, dni, altitude, azimuth).items():
+            table[column] = values
+    return table
 
 
 def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, frame: pd.DataFrame) -> dict:
