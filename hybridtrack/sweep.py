@@ -179,9 +179,8 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
     from .collectors import Collector
     from .simulation import simulate
 
-    spec = {**RUN_KEYS, **{k: v for k, v in base.items() if k != "config"}, **grid_values}
-    row = {key: _plain(spec[key]) for key in ("run", *RUN_KEYS) if key in spec}
-    row.update({key: _plain(value) for key, value in spec.items() if key not in row})
+    spec = _spec(base, grid_values)
+    row = _row(spec)
     try:
         site = sites.get(spec["site"])
         dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
@@ -196,9 +195,24 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
         row.update({m: error[m] if m in error else summary[m] for m in METRICS})
         row["error"] = None
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, not the end of the sweep
-        row.update({m: None for m in METRICS})
-        row["error"] = f"{type(exc).__name__}: {exc}"
+        return _failed(row, exc)
     return row
+
+
+def _spec(base: dict, grid_values: dict) -> dict:
+    """Everything a run is given: the defaults, the base run, its grid values."""
+    return {**RUN_KEYS, **{k: v for k, v in base.items() if k != "config"}, **grid_values}
+
+
+def _row(spec: dict) -> dict:
+    """The table cells naming a run: its number, its run keys, then any other key it was given."""
+    row = {key: _plain(spec[key]) for key in ("run", *RUN_KEYS) if key in spec}
+    row.update({key: _plain(value) for key, value in spec.items() if key not in row})
+    return row
+
+
+def _failed(row: dict, exc: BaseException) -> dict:
+    return {**row, **{m: None for m in METRICS}, "error": f"{type(exc).__name__}: {exc}"}
 
 
 def _client(scheduler: str | None, workers: int | None):
@@ -243,10 +257,13 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     client, cluster = _client(scheduler, workers)
     rows = []
     try:
-        futures = [client.submit(run_one, sweep.base, spec, sweep.source, pure=False) for spec in runs]
+        futures = {client.submit(run_one, sweep.base, spec, sweep.source, pure=False): spec for spec in runs}
         with tqdm(total=len(futures), unit="run", file=sys.stderr, disable=not progress, leave=False) as bar:
             for future in as_completed(futures):
-                rows.append(future.result())
+                try:
+                    rows.append(future.result())
+                except Exception as exc:  # noqa: BLE001 - the worker died (killed, out of memory): record it
+                    rows.append(_failed(_row(_spec(sweep.base, futures[future])), exc))
                 bar.update()
     finally:
         client.close()

@@ -101,3 +101,25 @@ def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, fla
     assert main(["sweep", str(path), "--out", str(tmp_path / "out"), *flags]) == 2
     error = capsys.readouterr().err.strip().splitlines()
     assert len(error) == 1 and error[0].startswith("hybridtrack: error:") and message in error[0]
+
+
+def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):
+    """A worker killed mid-run (out of memory, a signal) raises at the client; the run is still a row."""
+    from dask.distributed import LocalCluster
+
+    import hybridtrack.sweep as sweep_module
+
+    real = sweep_module.run_one
+
+    def dying(base, spec, source="sweep"):
+        if spec["run"] == 1:
+            raise MemoryError("the worker ran out of memory")
+        return real(base, spec, source)
+
+    monkeypatch.setattr(sweep_module, "run_one", dying)
+    sweep = Sweep.from_dict({"base": {"freq": "30min"}, "grid": {"seed": [0, 1, 2]}})
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        table = run_sweep(sweep, scheduler=cluster.scheduler_address, progress=False)
+    assert list(table["run"]) == [0, 1, 2] and list(table["seed"]) == [0, 1, 2]
+    assert table["error"].isna().tolist() == [True, False, True]
+    assert table.loc[1, "error"] == "MemoryError: the worker ran out of memory" and pd.isna(table.loc[1, "rms"])
