@@ -105,6 +105,19 @@ class Sweep:
             raise HybridtrackError(f"{source}: plot.{unknown[0]}: unknown key; known: x, y")
         return cls({**base, "config": config}, dict(grid), plot.get("x", "moves"), plot.get("y", "rms"), source)
 
+    def to_dict(self) -> dict:
+        """The sweep in its TOML layout; `from_dict` reads it back equal."""
+        base = {k: v for k, v in self.base.items() if k != "config"}
+        if self.base.get("config"):
+            base["config"] = self.base["config"]
+        return {"base": base, "grid": dict(self.grid), "plot": {"x": self.x, "y": self.y}}
+
+    def to_toml(self, path) -> Path:
+        """Write the sweep as TOML; `from_toml` reads it back equal."""
+        from .io import write_toml
+
+        return write_toml(self.to_dict(), path)
+
     def runs(self) -> list[dict]:
         """Every run of the grid, in order: the grid's values vary fastest from the last key."""
         keys = list(self.grid)
@@ -333,10 +346,11 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
 
 
 def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
-    """Write ``runs.parquet`` and ``tradeoff.png``."""
+    """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    written = {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png"}
+    written = {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png",
+               "sweep": sweep.to_toml(folder / "sweep.toml")}
     table.to_parquet(written["table"], index=False)
     colour = next(iter(sweep.grid))
     plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem).savefig(written["plot"],

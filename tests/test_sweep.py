@@ -18,6 +18,15 @@ TINY = {"base": {"site": "lanzhou", "collector": "fresnel", "start": "2021-06-21
         "grid": {"drive.deadband": [0.1, 0.4, -1.0], "seed": [0, 1]}}
 
 
+def test_a_sweep_round_trips_through_toml(tmp_path):
+    data = {"base": {"site": "nanjing", "start": __import__("datetime").date(2013, 6, 21), "days": 2,
+                     "config": {"drive": {"deadband": 0.3}}},
+            "grid": {"controller.sun_model": ["plc", "spa"], "collector.aim": [[0.0, 20.0, 100.0]]},
+            "plot": {"x": "travel_deg", "y": "energy_capture"}}
+    sweep = Sweep.from_dict(data, source=str(tmp_path / "s.toml"))
+    assert Sweep.from_toml(sweep.to_toml(tmp_path / "s.toml")) == sweep
+
+
 def test_the_grid_is_every_combination_in_order():
     runs = Sweep.from_dict(TINY).runs()
     assert [(r["run"], r["drive.deadband"], r["seed"]) for r in runs] == [
@@ -87,6 +96,7 @@ def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
     table = pd.read_parquet(out / "runs.parquet")
     assert list(table["strategy"]) == ["hybrid", "astronomical"] and table["start"].iloc[0] == "2021-03-20"
     assert np.all(table["steps"] == 72) and (out / "tradeoff.png").stat().st_size > 0
+    assert Sweep.from_toml(out / "sweep.toml").grid == {"strategy": ["hybrid", "astronomical"]}
 
 
 @pytest.mark.parametrize("content, flags, message", [

@@ -10,7 +10,8 @@ from .base import command
 def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", metavar="SWEEP.toml", help="the sweep: [base] run, [grid] of values, [plot] axes "
                                                            "(see examples/sweep-deadband.toml)")
-    parser.add_argument("--out", required=True, help="folder for runs.parquet (one row per run) and tradeoff.png")
+    parser.add_argument("--out", required=True,
+                        help="folder for runs.parquet (one row per run), tradeoff.png and sweep.toml")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
                                                                "(default: a local cluster on this machine's cores)")
     parser.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
