@@ -9,6 +9,7 @@ includes starting the cluster. The tables of the two must be equal, and are chec
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import pandas as pd
@@ -25,6 +26,7 @@ def main() -> None:
                                       "weather": "climate"},
                              "grid": {"seed": list(range(args.runs))}})
     seconds, tables = {}, {}
+    load = os.getloadavg()[0]
     for workers in (1, 2):
         start = time.perf_counter()
         tables[workers] = run_sweep(sweep, workers=workers, progress=False)
@@ -33,7 +35,8 @@ def main() -> None:
     failed = int(tables[1]["error"].notna().sum())
     rows = [[workers, args.runs, f"{seconds[workers]:.1f}", f"{seconds[workers] / args.runs:.2f}",
              f"{seconds[1] / seconds[workers]:.2f}x"] for workers in (1, 2)]
-    print(f"{args.runs} site-years at 1 min, one run each way; tables equal; {failed} failed runs")
+    print(f"{args.runs} site-years at 1 min, one run each way; tables equal; {failed} failed runs; "
+          f"load average {load:.1f} before, {os.getloadavg()[0]:.1f} after, on {os.cpu_count()} cores")
     print_table(["workers", "runs", "wall s", "s per run", "speed-up vs 1"], rows)
 
 
