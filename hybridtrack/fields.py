@@ -493,8 +493,8 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         Seeds the imperfection draws and each collector's sensor noise: collector ``i``'s
         draws depend only on `seed` and ``i``.
     keep_log : bool
-        Keep every collector's log in `FieldResult.dataset` (about 70 bytes per collector
-        and step); False keeps only the metrics.
+        Keep every collector's log in `FieldResult.dataset` (about 50 bytes per collector
+        and step, 80 for a heliostat); False keeps only the metrics.
     progress : bool, optional
         A progress bar over collectors (on stderr); by default when there are more than four.
 
@@ -517,7 +517,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     config = config or SimulationConfig()
     collectors = field.collectors()
     imperfections = field.spread.draw(config.imperfections, len(collectors), int(seed))
-    rows, events, logs = [], [], {}
+    rows, events, store = [], [], None
     with reuse_positions():
         truth = solar_position(frame.index, site, "spa")  # what every collector's run asks for, once
         bar = tqdm(total=len(collectors), unit="collector", file=sys.stderr, leave=False,
@@ -532,12 +532,13 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                              "offered": _offered(result.log["dni"].to_numpy(float), altitude, azimuth, collector)})
                 events.append(result.events.assign(collector=name))
                 if keep_log:
-                    logs[name] = result.log
+                    store = store or _LogStore(field.names, result.log)
+                    store.add(i, result.log)
                 bar.update()
     table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
-    dataset = _dataset(logs, table, field, site) if keep_log else None
+    dataset = store.dataset(table, field, site) if keep_log else None
     return FieldResult(table, summary, all_events, dataset, field, site)
 
 
@@ -572,29 +573,41 @@ def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, 
     return summary
 
 
-def _dataset(logs: dict[str, pd.DataFrame], table: pd.DataFrame, field, site: sites.Site):
-    """The logs as an xarray Dataset, collector × time; categories stored as codes with CF flag attributes."""
-    import xarray as xr
+class _LogStore:
+    """Every collector's log, kept as it comes in (collector × time arrays), each run's frame dropped.
 
-    first = next(iter(logs.values()))
-    time = first.index.tz_convert("UTC").tz_localize(None)
-    columns = [c for c in first.columns if c in LOG_VARIABLES or c.endswith("_azimuth")]
-    variables = {}
-    for column in columns:
-        stacked = np.stack([_values(log[column]) for log in logs.values()])
-        attrs = {}
-        if isinstance(first[column].dtype, pd.CategoricalDtype):
-            categories = list(first[column].cat.categories)
-            attrs = {"flag_values": np.arange(len(categories), dtype=np.int8), "flag_meanings": " ".join(categories)}
-        variables[column] = (("collector", "time"), stacked, attrs)
-    for column in SHARED_VARIABLES:
-        if column in first:
-            variables[column] = (("time",), first[column].to_numpy(float), {})
-    coords = {"collector": list(logs), "time": time,
-              **{axis: ("collector", table.loc[list(logs), axis].to_numpy()) for axis in ("east", "north", "up")}}
-    return xr.Dataset(variables, coords=coords,
-                      attrs={"site": site.name, "timezone": site.tz, "field": type(field).__name__,
-                             "time_note": "UTC; the site's clock is in the timezone attribute"})
+    Holding the runs' frames until the end would cost a whole log per collector; the arrays cost
+    about 50 bytes per collector and step (80 for a heliostat).
+    """
+
+    def __init__(self, names: list[str], first: pd.DataFrame) -> None:
+        self.names = names
+        self.time = first.index.tz_convert("UTC").tz_localize(None)
+        self.shared = {c: first[c].to_numpy(float) for c in SHARED_VARIABLES if c in first}
+        self.attrs, self.arrays = {}, {}
+        for column in (c for c in first.columns if c in LOG_VARIABLES or c.endswith("_azimuth")):
+            codes = _values(first[column])
+            self.arrays[column] = np.empty((len(names), len(first)), codes.dtype)
+            if isinstance(first[column].dtype, pd.CategoricalDtype):
+                categories = list(first[column].cat.categories)
+                self.attrs[column] = {"flag_values": np.arange(len(categories), dtype=np.int8),
+                                      "flag_meanings": " ".join(categories)}
+
+    def add(self, i: int, log: pd.DataFrame) -> None:
+        for column, array in self.arrays.items():
+            array[i] = _values(log[column])
+
+    def dataset(self, table: pd.DataFrame, field, site: sites.Site):
+        """The logs as an xarray Dataset; categories as codes with CF flag attributes, time in UTC."""
+        import xarray as xr
+
+        variables = {c: (("collector", "time"), a, self.attrs.get(c, {})) for c, a in self.arrays.items()}
+        variables.update({c: (("time",), a, {}) for c, a in self.shared.items()})
+        coords = {"collector": self.names, "time": self.time,
+                  **{axis: ("collector", table[axis].to_numpy()) for axis in ("east", "north", "up")}}
+        return xr.Dataset(variables, coords=coords,
+                          attrs={"site": site.name, "timezone": site.tz, "field": type(field).__name__,
+                                 "time_note": "UTC; the site's clock is in the timezone attribute"})
 
 
 def _values(column: pd.Series) -> np.ndarray:
