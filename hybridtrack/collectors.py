@@ -111,18 +111,32 @@ def trough_angle(altitude, azimuth, axis_azimuth=0.0):
     return _like(altitude, _cross_axis_angle(altitude, azimuth, axis), "trough_angle")
 
 
-def tracking_rate(angle: pd.Series) -> pd.Series:
-    """Rate of change of a tracking angle, degrees per minute.
+def tracking_rate(angle):
+    """Rate of change of tracking angles, degrees per minute.
 
-    Central differences on the series' own time index (one-sided at the ends), so any
-    regular or irregular sampling works; use a fine step where the peak rate matters.
+    Central differences on the time index (one-sided at the ends), so any regular or
+    irregular sampling works; use a fine step where the peak rate matters. A DataFrame (one
+    column per collector) gives each column's rate.
+
+    Parameters
+    ----------
+    angle : pandas.Series or pandas.DataFrame
+        Angles (degrees) on a DatetimeIndex.
+
+    Returns
+    -------
+    pandas.Series or pandas.DataFrame
+        Of the input's shape; a Series is named ``rate``.
     """
-    if not isinstance(angle, pd.Series) or not isinstance(angle.index, pd.DatetimeIndex):
-        raise HybridtrackError("tracking_rate needs a Series on a DatetimeIndex")
+    if not isinstance(angle, (pd.Series, pd.DataFrame)) or not isinstance(angle.index, pd.DatetimeIndex):
+        raise HybridtrackError("tracking_rate needs a Series or DataFrame on a DatetimeIndex")
     if len(angle) < 2:
         raise HybridtrackError("tracking_rate needs at least two samples")
     minutes = np.asarray((angle.index - angle.index[0]) / pd.Timedelta(minutes=1), float)
-    return pd.Series(np.gradient(angle.to_numpy(float), minutes), index=angle.index, name="rate")
+    rate = np.gradient(angle.to_numpy(float), minutes, axis=0)
+    if isinstance(angle, pd.DataFrame):
+        return pd.DataFrame(rate, index=angle.index, columns=angle.columns)
+    return pd.Series(rate, index=angle.index, name="rate")
 
 
 def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):

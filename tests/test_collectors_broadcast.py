@@ -8,7 +8,7 @@ import pytest
 from hybridtrack import HybridtrackError
 from hybridtrack.collectors import (
     THREE_POINT_SUPPORT, fresnel_angle, fresnel_end_loss, heliostat_normal, jack_heights, normal_angles,
-    receiver_angle, trough_angle,
+    receiver_angle, tracking_rate, trough_angle,
 )
 from hybridtrack.sun import altitude_azimuth, solar_position
 from hybridtrack.times import local_range
@@ -107,3 +107,16 @@ def test_heliostat_hand_cases():
 def test_bad_collector_parameters_are_refused_with_their_name(call, message):
     with pytest.raises(HybridtrackError, match=message):
         call()
+
+
+def test_tracking_rates_of_a_field_are_each_columns_own(sun):
+    rows = [-6.0, 0.0, 6.0]
+    angles = pd.DataFrame(fresnel_angle(sun.altitude.to_numpy()[:, None], sun.azimuth.to_numpy()[:, None], rows, 10.0),
+                          index=sun.index, columns=["west", "middle", "east"])
+    rates = tracking_rate(angles)
+    assert list(rates.columns) == ["west", "middle", "east"] and rates.index.equals(sun.index)
+    for column, d in zip(rates.columns, rows):
+        np.testing.assert_array_equal(rates[column], tracking_rate(fresnel_angle(sun.altitude, sun.azimuth, d, 10.0)))
+    # hand case: an angle growing 15° an hour turns at 0.25°/min
+    hours = pd.date_range("2021-06-21 08:00", periods=5, freq="1h", tz="UTC")
+    np.testing.assert_allclose(tracking_rate(pd.DataFrame({"a": 15.0 * np.arange(5)}, index=hours)), 0.25)
