@@ -55,6 +55,8 @@ METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture", "mov
            "stow_events", "faults", "steps")
 #: Metrics that count things (whole numbers; empty where a run failed).
 COUNTS = ("moves", "mode_switches", "stow_events", "faults", "steps")
+#: The most runs one sweep may hold (each is a task on the scheduler and a row of the table).
+MAX_RUNS = 100_000
 #: Metrics where more is better (the others: less is better).
 MAXIMISED = ("energy_capture", "within_0_5_deg")
 
@@ -96,6 +98,9 @@ class Sweep:
             _check_key(key, source, "grid")
             if not isinstance(values, list) or not values:
                 raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
+        count = int(np.prod([len(v) for v in grid.values()], dtype=float))
+        if count > MAX_RUNS:
+            raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
         for axis in ("x", "y"):
             if axis in plot and plot[axis] not in METRICS:
                 raise HybridtrackError(f"{source}: plot.{axis}: {plot[axis]!r} is not a metric; "

@@ -44,6 +44,7 @@ def test_the_grid_is_every_combination_in_order():
     ({"base": {"config": {"drive": {"deadband": "wide"}}}, "grid": {"seed": [0]}}, "drive.deadband: must be a number"),
     ({"grid": {"seed": [0]}, "plot": {"y": "happiness"}}, "plot.y: 'happiness' is not a metric"),
     ({"grid": {"seed": [0]}, "plot": {"z": "rms"}}, "plot.z: unknown key"),
+    ({"grid": {"seed": list(range(1000)), "days": list(range(1, 1001))}}, "makes 1,000,000 runs; at most 100,000"),
 ])
 def test_bad_sweeps_are_refused_before_any_run(data, message):
     with pytest.raises(HybridtrackError, match=message):
