@@ -134,3 +134,13 @@ def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):
     assert list(table["run"]) == [0, 1, 2] and list(table["seed"]) == [0, 1, 2]
     assert table["error"].isna().tolist() == [True, False, True]
     assert table.loc[1, "error"] == "MemoryError: the worker ran out of memory" and pd.isna(table.loc[1, "rms"])
+
+
+def test_the_example_sweep_is_valid_and_runs_one_of_its_runs():
+    from pathlib import Path
+
+    sweep = Sweep.from_toml(Path(__file__).resolve().parents[1] / "examples" / "sweep-deadband.toml")
+    runs = sweep.runs()
+    assert len(runs) == 25 and list(sweep.grid) == ["drive.deadband", "seed"] and (sweep.x, sweep.y) == ("moves", "rms")
+    row = run_one({**sweep.base, "days": 1, "freq": "10min"}, runs[0], sweep.source)
+    assert row["error"] is None and row["collector"] == "fresnel" and row["start"] == "2021-06-19"
