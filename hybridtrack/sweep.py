@@ -330,7 +330,7 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
     if colour is not None and colour in ok and pd.api.types.is_numeric_dtype(ok[colour]):
         points = ax.scatter(ok[x], ok[y], c=ok[colour], cmap="viridis", s=36, edgecolors="0.3", linewidths=0.4)
         fig.colorbar(points, ax=ax, label=colour)
-    elif colour is not None and colour in ok:
+    elif colour is not None and colour in ok and not ok.empty:
         for value, group in ok.groupby(colour, sort=False):
             ax.scatter(group[x], group[y], s=36, label=f"{colour} = {value}", edgecolors="0.3", linewidths=0.4)
         ax.legend(loc="best", fontsize="small")

@@ -105,13 +105,15 @@ def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
     ("[grid]\nseed = [0]\n", ["--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
     ("[grid\n", [], "not valid TOML"),
     ("[grid]\nwind = [1]\n", [], "grid.wind: unknown key"),
+    ("[base]\nfreq = '30min'\n[grid]\nstart = ['2021-02-30']\n", ["--workers", "1"],
+     "every run failed; run 0: HybridtrackError: date '2021-02-30' does not exist"),
 ])
 def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, flags, message):
     path = tmp_path / "s.toml"
     path.write_text(content)
     assert main(["sweep", str(path), "--out", str(tmp_path / "out"), *flags]) == 2
-    error = capsys.readouterr().err.strip().splitlines()
-    assert len(error) == 1 and error[0].startswith("hybridtrack: error:") and message in error[0]
+    error = [line for line in capsys.readouterr().err.splitlines() if "hybridtrack" in line]  # not the progress bar
+    assert len(error) == 1 and error[0].strip().startswith("hybridtrack: error:") and message in error[0]
 
 
 def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..errors import HybridtrackError
 from .base import command
 
 
@@ -40,4 +41,6 @@ def _sweep(args: argparse.Namespace) -> int:
         for _, row in failed.head(10).iterrows():
             print(f"  run {row['run']}: {row['error']}")
     print("wrote " + ", ".join(str(p) for p in written.values()))
+    if len(failed) == len(table):
+        raise HybridtrackError(f"every run failed; run {failed['run'].iloc[0]}: {failed['error'].iloc[0]}")
     return 0
