@@ -4,7 +4,7 @@ from .errors import HybridtrackError
 
 __version__ = "0.1.0"
 
-__all__ = ["HybridtrackError", "simulate", "__version__"]
+__all__ = ["HybridtrackError", "simulate", "simulate_field", "__version__"]
 
 
 def __getattr__(name: str):
@@ -13,4 +13,8 @@ def __getattr__(name: str):
         from .simulation import simulate
 
         return simulate
+    if name == "simulate_field":
+        from .fields import simulate_field
+
+        return simulate_field
     raise AttributeError(f"module 'hybridtrack' has no attribute {name!r}")

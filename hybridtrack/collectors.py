@@ -1,4 +1,4 @@
-"""Where each collector must point: pure functions over arrays (``domain.md`` §3).
+"""Where each collector must point: pure functions over arrays.
 
 Frame: x east, y north, z up; the sun's unit vector from altitude α and azimuth γ (from
 north) is ``s = (cos α sin γ, cos α cos γ, sin α)``. Every angle is in degrees. Tracking
@@ -8,6 +8,12 @@ Single-axis collectors (trough, Fresnel row) share one convention, the literatur
 angle is measured in the plane across the axis from the horizon at azimuth
 ``axis_azimuth + 90°`` (east for a north-south axis) through the zenith (90°, the stow
 position) to the opposite horizon (180°).
+
+Every function broadcasts its sun position against its collector parameters (row distances,
+receiver heights, axis azimuths, aim points) by numpy's rules, as pvlib's functions do: equal
+shapes go element by element, and a sun path with a trailing axis against N collectors gives a
+(T, N) table in one call, e.g. ``fresnel_angle(alt[:, None], az[:, None], d, h)`` with ``d`` of
+shape (N,). A pandas Series comes back as a Series when the result has its shape.
 """
 
 from __future__ import annotations
@@ -35,8 +41,8 @@ __all__ = [
     "AXIS_AZIMUTH",
 ]
 
-#: Named horizontal axes: the angle's 0° faces east for "ns" and north for "ew"
-#: (``domain.md``: an east-west axis tracks north-south "with y in place of x").
+#: Named horizontal axes: the angle's 0° faces east for "ns" and north for "ew" (an east-west
+#: axis tracks north-south with y in place of x).
 AXIS_AZIMUTH = {"ns": 0.0, "ew": 270.0}
 
 #: The published three-jack layout under a heliostat mirror, (x, y) in metres.
@@ -44,8 +50,8 @@ THREE_POINT_SUPPORT = np.array([[0.0, 1.0], [-0.707, -0.707], [0.707, -0.707]])
 
 
 def _like(template, values: np.ndarray, name: str | None = None):
-    """Return `values` as a Series on the template's index when the template is a Series."""
-    if isinstance(template, pd.Series):
+    """Return `values` as a Series on the template's index when the template is a Series of its shape."""
+    if isinstance(template, pd.Series) and np.shape(values) == template.shape:
         return pd.Series(values, index=template.index, name=name)
     return values
 
@@ -57,34 +63,37 @@ def sun_vector(altitude, azimuth) -> np.ndarray:
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
 
-def across_angle(vectors: np.ndarray, axis_azimuth: float) -> np.ndarray:
+def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     """Angle (degrees) of vectors ``(..., 3)`` projected on the plane across a horizontal axis.
 
     Measured from the horizontal direction at ``axis_azimuth + 90°`` through the zenith, the
     single-axis convention of this module, within [-90, 270) so that a direction just below
-    either horizon stays next to 0 or 180.
+    either horizon stays next to 0 or 180. `axis_azimuth` (degrees) broadcasts against
+    ``vectors[..., 0]``.
     """
-    b = np.radians(axis_azimuth)
+    vectors = np.asarray(vectors, float)
+    b = np.radians(np.asarray(axis_azimuth, float))
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     return np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
 
 
-def _cross_axis_angle(altitude, azimuth, axis_azimuth: float) -> np.ndarray:
+def _cross_axis_angle(altitude, azimuth, axis_azimuth) -> np.ndarray:
     """Angle of the sun's projection on the plane across a horizontal axis (0-180°)."""
     angle = across_angle(sun_vector(altitude, azimuth), axis_azimuth)
     return np.where(np.asarray(altitude, float) >= 0.0, angle, np.nan)
 
 
-def trough_angle(altitude, azimuth, axis_azimuth: float | str = 0.0):
+def trough_angle(altitude, azimuth, axis_azimuth=0.0):
     """Rotation angle of a parabolic trough on a horizontal axis.
 
     Parameters
     ----------
     altitude, azimuth : array_like or pandas.Series
         Sun altitude and azimuth (from north), degrees.
-    axis_azimuth : float or {"ns", "ew"}
+    axis_azimuth : float, array_like or {"ns", "ew"}
         Azimuth of the axis, degrees from north; 0 is a north-south axis tracking east-west.
+        An array gives one axis per collector, broadcast against the sun position.
 
     Returns
     -------
@@ -98,24 +107,39 @@ def trough_angle(altitude, azimuth, axis_azimuth: float | str = 0.0):
         if axis_azimuth not in AXIS_AZIMUTH:
             raise HybridtrackError(f"unknown axis {axis_azimuth!r}; use 'ns', 'ew' or degrees")
         axis_azimuth = AXIS_AZIMUTH[axis_azimuth]
-    return _like(altitude, _cross_axis_angle(altitude, azimuth, float(axis_azimuth)), "trough_angle")
+    axis = _finite(axis_azimuth, "axis azimuth")
+    return _like(altitude, _cross_axis_angle(altitude, azimuth, axis), "trough_angle")
 
 
-def tracking_rate(angle: pd.Series) -> pd.Series:
-    """Rate of change of a tracking angle, degrees per minute.
+def tracking_rate(angle):
+    """Rate of change of tracking angles, degrees per minute.
 
-    Central differences on the series' own time index (one-sided at the ends), so any
-    regular or irregular sampling works; use a fine step where the peak rate matters.
+    Central differences on the time index (one-sided at the ends), so any regular or
+    irregular sampling works; use a fine step where the peak rate matters. A DataFrame (one
+    column per collector) gives each column's rate.
+
+    Parameters
+    ----------
+    angle : pandas.Series or pandas.DataFrame
+        Angles (degrees) on a DatetimeIndex.
+
+    Returns
+    -------
+    pandas.Series or pandas.DataFrame
+        Of the input's shape; a Series is named ``rate``.
     """
-    if not isinstance(angle, pd.Series) or not isinstance(angle.index, pd.DatetimeIndex):
-        raise HybridtrackError("tracking_rate needs a Series on a DatetimeIndex")
+    if not isinstance(angle, (pd.Series, pd.DataFrame)) or not isinstance(angle.index, pd.DatetimeIndex):
+        raise HybridtrackError("tracking_rate needs a Series or DataFrame on a DatetimeIndex")
     if len(angle) < 2:
         raise HybridtrackError("tracking_rate needs at least two samples")
     minutes = np.asarray((angle.index - angle.index[0]) / pd.Timedelta(minutes=1), float)
-    return pd.Series(np.gradient(angle.to_numpy(float), minutes), index=angle.index, name="rate")
+    rate = np.gradient(angle.to_numpy(float), minutes, axis=0)
+    if isinstance(angle, pd.DataFrame):
+        return pd.DataFrame(rate, index=angle.index, columns=angle.columns)
+    return pd.Series(rate, index=angle.index, name="rate")
 
 
-def fresnel_angle(altitude, azimuth, d: float, h: float, axis_azimuth: float = 0.0):
+def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):
     """Tracking angle of a linear Fresnel mirror row.
 
     The mirror normal bisects the directions to the sun and to the receiver, in the plane
@@ -125,12 +149,12 @@ def fresnel_angle(altitude, azimuth, d: float, h: float, axis_azimuth: float = 0
     ----------
     altitude, azimuth : array_like or pandas.Series
         Sun position, degrees.
-    d : float
+    d : float or array_like
         Signed lateral distance of the row from the receiver line, metres, positive for a
         row on the ``axis_azimuth + 90°`` side (east of the receiver for a north-south field).
-    h : float
+    h : float or array_like
         Height of the receiver above the row's pivot, metres (> 0).
-    axis_azimuth : float
+    axis_azimuth : float or array_like
         Azimuth of the row axis, degrees from north.
 
     Returns
@@ -139,18 +163,35 @@ def fresnel_angle(altitude, azimuth, d: float, h: float, axis_azimuth: float = 0
         Angle of the mirror normal in the trough convention (90° = mirror horizontal, facing
         the zenith; below 90° tilted towards the ``axis_azimuth + 90°`` side). NaN at night.
     """
-    if not h > 0:
-        raise HybridtrackError(f"receiver height h must be positive, got {h!r} m")
-    sun = _cross_axis_angle(altitude, azimuth, axis_azimuth)
-    return _like(altitude, 0.5 * (sun + receiver_angle(d, h)), "fresnel_angle")
+    receiver = receiver_angle(d, h)
+    sun = _cross_axis_angle(altitude, azimuth, _finite(axis_azimuth, "axis azimuth"))
+    return _like(altitude, 0.5 * (sun + receiver), "fresnel_angle")
 
 
-def receiver_angle(d: float, h: float) -> float:
-    """Direction (trough convention, degrees) from a Fresnel row at lateral distance `d` to its receiver."""
-    return float(np.degrees(np.arctan2(h, -float(d))))
+def receiver_angle(d, h):
+    """Direction (trough convention, degrees) from a Fresnel row at lateral distance `d` to its receiver.
+
+    A float for scalar `d` and `h`, else an array of their broadcast shape.
+    """
+    d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
+    if not np.all(h > 0):
+        raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
+    angle = np.degrees(np.arctan2(h, -d))
+    return float(angle) if angle.ndim == 0 else angle
 
 
-def fresnel_end_loss(altitude, azimuth, d: float, h: float):
+def _finite(values, name: str) -> np.ndarray:
+    """`values` as a float array, refused with its name unless every element is finite."""
+    try:
+        array = np.asarray(values, float)
+    except (TypeError, ValueError):
+        raise HybridtrackError(f"{name} must be numbers, got {values!r}") from None
+    if not np.all(np.isfinite(array)):
+        raise HybridtrackError(f"{name} must be finite, got {array.tolist()!r}")
+    return array
+
+
+def fresnel_end_loss(altitude, azimuth, d, h):
     """End loss of a north-south Fresnel row: how far the reflected light runs past the receiver end.
 
     ``L_end = f cos α cos γ_s / sqrt(cos²α sin²γ_s + sin²α)`` with ``f = sqrt(d² + h²)`` and
@@ -160,8 +201,10 @@ def fresnel_end_loss(altitude, azimuth, d: float, h: float):
     ----------
     altitude, azimuth : array_like or pandas.Series
         Sun position, degrees (azimuth from north).
-    d, h : float
-        Row's lateral distance from the receiver line and the receiver's height, metres.
+    d, h : float or array_like
+        Row's lateral distance from the receiver line and the receiver's height, metres; arrays
+        give one row each, broadcast against the sun position (``altitude[:, None]`` against
+        ``d`` of shape (N,) gives (T, N)).
 
     Returns
     -------
@@ -171,7 +214,7 @@ def fresnel_end_loss(altitude, azimuth, d: float, h: float):
     """
     a = np.radians(np.asarray(altitude, float))
     gs = np.radians(np.asarray(azimuth, float) - 180.0)
-    f = np.hypot(float(d), float(h))
+    f = np.hypot(_finite(d, "row distance d"), _finite(h, "receiver height h"))
     with np.errstate(invalid="ignore", divide="ignore"):
         loss = f * np.cos(a) * np.cos(gs) / np.sqrt((np.cos(a) * np.sin(gs)) ** 2 + np.sin(a) ** 2)
     return _like(altitude, np.where(a > 0.0, loss, np.nan), "end_loss")
@@ -187,29 +230,34 @@ def heliostat_normal(altitude, azimuth, aim) -> np.ndarray:
     ----------
     altitude, azimuth : array_like
         Sun position, degrees.
-    aim : array_like, shape (3,)
-        Aim point relative to the mirror centre, (east, north, up) metres.
+    aim : array_like, shape (3,) or (..., 3)
+        Aim point relative to the mirror centre, (east, north, up) metres; one per mirror with
+        shape (M, 3), broadcast against the sun position.
 
     Returns
     -------
-    ndarray, shape (N, 3)
-        Unit normals in (east, north, up); rows of NaN while the sun is down.
+    ndarray, shape (..., 3)
+        Unit normals in (east, north, up), of the broadcast shape of the sun position and the
+        aim points (a scalar sun gives (1, 3)); NaN while the sun is down. Altitudes of shape
+        (T, 1) against aim points (M, 3) give all M mirrors at T steps, (T, M, 3).
     """
     target = np.asarray(aim, float)
-    if target.shape != (3,) or not np.all(np.isfinite(target)) or not np.linalg.norm(target) > 0:
+    norm = np.linalg.norm(target, axis=-1, keepdims=True) if target.ndim else np.zeros(1)
+    if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
-    s = np.atleast_2d(sun_vector(altitude, azimuth))
-    bisector = s + target / np.linalg.norm(target)
-    n = bisector / np.linalg.norm(bisector, axis=1, keepdims=True)
-    n[np.atleast_1d(np.asarray(altitude, float)) < 0.0] = np.nan
-    return n
+    alt = np.asarray(altitude, float)
+    s = sun_vector(alt, azimuth)
+    bisector = s + target / norm
+    n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
+    n = np.where((alt < 0.0)[..., None], np.nan, n)
+    return np.atleast_2d(n)
 
 
 def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
-    """Azimuth (from north, 0-360) and elevation of unit normals ``(N, 3)``, degrees."""
+    """Azimuth (from north, 0-360) and elevation of unit normals ``(..., 3)``, degrees, shape ``(...)``."""
     n = np.atleast_2d(np.asarray(normals, float))
-    azimuth = np.degrees(np.arctan2(n[:, 0], n[:, 1])) % 360.0
-    elevation = np.degrees(np.arcsin(np.clip(n[:, 2], -1.0, 1.0)))
+    azimuth = np.degrees(np.arctan2(n[..., 0], n[..., 1])) % 360.0
+    elevation = np.degrees(np.arcsin(np.clip(n[..., 2], -1.0, 1.0)))
     return azimuth, elevation
 
 
@@ -221,7 +269,7 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
 
     Parameters
     ----------
-    normals : array_like, shape (N, 3)
+    normals : array_like, shape (..., 3)
         Unit mirror normals in (east, north, up), with n_z > 0.
     supports : array_like, shape (K, 2)
         Horizontal jack positions (east, north), metres; the published three-jack layout by
@@ -229,7 +277,7 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (N, K)
+    ndarray, shape (..., K)
         Jack heights in metres relative to the mirror centre.
     """
     n = np.atleast_2d(np.asarray(normals, float))
@@ -237,7 +285,7 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise HybridtrackError(f"supports must be (x, y) pairs, got shape {xy.shape}")
     with np.errstate(invalid="ignore", divide="ignore"):
-        return -(n[:, :1] * xy[:, 0] + n[:, 1:2] * xy[:, 1]) / n[:, 2:3]
+        return -(n[..., :1] * xy[:, 0] + n[..., 1:2] * xy[:, 1]) / n[..., 2:3]
 
 
 #: The collector kinds the project serves.

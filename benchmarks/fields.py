@@ -1,0 +1,130 @@
+"""Whole fields on today's per-collector loop: wall time and peak memory, each case in its own process.
+
+Run: ``python benchmarks/fields.py [--repeats N]``. Every case runs in a fresh Python process
+(so its peak resident memory is its own, weather frame included) on the same Lanzhou site-year
+at 1-minute steps (525,600 steps, climate weather, seed 1):
+
+* ``SPA site-year``: pvlib's SPA over the year's stamps, the reference of the ratios;
+* ``one Fresnel row``: ``simulate`` for one row;
+* ``20-row Fresnel field``: ``simulate_field`` of the default 20-row field, metrics only
+  (``keep_log=False``), running ``simulate`` per row;
+* ``1,000 heliostats, geometry, per mirror``: every mirror's normal, azimuth and elevation for
+  the year, one mirror per call, as the per-collector loop does it;
+* ``1,000 heliostats, geometry, vectorised``: the same numbers for all mirrors in one call a day
+  (``HeliostatField.targets``, 1,440 x 1,000 x 3 at a time).
+
+Medians of `--repeats` runs of each (1 by default: the field-year takes minutes).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+from _timing import print_table
+
+YEAR = ("2021-01-01", "2021-12-31")
+
+
+def _year():
+    from hybridtrack.sky import synthetic
+
+    return synthetic("lanzhou", *YEAR, weather="climate", seed=1, gusts_per_day=1.0)
+
+
+def _spa(frame):
+    import pvlib
+
+    from hybridtrack import sites
+
+    site = sites.get("lanzhou")
+    pvlib.solarposition.spa_python(frame.index, site.latitude, site.longitude, site.altitude)
+
+
+def _one_row(frame):
+    from hybridtrack import simulate
+    from hybridtrack.collectors import Collector
+
+    simulate(frame, "lanzhou", collector=Collector("fresnel"))
+
+
+def _fresnel_field(frame):
+    from hybridtrack import simulate_field
+    from hybridtrack.fields import FresnelField
+
+    simulate_field(frame, "lanzhou", FresnelField(), keep_log=False, progress=False)
+
+
+def _sun(frame):
+    from hybridtrack.sun import solar_position
+
+    return solar_position(frame.index, "lanzhou", "spa-fast")
+
+
+def _geometry_per_mirror(sun):
+    from hybridtrack.collectors import heliostat_normal, normal_angles
+    from hybridtrack.fields import HeliostatField
+
+    field = HeliostatField.rings(1000)
+    alt, az = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    for aim in field.relative_aims:
+        normal_angles(heliostat_normal(alt, az, aim))
+
+
+def _geometry_vectorised(sun):
+    from hybridtrack.fields import HeliostatField
+
+    field = HeliostatField.rings(1000)
+    alt, az = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    for start in range(0, len(alt), 1440):
+        field.targets(alt[start:start + 1440], az[start:start + 1440])
+
+
+CASES = {"SPA site-year": (_year, _spa), "one Fresnel row": (_year, _one_row),
+         "20-row Fresnel field": (_year, _fresnel_field),
+         "1,000 heliostats, geometry, per mirror": (lambda: _sun(_year()), _geometry_per_mirror),
+         "1,000 heliostats, geometry, vectorised": (lambda: _sun(_year()), _geometry_vectorised)}
+
+
+def _child(case: str) -> None:
+    prepare, run = CASES[case]
+    data = prepare()
+    start = time.perf_counter()
+    run(data)
+    seconds = time.perf_counter() - start
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
+    print(json.dumps({"seconds": seconds, "peak_mib": peak}))
+
+
+def _measure(case: str, repeats: int) -> tuple[float, float]:
+    results = []
+    for _ in range(repeats):
+        done = subprocess.run([sys.executable, __file__, "--case", case], capture_output=True, text=True, check=True)
+        results.append(json.loads(done.stdout.strip().splitlines()[-1]))
+    return statistics.median(r["seconds"] for r in results), max(r["peak_mib"] for r in results)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--case", choices=list(CASES), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.case:
+        _child(args.case)
+        return
+    measured = {case: _measure(case, args.repeats) for case in CASES}
+    spa = measured["SPA site-year"][0]
+    per_mirror = measured["1,000 heliostats, geometry, per mirror"][0]
+    rows = [[case, f"{seconds:.2f}", f"{seconds / spa:.2f}x", f"{per_mirror / seconds:.1f}x" if "heliostat" in case
+             else "", f"{peak:,.0f}"] for case, (seconds, peak) in measured.items()]
+    print(f"Lanzhou site-year at 1 min (525,600 steps), median of {args.repeats} run(s) each, one process per case")
+    print_table(["case", "wall s", "/ SPA", "per-mirror / this", "peak RSS MiB"], rows)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,170 @@
+"""Whole fields: ``field``."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+
+import numpy as np
+import pandas as pd
+
+from ..errors import HybridtrackError
+from .base import (
+    add_synthetic_arguments, command, parse_mapping, simulation_config, site_from_arguments, synthetic_frame,
+)
+
+
+def _field_arguments(parser: argparse.ArgumentParser) -> None:
+    from ..control import STRATEGIES
+    from ..fields import FIELD_KINDS
+
+    parser.add_argument("kind", choices=tuple(FIELD_KINDS),
+                        help="a linear Fresnel field, a trough loop or a heliostat field")
+    add_synthetic_arguments(parser)
+    group = parser.add_argument_group("field")
+    group.add_argument("--rows", help="Fresnel: row distances from the receiver line, m, comma-separated "
+                                      "(default 20 rows, -9.5 to 9.5 every 1 m); write --rows=-4,0,4 when the first is "
+                                      "negative")
+    group.add_argument("--receiver-height", type=float, default=10.0, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--row-length", type=float, default=100.0, help="Fresnel: row length, m (default 100)")
+    group.add_argument("--count", type=int, default=12, help="trough: collectors in the loop (default 12); "
+                                                             "heliostat: mirrors on rings when no --positions")
+    group.add_argument("--collector-length", type=float, default=150.0,
+                       help="trough: collector length, m (default 150)")
+    group.add_argument("--axis-azimuth", type=float, default=0.0,
+                       help="Fresnel/trough: axis azimuth, degrees from north (default 0, north-south)")
+    group.add_argument("--positions", help="heliostat: CSV of mirror centres with columns east, north (and up), m; "
+                                           "aim_east, aim_north, aim_up give each its own aim point")
+    group.add_argument("--aim", type=float, nargs=3, default=(0.0, 0.0, 100.0), metavar=("E", "N", "U"),
+                       help="heliostat: the receiver's aim point from the tower foot, m (default 0 0 100)")
+    group.add_argument("--spread", action="append", metavar="NAME=SD",
+                       help="standard deviation of a per-collector imperfection, e.g. --spread encoder_offset=0.3 "
+                            "(repeatable; see hybridtrack.fields.ImperfectionSpread)")
+    group.add_argument("--no-spread", action="store_true", help="every collector gets the config's imperfections")
+    run = parser.add_argument_group("run")
+    run.add_argument("--strategy", choices=STRATEGIES, default="hybrid", help="tracking strategy (default hybrid)")
+    run.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
+    run.add_argument("--perfect", action="store_true", help="no imperfections at the centre of the draws")
+    run.add_argument("--metric", default="rms", help="collector metric the field map shows (default rms; "
+                                                     "energy_capture, moves, p95, end_loss_share, ...)")
+    run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
+    run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
+
+
+def _spread(args: argparse.Namespace):
+    from ..fields import ImperfectionSpread
+
+    if args.no_spread:
+        if args.spread:
+            raise HybridtrackError("give either --spread or --no-spread, not both")
+        return ImperfectionSpread.none()
+    changes = {}
+    known = {f.name for f in dataclasses.fields(ImperfectionSpread)}
+    for name, value in parse_mapping(args.spread, "--spread").items():
+        if name not in known:
+            raise HybridtrackError(f"--spread: unknown imperfection {name!r}; known: {', '.join(sorted(known))}")
+        try:
+            changes[name] = float(value)
+        except ValueError:
+            raise HybridtrackError(f"--spread {name}: {value!r} is not a number") from None
+    return ImperfectionSpread(**changes)
+
+
+def _numbers(text: str, flag: str) -> list[float]:
+    try:
+        return [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise HybridtrackError(f"{flag} takes numbers separated by commas, got {text!r}") from None
+
+
+def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
+    """Mirror centres (N, 2 or 3) and optional aim points (N, 3) from a CSV file."""
+    import io
+
+    from ..io import numeric_columns, read_text
+
+    try:
+        table = pd.read_csv(io.StringIO(read_text(path)), skipinitialspace=True)
+    except pd.errors.ParserError as exc:
+        raise HybridtrackError(f"{path}: not a CSV table: {exc}") from None
+    table.columns = [str(c).strip().lower() for c in table.columns]
+    for column in ("east", "north"):
+        if column not in table.columns:
+            raise HybridtrackError(f"{path}: no column {column!r}; columns are {', '.join(table.columns)}")
+    position_columns = [c for c in ("east", "north", "up") if c in table.columns]
+    aim_columns = [c for c in ("aim_east", "aim_north", "aim_up") if c in table.columns]
+    if aim_columns and len(aim_columns) != 3:
+        raise HybridtrackError(f"{path}: aim points need all of aim_east, aim_north, aim_up")
+    table = numeric_columns(table, position_columns + aim_columns, str(path))
+    for column in position_columns + aim_columns:
+        bad = ~np.isfinite(table[column].to_numpy(float))
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise HybridtrackError(f"{path}: row {row + 2}, column {column!r}: empty or not finite")
+    if table.empty:
+        raise HybridtrackError(f"{path}: no heliostats in the file")
+    aims = table[aim_columns].to_numpy(float) if aim_columns else None
+    return table[position_columns].to_numpy(float), aims
+
+
+def field_from_arguments(args: argparse.Namespace):
+    """The field the flags describe."""
+    from ..fields import FresnelField, HeliostatField, TroughLoop
+
+    spread = _spread(args)
+    if args.kind == "fresnel":
+        rows = _numbers(args.rows, "--rows") if args.rows else FresnelField().row_distances
+        return FresnelField(row_distances=rows, receiver_height=args.receiver_height, row_length=args.row_length,
+                            axis_azimuth=args.axis_azimuth, spread=spread)
+    if args.kind == "trough":
+        return TroughLoop(count=args.count, collector_length=args.collector_length, axis_azimuth=args.axis_azimuth,
+                          spread=spread)
+    if args.positions:
+        positions, aims = read_positions(args.positions)
+        return HeliostatField(positions=positions, aim=tuple(args.aim), aims=aims, spread=spread)
+    return HeliostatField.rings(args.count, aim=tuple(args.aim), spread=spread)
+
+
+def field_table(summary: dict) -> str:
+    """A field summary as two aligned columns."""
+    labels = {"collectors": "collectors", "steps": "steps", "energy_capture": "energy capture (field)",
+              "rms": "pointing error RMS (°, field)", "rms_worst": "worst collector RMS (°)",
+              "rms_worst_collector": "worst collector", "moves": "moves (all collectors)",
+              "travel_deg": "travel (°, all)", "stow_events": "wind stow events", "faults": "faults",
+              "end_loss_share": "end loss (share of the light)"}
+    rows = [(label, summary[key]) for key, label in labels.items() if key in summary]
+    width = max(len(label) for label, _ in rows)
+    return "\n".join(f"{label:<{width}}  {_format(value)}" for label, value in rows)
+
+
+def _format(value) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:,.0f}" if abs(value) >= 1000 else f"{value:.4g}"
+    return f"{value:,}" if isinstance(value, int) else str(value)
+
+
+@command("field", "run a tracker for every collector of a Fresnel field, a trough loop or a heliostat field",
+         _field_arguments)
+def _field(args: argparse.Namespace) -> int:
+    from ..fields import collector_columns, simulate_field
+
+    site = site_from_arguments(args)
+    field = field_from_arguments(args)
+    if args.metric not in collector_columns(field):
+        raise HybridtrackError(f"--metric: no collector metric {args.metric!r}; "
+                               f"choose from {', '.join(collector_columns(field))}")
+    frame = synthetic_frame(args, site)
+    result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
+                            seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True)
+    print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
+          f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {args.strategy}")
+    print(field_table(result.summary))
+    shown = ["east", "north", "rms", "energy_capture", "moves"] + \
+        (["end_loss_share"] if "end_loss_share" in result.collectors else [])
+    print(result.collectors[shown].to_string(max_rows=12, float_format=lambda v: f"{v:.4g}"))
+    if args.out:
+        written = result.save(args.out, metric=args.metric)
+        print("wrote " + ", ".join(str(p) for p in written.values()))
+    return 0

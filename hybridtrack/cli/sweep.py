@@ -1,0 +1,46 @@
+"""Parameter studies: ``sweep``."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import HybridtrackError
+from .base import command
+
+
+def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", metavar="SWEEP.toml", help="the sweep: [base] run, [grid] of values, [plot] axes "
+                                                           "(see examples/sweep-deadband.toml)")
+    parser.add_argument("--out", required=True,
+                        help="folder for runs.parquet (one row per run), tradeoff.png and sweep.toml")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
+                                                               "(default: a local cluster on this machine's cores)")
+    parser.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+
+
+@command("sweep", "run a grid of runs (config fields, sites, dates, weather, seeds, strategies, collectors) on Dask",
+         _sweep_arguments)
+def _sweep(args: argparse.Namespace) -> int:
+    from ..sweep import Sweep, pareto_front, run_sweep, save_sweep
+
+    from pathlib import Path
+
+    sweep = Sweep.from_toml(args.file)
+    Path(args.out).mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails now, not after the runs
+    runs = len(sweep.runs())
+    print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
+    table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
+    written = save_sweep(table, sweep, args.out)
+    failed = table[table["error"].notna()]
+    keys = [k for k in ("run", *sweep.grid) if k in table]
+    front = pareto_front(table, sweep.x, sweep.y)
+    print(f"Pareto front of {sweep.x} against {sweep.y} ({len(front)} of {len(table) - len(failed)} runs):")
+    print(front[keys + [sweep.x, sweep.y]].to_string(index=False))
+    if len(failed):
+        print(f"{len(failed)} run{'s' if len(failed) != 1 else ''} failed:")
+        for _, row in failed.head(10).iterrows():
+            print(f"  run {row['run']}: {row['error']}")
+    print("wrote " + ", ".join(str(p) for p in written.values()))
+    if len(failed) == len(table):
+        raise HybridtrackError(f"every run failed; run {failed['run'].iloc[0]}: {failed['error'].iloc[0]}")
+    return 0

@@ -1,0 +1,618 @@
+"""Whole collector fields: a linear Fresnel field, a trough loop, a heliostat field.
+
+A field is a list of collectors at positions (metres east, north, up from the field's origin),
+each with its own imperfections drawn from seeded distributions (`ImperfectionSpread`):
+no two rows of a real field are aligned alike. `simulate_field` runs the controller for every
+collector on the same weather and site and scores each one and the field. For now it runs
+`hybridtrack.simulate` once per collector (the reference path), with the sun positions every
+collector shares computed once (`hybridtrack.sun.reuse_positions`).
+
+The field geometry itself is vectorised over collectors: `FresnelField.targets`,
+`TroughLoop.targets` and `HeliostatField.targets` give every collector's nominal target at
+every step in one call of the broadcasting functions of `hybridtrack.collectors`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import sites
+from .collectors import (
+    AXIS_AZIMUTH, Collector, fresnel_angle, fresnel_end_loss, heliostat_normal, normal_angles, trough_angle,
+)
+from .errors import HybridtrackError
+from .world import Imperfections, incidence_cosine
+
+__all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
+           "collector_columns", "FIELD_KINDS", "LOG_VARIABLES", "COLLECTOR_METRICS"]
+
+#: The per-collector log columns kept in `FieldResult.dataset` (collector × time).
+LOG_VARIABLES = ("target_true", "target", "angle", "error", "mode", "sky", "sensor_status", "intensity_ma",
+                 "calibration")
+#: Log columns every collector shares (the weather and the sky class); kept once, over time.
+SHARED_VARIABLES = ("dni", "wind_speed")
+
+
+@dataclass(frozen=True)
+class ImperfectionSpread:
+    """Standard deviations of the per-collector imperfections around the config's values.
+
+    Each collector's `Imperfections` field is drawn from a normal distribution centred on the
+    run config's value with the standard deviation given here (same units: degrees, seconds).
+    ``sensor_noise``, a standard deviation itself, is folded at zero (its absolute value).
+    The defaults spread what differs from collector to collector in a commissioned field
+    (each row is set up and surveyed on its own: a few tenths of a degree of axis and encoder
+    error, a few hundredths of sensor bias) and keep what one field controller shares (its
+    clock and its site coordinates) equal for all.
+    """
+
+    axis_azimuth_error: float = 0.2
+    axis_tilt_error: float = 0.15
+    encoder_offset: float = 0.2
+    clock_error: float = 0.0
+    latitude_error: float = 0.0
+    longitude_error: float = 0.0
+    sensor_bias: float = 0.02
+    sensor_noise: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not number or not (np.isfinite(value) and value >= 0):
+                raise HybridtrackError(f"imperfection spread: {f.name} must be a finite number >= 0, got {value!r}")
+
+    @classmethod
+    def none(cls) -> ImperfectionSpread:
+        """Every collector gets the config's imperfections exactly."""
+        return cls(**{f.name: 0.0 for f in dataclasses.fields(cls)})
+
+    def draw(self, mean: Imperfections, count: int, seed: int) -> list[Imperfections]:
+        """`count` imperfection records; collector ``i``'s draw depends only on `seed` and ``i``."""
+        records = []
+        for i in range(count):
+            rng = np.random.default_rng([seed, i])
+            values = {f.name: getattr(mean, f.name) + getattr(self, f.name) * rng.standard_normal()
+                      for f in dataclasses.fields(Imperfections)}
+            values["sensor_noise"] = abs(values["sensor_noise"])
+            try:
+                records.append(Imperfections(**values))
+            except HybridtrackError as exc:
+                raise HybridtrackError(f"collector {i}: the drawn {exc}; narrow the spread") from None
+        return records
+
+
+def _sun_columns(altitude, azimuth) -> tuple[np.ndarray, np.ndarray]:
+    """Sun path as (T, 1) columns that broadcast against N collectors."""
+    return np.asarray(altitude, float)[:, None], np.asarray(azimuth, float)[:, None]
+
+
+def _along_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
+    """Positions (N, 3) at `offsets` metres along a horizontal axis through the origin."""
+    b = np.radians(axis_azimuth)
+    xyz = np.stack([offsets * np.sin(b), offsets * np.cos(b), np.zeros_like(offsets)], axis=-1)
+    return np.round(xyz, 9) + 0.0  # no 1e-16 m (or -0.0) from the sine of a right angle
+
+
+def _across_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
+    """Positions (N, 3) at `offsets` metres across a horizontal axis (towards ``axis_azimuth + 90°``)."""
+    return _along_axis(offsets, axis_azimuth + 90.0)
+
+
+def _finite_vector(values, name: str, *, positive: bool = False) -> np.ndarray:
+    try:
+        array = np.atleast_1d(np.asarray(values, float))
+    except (TypeError, ValueError):
+        raise HybridtrackError(f"{name} must be numbers, got {values!r}") from None
+    if array.ndim != 1 or array.size == 0:
+        raise HybridtrackError(f"{name} must be a non-empty list of numbers, got shape {array.shape}")
+    if not np.all(np.isfinite(array)) or (positive and not np.all(array > 0)):
+        raise HybridtrackError(f"{name} must be finite{' and positive' if positive else ''}, got {array.tolist()}")
+    return array
+
+
+def _finite_number(value, name: str, *, positive: bool = False) -> float:
+    return float(_finite_vector([value], name, positive=positive)[0])
+
+
+@dataclass(frozen=True)
+class FresnelField:
+    """A linear Fresnel field: parallel mirror rows under one receiver line.
+
+    Parameters
+    ----------
+    row_distances : sequence of float
+        Each row's signed lateral distance from the receiver line, metres, positive towards
+        ``axis_azimuth + 90°`` (east for a north-south field).
+    receiver_height : float
+        Height of the receiver above the rows' pivots, metres.
+    row_length : float
+        Length of every row, metres; the end loss is counted against it.
+    axis_azimuth : float
+        Azimuth of the rows' axis, degrees from north (0: north-south rows).
+    spread : ImperfectionSpread
+        How each row's imperfections scatter around the config's.
+    """
+
+    row_distances: tuple[float, ...] = tuple(np.arange(-9.5, 10.0, 1.0))
+    receiver_height: float = 10.0
+    row_length: float = 100.0
+    axis_azimuth: float = 0.0
+    spread: ImperfectionSpread = field(default_factory=ImperfectionSpread)
+
+    kind = "fresnel"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "row_distances", tuple(_finite_vector(self.row_distances, "row distances").tolist()))
+        for name in ("receiver_height", "row_length"):
+            object.__setattr__(self, name, _finite_number(getattr(self, name), name.replace("_", " "), positive=True))
+        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth"))
+
+    @property
+    def names(self) -> list[str]:
+        return [f"row {i + 1}" for i in range(len(self.row_distances))]
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Row centres (N, 3), metres east, north, up from the receiver line's middle."""
+        return _across_axis(np.asarray(self.row_distances), self.axis_azimuth)
+
+    def collectors(self) -> list[Collector]:
+        return [Collector("fresnel", self.axis_azimuth, d, self.receiver_height) for d in self.row_distances]
+
+    def targets(self, altitude, azimuth) -> np.ndarray:
+        """Every row's nominal tracking angle (T, N), degrees; NaN at night."""
+        alt, az = _sun_columns(altitude, azimuth)
+        return fresnel_angle(alt, az, np.asarray(self.row_distances), self.receiver_height, self.axis_azimuth)
+
+    def end_loss(self, altitude, azimuth) -> np.ndarray:
+        """Every row's end loss (T, N), metres (north-south rows only; see `fresnel_end_loss`)."""
+        if self.axis_azimuth % 180.0 != 0.0:
+            raise HybridtrackError("end loss is defined for north-south rows (axis azimuth 0 or 180)")
+        alt, az = _sun_columns(altitude, azimuth)
+        return fresnel_end_loss(alt, az, np.asarray(self.row_distances), self.receiver_height)
+
+
+@dataclass(frozen=True)
+class TroughLoop:
+    """A loop of parabolic trough collectors in a line on one horizontal axis.
+
+    Parameters
+    ----------
+    count : int
+        Number of collectors (solar collector assemblies), each with its own drive.
+    collector_length : float
+        Length of one collector along the axis, metres (their centres are this far apart).
+    axis_azimuth : float
+        Azimuth of the axis, degrees from north (0: north-south, 270: east-west).
+    spread : ImperfectionSpread
+    """
+
+    count: int = 12
+    collector_length: float = 150.0
+    axis_azimuth: float = 0.0
+    spread: ImperfectionSpread = field(default_factory=ImperfectionSpread)
+
+    def __post_init__(self) -> None:
+        whole = isinstance(self.count, (int, np.integer)) and not isinstance(self.count, bool)
+        if not whole or not 1 <= self.count <= 100_000:
+            raise HybridtrackError(f"trough loop: count must be a whole number from 1 to 100000, got {self.count!r}")
+        object.__setattr__(self, "collector_length",
+                           _finite_number(self.collector_length, "collector length", positive=True))
+        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth"))
+
+    @property
+    def kind(self) -> str:
+        return "trough-ew" if self.axis_azimuth % 180.0 == AXIS_AZIMUTH["ew"] % 180.0 else "trough-ns"
+
+    @property
+    def names(self) -> list[str]:
+        return [f"SCA {i + 1}" for i in range(self.count)]
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Collector centres (N, 3) along the axis, the first at the origin."""
+        return _along_axis(np.arange(self.count) * self.collector_length, self.axis_azimuth)
+
+    def collectors(self) -> list[Collector]:
+        return [Collector(self.kind, self.axis_azimuth)] * self.count
+
+    def targets(self, altitude, azimuth) -> np.ndarray:
+        """Every collector's nominal rotation angle (T, N), degrees; NaN at night."""
+        alt, az = _sun_columns(altitude, azimuth)
+        return np.broadcast_to(trough_angle(alt, az, self.axis_azimuth), (alt.shape[0], self.count))
+
+
+@dataclass(frozen=True, eq=False)
+class HeliostatField:
+    """Heliostats around a tower, all aiming at one point unless given their own.
+
+    Parameters
+    ----------
+    positions : array_like, shape (N, 2) or (N, 3)
+        Mirror centres, metres east, north (and up; 0 when left out) from the tower's foot.
+    aim : tuple of float
+        The receiver's aim point, (east, north, up) metres from the tower's foot.
+    aims : array_like, shape (N, 3), optional
+        One aim point per heliostat (aim-point strategies spread the flux on the receiver).
+    spread : ImperfectionSpread
+    """
+
+    positions: np.ndarray = field(default_factory=lambda: np.array([[0.0, -100.0], [50.0, -90.0], [-50.0, -90.0]]))
+    aim: tuple[float, float, float] = (0.0, 0.0, 100.0)
+    aims: np.ndarray | None = None
+    spread: ImperfectionSpread = field(default_factory=ImperfectionSpread)
+
+    kind = "heliostat"
+
+    def __post_init__(self) -> None:
+        xyz = np.asarray(self.positions, float) if _is_numeric(self.positions) else None
+        if xyz is None or xyz.ndim != 2 or xyz.shape[1] not in (2, 3) or len(xyz) == 0:
+            raise HybridtrackError(f"heliostat positions must be (N, 2) or (N, 3) metres, got {self.positions!r:.80}")
+        if xyz.shape[1] == 2:
+            xyz = np.column_stack([xyz, np.zeros(len(xyz))])
+        if not np.all(np.isfinite(xyz)):
+            raise HybridtrackError(f"heliostat {int(np.flatnonzero(~np.isfinite(xyz).all(1))[0]) + 1}: "
+                                   "position is not finite")
+        object.__setattr__(self, "positions", xyz)
+        aims = np.broadcast_to(np.asarray(self.aim, float), xyz.shape) if self.aims is None else self.aims
+        aims = np.asarray(aims, float) if _is_numeric(aims) else None
+        if aims is None or aims.shape != xyz.shape:
+            raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
+        relative = aims - xyz
+        bad = ~np.isfinite(relative).all(axis=1) | (np.linalg.norm(relative, axis=1) == 0)
+        if bad.any():
+            raise HybridtrackError(f"heliostat {int(np.flatnonzero(bad)[0]) + 1}: its aim point is not finite or is "
+                                   "the mirror itself")
+        object.__setattr__(self, "aim", tuple(float(v) for v in np.asarray(self.aim, float)))
+        object.__setattr__(self, "aims", aims)
+
+    @classmethod
+    def rings(cls, count: int, *, first_radius: float = 60.0, spacing: float = 12.0,
+              aim: tuple[float, float, float] = (0.0, 0.0, 100.0), spread: ImperfectionSpread | None = None
+              ) -> HeliostatField:
+        """`count` heliostats on concentric rings round the tower's foot, `spacing` metres apart
+        along and between the rings, every other ring turned by half a place (a radial stagger)."""
+        whole = isinstance(count, (int, np.integer)) and not isinstance(count, bool)
+        if not whole or not 1 <= count <= 100_000:
+            raise HybridtrackError(f"heliostat count must be a whole number from 1 to 100000, got {count!r}")
+        first_radius = _finite_number(first_radius, "first ring radius", positive=True)
+        spacing = _finite_number(spacing, "heliostat spacing", positive=True)
+        placed, ring = [], 0
+        while sum(len(p) for p in placed) < count:
+            radius = first_radius + ring * spacing
+            places = max(int(2 * np.pi * radius / spacing), 1)
+            angle = 2 * np.pi * (np.arange(places) + 0.5 * (ring % 2)) / places
+            placed.append(np.column_stack([radius * np.sin(angle), radius * np.cos(angle)]))
+            ring += 1
+        spread = spread if spread is not None else ImperfectionSpread()
+        return cls(positions=np.concatenate(placed)[:count], aim=aim, spread=spread)
+
+    @property
+    def names(self) -> list[str]:
+        return [f"H{i + 1}" for i in range(len(self.positions))]
+
+    @property
+    def relative_aims(self) -> np.ndarray:
+        """Each aim point from its mirror's centre (N, 3), metres."""
+        return self.aims - self.positions
+
+    def collectors(self) -> list[Collector]:
+        return [Collector("heliostat", aim=tuple(a)) for a in self.relative_aims.tolist()]
+
+    def normals(self, altitude, azimuth) -> np.ndarray:
+        """Every mirror's nominal unit normal at every step (T, N, 3); NaN at night."""
+        alt, az = _sun_columns(altitude, azimuth)
+        up = alt[:, 0] >= 0.0  # at night every normal is NaN: compute the day only
+        normals = np.full((len(alt), len(self.positions), 3), np.nan)
+        if up.any():
+            normals[up] = heliostat_normal(alt[up], az[up], self.relative_aims)
+        return normals
+
+    def targets(self, altitude, azimuth) -> np.ndarray:
+        """Every mirror's nominal normal azimuth and elevation (T, N, 2), degrees."""
+        return np.stack(normal_angles(self.normals(altitude, azimuth)), axis=-1)
+
+
+def _is_numeric(values) -> bool:
+    try:
+        np.asarray(values, float)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+#: The field kinds, by the name the CLI and sweeps use.
+FIELD_KINDS = {"fresnel": FresnelField, "trough": TroughLoop, "heliostat": HeliostatField}
+
+
+@dataclass
+class FieldResult:
+    """A finished field run.
+
+    Attributes
+    ----------
+    collectors : pandas.DataFrame
+        One row per collector: position (``east``, ``north``, ``up``, metres), its drawn
+        imperfections, and its metrics (as in a single run's summary).
+    summary : dict
+        Field metrics: energy capture of the whole field (each collector weighted by the direct
+        light it is offered), pointing error RMS over the field, total moves and travel, the
+        worst collector; a Fresnel field adds its end loss.
+    events : pandas.DataFrame
+        Every collector's mode changes, with a ``collector`` column.
+    dataset : xarray.Dataset or None
+        The logs, collector × time (`LOG_VARIABLES`; the shared weather over time only);
+        None when the run was asked not to keep them.
+    """
+
+    collectors: pd.DataFrame
+    summary: dict
+    events: pd.DataFrame
+    dataset: object
+    field: object
+    site: sites.Site
+
+    def _repr_html_(self) -> str:
+        return f"<p><b>{self.summary['field']}</b> at {self.site.name}</p>" + self.collectors.to_html(max_rows=20)
+
+    def plot_map(self, metric: str = "rms"):
+        """The field map: every collector at its position, coloured by `metric` (a column of `collectors`).
+
+        Returns a `matplotlib.figure.Figure`.
+        """
+        from matplotlib.figure import Figure
+
+        if metric not in self.collectors.columns:
+            raise HybridtrackError(f"no collector metric {metric!r}; choose from {', '.join(self.collectors.columns)}")
+        fig = Figure(figsize=(7, 6), layout="constrained")
+        ax = fig.add_subplot()
+        values = pd.to_numeric(self.collectors[metric], errors="coerce").to_numpy(float)
+        segments = _segments(self.field)
+        if segments is None:  # heliostats: a marker per mirror
+            points = ax.scatter(self.collectors["east"], self.collectors["north"], c=values, cmap="viridis",
+                                marker="^", s=max(12.0, 4000.0 / len(values) ** 0.8), edgecolors="0.3",
+                                linewidths=0.3)
+        else:  # rows and troughs: a line of their length along their axis
+            from matplotlib.collections import LineCollection
+
+            points = LineCollection(segments, array=values, cmap="viridis", linewidths=max(2.0, 60.0 / len(values)))
+            ax.add_collection(points)
+            ax.autoscale_view()
+        fig.colorbar(points, ax=ax, label=_METRIC_LABELS.get(metric, metric))
+        if isinstance(self.field, HeliostatField):
+            ax.plot(*self.field.aim[:2], marker="*", color="tab:red", markersize=14, ls="", label="aim point")
+            ax.legend(loc="best")
+        ax.set_xlabel("east (m)")
+        ax.set_ylabel("north (m)")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(f"{self.summary['field']} at {self.site.name}: {_METRIC_LABELS.get(metric, metric)}")
+        return fig
+
+    def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
+        """Write ``collectors.csv``, ``events.csv``, ``summary.json``, ``field_map.png`` and, when
+        the logs were kept, ``log.nc`` (netCDF, the `dataset`)."""
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        written = {"collectors": folder / "collectors.csv", "events": folder / "events.csv",
+                   "summary": folder / "summary.json", "map": folder / "field_map.png"}
+        self.collectors.to_csv(written["collectors"], index_label="collector", float_format="%.6g")
+        self.events.to_csv(written["events"], index=False)
+        written["summary"].write_text(json.dumps(self.summary, indent=2) + "\n")
+        self.plot_map(metric).savefig(written["map"], dpi=120)
+        if self.dataset is not None:
+            written["log"] = folder / "log.nc"
+            self.dataset.to_netcdf(written["log"], engine="scipy")
+        return written
+
+
+def _segments(field) -> np.ndarray | None:
+    """Each row's or trough's ends (N, 2, 2) in (east, north), or None for heliostats."""
+    if isinstance(field, HeliostatField):
+        return None
+    length = field.row_length if isinstance(field, FresnelField) else field.collector_length
+    half = 0.5 * length * _along_axis(np.ones(1), field.axis_azimuth)[0, :2]
+    centres = field.positions[:, :2]
+    return np.stack([centres - half, centres + half], axis=1)
+
+
+_METRIC_LABELS = {"rms": "pointing error RMS (°)", "p95": "pointing error p95 (°)", "energy_capture": "energy capture",
+                  "moves": "moves", "travel_deg": "travel (°)", "end_loss_share": "end loss (share of the row)"}
+
+
+#: The metrics each collector gets in `FieldResult.collectors` (after its position and imperfections).
+COLLECTOR_METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture", "moves", "travel_deg",
+                     "mode_switches", "stow_events", "faults")
+
+
+def collector_columns(field) -> list[str]:
+    """The columns `simulate_field` gives `field`'s collector table (what a field map can show)."""
+    columns = ["east", "north", "up"] + (["row_distance"] if isinstance(field, FresnelField) else [])
+    columns += [f.name for f in dataclasses.fields(Imperfections)] + list(COLLECTOR_METRICS) + ["offered"]
+    if isinstance(field, FresnelField) and field.axis_azimuth % 180.0 == 0.0:
+        columns += ["end_loss_m", "end_loss_share"]
+    return columns
+
+
+def _metrics(summary: dict) -> dict:
+    error = summary["tracking_error_deg"]
+    return {name: error[name] if name in error else summary[name] for name in COLLECTOR_METRICS}
+
+
+def _offered(dni: np.ndarray, altitude: np.ndarray, azimuth: np.ndarray, collector: Collector) -> float:
+    """Direct light a perfect tracker would take in, the weight of a collector in the field's figures."""
+    beam = np.nan_to_num(dni) * incidence_cosine(altitude, azimuth, collector)
+    return float(np.sum(beam[(altitude > 0) & (np.nan_to_num(dni) > 0)]))
+
+
+def _weighted(values: pd.Series, weights: pd.Series, *, squared: bool = False) -> float | None:
+    ok = values.notna() & (weights > 0)
+    if not ok.any():
+        return None
+    v, w = values[ok].astype(float), weights[ok]
+    mean = float(np.sum(w * (v * v if squared else v)) / np.sum(w))
+    return round(float(np.sqrt(mean)) if squared else mean, 5)
+
+
+def _end_loss_columns(field: FresnelField, dni, altitude, azimuth) -> dict[str, np.ndarray]:
+    """Each row's mean end loss (metres) and the share of its light lost past the receiver's end."""
+    if field.axis_azimuth % 180.0 != 0.0:
+        return {}
+    up = (altitude > 0) & (np.nan_to_num(dni) > 0)
+    loss = np.abs(field.end_loss(altitude[up], azimuth[up]))
+    beam = (np.nan_to_num(dni) * incidence_cosine(altitude, azimuth, field.collectors()[0]))[up][:, None]
+    total = beam.sum()
+    share = np.minimum(loss, field.row_length) / field.row_length
+    if not total > 0:
+        return {"end_loss_m": np.full(loss.shape[1], np.nan), "end_loss_share": np.full(loss.shape[1], np.nan)}
+    return {"end_loss_m": np.sum(beam * loss, axis=0) / total, "end_loss_share": np.sum(beam * share, axis=0) / total}
+
+
+def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None, seed: int = 0,
+                   keep_log: bool = True, progress: bool | None = None) -> FieldResult:
+    """Run the tracker for every collector of a field on the same weather.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A weather frame, as for `hybridtrack.simulate`.
+    site : Site or str
+    field : FresnelField, TroughLoop or HeliostatField
+    strategy : str, optional
+        As for `hybridtrack.simulate`.
+    config : SimulationConfig, optional
+        The run config; its imperfections are the centre of every collector's draw.
+    seed : int
+        Seeds the imperfection draws and each collector's sensor noise: collector ``i``'s
+        draws depend only on `seed` and ``i``.
+    keep_log : bool
+        Keep every collector's log in `FieldResult.dataset` (about 50 bytes per collector
+        and step, 80 for a heliostat); False keeps only the metrics.
+    progress : bool, optional
+        A progress bar over collectors (on stderr); by default when there are more than four.
+
+    Returns
+    -------
+    FieldResult
+    """
+    from tqdm import tqdm
+
+    from .simulation import SimulationConfig, _check_frame, simulate
+    from .sun import reuse_positions, solar_position
+
+    if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
+        raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
+                               f"got {type(field).__name__}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise HybridtrackError(f"seed must be a whole number >= 0, got {seed!r}")
+    site = sites.get(site)
+    frame = _check_frame(frame)
+    config = config or SimulationConfig()
+    collectors = field.collectors()
+    imperfections = field.spread.draw(config.imperfections, len(collectors), int(seed))
+    rows, events, store = [], [], None
+    with reuse_positions():
+        truth = solar_position(frame.index, site, "spa")  # what every collector's run asks for, once
+        bar = tqdm(total=len(collectors), unit="collector", file=sys.stderr, leave=False,
+                   disable=not (progress if progress is not None else len(collectors) > 4))
+        with bar:
+            for i, (name, collector, imperfect) in enumerate(zip(field.names, collectors, imperfections)):
+                run_config = dataclasses.replace(config, imperfections=imperfect,
+                                                 seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
+                result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
+                altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
+                rows.append({**dataclasses.asdict(imperfect), **_metrics(result.summary),
+                             "offered": _offered(result.log["dni"].to_numpy(float), altitude, azimuth, collector)})
+                events.append(result.events.assign(collector=name))
+                if keep_log:
+                    store = store or _LogStore(field.names, result.log)
+                    store.add(i, result.log)
+                bar.update()
+    table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
+    summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
+    all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
+    dataset = store.dataset(table, field, site) if keep_log else None
+    return FieldResult(table, summary, all_events, dataset, field, site)
+
+
+def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:
+    """The collectors' rows with their positions first and, for a Fresnel field, their end loss last."""
+    table = pd.DataFrame(rows, index=pd.Index(field.names, name="collector"))
+    for i, axis in enumerate(("east", "north", "up")):
+        table.insert(i, axis, field.positions[:, i])
+    if isinstance(field, FresnelField):
+        table.insert(3, "row_distance", field.row_distances)
+        altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
+        for column, values in _end_loss_columns(field, dni, altitude, azimuth).items():
+            table[column] = values
+    return table
+
+
+def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, frame: pd.DataFrame) -> dict:
+    weight = table["offered"]
+    worst = table["rms"].astype(float).idxmax() if table["rms"].notna().any() else None
+    summary = {
+        "field": type(field).__name__, "kind": field.kind, "site": site.name, "strategy": strategy,
+        "collectors": int(len(table)), "steps": int(len(frame)),
+        "start": frame.index[0].isoformat(), "end": frame.index[-1].isoformat(),
+        "energy_capture": _weighted(table["energy_capture"], weight),
+        "rms": _weighted(table["rms"], weight, squared=True),
+        "rms_worst_collector": worst, "rms_worst": None if worst is None else round(float(table.at[worst, "rms"]), 5),
+        "moves": int(table["moves"].sum()), "travel_deg": round(float(table["travel_deg"].sum()), 3),
+        "stow_events": int(table["stow_events"].sum()), "faults": int(table["faults"].sum()),
+    }
+    if "end_loss_share" in table:
+        summary["end_loss_share"] = _weighted(table["end_loss_share"], weight)
+    return summary
+
+
+class _LogStore:
+    """Every collector's log, kept as it comes in (collector × time arrays), each run's frame dropped.
+
+    Holding the runs' frames until the end would cost a whole log per collector; the arrays cost
+    about 50 bytes per collector and step (80 for a heliostat).
+    """
+
+    def __init__(self, names: list[str], first: pd.DataFrame) -> None:
+        self.names = names
+        self.time = first.index.tz_convert("UTC").tz_localize(None)
+        self.shared = {c: first[c].to_numpy(float) for c in SHARED_VARIABLES if c in first}
+        self.attrs, self.arrays = {}, {}
+        for column in (c for c in first.columns if c in LOG_VARIABLES or c.endswith("_azimuth")):
+            codes = _values(first[column])
+            self.arrays[column] = np.empty((len(names), len(first)), codes.dtype)
+            if isinstance(first[column].dtype, pd.CategoricalDtype):
+                categories = list(first[column].cat.categories)
+                self.attrs[column] = {"flag_values": np.arange(len(categories), dtype=np.int8),
+                                      "flag_meanings": " ".join(categories)}
+
+    def add(self, i: int, log: pd.DataFrame) -> None:
+        for column, array in self.arrays.items():
+            array[i] = _values(log[column])
+
+    def dataset(self, table: pd.DataFrame, field, site: sites.Site):
+        """The logs as an xarray Dataset; categories as codes with CF flag attributes, time in UTC."""
+        import xarray as xr
+
+        variables = {c: (("collector", "time"), a, self.attrs.get(c, {})) for c, a in self.arrays.items()}
+        variables.update({c: (("time",), a, {}) for c, a in self.shared.items()})
+        coords = {"collector": self.names, "time": self.time,
+                  **{axis: ("collector", table[axis].to_numpy()) for axis in ("east", "north", "up")}}
+        return xr.Dataset(variables, coords=coords,
+                          attrs={"site": site.name, "timezone": site.tz, "field": type(field).__name__,
+                                 "time_note": "UTC; the site's clock is in the timezone attribute"})
+
+
+def _values(column: pd.Series) -> np.ndarray:
+    if isinstance(column.dtype, pd.CategoricalDtype):
+        return column.cat.codes.to_numpy(np.int8)
+    if column.dtype == bool:
+        return column.to_numpy(np.int8)
+    return column.to_numpy(float)

@@ -1,0 +1,363 @@
+"""Parameter sweeps on Dask: a grid of runs, one tidy table, the trade-off it asked about.
+
+A sweep file (TOML) names a base run and a grid::
+
+    [base]                      # every run starts from this
+    site = "lanzhou"
+    collector = "fresnel"
+    strategy = "hybrid"
+    start = 2021-06-19
+    days = 3
+    weather = "mixed"
+
+    [grid]                      # every combination of these is one run
+    "drive.deadband" = [0.1, 0.2, 0.4]
+    seed = [0, 1, 2]
+
+    [plot]                      # the trade-off to draw (default: moves against rms)
+    x = "moves"
+    y = "rms"
+
+Run keys are ``site``, ``collector``, ``strategy``, ``start``, ``days``, ``weather``, ``freq``,
+``seed`` (seeds the synthetic sky and the sensor noise) and ``gusts_per_day``; a dotted key is a
+field of the run config in its TOML layout (``drive.deadband``, ``controller.sun_model``,
+``imperfections.encoder_offset``), or of the collector (``collector.row_distance``). A base
+``[base.config]`` table is a whole run config. Keys and their places are checked before the sweep
+starts; values are checked by each run, so a bad value fails that run only.
+
+Every run is independent and seeded, and the table is sorted by run number, so it is the same
+whatever the number of workers. A run that fails is kept, with its error, and the sweep goes on.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import itertools
+import os
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .errors import HybridtrackError
+
+__all__ = ["Sweep", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
+           "MAXIMISED"]
+
+#: Keys of a run besides its config, with their defaults.
+RUN_KEYS = {"site": "lanzhou", "collector": "trough-ns", "strategy": "hybrid", "start": "2021-06-21", "days": 1,
+            "weather": "mixed", "freq": "1min", "seed": 0, "gusts_per_day": 0.0}
+#: The metrics of every run's row (from its summary), in the table's order.
+METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture", "moves", "travel_deg", "mode_switches",
+           "stow_events", "faults", "steps")
+#: Metrics that count things (whole numbers; empty where a run failed).
+COUNTS = ("moves", "mode_switches", "stow_events", "faults", "steps")
+#: The most runs one sweep may hold (each is a task on the scheduler and a row of the table).
+MAX_RUNS = 100_000
+#: Metrics where more is better (the others: less is better).
+MAXIMISED = ("energy_capture", "within_0_5_deg")
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A parsed sweep: the base run, the grid (key -> values, in file order), the plot axes."""
+
+    base: dict
+    grid: dict
+    x: str = "moves"
+    y: str = "rms"
+    source: str = "sweep"
+
+    @classmethod
+    def from_toml(cls, path) -> Sweep:
+        from .io import read_toml
+
+        return cls.from_dict(read_toml(path, "sweep"), source=str(path))
+
+    @classmethod
+    def from_dict(cls, data: dict, *, source: str = "sweep") -> Sweep:
+        unknown = sorted(set(data) - {"base", "grid", "plot"})
+        if unknown:
+            raise HybridtrackError(f"{source}: {unknown[0]}: unknown table; a sweep has [base], [grid] and [plot]")
+        base = dict(data.get("base", {}))
+        config = base.pop("config", {})
+        grid = data.get("grid", {})
+        plot = data.get("plot", {})
+        for name, table in (("base", base), ("grid", grid), ("plot", plot), ("base.config", config)):
+            if not isinstance(table, dict):
+                raise HybridtrackError(f"{source}: [{name}] must be a table")
+        _config_from(config, {}, source)  # the base config must stand on its own
+        for key in base:
+            _check_key(key, source, "base")
+        if not grid:
+            raise HybridtrackError(f"{source}: [grid] is empty; give at least one key with a list of values")
+        for key, values in grid.items():
+            _check_key(key, source, "grid")
+            if not isinstance(values, list) or not values:
+                raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
+        count = int(np.prod([len(v) for v in grid.values()], dtype=float))
+        if count > MAX_RUNS:
+            raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
+        for axis in ("x", "y"):
+            if axis in plot and plot[axis] not in METRICS:
+                raise HybridtrackError(f"{source}: plot.{axis}: {plot[axis]!r} is not a metric; "
+                                       f"choose from {', '.join(METRICS)}")
+        unknown = sorted(set(plot) - {"x", "y"})
+        if unknown:
+            raise HybridtrackError(f"{source}: plot.{unknown[0]}: unknown key; known: x, y")
+        return cls({**base, "config": config}, dict(grid), plot.get("x", "moves"), plot.get("y", "rms"), source)
+
+    def to_dict(self) -> dict:
+        """The sweep in its TOML layout; `from_dict` reads it back equal."""
+        base = {k: v for k, v in self.base.items() if k != "config"}
+        if self.base.get("config"):
+            base["config"] = self.base["config"]
+        return {"base": base, "grid": dict(self.grid), "plot": {"x": self.x, "y": self.y}}
+
+    def to_toml(self, path) -> Path:
+        """Write the sweep as TOML; `from_toml` reads it back equal."""
+        from .io import write_toml
+
+        return write_toml(self.to_dict(), path)
+
+    def runs(self) -> list[dict]:
+        """Every run of the grid, in order: the grid's values vary fastest from the last key."""
+        keys = list(self.grid)
+        return [{"run": i, **dict(zip(keys, values))}
+                for i, values in enumerate(itertools.product(*(self.grid[k] for k in keys)))]
+
+
+def _check_key(key: str, source: str, table: str) -> None:
+    """A run key, a collector field or a config field that exists; its value is checked by the run."""
+    from .collectors import Collector
+    from .simulation import SimulationConfig
+
+    if key in RUN_KEYS:
+        return
+    head, _, rest = key.partition(".")
+    if head == "collector" and rest in {f.name for f in dataclasses.fields(Collector)} - {"kind"}:
+        return
+    node = SimulationConfig()
+    for part in key.split("."):
+        if not dataclasses.is_dataclass(node) or part not in {f.name for f in dataclasses.fields(node)}:
+            raise HybridtrackError(f"{source}: {table}.{key}: unknown key; use {', '.join(RUN_KEYS)}, "
+                                   "collector.FIELD or a dotted config key such as drive.deadband")
+        node = getattr(node, part)
+    if dataclasses.is_dataclass(node):
+        raise HybridtrackError(f"{source}: {table}.{key}: is a whole table; name one of its fields")
+
+
+def _config_from(base: dict, dotted: dict, source: str):
+    """The run config: the base table with the dotted values set in it."""
+    import copy
+
+    from .simulation import SimulationConfig
+
+    data = copy.deepcopy(base)
+    for key, value in dotted.items():
+        *path, last = key.split(".")
+        node = data
+        for part in path:
+            node = node.setdefault(part, {})
+        node[last] = value
+    return SimulationConfig.from_dict(data, source=source)
+
+
+@functools.lru_cache(maxsize=8)
+def _frame(site, start: str, days: int, weather: str, freq: str, seed: int, gusts_per_day: float) -> pd.DataFrame:
+    """The synthetic weather of a run; runs that differ only in their config share it (per worker)."""
+    import datetime as dt
+
+    from .sky import synthetic
+    from .times import parse_date
+
+    if isinstance(days, bool) or not isinstance(days, int) or not 1 <= days <= 3660:
+        raise HybridtrackError(f"days must be a whole number from 1 to 3660, got {days!r}")
+    first = parse_date(start)
+    sky = weather.split(",") if "," in weather else weather
+    return synthetic(site, first, first + dt.timedelta(days=days - 1), weather=sky, freq=freq, seed=seed,
+                     gusts_per_day=gusts_per_day)
+
+
+def _plain(value):
+    """A table cell: dates and lists as text, everything else as it is."""
+    if isinstance(value, (list, tuple)):
+        return ",".join(str(v) for v in value)
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
+    return value
+
+
+def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
+    """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``."""
+    from . import sites
+    from .collectors import Collector
+    from .simulation import simulate
+
+    spec = _spec(base, grid_values)
+    row = _row(spec)
+    try:
+        site = sites.get(spec["site"])
+        dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
+        config = dataclasses.replace(_config_from(base.get("config", {}), dotted, source), seed=int(spec["seed"]))
+        geometry = {k.partition(".")[2]: (tuple(v) if isinstance(v, list) else v)
+                    for k, v in spec.items() if k.startswith("collector.")}
+        collector = Collector(spec["collector"], **geometry)
+        frame = _frame(site, _plain(spec["start"]), spec["days"], _plain(spec["weather"]), spec["freq"],
+                       int(spec["seed"]), float(spec["gusts_per_day"]))
+        summary = simulate(frame, site, collector=collector, strategy=spec["strategy"], config=config).summary
+        error = summary["tracking_error_deg"]
+        row.update({m: error[m] if m in error else summary[m] for m in METRICS})
+        row["error"] = None
+    except Exception as exc:  # noqa: BLE001 - a failed run is a row, not the end of the sweep
+        return _failed(row, exc)
+    return row
+
+
+def _spec(base: dict, grid_values: dict) -> dict:
+    """Everything a run is given: the defaults, the base run, its grid values."""
+    return {**RUN_KEYS, **{k: v for k, v in base.items() if k != "config"}, **grid_values}
+
+
+def _row(spec: dict) -> dict:
+    """The table cells naming a run: its number, its run keys, then any other key it was given."""
+    row = {key: _plain(spec[key]) for key in ("run", *RUN_KEYS) if key in spec}
+    row.update({key: _plain(value) for key, value in spec.items() if key not in row})
+    return row
+
+
+def _failed(row: dict, exc: BaseException) -> dict:
+    return {**row, **{m: None for m in METRICS}, "error": f"{type(exc).__name__}: {exc}"}
+
+
+def _client(scheduler: str | None, workers: int | None):
+    """A Dask client: on `scheduler` when given, else on a local cluster of `workers` processes."""
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover - a declared dependency
+        raise HybridtrackError("sweeps need dask.distributed: pip install 'dask[distributed]'") from None
+    if scheduler:
+        if workers is not None:
+            raise HybridtrackError("give either --scheduler or --workers, not both")
+        try:
+            return Client(scheduler, timeout="10s"), None
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    count = workers if workers is not None else (os.cpu_count() or 1)
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 1024:
+        raise HybridtrackError(f"workers must be a whole number from 1 to 1024, got {count!r}")
+    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=40)
+    return Client(cluster), cluster
+
+
+def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None = None,
+              progress: bool = True) -> pd.DataFrame:
+    """Run every run of `sweep` on Dask and return the table, one row per run, sorted by run.
+
+    Parameters
+    ----------
+    sweep : Sweep
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``); by default a local cluster.
+    workers : int, optional
+        Worker processes of the local cluster, one thread each; the machine's cores by default.
+    progress : bool
+        A progress bar over runs on stderr.
+    """
+    from dask.distributed import as_completed
+    from tqdm import tqdm
+
+    runs = sweep.runs()
+    client, cluster = _client(scheduler, workers)
+    rows = []
+    try:
+        futures = {client.submit(run_one, sweep.base, spec, sweep.source, pure=False): spec for spec in runs}
+        with tqdm(total=len(futures), unit="run", file=sys.stderr, disable=not progress, leave=False) as bar:
+            for future in as_completed(futures):
+                try:
+                    rows.append(future.result())
+                except Exception as exc:  # noqa: BLE001 - the worker died (killed, out of memory): record it
+                    rows.append(_failed(_row(_spec(sweep.base, futures[future])), exc))
+                bar.update()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return _table(rows)
+
+
+def _table(rows: list[dict]) -> pd.DataFrame:
+    table = pd.DataFrame(rows).sort_values("run", kind="stable").reset_index(drop=True)
+    for metric in METRICS:
+        table[metric] = pd.to_numeric(table[metric], errors="coerce").astype("Int64" if metric in COUNTS else float)
+    table["error"] = table["error"].astype("string")
+    return table
+
+
+def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:
+    """The runs no other run beats on both `x` and `y` (each minimised, or maximised if in `MAXIMISED`)."""
+    ok = table.dropna(subset=[x, y])
+    sx = -1.0 if x in MAXIMISED else 1.0
+    sy = -1.0 if y in MAXIMISED else 1.0
+    order = ok.assign(_x=sx * ok[x], _y=sy * ok[y]).sort_values(["_x", "_y"], kind="stable")
+    best = np.inf
+    keep = []
+    for index, value in zip(order.index, order["_y"]):
+        if value < best:
+            keep.append(index)
+            best = value
+    return ok.loc[keep]
+
+
+def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colour: str | None = None,
+                  title: str = ""):
+    """Every run as a point of `x` against `y`, coloured by a grid key, with the Pareto front drawn.
+
+    When the runs have several seeds, the mean over seeds of each `colour` value is marked too:
+    a seed changes the sky, so single runs scatter more than the setting moves them.
+
+    Returns a `matplotlib.figure.Figure`.
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(7.5, 5), layout="constrained")
+    ax = fig.add_subplot()
+    ok = table.dropna(subset=[x, y])
+    if colour is not None and colour in ok and pd.api.types.is_numeric_dtype(ok[colour]):
+        points = ax.scatter(ok[x], ok[y], c=ok[colour], cmap="viridis", s=36, edgecolors="0.3", linewidths=0.4)
+        fig.colorbar(points, ax=ax, label=colour)
+    elif colour is not None and colour in ok and not ok.empty:
+        for value, group in ok.groupby(colour, sort=False):
+            ax.scatter(group[x], group[y], s=36, label=f"{colour} = {value}", edgecolors="0.3", linewidths=0.4)
+        ax.legend(loc="best", fontsize="small")
+    else:
+        ax.scatter(ok[x], ok[y], s=36, edgecolors="0.3", linewidths=0.4)
+    if colour is not None and colour != "seed" and colour in ok and "seed" in ok and ok["seed"].nunique() > 1:
+        means = ok.groupby(colour, sort=True)[[x, y]].mean()
+        ax.plot(means[x], means[y], marker="X", color="black", ls=":", lw=0.8, markersize=8,
+                label=f"mean over {ok['seed'].nunique()} seeds")
+        ax.legend(loc="best", fontsize="small")
+    front = pareto_front(ok, x, y)
+    ax.plot(front[x], front[y], color="tab:red", lw=1.2, drawstyle="steps-post", label="Pareto front", zorder=0)
+    ax.set_xlabel(x + (" (more is better)" if x in MAXIMISED else ""))
+    ax.set_ylabel(y + (" (more is better)" if y in MAXIMISED else ""))
+    failed = int(table["error"].notna().sum())
+    ax.set_title(title + (f" ({failed} failed run{'s' if failed != 1 else ''} left out)" if failed else ""))
+    return fig
+
+
+def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
+    """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png",
+               "sweep": sweep.to_toml(folder / "sweep.toml")}
+    table.to_parquet(written["table"], index=False)
+    colour = next(iter(sweep.grid))
+    plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem).savefig(written["plot"],
+                                                                                              dpi=120)
+    return written

@@ -1,0 +1,60 @@
+"""The field command: a run end to end, and every mistake as one line with status 2."""
+
+import json
+
+import pytest
+
+from hybridtrack.cli import main
+
+
+def test_field_runs_a_fresnel_field_and_writes_its_files(tmp_path, capsys):
+    out = tmp_path / "field"
+    assert main(["field", "fresnel", "--site", "lanzhou", "--date", "2021-06-21", "--weather", "sunny",
+                 "--rows=-4,0,4", "--metric", "energy_capture", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "FresnelField of 3 (fresnel)" in printed and "energy capture (field)" in printed and "row 3" in printed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["collectors"] == 3 and summary["site"] == "lanzhou"
+    assert (out / "field_map.png").stat().st_size > 0 and (out / "log.nc").exists()
+
+
+def test_field_reads_heliostat_positions_and_aims(tmp_path, capsys):
+    path = tmp_path / "mirrors.csv"
+    path.write_text("East, North, Up, aim_east, aim_north, aim_up\n0,-80,0,0,0,100\n40,-70,1,2,0,98\n")
+    assert main(["field", "heliostat", "--site", "nanjing", "--date", "2021-03-20", "--positions", str(path)]) == 0
+    assert "HeliostatField of 2 (heliostat)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("content, extra, message", [
+    ("east,north\n0,-100\n50,abc\n", [], "row 3, column 'north': 'abc' is not a number"),
+    ("east,north\n0,-100\n50,\n", [], "row 3, column 'north': empty or not finite"),
+    ("x,y\n0,1\n", [], "no column 'east'"),
+    ("east,north,aim_up\n0,-100,4\n", [], "aim points need all of"),
+    ("east,north\n0,-100\n", ["--metric", "shine"], "--metric: no collector metric 'shine'"),
+    ("east,north\n0,-100\n", ["--spread", "encoder_offset=-1"], "encoder_offset must be a finite number >= 0"),
+    ("east,north\n0,-100\n", ["--spread", "colour=1"], "--spread: unknown imperfection 'colour'"),
+    ("east,north\n0,-100\n", ["--spread", "encoder_offset=1", "--no-spread"], "not both"),
+])
+def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, extra, message):
+    path = tmp_path / "mirrors.csv"
+    path.write_text(content)
+    status = main(["field", "heliostat", "--site", "nanjing", "--date", "2021-03-20", "--positions", str(path), *extra])
+    error = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(error) == 1 and error[0].startswith("hybridtrack: error:") and message in error[0]
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["fresnel", "--rows", "1,x"], "--rows takes numbers"),
+    (["fresnel", "--receiver-height", "0"], "receiver height must be finite and positive"),
+    (["trough", "--count", "0"], "count must be a whole number"),
+    (["heliostat", "--positions", "/no/such/file.csv"], "no such file"),
+])
+def test_bad_field_flags(capsys, flags, message):
+    assert main(["field", *flags, "--site", "lanzhou", "--date", "2021-06-21"]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_field_help(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["field", "--help"])
+    assert stop.value.code == 0 and "--positions" in capsys.readouterr().out

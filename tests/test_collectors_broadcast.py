@@ -1,0 +1,122 @@
+"""Geometry over many collectors at once: one call equals the per-collector loop and hand cases."""
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from hybridtrack import HybridtrackError
+from hybridtrack.collectors import (
+    THREE_POINT_SUPPORT, fresnel_angle, fresnel_end_loss, heliostat_normal, jack_heights, normal_angles,
+    receiver_angle, tracking_rate, trough_angle,
+)
+from hybridtrack.sun import altitude_azimuth, solar_position
+from hybridtrack.times import local_range
+
+KUNMING_LATITUDE = 25 + 1 / 60
+DISTANCES = np.arange(2.5, 25.01, 2.5)
+# published end losses at Kunming, equinox, h = 10 m: noon and 07:00 solar time
+END_LOSS_NOON = [4.810, 5.217, 5.833, 6.600, 7.470, 8.413, 9.406, 10.435, 11.490, 12.565]
+END_LOSS_0700 = [1.135, 1.232, 1.376, 1.558, 1.763, 1.985, 2.219, 2.462, 2.711, 2.965]
+
+
+@pytest.fixture(scope="module")
+def sun():
+    return solar_position(local_range("2021-06-21", "Asia/Shanghai", freq="10min"), "lanzhou")
+
+
+def test_end_loss_takes_every_row_distance_in_one_call():
+    alt, az = altitude_azimuth(0.0, np.array([0.0, -75.0]), KUNMING_LATITUDE)  # equinox: noon and 07:00
+    losses = fresnel_end_loss(alt[:, None], az[:, None], DISTANCES, 10.0)
+    assert losses.shape == (2, len(DISTANCES))
+    np.testing.assert_allclose(losses, [END_LOSS_NOON, END_LOSS_0700], atol=0.002)
+
+
+def test_end_loss_broadcasts_receiver_heights_too(sun):
+    rows = np.array([-7.5, 2.5, 10.0])
+    heights = np.array([8.0, 10.0, 12.0])
+    table = fresnel_end_loss(sun.altitude.to_numpy()[:, None], sun.azimuth.to_numpy()[:, None], rows, heights)
+    for i, (d, h) in enumerate(zip(rows, heights)):
+        np.testing.assert_array_equal(table[:, i], fresnel_end_loss(sun.altitude, sun.azimuth, d, h).to_numpy())
+
+
+def test_fresnel_angles_of_a_field_equal_the_row_by_row_results(sun):
+    rows = np.linspace(-12.0, 12.0, 9)
+    table = fresnel_angle(sun.altitude.to_numpy()[:, None], sun.azimuth.to_numpy()[:, None], rows, 10.0)
+    assert table.shape == (len(sun), len(rows))
+    for i, d in enumerate(rows):
+        np.testing.assert_array_equal(table[:, i], fresnel_angle(sun.altitude, sun.azimuth, d, 10.0).to_numpy())
+
+
+def test_fresnel_angle_hand_cases():
+    # sun at the zenith: the normal bisects 90° and the receiver direction atan2(h, -d)
+    assert fresnel_angle(90.0, 0.0, [0.0, 10.0, -10.0], 10.0) == pytest.approx([90.0, 112.5, 67.5])
+    assert receiver_angle([10.0, -10.0], [10.0, 10.0]) == pytest.approx([135.0, 45.0])
+    assert isinstance(receiver_angle(5.0, 10.0), float)
+
+
+def test_elementwise_broadcast_keeps_a_series_and_axes_per_collector(sun):
+    up = sun[sun.altitude > 0]
+    one_per_step = trough_angle(up.altitude, up.azimuth, np.zeros(len(up)))
+    assert isinstance(one_per_step, pd.Series)
+    pv = pvlib.tracking.singleaxis(90 - up.altitude, up.azimuth, axis_azimuth=180, backtrack=False, max_angle=90)
+    np.testing.assert_allclose(one_per_step, 90 + pv.tracker_theta, atol=1e-9)
+    axes = np.array([0.0, 30.0, 270.0])
+    table = trough_angle(up.altitude.to_numpy()[:, None], up.azimuth.to_numpy()[:, None], axes)
+    for i, axis in enumerate(axes):
+        np.testing.assert_array_equal(table[:, i], trough_angle(up.altitude, up.azimuth, axis).to_numpy())
+
+
+def test_trough_hand_case_sun_along_and_across_the_axis():
+    # sun low in the east at 30°: a north-south trough faces it at 30°; an east-west axis sees it along itself
+    assert trough_angle(30.0, 90.0, [0.0, 90.0]) == pytest.approx([30.0, 90.0])
+
+
+def test_heliostat_normals_of_m_mirrors_at_t_steps_in_one_call(sun):
+    aims = np.array([[0.0, 20.0, 100.0], [30.0, -40.0, 95.0], [-60.0, 10.0, 102.0], [5.0, 80.0, 99.0]])
+    alt, az = sun.altitude.to_numpy(), sun.azimuth.to_numpy()
+    normals = heliostat_normal(alt[:, None], az[:, None], aims)
+    assert normals.shape == (len(sun), len(aims), 3)
+    azimuth, elevation = normal_angles(normals)
+    jacks = jack_heights(normals)
+    assert azimuth.shape == (len(sun), len(aims)) and jacks.shape == (len(sun), len(aims), 3)
+    for m, aim in enumerate(aims):
+        one = heliostat_normal(alt, az, aim)
+        np.testing.assert_array_equal(normals[:, m], one)
+        np.testing.assert_array_equal(jacks[:, m], jack_heights(one, THREE_POINT_SUPPORT))
+        np.testing.assert_array_equal(elevation[:, m], normal_angles(one)[1])
+
+
+def test_heliostat_hand_cases():
+    # sun at the zenith: aim straight up keeps the mirror flat; aim due north on the horizon tilts it 45°
+    n = heliostat_normal(90.0, 0.0, [[0.0, 0.0, 50.0], [0.0, 100.0, 0.0]])
+    np.testing.assert_allclose(n, [[0.0, 0.0, 1.0], [0.0, np.sqrt(0.5), np.sqrt(0.5)]], atol=1e-12)
+    assert heliostat_normal(45.0, 180.0, (0.0, 20.0, 100.0)).shape == (1, 3)  # a scalar sun keeps its (1, 3)
+    night = heliostat_normal(np.array([[-5.0], [30.0]]), np.array([[90.0], [120.0]]), [[0, 1, 1], [1, 0, 1]])
+    assert np.isnan(night[0]).all() and np.isfinite(night[1]).all()
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: fresnel_end_loss(50.0, 180.0, [1.0, np.nan], 10.0), "row distance d must be finite"),
+    (lambda: fresnel_angle(50.0, 180.0, [1.0, 2.0], [10.0, -1.0]), "receiver height h must be positive"),
+    (lambda: fresnel_angle(50.0, 180.0, 1.0, 10.0, [0.0, np.inf]), "axis azimuth must be finite"),
+    (lambda: trough_angle(50.0, 180.0, ["north"]), "axis azimuth must be numbers"),
+    (lambda: heliostat_normal(50.0, 180.0, [[0, 0, 1], [0, 0, 0]]), "aim point must be three finite"),
+    (lambda: heliostat_normal(50.0, 180.0, [[0, 0, 1, 2]]), "aim point must be three finite"),
+])
+def test_bad_collector_parameters_are_refused_with_their_name(call, message):
+    with pytest.raises(HybridtrackError, match=message):
+        call()
+
+
+def test_tracking_rates_of_a_field_are_each_columns_own(sun):
+    rows = [-6.0, 0.0, 6.0]
+    angles = pd.DataFrame(fresnel_angle(sun.altitude.to_numpy()[:, None], sun.azimuth.to_numpy()[:, None], rows, 10.0),
+                          index=sun.index, columns=["west", "middle", "east"])
+    rates = tracking_rate(angles)
+    assert list(rates.columns) == ["west", "middle", "east"] and rates.index.equals(sun.index)
+    for column, d in zip(rates.columns, rows):
+        np.testing.assert_array_equal(rates[column], tracking_rate(fresnel_angle(sun.altitude, sun.azimuth, d, 10.0)))
+    # hand case: an angle growing 15° an hour turns at 0.25°/min
+    hours = pd.date_range("2021-06-21 08:00", periods=5, freq="1h", tz="UTC")
+    np.testing.assert_allclose(tracking_rate(pd.DataFrame({"a": 15.0 * np.arange(5)}, index=hours)), 0.25)

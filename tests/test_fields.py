@@ -1,0 +1,163 @@
+"""Whole fields: geometry over collectors, seeded imperfections, field runs against per-collector runs."""
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.figure import Figure
+
+from hybridtrack import HybridtrackError, simulate, simulate_field
+from hybridtrack.collectors import fresnel_angle, heliostat_normal, trough_angle
+from hybridtrack.fields import FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns
+from hybridtrack.simulation import SimulationConfig
+from hybridtrack.sky import synthetic
+from hybridtrack.sun import altitude_azimuth, solar_position
+from hybridtrack.times import local_range
+from hybridtrack.world import Imperfections
+
+KUNMING_LATITUDE = 25 + 1 / 60
+END_LOSS_NOON = [4.810, 5.217, 5.833, 6.600, 7.470, 8.413, 9.406, 10.435, 11.490, 12.565]
+
+
+@pytest.fixture(scope="module")
+def day():
+    return synthetic("lanzhou", "2021-06-21", weather="mixed", seed=3)
+
+
+@pytest.fixture(scope="module")
+def sun():
+    return solar_position(local_range("2021-03-20", "Asia/Shanghai", freq="15min"), "lanzhou")
+
+
+def test_fresnel_field_geometry_is_each_rows_own(sun):
+    field = FresnelField(row_distances=[-6.0, -2.0, 3.0, 7.5], receiver_height=8.0)
+    table = field.targets(sun.altitude, sun.azimuth)
+    for i, d in enumerate(field.row_distances):
+        np.testing.assert_array_equal(table[:, i], fresnel_angle(sun.altitude, sun.azimuth, d, 8.0).to_numpy())
+    np.testing.assert_array_equal(field.positions, [[-6, 0, 0], [-2, 0, 0], [3, 0, 0], [7.5, 0, 0]])
+
+
+def test_fresnel_field_end_loss_per_row_matches_the_published_table():
+    field = FresnelField(row_distances=np.arange(2.5, 25.01, 2.5), receiver_height=10.0)
+    alt, az = altitude_azimuth(0.0, 0.0, KUNMING_LATITUDE)  # equinox solar noon at Kunming
+    np.testing.assert_allclose(field.end_loss([alt], [az])[0], END_LOSS_NOON, atol=0.002)
+
+
+def test_trough_loop_lies_on_one_axis_line(sun):
+    loop = TroughLoop(count=3, collector_length=150.0, axis_azimuth=270.0)
+    assert loop.kind == "trough-ew"
+    np.testing.assert_allclose(loop.positions, [[0, 0, 0], [-150, 0, 0], [-300, 0, 0]], atol=1e-9)
+    np.testing.assert_array_equal(loop.targets(sun.altitude, sun.azimuth)[:, 2],
+                                  trough_angle(sun.altitude, sun.azimuth, 270.0).to_numpy())
+
+
+def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
+    field = HeliostatField(positions=[[0.0, -100.0, 0.0], [80.0, -60.0, 0.0], [-40.0, 120.0, 2.0]], aim=(0, 0, 100))
+    normals = field.normals(sun.altitude, sun.azimuth)
+    assert normals.shape == (len(sun), 3, 3)
+    np.testing.assert_array_equal(normals[:, 2], heliostat_normal(sun.altitude, sun.azimuth, (40.0, -120.0, 98.0)))
+    flat = HeliostatField(positions=[[0.0, -100.0], [80.0, -60.0]], aim=(0, 0, 100))
+    np.testing.assert_array_equal(flat.positions[:, 2], [0.0, 0.0])
+    own = HeliostatField(positions=[[0, -100], [80, -60]], aims=[[0, 0, 100], [3, 0, 95]])
+    np.testing.assert_array_equal(own.relative_aims, [[0, 100, 100], [-77, 60, 95]])
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: HeliostatField(positions=[[0.0, np.nan]]), "heliostat 1: position is not finite"),
+    (lambda: HeliostatField(positions=[[0, 0, 0, 0]]), r"\(N, 2\) or \(N, 3\)"),
+    (lambda: HeliostatField(positions=[[1, 2], [0, 0]], aim=(0, 0, 0)), "heliostat 2: its aim point"),
+    (lambda: HeliostatField(positions=[[1, 2]], aims=[[0, 0, 1], [0, 0, 2]]), "one \\(x, y, z\\) per heliostat"),
+    (lambda: FresnelField(row_distances=[1.0, float("inf")]), "row distances must be finite"),
+    (lambda: FresnelField(row_distances=[]), "non-empty"),
+    (lambda: FresnelField(receiver_height=-2), "receiver height must be finite and positive"),
+    (lambda: TroughLoop(count=0), "count must be a whole number"),
+    (lambda: TroughLoop(count=2.5), "count must be a whole number"),
+    (lambda: ImperfectionSpread(encoder_offset=-0.1), "encoder_offset must be a finite number >= 0"),
+    (lambda: ImperfectionSpread(sensor_bias=float("nan")), "sensor_bias must be a finite number >= 0"),
+])
+def test_bad_fields_are_refused_with_what_is_wrong(make, message):
+    with pytest.raises(HybridtrackError, match=message):
+        make()
+
+
+def test_imperfection_draws_are_seeded_per_collector_and_spread_as_asked():
+    spread = ImperfectionSpread(axis_azimuth_error=0.2, sensor_noise=0.05)
+    mean = Imperfections()
+    many = spread.draw(mean, 4000, seed=7)
+    assert spread.draw(mean, 3, seed=7) == many[:3]  # collector i's draw does not depend on the field's size
+    assert spread.draw(mean, 3, seed=8) != many[:3]
+    azimuth = np.array([m.axis_azimuth_error for m in many])
+    assert azimuth.mean() == pytest.approx(mean.axis_azimuth_error, abs=4 * 0.2 / np.sqrt(4000))
+    assert azimuth.std() == pytest.approx(0.2, rel=0.05)
+    assert all(m.sensor_noise >= 0 for m in many)
+    assert {m.clock_error for m in many} == {mean.clock_error}  # no spread: every collector gets the config's
+    with pytest.raises(HybridtrackError, match="collector 0: the drawn imperfections"):
+        ImperfectionSpread(axis_tilt_error=1e4).draw(mean, 1, seed=0)
+
+
+def test_a_field_run_is_each_collectors_own_run(day):
+    field = FresnelField(row_distances=[-4.0, 6.0])
+    config = SimulationConfig()
+    result = simulate_field(day, "lanzhou", field, seed=11, config=config)
+    drawn = field.spread.draw(config.imperfections, 2, 11)
+    for i, (name, collector) in enumerate(zip(field.names, field.collectors())):
+        alone = simulate(day, "lanzhou", collector=collector, config=dataclasses.replace(
+            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([11, i]).generate_state(1)[0])))
+        row = result.collectors.loc[name]
+        assert row["rms"] == alone.summary["tracking_error_deg"]["rms"]
+        assert row["moves"] == alone.summary["moves"] and row["energy_capture"] == alone.summary["energy_capture"]
+        assert row["axis_azimuth_error"] == drawn[i].axis_azimuth_error
+        np.testing.assert_array_equal(result.dataset["angle"].sel(collector=name).to_numpy(), alone.log["angle"])
+        codes = result.dataset["mode"].sel(collector=name).to_numpy()
+        meanings = result.dataset["mode"].attrs["flag_meanings"].split()
+        assert list(np.asarray(meanings)[codes]) == list(alone.log["mode"].astype(str))
+    assert len(result.events) > 0 and set(result.events["collector"]) == set(field.names)
+
+
+def test_field_figures_weigh_each_collector_by_the_light_it_is_offered(day):
+    result = simulate_field(day, "lanzhou", HeliostatField(), seed=2, keep_log=False)
+    table = result.collectors
+    weight = table["offered"] / table["offered"].sum()
+    assert result.summary["energy_capture"] == pytest.approx(float((weight * table["energy_capture"]).sum()), abs=1e-5)
+    assert result.summary["rms"] == pytest.approx(float(np.sqrt((weight * table["rms"] ** 2).sum())), abs=1e-5)
+    assert result.summary["moves"] == table["moves"].sum()
+    assert result.summary["rms_worst_collector"] == table["rms"].idxmax()
+    assert result.dataset is None
+    assert list(table.columns) == collector_columns(HeliostatField())
+
+
+def test_heliostat_rings_are_spaced_and_staggered():
+    field = HeliostatField.rings(300, first_radius=50.0, spacing=10.0)
+    xy = field.positions[:, :2]
+    gaps = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1)) + np.diag(np.full(len(xy), np.inf))
+    assert len(xy) == 300 and gaps.min() >= 10.0 - 1e-9
+    radii = np.hypot(*xy.T)
+    assert radii.min() == pytest.approx(50.0) and set(np.round(radii, 6)) <= {50.0 + 10.0 * k for k in range(10)}
+
+
+def test_field_result_map_dataset_and_files(day, tmp_path):
+    field = FresnelField(row_distances=[-5.0, 0.0, 5.0])
+    result = simulate_field(day, "lanzhou", field, seed=0)
+    assert list(result.collectors.columns) == collector_columns(field)
+    assert isinstance(result.plot_map("energy_capture"), Figure)
+    with pytest.raises(HybridtrackError, match="no collector metric 'shine'"):
+        result.plot_map("shine")
+    dataset = result.dataset
+    assert dict(dataset.sizes) == {"collector": 3, "time": len(day)}
+    np.testing.assert_array_equal(dataset["east"], [-5.0, 0.0, 5.0])
+    assert pd.DatetimeIndex(dataset["time"].to_numpy()).tz_localize("UTC").equals(day.index.tz_convert("UTC"))
+    assert 0 < result.summary["end_loss_share"] < 1 and (result.collectors["end_loss_m"] > 0).all()
+    written = result.save(tmp_path / "field")
+    assert {p.name for p in written.values()} == {"collectors.csv", "events.csv", "summary.json", "field_map.png",
+                                                  "log.nc"}
+    assert "<b>FresnelField</b>" in result._repr_html_()
+
+
+def test_simulate_field_refuses_what_is_not_a_field(day):
+    with pytest.raises(HybridtrackError, match="field must be"):
+        simulate_field(day, "lanzhou", "fresnel")
+    with pytest.raises(HybridtrackError, match="seed must be"):
+        simulate_field(day, "lanzhou", TroughLoop(count=1), seed=-1)
+    with pytest.raises(HybridtrackError, match="naive"):
+        simulate_field(day.tz_localize(None), "lanzhou", TroughLoop(count=1))

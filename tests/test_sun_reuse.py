@@ -1,0 +1,48 @@
+"""Reusing sun positions inside a block gives the very numbers the model gives, computed once."""
+
+import pandas as pd
+import pvlib
+import pytest
+
+from hybridtrack.sun import reuse_positions, solar_position
+
+
+@pytest.mark.parametrize("model", ["spa", "spa-fast", "plc"])
+def test_remembered_positions_equal_fresh_ones(model):
+    times = pd.date_range("2021-06-21", "2021-06-23", freq="1min", tz="Asia/Shanghai")
+    some = times[::7]
+    with reuse_positions():
+        solar_position(times, "nanjing", model)
+        remembered = solar_position(some, "nanjing", model)
+    pd.testing.assert_frame_equal(remembered, solar_position(some, "nanjing", model))
+
+
+def test_each_request_is_computed_once_and_only_inside_the_block(monkeypatch):
+    calls = []
+    original = pvlib.solarposition.spa_python
+    monkeypatch.setattr(pvlib.solarposition, "spa_python", lambda *a, **k: calls.append(1) or original(*a, **k))
+    times = pd.date_range("2021-06-21", periods=300, freq="1min", tz="Asia/Shanghai")
+    with reuse_positions():
+        solar_position(times, "nanjing")
+        solar_position(times[10:50], "nanjing")
+        solar_position(times, "nanjing")
+        assert len(calls) == 1
+        solar_position(times, "lanzhou")  # another site is another request
+        solar_position(times, "nanjing", temperature=30.0)  # and other options
+        assert len(calls) == 3
+        later = pd.date_range("2021-06-22", periods=5, freq="1min", tz="Asia/Shanghai")
+        solar_position(later, "nanjing")  # times it has not seen
+        assert len(calls) == 4
+    solar_position(times, "nanjing")
+    assert len(calls) == 5
+
+
+def test_memory_keeps_only_the_newest_answers(monkeypatch):
+    calls = []
+    original = pvlib.solarposition.spa_python
+    monkeypatch.setattr(pvlib.solarposition, "spa_python", lambda *a, **k: calls.append(1) or original(*a, **k))
+    times = pd.date_range("2021-06-21", periods=50, freq="1min", tz="UTC")
+    with reuse_positions(entries=2):
+        for temperature in (10.0, 20.0, 30.0, 10.0):
+            solar_position(times, "nanjing", temperature=temperature)
+    assert len(calls) == 4  # the first answer was forgotten by the time it was asked again

@@ -1,0 +1,148 @@
+"""Sweeps: the grid, a run's row against a direct run, failures kept, the same table on 1 and 2 workers."""
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.figure import Figure
+
+from hybridtrack import HybridtrackError, simulate
+from hybridtrack.cli import main
+from hybridtrack.collectors import Collector
+from hybridtrack.simulation import SimulationConfig
+from hybridtrack.sky import synthetic
+from hybridtrack.sweep import METRICS, Sweep, pareto_front, plot_tradeoff, run_one, run_sweep
+
+TINY = {"base": {"site": "lanzhou", "collector": "fresnel", "start": "2021-06-21", "days": 1, "freq": "15min"},
+        "grid": {"drive.deadband": [0.1, 0.4, -1.0], "seed": [0, 1]}}
+
+
+def test_a_sweep_round_trips_through_toml(tmp_path):
+    data = {"base": {"site": "nanjing", "start": __import__("datetime").date(2013, 6, 21), "days": 2,
+                     "config": {"drive": {"deadband": 0.3}}},
+            "grid": {"controller.sun_model": ["plc", "spa"], "collector.aim": [[0.0, 20.0, 100.0]]},
+            "plot": {"x": "travel_deg", "y": "energy_capture"}}
+    sweep = Sweep.from_dict(data, source=str(tmp_path / "s.toml"))
+    assert Sweep.from_toml(sweep.to_toml(tmp_path / "s.toml")) == sweep
+
+
+def test_the_grid_is_every_combination_in_order():
+    runs = Sweep.from_dict(TINY).runs()
+    assert [(r["run"], r["drive.deadband"], r["seed"]) for r in runs] == [
+        (0, 0.1, 0), (1, 0.1, 1), (2, 0.4, 0), (3, 0.4, 1), (4, -1.0, 0), (5, -1.0, 1)]
+
+
+@pytest.mark.parametrize("data, message", [
+    ({"grid": {"seed": [0]}, "runs": {}}, "runs: unknown table"),
+    ({"grid": {}}, r"\[grid\] is empty"),
+    ({"grid": {"seed": 3}}, "grid.seed: must be a non-empty list"),
+    ({"grid": {"drive.deadbnd": [0.1]}}, "grid.drive.deadbnd: unknown key"),
+    ({"grid": {"drive": [0.1]}}, "grid.drive: is a whole table"),
+    ({"grid": {"planet": ["mars"]}}, "grid.planet: unknown key"),
+    ({"base": {"colour": "red"}, "grid": {"seed": [0]}}, "base.colour: unknown key"),
+    ({"base": {"config": {"drive": {"deadband": "wide"}}}, "grid": {"seed": [0]}}, "drive.deadband: must be a number"),
+    ({"grid": {"seed": [0]}, "plot": {"y": "happiness"}}, "plot.y: 'happiness' is not a metric"),
+    ({"grid": {"seed": [0]}, "plot": {"z": "rms"}}, "plot.z: unknown key"),
+    ({"grid": {"seed": list(range(1000)), "days": list(range(1, 1001))}}, "makes 1,000,000 runs; at most 100,000"),
+])
+def test_bad_sweeps_are_refused_before_any_run(data, message):
+    with pytest.raises(HybridtrackError, match=message):
+        Sweep.from_dict(data, source="s.toml")
+
+
+def test_a_runs_row_is_that_run_and_a_failure_is_a_row():
+    sweep = Sweep.from_dict(TINY)
+    runs = sweep.runs()
+    row = run_one(sweep.base, runs[3])
+    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", freq="15min", seed=1)
+    config = dataclasses.replace(SimulationConfig(), seed=1,
+                                 drive=dataclasses.replace(SimulationConfig().drive, deadband=0.4))
+    direct = simulate(frame, "lanzhou", collector=Collector("fresnel"), strategy="hybrid", config=config).summary
+    assert row["error"] is None and row["drive.deadband"] == 0.4 and row["seed"] == 1
+    assert row["rms"] == direct["tracking_error_deg"]["rms"] and row["moves"] == direct["moves"]
+    failed = run_one(sweep.base, runs[4])
+    assert failed["error"].startswith("HybridtrackError:") and "deadband" in failed["error"]
+    assert all(failed[m] is None for m in METRICS)
+    geometry = run_one({**sweep.base, "collector.row_distance": -4.0}, {"run": 0, "seed": 0})
+    assert geometry["error"] is None and geometry["collector.row_distance"] == -4.0
+
+
+def test_pareto_front_hand_case():
+    table = pd.DataFrame({"moves": [10, 20, 30, 15, 40], "rms": [0.5, 0.3, 0.1, 0.6, 0.1],
+                          "energy_capture": [0.9, 0.95, 0.97, 0.99, 0.96]})
+    assert list(pareto_front(table, "moves", "rms").index) == [0, 1, 2]
+    assert list(pareto_front(table, "moves", "energy_capture").index) == [0, 3]  # 15 moves at 0.99 beats 20 and 30
+
+
+def test_the_table_is_the_same_on_one_and_two_workers_and_failures_are_kept():
+    sweep = Sweep.from_dict(TINY)
+    one = run_sweep(sweep, workers=1, progress=False)
+    two = run_sweep(sweep, workers=2, progress=False)
+    pd.testing.assert_frame_equal(one, two)
+    assert list(one["run"]) == list(range(6))
+    assert one["error"].notna().tolist() == [False, False, False, False, True, True]
+    assert one.loc[one["error"].isna(), "rms"].notna().all()
+    assert isinstance(plot_tradeoff(one, "moves", "rms", colour="drive.deadband"), Figure)
+
+
+def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
+    path = tmp_path / "s.toml"
+    path.write_text('[base]\nsite = "nanjing"\nstart = 2021-03-20\nfreq = "20min"\n'
+                    '[grid]\nstrategy = ["hybrid", "astronomical"]\n[plot]\ny = "energy_capture"\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert "2 runs over strategy" in printed and "Pareto front of moves against energy_capture" in printed
+    table = pd.read_parquet(out / "runs.parquet")
+    assert list(table["strategy"]) == ["hybrid", "astronomical"] and table["start"].iloc[0] == "2021-03-20"
+    assert np.all(table["steps"] == 72) and (out / "tradeoff.png").stat().st_size > 0
+    assert Sweep.from_toml(out / "sweep.toml").grid == {"strategy": ["hybrid", "astronomical"]}
+
+
+@pytest.mark.parametrize("content, flags, message", [
+    ("[grid]\nseed = [0]\n", ["--workers", "0"], "workers must be a whole number"),
+    ("[grid]\nseed = [0]\n", ["--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
+    ("[grid\n", [], "not valid TOML"),
+    ("[grid]\nwind = [1]\n", [], "grid.wind: unknown key"),
+    ("[base]\nfreq = '30min'\n[grid]\nstart = ['2021-02-30']\n", ["--workers", "1"],
+     "every run failed; run 0: HybridtrackError: date '2021-02-30' does not exist"),
+])
+def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, flags, message):
+    path = tmp_path / "s.toml"
+    path.write_text(content)
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), *flags]) == 2
+    error = [line for line in capsys.readouterr().err.splitlines() if "hybridtrack" in line]  # not the progress bar
+    assert len(error) == 1 and error[0].strip().startswith("hybridtrack: error:") and message in error[0]
+
+
+def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):
+    """A worker killed mid-run (out of memory, a signal) raises at the client; the run is still a row."""
+    from dask.distributed import LocalCluster
+
+    import hybridtrack.sweep as sweep_module
+
+    real = sweep_module.run_one
+
+    def dying(base, spec, source="sweep"):
+        if spec["run"] == 1:
+            raise MemoryError("the worker ran out of memory")
+        return real(base, spec, source)
+
+    monkeypatch.setattr(sweep_module, "run_one", dying)
+    sweep = Sweep.from_dict({"base": {"freq": "30min"}, "grid": {"seed": [0, 1, 2]}})
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        table = run_sweep(sweep, scheduler=cluster.scheduler_address, progress=False)
+    assert list(table["run"]) == [0, 1, 2] and list(table["seed"]) == [0, 1, 2]
+    assert table["error"].isna().tolist() == [True, False, True]
+    assert table.loc[1, "error"] == "MemoryError: the worker ran out of memory" and pd.isna(table.loc[1, "rms"])
+
+
+def test_the_example_sweep_is_valid_and_runs_one_of_its_runs():
+    from pathlib import Path
+
+    sweep = Sweep.from_toml(Path(__file__).resolve().parents[1] / "examples" / "sweep-deadband.toml")
+    runs = sweep.runs()
+    assert len(runs) == 25 and list(sweep.grid) == ["drive.deadband", "seed"] and (sweep.x, sweep.y) == ("moves", "rms")
+    row = run_one({**sweep.base, "days": 1, "freq": "10min"}, runs[0], sweep.source)
+    assert row["error"] is None and row["collector"] == "fresnel" and row["start"] == "2021-06-19"
