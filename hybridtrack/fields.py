@@ -25,10 +25,17 @@ import pandas as pd
 
 from . import sites
 from .collectors import (
-    AXIS_AZIMUTH, Collector, fresnel_angle, fresnel_end_loss, heliostat_normal, normal_angles, trough_angle,
+    AXIS_AZIMUTH,
+    Collector,
+    fresnel_angle,
+    fresnel_end_loss,
+    heliostat_normal,
+    normal_angles,
+    trough_angle,
 )
 from .errors import HybridtrackError
-from .world import Imperfections, incidence_cosine
+from .mounting import incidence_cosine
+from .world import Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
            "collector_columns", "FIELD_KINDS", "LOG_VARIABLES", "COLLECTOR_METRICS"]
@@ -50,7 +57,8 @@ class ImperfectionSpread:
     The defaults spread what differs from collector to collector in a commissioned field
     (each row is set up and surveyed on its own: a few tenths of a degree of axis and encoder
     error, a few hundredths of sensor bias) and keep what one field controller shares (its
-    clock and its site coordinates) equal for all.
+    clock, its drift and its site coordinates, and the day the field was commissioned) equal for
+    all.
     """
 
     axis_azimuth_error: float = 0.2
@@ -61,6 +69,8 @@ class ImperfectionSpread:
     longitude_error: float = 0.0
     sensor_bias: float = 0.02
     sensor_noise: float = 0.0
+    clock_drift: float = 0.0
+    commissioned_days_ago: float = 0.0
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -519,7 +529,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     imperfections = field.spread.draw(config.imperfections, len(collectors), int(seed))
     rows, events, store = [], [], None
     with reuse_positions():
-        truth = solar_position(frame.index, site, "spa")  # what every collector's run asks for, once
+        truth = solar_position(frame.index, site, config.truth)  # what every collector's run asks for, once
         bar = tqdm(total=len(collectors), unit="collector", file=sys.stderr, leave=False,
                    disable=not (progress if progress is not None else len(collectors) > 4))
         with bar:

@@ -478,7 +478,7 @@ def describe_html(result, *, events: int = 12) -> str:
 def _true_sun(result, index=None):
     """Sun-up flags and the incidence cosine on a perfect aperture at every step (SPA)."""
     from .sun import solar_position
-    from .world import incidence_cosine
+    from .mounting import incidence_cosine
 
     sun = solar_position(result.log.index if index is None else index, result.site, "spa")
     altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()

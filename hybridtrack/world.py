@@ -129,10 +129,12 @@ class World:
     seed : int
     faults : dict
         Injected faults, one array per step (see ``hybridtrack.simulation.FAULTS``).
+    truth : {"spa-fast", "spa"}
+        The true sun's model (``hybridtrack.sun.solar_position``).
     """
 
     def __init__(self, frame: pd.DataFrame, site: sites.Site, collector: Collector, imperfections: Imperfections,
-                 sensor: SensorModel, drives: list[Drive], seed: int, faults: dict):
+                 sensor: SensorModel, drives: list[Drive], seed: int, faults: dict, truth: str = "spa-fast"):
         index = frame.index
         self.n, self.axes = len(index), len(drives)
         self.index, self.site, self.collector, self.imperfections = index, site, collector, imperfections
@@ -140,7 +142,7 @@ class World:
         self.drives = drives
         self.faults = faults
         rng = np.random.default_rng(seed)
-        position = self._true_sun()
+        position = self._true_sun(truth)
         self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis)
         self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation)
@@ -171,13 +173,13 @@ class World:
 
     # -- set up ----------------------------------------------------------------------------------
 
-    def _true_sun(self) -> pd.DataFrame:
+    def _true_sun(self, model: str) -> pd.DataFrame:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
         cheap = solar_position(self.index, self.site, "plc")["altitude"].to_numpy()
         candidate = cheap > -3.0
         position = pd.DataFrame({"altitude": -90.0, "azimuth": 0.0, "zenith": 180.0}, index=self.index)
         if candidate.any():
-            spa = solar_position(self.index[candidate], self.site, "spa")
+            spa = solar_position(self.index[candidate], self.site, model)
             position.loc[candidate, ["altitude", "azimuth", "zenith"]] = \
                 np.column_stack([spa["altitude"], spa["azimuth"], 90.0 - spa["altitude"]])
         return position
