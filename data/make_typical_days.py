@@ -1,7 +1,7 @@
 """Regenerate the typical-day weather records in data/, byte for byte.
 
 Run from the repository root: ``python data/make_typical_days.py [--out data]``.
-Each file holds one site's four typical days (domain.md §1) under one weather type, over
+Each file holds one site's four typical days (docs/physics.md §1) under one weather type, over
 the controller's working hours 05:00-20:00 local time, at 1-minute steps.
 """
 

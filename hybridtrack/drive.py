@@ -1,4 +1,4 @@
-"""The actuator and its position feedback, as run in the field (``domain.md`` §5).
+"""The actuator and its position feedback, as run in the field (``docs/physics.md`` §5).
 
 Intermittent drive: the target is recomputed every control period, and the drive moves
 only when the target and the encoder reading differ by more than the deadband (0.4°). It

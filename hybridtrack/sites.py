@@ -1,7 +1,7 @@
 """Named sites and user-defined ones.
 
 The built-in sites are the ones the published hybrid-tracking work was done at
-(see ``domain.md`` section 1): Lanzhou and Nanjing, which every feature serves, plus
+(see ``docs/physics.md`` §1): Lanzhou and Nanjing, which every feature serves, plus
 Kunming (linear Fresnel end loss) and a Delingha-type tower site (heliostats).
 """
 

@@ -139,7 +139,7 @@ def test_jacks_rear_pair_equal_at_noon_and_mirror_morning_and_evening():
 
 
 def test_published_jack_table_needs_an_unnormalised_receiver_vector():
-    """domain.md §3: the printed table adds (0, 20, 100) un-normalised; we keep the true law."""
+    """docs/physics.md §3: the printed table adds (0, 20, 100) un-normalised; we keep the true law."""
     alt, az = altitude_azimuth(23.44, -45.0, 37.352317)
     ours = heliostat_normal(alt, az, (0, 20, 100))
     s = sun_vector(alt, az)[0]

@@ -26,7 +26,7 @@ def test_both_models_return_the_documented_columns():
 
 
 def test_plc_trough_angle_stays_within_published_bound_of_spa():
-    """domain.md §2: 0.123° against pvlib's SPA at Nanjing, typical days, altitude above 10°."""
+    """docs/physics.md §2: 0.123° against pvlib's SPA at Nanjing, typical days, altitude above 10°."""
     worst = {}
     for date in NANJING_DAYS:
         times = day(date, "nanjing")
