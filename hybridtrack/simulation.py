@@ -57,9 +57,12 @@ class SimulationConfig:
         The world's errors; `Imperfections.none()` for a perfect installation.
     sensor : SensorModel
     drive : Drive
-        The drive of a single-axis collector. A heliostat uses it for its elevation axis
-        (limits 0-90°, stow 90°) and for its azimuth axis, which turns all the way round:
-        limits -180° to 540° (a cable wrap of one turn either way), stow at 180°.
+        The drive of a single-axis collector.
+    heliostat_drive : Drive
+        A heliostat's drive: fine steps and a deadband of about a milliradian, as heliostat
+        practice uses (0.05° deadband, a 16-bit encoder of 0.0055°), not a trough's 0.4°. It
+        serves the elevation axis (limits 0-90°, stow 90°) and the azimuth axis, which turns all
+        the way round: limits -180° to 540° (a cable wrap of one turn either way), stow at 180°.
     seed : int
         Seeds the sensor noise.
     truth : {"spa-fast", "spa"}
@@ -71,6 +74,7 @@ class SimulationConfig:
     imperfections: Imperfections = field(default_factory=Imperfections)
     sensor: SensorModel = field(default_factory=SensorModel)
     drive: Drive = field(default_factory=Drive)
+    heliostat_drive: Drive = field(default_factory=lambda: Drive(deadband=0.05, encoder_bits=16))
     seed: int = 0
     truth: str = "spa-fast"
 
@@ -90,7 +94,8 @@ class SimulationConfig:
     @classmethod
     def from_dict(cls, data, *, source: str = "config") -> SimulationConfig:
         """Build from the TOML layout; unknown keys and wrong types are refused with their key."""
-        def build(kind, values, where):
+        def build(default, values, where):
+            kind = type(default)
             if not isinstance(values, dict):
                 raise HybridtrackError(f"{source}: {where or 'config'} must be a table")
             known = {f.name: f for f in dataclasses.fields(kind)}
@@ -98,13 +103,12 @@ class SimulationConfig:
             if unknown:
                 raise HybridtrackError(f"{source}: {where + '.' if where else ''}{unknown[0]}: unknown key; "
                                        f"known: {', '.join(known)}")
-            default = kind()
             changes = {}
             for name, value in values.items():
                 key = f"{where}.{name}" if where else name
                 current = getattr(default, name)
                 if dataclasses.is_dataclass(current):
-                    changes[name] = build(type(current), value, key)
+                    changes[name] = build(current, value, key)
                 elif isinstance(current, tuple):
                     if not isinstance(value, list) or len(value) != len(current):
                         raise HybridtrackError(f"{source}: {key}: must be a list of {len(current)}, got {value!r}")
@@ -128,7 +132,7 @@ class SimulationConfig:
             except HybridtrackError as exc:
                 raise HybridtrackError(f"{source}: {where}: {exc}" if where else f"{source}: {exc}") from None
 
-        return build(cls, dict(data), "")
+        return build(cls(), dict(data), "")
 
     @classmethod
     def from_toml(cls, path) -> SimulationConfig:
@@ -230,9 +234,10 @@ def _has_parquet() -> bool:
     return True
 
 
-def _drives(collector: Collector, drive: Drive) -> list[Drive]:
+def _drives(collector: Collector, config: SimulationConfig) -> list[Drive]:
     if collector.kind != "heliostat":
-        return [drive]
+        return [config.drive]
+    drive = config.heliostat_drive
     return [dataclasses.replace(drive, limits=(-180.0, 540.0), stow=180.0),
             dataclasses.replace(drive, limits=(0.0, 90.0), stow=90.0)]
 
@@ -293,7 +298,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     collector = Collector(collector) if isinstance(collector, str) else collector
     frame = _check_frame(frame)
     faults = _check_faults(faults or {}, len(frame), 2 if collector.kind == "heliostat" else 1)
-    drives = _drives(collector, config.drive)
+    drives = _drives(collector, config)
     world = World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults,
                   truth=config.truth)
     if config.controller.strategy == "hybrid-oracle" and not world.has_true_sky:
@@ -317,7 +322,19 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                         incidence=incidence_cosine(world.altitude, world.azimuth, collector))
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
     summary["wind_data"] = _wind_data(frame)
+    summary["day_cycle"] = _day_cycle(events, site)
     return Result(log, summary, events, site, collector, config, controller.memory())
+
+
+def _day_cycle(events: pd.DataFrame, site: sites.Site) -> list[dict]:
+    """When the collector woke and stowed for the night each day (local time), and why."""
+    woke = events[(events["from"] == "stow_night") & (events["to"] != "stow_night")]
+    slept = events[(events["to"] == "stow_night") & (events["from"] != "stow_night")]
+    days = []
+    for _, row in pd.concat([woke.assign(kind="woke"), slept.assign(kind="stowed")]).sort_values("time").iterrows():
+        local = row["time"].tz_convert(site.tz)
+        days.append({"time": local.isoformat(), "event": row["kind"], "reason": row["reason"]})
+    return days
 
 
 def _wind_data(frame: pd.DataFrame) -> str:

@@ -176,7 +176,7 @@ def test_calibration_corrects_an_encoder_offset():
     assert abs(hybrid.summary["tracking_error_deg"]["mean"]) < 0.15
 
 
-def test_day_cycle_wakes_before_sunrise_and_stows_at_sunset():
+def test_day_cycle_wakes_before_sunrise_and_stows_after_sunset():
     frame = synthetic("nanjing", "2013-12-22", weather="sunny", seed=9)  # sunrise near 07:00, after 05:00
     result = simulate(frame, "nanjing", config=perfect())
     events = result.events
@@ -184,7 +184,8 @@ def test_day_cycle_wakes_before_sunrise_and_stows_at_sunset():
     sleep = events.loc[events["to"] == "stow_night", "time"].iloc[0]
     sun_up = result.log.index[result.log["target_true"].notna()]
     assert pd.Timedelta("20min") <= sun_up[0] - wake <= pd.Timedelta("35min")
-    assert abs(sleep - sun_up[-1]) <= pd.Timedelta("3min")
+    assert pd.Timedelta("12min") <= sleep - sun_up[-1] <= pd.Timedelta("18min")  # stows 15 min after its sunset
+    assert [d["event"] for d in result.summary["day_cycle"]] == ["woke", "stowed"]
     at_sunrise = result.log.loc[sun_up[0]]
     assert abs(at_sunrise["angle"] - max(at_sunrise["target_true"], 0.0)) < 1.0  # pre-positioned
 

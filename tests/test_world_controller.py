@@ -48,7 +48,7 @@ def reachable(root, limit=200_000):
 def test_the_controller_cannot_reach_the_worlds_state():
     frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=1)
     site, collector, config = sites.get("lanzhou"), Collector("trough-ns"), SimulationConfig()
-    drives = _drives(collector, config.drive)
+    drives = _drives(collector, config)
     world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
     plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
     controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), 20.0, east_park(collector))
@@ -62,7 +62,7 @@ def test_the_kalman_filter_takes_its_noise_from_the_controllers_datasheet_not_th
     quiet = SimulationConfig(imperfections=Imperfections(sensor_noise=0.001))
     loud = SimulationConfig(imperfections=Imperfections(sensor_noise=0.3))
     for config in (quiet, loud):
-        drives = _drives(Collector("trough-ns"), config.drive)
+        drives = _drives(Collector("trough-ns"), config)
         plan = make_plan(frame.index, np.arange(len(frame), dtype=float), sites.get("nanjing"),
                          Collector("trough-ns"), config.controller)
         controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), 20.0, [90.0])

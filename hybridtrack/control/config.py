@@ -44,7 +44,8 @@ class ControllerConfig:
         file that has no wind at all (``hybridtrack replay`` chooses it then, and says so). In
         both cases the run reports the wind as missing, never as calm.
     working_hours : tuple of str
-        Local clock times the controller works between.
+        Local clock times the controller may work between: an optional limit on a day that the
+        computed sun sets (the default spans the whole day).
     min_altitude : float
         Degrees: the computed sun must be above this to track.
     calibration_tau : str
@@ -96,7 +97,7 @@ class ControllerConfig:
     wind_release: float = 12.0
     wind_hold: str = "10min"
     wind_missing: str = "stow"
-    working_hours: tuple[str, str] = ("05:00", "20:00")
+    working_hours: tuple[str, str] = ("00:00", "23:59")
     min_altitude: float = 0.0
     calibration_tau: str = "30min"
     sensor_loss: str = "3min"

@@ -10,8 +10,9 @@ own per-scan computation would:
 * the computed sun at the (re-based) clock, the believed site and the controller's sun model;
 * the computed target of each axis on the mount as the controller believes it to be (nominal,
   or corrected by a commissioning fit), in encoder coordinates;
-* awake: within working hours and with the computed sun up, or rising within 30 minutes (to
-  pre-position). The sensor-only tracker has no sun model and no working hours: it wakes and
+* awake: with the computed sun up, or rising within 30 minutes (to pre-position), or set less
+  than 15 minutes ago (to catch the last light), within the working hours, which by default span
+  the whole day: the day is set by the sun, and clock hours are an optional limit. The sensor-only tracker has no sun model and no working hours: it wakes and
   sleeps by the light its sensor reads (`Controller`), so its plan is awake throughout.
 """
 
@@ -35,6 +36,8 @@ __all__ = ["MountEstimate", "ControllerPlan", "make_plan", "east_park", "CLOCK_S
 CLOCK_STEP_SECONDS = 5.0
 #: How long before its computed sunrise the controller wakes to pre-position.
 PRE_POSITION = pd.Timedelta(minutes=30)
+#: How long after its computed sunset the controller goes on before it stows.
+AFTER_SUNSET = pd.Timedelta(minutes=15)
 
 
 @dataclass(frozen=True)
@@ -126,9 +129,11 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
         awake = np.ones(len(clock), bool)
     else:
         soon = solar_position(clock + PRE_POSITION, site, config.sun_model)["altitude"].to_numpy()
+        before = solar_position(clock - AFTER_SUNSET, site, config.sun_model)["altitude"].to_numpy()
         up = altitude > config.min_altitude
         rising = (soon > config.min_altitude) & ~up & (soon > altitude)
-        awake = working & (up | rising)
+        setting = (before > config.min_altitude) & ~up & (before > altitude)
+        awake = working & (up | rising | setting)
     plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps)
     if config.calibrates:
         from .mountfit import jacobian
