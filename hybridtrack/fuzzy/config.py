@@ -467,6 +467,29 @@ class FuzzyConfig:
 
         return write_fis(self, path)
 
+    # -- IEC 61131-7 FCL ---------------------------------------------------------------------
+
+    @classmethod
+    def from_fcl(cls, path, *, raw_ranges=None, bands=None, resolution=None) -> FuzzyConfig:
+        """Load an FCL function block with two inputs and one output (see `hybridtrack.fuzzy.fcl`)."""
+        from .fcl import read_fcl
+        from .system import config_from_system
+
+        system = read_fcl(path, resolution=resolution)
+        return config_from_system(system, raw_ranges=raw_ranges, bands=bands, where=str(path))
+
+    def to_fcl(self, path) -> Path:
+        """Write the config as an IEC 61131-7 FCL function block."""
+        from .fcl import write_fcl
+
+        return write_fcl(self, path)
+
+    def system(self):
+        """The general `hybridtrack.fuzzy.system.MamdaniSystem` this classifier runs."""
+        from .system import system_of
+
+        return system_of(self)
+
 
 class _Reader:
     """Type-checks the TOML layout, naming the key of the first problem."""

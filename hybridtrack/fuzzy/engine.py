@@ -338,14 +338,21 @@ def evaluate(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto") -> 
     x = np.ascontiguousarray(x, dtype=float)
     if engine not in ("auto", "numba", "numpy"):
         raise HybridtrackError(f"unknown engine {engine!r}; choose auto, numba or numpy")
+    outputs = None
     if engine != "numpy":
         from . import compiled
 
         kernel = compiled.kernel_for(system, required=engine == "numba")
         if kernel is not None:
-            return kernel.evaluate(x)
-    firing = system.firing(x)
-    return system.outputs(firing), firing
+            outputs, firing = kernel.evaluate(x)
+    if outputs is None:
+        firing = system.firing(x)
+        outputs = system.outputs(firing)
+    for o in range(outputs.shape[1]):  # FCL's DEFAULT: the value when no rule fires
+        default = system.system.default(o)
+        if default is not None:
+            outputs[np.isnan(outputs[:, o]) & ~np.isnan(x).any(axis=1), o] = default
+    return outputs, firing
 
 
 def _probor(a, b):
@@ -373,8 +380,10 @@ def skfuzzy_system(system: MamdaniSystem, output: int = 0):
         antecedents.append(ant)
     out = system.outputs[output]
     consequent = ctrl.Consequent(np.linspace(*out.universe, n_out), out.name, defuzzify_method=methods.defuzzification)
-    for term in out.terms:
-        consequent[term.name] = sample_term(term, consequent.universe)
+    used = {abs(rule.consequent[output]) for rule in system.rules}
+    for k, term in enumerate(out.terms, start=1):
+        if k in used:  # scikit-fuzzy's array mode fails on a term no rule names; it adds nothing anyway
+            consequent[term.name] = sample_term(term, consequent.universe)
     and_func = np.fmin if methods.and_method == "min" else np.multiply
     or_func = np.fmax if methods.or_method == "max" else _probor
     rules = []

@@ -53,6 +53,9 @@ def _quote(text: str) -> str:
 
 def fis_text(system: MamdaniSystem) -> str:
     """The system as MATLAB ``.fis`` (v2) text."""
+    if any(d is not None for d in system.defaults):
+        raise HybridtrackError("a .fis file has no place for a DEFAULT output value (MATLAB gives the middle of the "
+                               "range when no rule fires); remove it from the system to write .fis")
     methods = system.methods
     lines = ["[System]", f"Name={_quote(system.name)}", "Type='mamdani'", "Version=2.0",
              f"NumInputs={len(system.inputs)}", f"NumOutputs={len(system.outputs)}", f"NumRules={len(system.rules)}"]

@@ -10,7 +10,7 @@ bands; `FuzzyConfig.system` and `FuzzyConfig.from_system` convert.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ..errors import HybridtrackError
 from .config import FuzzyConfig, Methods, Rule, Variable
@@ -42,6 +42,9 @@ class MamdaniSystem:
     inputs, outputs : tuple of Variable
     rules : tuple of SystemRule
     methods : Methods
+    defaults : tuple of (float or None)
+        Per output, the value given when no rule fires (FCL's ``DEFAULT``); empty or None
+        leaves it NaN. ``.fis`` files have no such value.
     resolution : (int, int)
         Samples across every input universe and every output universe. The engine evaluates
         the system on these samples exactly as scikit-fuzzy does: input memberships are
@@ -56,10 +59,11 @@ class MamdaniSystem:
     methods: Methods = Methods()
     resolution: tuple[int, int] = (1001, 3001)
     name: str = "system"
-    comments: tuple[str, ...] = field(default=(), compare=False)
+    defaults: tuple[float | None, ...] = ()
 
     def __post_init__(self) -> None:
-        for key in ("inputs", "outputs", "rules", "comments"):
+        object.__setattr__(self, "defaults", tuple(None if d is None else float(d) for d in self.defaults))
+        for key in ("inputs", "outputs", "rules"):
             object.__setattr__(self, key, tuple(getattr(self, key)))
         object.__setattr__(self, "resolution", tuple(int(r) for r in self.resolution))
         self.validate()
@@ -88,6 +92,10 @@ class MamdaniSystem:
             raise HybridtrackError("the rule table is empty")
         for number, rule in enumerate(self.rules, start=1):
             self._check_rule(rule, f"rules[{number}]")
+        if self.defaults and len(self.defaults) != len(self.outputs):
+            raise HybridtrackError(f"defaults: one per output ({len(self.outputs)}), got {len(self.defaults)}")
+        if any(d is not None and d != d for d in self.defaults):
+            raise HybridtrackError("defaults must be numbers")
         if len(self.resolution) != 2 or any(r < 3 for r in self.resolution):
             raise HybridtrackError(f"resolution needs two sample counts of at least 3, got {list(self.resolution)}")
 
@@ -103,6 +111,10 @@ class MamdaniSystem:
         if not any(rule.consequent):
             raise HybridtrackError(f"{where}: a rule needs at least one consequent")
         Rule({}, "", rule.weight, rule.connection).check(where)
+
+    def default(self, output: int) -> float | None:
+        """The value of output `output` when no rule fires, or None (NaN)."""
+        return self.defaults[output] if self.defaults else None
 
     def describe(self, rule: SystemRule) -> str:
         """``IF service IS poor OR food IS rancid THEN tip IS cheap``."""
@@ -137,6 +149,9 @@ def config_from_system(system: MamdaniSystem, *, raw_ranges=None, units=None, ba
     0-180 mA by default). By default the `bands` meet halfway between the centres of
     neighbouring output terms, which gives the published 10/20 split for the published terms.
     """
+    if any(d is not None for d in system.defaults):
+        raise HybridtrackError(f"{where}: the classifier labels a reading 'unknown' when no rule fires; "
+                               "it takes no DEFAULT output value")
     if len(system.inputs) != 2 or len(system.outputs) != 1:
         raise HybridtrackError(f"{where}: the sky classifier needs two inputs and one output, this system has "
                                f"{len(system.inputs)} and {len(system.outputs)}")
