@@ -48,9 +48,8 @@ from pathlib import Path
 
 from ..errors import HybridtrackError
 from .config import FuzzyConfig, Methods, Term, Variable
-from .fis import format_number
 from .membership import SHAPES, from_matlab, to_matlab
-from .system import MamdaniSystem, SystemRule, system_of
+from .system import MamdaniSystem, SystemRule, format_number, system_of
 
 __all__ = ["read_fcl", "write_fcl", "fcl_text"]
 
@@ -211,7 +210,8 @@ class _Reader:
                 if head in ("FUZZIFY", "DEFUZZIFY"):
                     known = self.inputs if head == "FUZZIFY" else self.outputs
                     if owner not in known:
-                        self.fail(number, f"{head} {owner}: not declared in {'VAR_INPUT' if known is self.inputs else 'VAR_OUTPUT'}")
+                        where = "VAR_INPUT" if head == "FUZZIFY" else "VAR_OUTPUT"
+                        self.fail(number, f"{head} {owner}: not declared in {where}")
                     self.terms.setdefault(owner, [])
                 continue
             if block in ("VAR_INPUT", "VAR_OUTPUT"):

@@ -29,7 +29,7 @@ from pathlib import Path
 from ..errors import HybridtrackError
 from .config import METHOD_CHOICES, FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
-from .system import MamdaniSystem, SystemRule, config_from_system, system_of
+from .system import MamdaniSystem, SystemRule, config_from_system, format_number, system_of
 
 __all__ = ["read_fis", "write_fis", "read_fis_system", "fis_text", "format_number"]
 
@@ -37,12 +37,6 @@ _METHOD_KEYS = {"AndMethod": "and_method", "OrMethod": "or_method", "ImpMethod":
                 "AggMethod": "aggregation", "DefuzzMethod": "defuzzification"}
 _SYSTEM_KEYS = {"Name", "Type", "Version", "NumInputs", "NumOutputs", "NumRules", *_METHOD_KEYS}
 _TYPE2_KEYS = {"TypeReductionMethod", "OutputSampleRate"}
-
-
-def format_number(value: float) -> str:
-    """The shortest text that reads back as the same float (``10`` rather than ``10.0``)."""
-    text = repr(float(value))
-    return text[:-2] if text.endswith(".0") else text
 
 
 def _quote(text: str) -> str:

@@ -15,7 +15,13 @@ from dataclasses import dataclass
 from ..errors import HybridtrackError
 from .config import FuzzyConfig, Methods, Rule, Variable
 
-__all__ = ["MamdaniSystem", "SystemRule", "system_of", "config_from_system"]
+__all__ = ["MamdaniSystem", "SystemRule", "system_of", "config_from_system", "format_number"]
+
+
+def format_number(value: float) -> str:
+    """The shortest text that reads back as the same float (``10`` rather than ``10.0``)."""
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
 
 
 @dataclass(frozen=True)
@@ -28,6 +34,8 @@ class SystemRule:
     connection: str = "and"
 
     def __post_init__(self) -> None:
+        if sum(1 for v in self.antecedent if v) <= 1:  # one condition: AND and OR are the same rule
+            object.__setattr__(self, "connection", "and")
         object.__setattr__(self, "antecedent", tuple(int(v) for v in self.antecedent))
         object.__setattr__(self, "consequent", tuple(int(v) for v in self.consequent))
         object.__setattr__(self, "weight", float(self.weight))
@@ -123,7 +131,7 @@ class MamdaniSystem:
 
         ifs = [phrase(v, i) for v, i in zip(self.inputs, rule.antecedent) if i]
         thens = [phrase(v, i) for v, i in zip(self.outputs, rule.consequent) if i]
-        weight = f" WITH {rule.weight:g}" if rule.weight != 1.0 else ""
+        weight = f" WITH {format_number(rule.weight)}" if rule.weight != 1.0 else ""
         return f"IF {f' {rule.connection.upper()} '.join(ifs)} THEN {', '.join(thens)}{weight}"
 
 
