@@ -12,7 +12,6 @@ from hybridtrack.fuzzy.config import Methods, Rule
 from hybridtrack.fuzzy.engine import CompiledSystem, evaluate, evaluate_skfuzzy
 from hybridtrack.fuzzy.fcl import fcl_text, read_fcl
 from hybridtrack.fuzzy.fis import fis_text, read_fis_system
-from hybridtrack.fuzzy.system import MamdaniSystem
 
 from test_fuzzy_engine import random_system, readings
 
@@ -149,7 +148,8 @@ TIPPER_FCL = (CONFORMANCE / "jfuzzylogic_tipper.fcl").read_text()
 @pytest.mark.parametrize("old, new, message", [
     ("METHOD : COG;", "METHOD : COGS;", ":29: METHOD : COGS"),
     ("METHOD : COG;", "METHOD : MEAN;", ":29: METHOD : MEAN is not supported"),
-    ("IF service IS excellent AND food", "IF service IS excellent AND service IS poor OR food", ":39: a rule mixing AND and OR"),
+    ("IF service IS excellent AND food", "IF service IS excellent AND service IS poor OR food",
+     ":39: a rule mixing AND and OR"),
     ("IF service IS good THEN", "IF (service IS good) THEN", ":38: parentheses"),
     ("THEN tip IS average", "THEN tip IS middling", ":38: tip has no term 'middling'"),
     ("TERM cheap := (0, 0) (5, 1) (10, 0);", "TERM cheap := 5;", ":26: cannot read term '5'"),

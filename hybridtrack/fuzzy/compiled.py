@@ -37,6 +37,7 @@ _TOLERANCE = 1e-12  # as engine.MAXIMUM_TOLERANCE
 _CHUNKS = 64
 #: Readings below which the kernels run on one thread: starting threads costs more.
 PARALLEL_FROM = 20_000
+_STEPS = 1024  # even level steps indexing the sorted tables, so that a look-up searches a short stretch
 
 
 def available() -> bool:
@@ -143,9 +144,10 @@ def _levels(firing, n, rule_unit, n_units, aggregate_max, s):
     return True
 
 
-def _table(s, block, bp, pa, qa, pm, qm, offsets):
+def _table(s, block, bp, pa, qa, pm, qm, offsets, steps):
     """G_T(s) for area and moment of the unit subset `block`."""
-    a, b = offsets[block], offsets[block + 1] - 1  # bp[b] is +inf
+    q = min(int(s * (steps.shape[1] - 1)), steps.shape[1] - 2)  # s lies between level steps q and q + 1
+    a, b = steps[block, q], steps[block, q + 1]  # first breakpoint >= s is in [a, b]
     while a < b:
         mid = (a + b) // 2
         if bp[mid] < s:
@@ -155,22 +157,23 @@ def _table(s, block, bp, pa, qa, pm, qm, offsets):
     return pa[a] + s * qa[a], pm[a] + s * qm[a]
 
 
-def _crossing(curves, u, a, b, rising, s):
-    """Cell j in [a, b) of a monotone run of curve u where it crosses level s, or -1."""
-    if rising:
+def _crossing(curves, u, a, b, rising, s, steps, r):
+    """Cell j in [a, b) of a monotone run r of curve u where it crosses level s, or -1."""
+    q = min(int(s * (steps.shape[1] - 1)), steps.shape[1] - 2)
+    if rising:  # first point at or above s
         if not (curves[u, a] < s and curves[u, b] >= s):
             return -1
-        lo, hi = a, b
+        lo, hi = steps[r, q], steps[r, q + 1]
         while lo < hi:
             mid = (lo + hi) // 2
             if curves[u, mid] >= s:
                 hi = mid
             else:
                 lo = mid + 1
-    else:
+    else:  # first point below s
         if not (curves[u, a] >= s and curves[u, b] < s):
             return -1
-        lo, hi = a, b
+        lo, hi = steps[r, q + 1], steps[r, q]
         while lo < hi:
             mid = (lo + hi) // 2
             if curves[u, mid] < s:
@@ -247,7 +250,8 @@ def _cell_integral(y, curves, s, n_units, j, imp_min, agg, pts):
 
 
 def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, area_c, moment_c, level_offsets, buckets,
-                     bucket_scale, shared, bp, pa, qa, pm, qm, offsets, run_unit, run_a, run_b, run_rising, out):
+                     bucket_scale, shared, bp, pa, qa, pm, qm, offsets, steps, run_unit, run_a, run_b, run_rising,
+                     run_steps, out):
     n_read = firing.shape[0]
     chunk = (n_read + _CHUNKS - 1) // _CHUNKS
     for c in _prange(_CHUNKS):
@@ -266,15 +270,15 @@ def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, area_c, mome
                     area += a
                     moment += m
             if shared:
-                a, m = _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, run_unit, run_a,
-                                    run_b, run_rising, cells, pts)
+                a, m = _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, steps, run_unit,
+                                    run_a, run_b, run_rising, run_steps, cells, pts)
                 area += a
                 moment += m
             out[n] = moment / area if area > 0.0 else np.nan
 
 
-def _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, run_unit, run_a, run_b, run_rising,
-                 cells, pts):
+def _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, steps, run_unit, run_a, run_b,
+                 run_rising, run_steps, cells, pts):
     """Area and moment over the cells where output units overlap (subset tables, cut cells exact)."""
     for u in range(n_units):  # insertion sort, highest level first
         k = u
@@ -291,15 +295,15 @@ def _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, run_
         lo = s[order[k + 1]] if k + 1 < n_units else 0.0
         block |= 1 << order[k]
         if hi > lo:
-            a1, m1 = _table(hi, block - 1, bp, pa, qa, pm, qm, offsets)
-            a0, m0 = _table(lo, block - 1, bp, pa, qa, pm, qm, offsets)
+            a1, m1 = _table(hi, block - 1, bp, pa, qa, pm, qm, offsets, steps)
+            a0, m0 = _table(lo, block - 1, bp, pa, qa, pm, qm, offsets, steps)
             area += a1 - a0
             moment += m1 - m0
     n_cells = 0
     for r in range(run_unit.shape[0]):  # runs cover the shared cells only
         u = run_unit[r]
         if s[u] > 0.0:
-            j = _crossing(curves, u, run_a[r], run_b[r], run_rising[r], s[u])
+            j = _crossing(curves, u, run_a[r], run_b[r], run_rising[r], s[u], run_steps, r)
             if j >= 0:
                 k = n_cells
                 while k > 0 and cells[k - 1] > j:
@@ -506,7 +510,10 @@ def _subset_tables(y: np.ndarray, curves: np.ndarray, cells: np.ndarray) -> tupl
             blocks[1 + 2 * k].append(np.concatenate([[0.0], np.cumsum(weighted)]))
             blocks[2 + 2 * k].append(plain.sum() - np.concatenate([[0.0], np.cumsum(plain)]))
         offsets.append(offsets[-1] + len(breakpoints) + 1)
-    return (*(np.concatenate(b) if b else np.zeros(1) for b in blocks), np.array(offsets, np.int64))
+    levels = np.linspace(0.0, 1.0, _STEPS + 1)
+    steps = np.array([offsets[k] + np.searchsorted(b[:-1], levels) for k, b in enumerate(blocks[0])], np.int64)
+    return (*(np.concatenate(b) if b else np.zeros(1) for b in blocks), np.array(offsets, np.int64),
+            steps.reshape(-1, _STEPS + 1))
 
 
 def _runs(curves: np.ndarray, cells: np.ndarray) -> tuple:
@@ -524,5 +531,13 @@ def _runs(curves: np.ndarray, cells: np.ndarray) -> tuple:
                     start = j
                 direction = step
             unit.append(u), first.append(start), last.append(end), rising.append(direction >= 0)
+    levels = np.linspace(0.0, 1.0, _STEPS + 1)
+    steps = np.zeros((len(unit), _STEPS + 1), np.int64)
+    for r, (u, a, b, up) in enumerate(zip(unit, first, last, rising)):
+        values = curves[u, a:b + 1]
+        if up:  # first point at or above each level
+            steps[r] = a + np.searchsorted(values, levels, side="left")
+        else:  # first point below each level
+            steps[r] = b + 1 - np.searchsorted(values[::-1], levels, side="left")
     return (np.array(unit, np.int64), np.array(first, np.int64), np.array(last, np.int64),
-            np.array(rising, np.bool_))
+            np.array(rising, np.bool_), steps)
