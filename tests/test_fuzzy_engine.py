@@ -252,3 +252,10 @@ def test_classifier_engines_agree_on_the_published_system():
     numba_scores = clf.score(raw[:, 0], raw[:, 1], engine="numba")
     numpy_scores = clf.score(raw[:, 0], raw[:, 1], engine="numpy")
     np.testing.assert_allclose(numba_scores, numpy_scores, atol=1e-9, rtol=0)
+
+
+@pytest.mark.parametrize("x", [np.zeros((3, 2)), np.zeros(3), [["a"]]])
+def test_readings_of_the_wrong_shape_are_refused(x):
+    system = CompiledSystem(random_system(3))
+    with pytest.raises(HybridtrackError, match="readings must be"):
+        evaluate(system, x if np.shape(x) != (3, 2) or len(system.system.inputs) != 2 else np.zeros((3, 5)))

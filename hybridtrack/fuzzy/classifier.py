@@ -52,7 +52,7 @@ class Explanation:
 
 
 class FuzzyWeatherClassifier:
-    """Mamdani classifier of the sky from a sun sensor's light (``domain.md`` §4).
+    """Mamdani classifier of the sky from a sun sensor's light (docs/fuzzy-engine.md).
 
     Parameters
     ----------

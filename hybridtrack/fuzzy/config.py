@@ -4,7 +4,7 @@ Parameters follow scikit-fuzzy's argument order (``gaussmf``: mean, sigma; ``gau
 mean1, sigma1, mean2, sigma2; ``trimf``: a, b, c; ``trapmf``: a, b, c, d). MATLAB's ``.fis``
 order differs for the Gaussians; `hybridtrack.fuzzy.fis` converts.
 
-The default is the published system (``domain.md`` §4): intensity 30-300 mA and variation
+The default is the published system (docs/fuzzy-engine.md): intensity 30-300 mA and variation
 0-180 mA, each normalised onto 0-10; Gaussian terms; a triangular output on 0-30; four rules.
 The sigmas are a documented choice, since the publication gives only the shapes. Intensity
 terms use σ = 1.5: a term is down to 0.004 five units from its peak ("nothing left").
@@ -277,7 +277,7 @@ class FuzzyConfig:
 
     @classmethod
     def default(cls) -> FuzzyConfig:
-        """The published system (``domain.md`` §4)."""
+        """The published system (docs/fuzzy-engine.md)."""
         return cls()
 
     @classmethod

@@ -335,7 +335,13 @@ def evaluate_fast(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto"
 
 def evaluate(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto") -> tuple[np.ndarray, np.ndarray]:
     """Every output's value (N, outputs) and every rule's firing (N, rules) for readings `x`."""
-    x = np.ascontiguousarray(x, dtype=float)
+    try:
+        x = np.ascontiguousarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise HybridtrackError(f"readings must be numbers: {exc}") from None
+    if x.ndim != 2 or x.shape[1] != len(system.system.inputs):
+        raise HybridtrackError(f"readings must be an (N, {len(system.system.inputs)}) array, one column per input "
+                               f"({', '.join(system.system.input_names)}); got shape {x.shape}")
     if engine not in ("auto", "numba", "numpy"):
         raise HybridtrackError(f"unknown engine {engine!r}; choose auto, numba or numpy")
     outputs = None
