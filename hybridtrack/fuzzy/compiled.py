@@ -55,13 +55,13 @@ def available() -> bool:
                 namespace = globals()
                 namespace["_prange"] = numba.prange
                 for name in _HELPERS:
-                    namespace[name] = numba.njit(cache=True, inline="always")(namespace[name])
+                    namespace[name] = numba.njit(cache=True, inline="always", error_model="numpy")(namespace[name])
                 for name in _PARALLEL:
                     function = namespace[name]
                     serial = types.FunctionType(function.__code__, namespace, f"{name}_serial")
                     serial.__qualname__ = f"{name}_serial"
-                    namespace[f"{name}_serial"] = numba.njit(cache=True)(serial)
-                    namespace[name] = numba.njit(cache=True, parallel=True)(function)
+                    namespace[f"{name}_serial"] = numba.njit(cache=True, error_model="numpy")(serial)
+                    namespace[name] = numba.njit(cache=True, parallel=True, error_model="numpy")(function)
                 _STATE["compiled"] = True
             _STATE["numba"] = True
     return _STATE["numba"]
@@ -144,39 +144,39 @@ def _levels(firing, n, rule_unit, n_units, aggregate_max, s):
     return True
 
 
-def _table(s, block, bp, pa, qa, pm, qm, offsets, steps):
-    """G_T(s) for area and moment of the unit subset `block`."""
+def _table(s, block, table, offsets, steps):
+    """G_T(s) for area and moment of the unit subset `block`; table rows are (breakpoint, P_a, Q_a, P_m, Q_m)."""
     q = min(int(s * (steps.shape[1] - 1)), steps.shape[1] - 2)  # s lies between level steps q and q + 1
     a, b = steps[block, q], steps[block, q + 1]  # first breakpoint >= s is in [a, b]
     while a < b:
         mid = (a + b) // 2
-        if bp[mid] < s:
+        if table[mid, 0] < s:
             a = mid + 1
         else:
             b = mid
-    return pa[a] + s * qa[a], pm[a] + s * qm[a]
+    return table[a, 1] + s * table[a, 2], table[a, 3] + s * table[a, 4]
 
 
 def _crossing(curves, u, a, b, rising, s, steps, r):
     """Cell j in [a, b) of a monotone run r of curve u where it crosses level s, or -1."""
     q = min(int(s * (steps.shape[1] - 1)), steps.shape[1] - 2)
     if rising:  # first point at or above s
-        if not (curves[u, a] < s and curves[u, b] >= s):
+        if not (curves[a, u] < s and curves[b, u] >= s):
             return -1
         lo, hi = steps[r, q], steps[r, q + 1]
         while lo < hi:
             mid = (lo + hi) // 2
-            if curves[u, mid] >= s:
+            if curves[mid, u] >= s:
                 hi = mid
             else:
                 lo = mid + 1
     else:  # first point below s
-        if not (curves[u, a] >= s and curves[u, b] < s):
+        if not (curves[a, u] >= s and curves[b, u] < s):
             return -1
         lo, hi = steps[r, q + 1], steps[r, q]
         while lo < hi:
             mid = (lo + hi) // 2
-            if curves[u, mid] < s:
+            if curves[mid, u] < s:
                 hi = mid
             else:
                 lo = mid + 1
@@ -202,8 +202,8 @@ def _value(curves, s, n_units, j, frac, imp_min, agg):
     """Aggregated implied sets at fraction `frac` of cell j (agg 0 max, 1 sum, 2 probor)."""
     total = 0.0
     for u in range(n_units):
-        a = curves[u, j]
-        v = a + frac * (curves[u, j + 1] - a)
+        a = curves[j, u]
+        v = a + frac * (curves[j + 1, u] - a)
         v = min(s[u], v) if imp_min else s[u] * v
         if agg == 0:
             total = max(total, v)
@@ -221,7 +221,7 @@ def _cell_points(y, curves, s, n_units, j, imp_min, pts):
     pts[0] = y1
     if imp_min:
         for u in range(n_units):
-            v1, v2 = curves[u, j], curves[u, j + 1]
+            v1, v2 = curves[j, u], curves[j + 1, u]
             if (v1 >= s[u]) != (v2 >= s[u]):
                 c = y1 + (s[u] - v1) * (y2 - y1) / (v2 - v1)
                 if y1 < c < y2:
@@ -250,7 +250,7 @@ def _cell_integral(y, curves, s, n_units, j, imp_min, agg, pts):
 
 
 def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, area_c, moment_c, level_offsets, buckets,
-                     bucket_scale, shared, bp, pa, qa, pm, qm, offsets, steps, run_unit, run_a, run_b, run_rising,
+                     bucket_scale, shared, table, offsets, steps, run_unit, run_a, run_b, run_rising,
                      run_steps, out):
     n_read = firing.shape[0]
     chunk = (n_read + _CHUNKS - 1) // _CHUNKS
@@ -270,14 +270,14 @@ def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, area_c, mome
                     area += a
                     moment += m
             if shared:
-                a, m = _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, steps, run_unit,
+                a, m = _shared_part(s, n_units, order, y, curves, table, offsets, steps, run_unit,
                                     run_a, run_b, run_rising, run_steps, cells, pts)
                 area += a
                 moment += m
             out[n] = moment / area if area > 0.0 else np.nan
 
 
-def _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, steps, run_unit, run_a, run_b,
+def _shared_part(s, n_units, order, y, curves, table, offsets, steps, run_unit, run_a, run_b,
                  run_rising, run_steps, cells, pts):
     """Area and moment over the cells where output units overlap (subset tables, cut cells exact)."""
     for u in range(n_units):  # insertion sort, highest level first
@@ -295,8 +295,8 @@ def _shared_part(s, n_units, order, y, curves, bp, pa, qa, pm, qm, offsets, step
         lo = s[order[k + 1]] if k + 1 < n_units else 0.0
         block |= 1 << order[k]
         if hi > lo:
-            a1, m1 = _table(hi, block - 1, bp, pa, qa, pm, qm, offsets, steps)
-            a0, m0 = _table(lo, block - 1, bp, pa, qa, pm, qm, offsets, steps)
+            a1, m1 = _table(hi, block - 1, table, offsets, steps)
+            a0, m0 = _table(lo, block - 1, table, offsets, steps)
             area += a1 - a0
             moment += m1 - m0
     n_cells = 0
@@ -431,8 +431,9 @@ class _Kernel:
         self.agg = ("max", "sum", "probor").index(methods.aggregation)
         self.outputs = []
         for stage, units in zip(system.stages, system.rule_units):
-            curves = np.ascontiguousarray(stage.curves)
-            subset = (self.method == 0 and self.imp_min and self.agg == 0 and 0 < len(curves) <= MAX_SUBSET_UNITS)
+            curves = np.ascontiguousarray(stage.curves.T)  # (points, units): a cell's values share a cache line
+            subset = (self.method == 0 and self.imp_min and self.agg == 0
+                      and 0 < curves.shape[1] <= MAX_SUBSET_UNITS)
             self.outputs.append((np.ascontiguousarray(units, np.int64), stage.y, curves,
                                  _stage_tables(stage) if subset else None))
 
@@ -450,9 +451,9 @@ class _Kernel:
         for o, (units, y, curves, tables) in enumerate(self.outputs):
             value = np.empty(len(x))
             if tables is not None:
-                subset_kernel(firing, units, len(curves), y, curves, *tables, value)
+                subset_kernel(firing, units, curves.shape[1], y, curves, *tables, value)
             else:
-                dense_kernel(firing, units, len(curves), self.agg == 0, y, curves, self.imp_min, self.agg,
+                dense_kernel(firing, units, curves.shape[1], self.agg == 0, y, curves, self.imp_min, self.agg,
                              self.method, value)
             out[:, o] = value
         return out, firing
@@ -512,7 +513,8 @@ def _subset_tables(y: np.ndarray, curves: np.ndarray, cells: np.ndarray) -> tupl
         offsets.append(offsets[-1] + len(breakpoints) + 1)
     levels = np.linspace(0.0, 1.0, _STEPS + 1)
     steps = np.array([offsets[k] + np.searchsorted(b[:-1], levels) for k, b in enumerate(blocks[0])], np.int64)
-    return (*(np.concatenate(b) if b else np.zeros(1) for b in blocks), np.array(offsets, np.int64),
+    columns = [np.concatenate(b) if b else np.zeros(1) for b in blocks]
+    return (np.ascontiguousarray(np.stack(columns, axis=1)), np.array(offsets, np.int64),
             steps.reshape(-1, _STEPS + 1))
 
 
