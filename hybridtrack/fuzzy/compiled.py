@@ -183,7 +183,7 @@ def _crossing(curves, u, a, b, rising, s, steps, r):
     return lo - 1
 
 
-def _cubic(s, u, levels, area, moment, offsets, buckets, bucket_scale):
+def _cubic(s, u, levels, coefficients, offsets, buckets, bucket_scale):
     """Area and moment of unit u's own cells (tabulated piecewise cubic in its level s)."""
     b = offsets[u + 1] - 1  # levels[offsets[u]..b]; intervals offsets[u]..b-1
     level = min(s, levels[b])
@@ -193,9 +193,10 @@ def _cubic(s, u, levels, area, moment, offsets, buckets, bucket_scale):
     while lo < b - 1 and levels[lo + 1] <= level:
         lo += 1
     t = (level - levels[lo]) / (levels[lo + 1] - levels[lo])
-    i = lo - u  # coefficient rows: one fewer per unit than levels
-    return (area[i, 0] + t * (area[i, 1] + t * (area[i, 2] + t * area[i, 3])),
-            moment[i, 0] + t * (moment[i, 1] + t * (moment[i, 2] + t * moment[i, 3])))
+    i = lo - u  # coefficient rows: one fewer per unit than levels; area then moment
+    c = coefficients
+    return (c[i, 0] + t * (c[i, 1] + t * (c[i, 2] + t * c[i, 3])),
+            c[i, 4] + t * (c[i, 5] + t * (c[i, 6] + t * c[i, 7])))
 
 
 def _value(curves, s, n_units, j, frac, imp_min, agg):
@@ -249,7 +250,7 @@ def _cell_integral(y, curves, s, n_units, j, imp_min, agg, pts):
     return area, moment
 
 
-def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, area_c, moment_c, level_offsets, buckets,
+def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, coefficients, level_offsets, buckets,
                      bucket_scale, shared, table, offsets, steps, run_unit, run_a, run_b, run_rising,
                      run_steps, out):
     n_read = firing.shape[0]
@@ -266,7 +267,7 @@ def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, area_c, mome
             area = moment = 0.0
             for u in range(n_units):  # cells where one unit alone is non-zero
                 if s[u] > 0.0:
-                    a, m = _cubic(s[u], u, levels, area_c, moment_c, level_offsets, buckets, bucket_scale)
+                    a, m = _cubic(s[u], u, levels, coefficients, level_offsets, buckets, bucket_scale)
                     area += a
                     moment += m
             if shared:
@@ -464,14 +465,13 @@ def _stage_tables(stage) -> tuple:
     tables = stage.__dict__.get("_kernel_tables")
     if tables is None:
         levels = np.concatenate([t.levels for t in stage.tables])
-        area = np.concatenate([t.area for t in stage.tables])
-        moment = np.concatenate([t.moment for t in stage.tables])
+        coefficients = np.ascontiguousarray(np.concatenate([np.hstack([t.area, t.moment]) for t in stage.tables]))
         level_offsets = np.cumsum([0] + [len(t.levels) for t in stage.tables]).astype(np.int64)
         cells = np.zeros(len(stage.y) - 1, bool)
         cells[stage.shared_cells] = True
         curves = np.ascontiguousarray(stage.curves)
         buckets, bucket_scale = _buckets(stage.tables, level_offsets)
-        tables = (levels, area, moment, level_offsets, buckets, bucket_scale, bool(cells.any()),
+        tables = (levels, coefficients, level_offsets, buckets, bucket_scale, bool(cells.any()),
                   *_subset_tables(stage.y, curves, cells), *_runs(curves, cells))
         object.__setattr__(stage, "_kernel_tables", tables)
     return tables
