@@ -259,3 +259,26 @@ def test_readings_of_the_wrong_shape_are_refused(x):
     system = CompiledSystem(random_system(3))
     with pytest.raises(HybridtrackError, match="readings must be"):
         evaluate(system, x if np.shape(x) != (3, 2) or len(system.system.inputs) != 2 else np.zeros((3, 5)))
+
+
+@pytest.mark.parametrize("parallel_from", [10**9, 1], ids=["serial", "parallel"])
+def test_every_compiled_path_matches_the_numpy_engine(parallel_from, monkeypatch):
+    """The fused (no firing kept), two-pass, serial and multi-threaded kernels, on the shipped systems."""
+    from pathlib import Path
+
+    from hybridtrack.fuzzy import compiled
+    from hybridtrack.fuzzy.fis import read_fis_system
+
+    monkeypatch.setattr(compiled, "PARALLEL_FROM", parallel_from)
+    here = Path(__file__).parent / "fuzzy_conformance"
+    for system in (FuzzyWeatherClassifier().config.system(), read_fis_system(here / "mixed27.fis"),
+                   read_fis_system(here / "tipper.fis")):
+        x = readings(system, 3000, 9)
+        x[:5] = np.nan
+        compiled_system = CompiledSystem(system)
+        reference = evaluate(compiled_system, x, engine="numpy")[0]
+        fused = evaluate(compiled_system, x, engine="numba", with_firing=False)[0]
+        two_pass, firing = evaluate(compiled_system, x, engine="numba")
+        np.testing.assert_allclose(fused, reference, atol=1e-9, rtol=0)
+        np.testing.assert_array_equal(fused, two_pass)
+        np.testing.assert_allclose(firing, compiled_system.firing(x), atol=1e-12, rtol=0)

@@ -125,7 +125,8 @@ class FuzzyWeatherClassifier:
         """
         x, shape = self._prepare(intensity, variation, raw)
         if engine in ("fast", "numba", "numpy"):
-            scores, _ = evaluate_fast(self._system, x, engine="auto" if engine == "fast" else engine)
+            scores, _ = evaluate_fast(self._system, x, engine="auto" if engine == "fast" else engine,
+                                      with_firing=False)
         elif engine in ("skfuzzy", "skfuzzy-scalar"):
             scores = evaluate_skfuzzy(self.config, x, one_at_a_time=engine == "skfuzzy-scalar")
         else:

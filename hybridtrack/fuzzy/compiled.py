@@ -85,45 +85,47 @@ def kernel_for(system, *, required: bool = False):
 
 def _firing(x, lo, scale, last, samples, nterms, ante, weights, is_or, and_prod, or_probor, firing):
     n_read, n_in = x.shape
-    n_rules = ante.shape[0]
     chunk = (n_read + _CHUNKS - 1) // _CHUNKS
     for c in _prange(_CHUNKS):
-        mu = np.empty((n_in, samples.shape[1]))
+        mu = np.empty((n_in, samples.shape[2]))
         for n in range(c * chunk, min(n_read, (c + 1) * chunk)):
-            bad = False
-            for i in range(n_in):
-                v = x[n, i]
-                if v != v:
-                    bad = True
-                    break
-                pos = (v - lo[i]) * scale[i]
-                if pos <= 0.0:
-                    j, t = 0, 0.0
-                elif pos >= last[i]:
-                    j, t = last[i] - 1, 1.0
-                else:
-                    j = int(pos)
-                    t = pos - j
-                for k in range(nterms[i]):
-                    a = samples[i, k, j]
-                    mu[i, k] = a + t * (samples[i, k, j + 1] - a)
-            for r in range(n_rules):
-                if bad:
-                    firing[n, r] = np.nan
-                    continue
-                value = -1.0
-                for i in range(n_in):
-                    k = ante[r, i]
-                    if k == 0:
-                        continue
-                    m = mu[i, k - 1] if k > 0 else 1.0 - mu[i, -k - 1]
-                    if value < 0.0:
-                        value = m
-                    elif is_or[r]:
-                        value = max(value, m) if not or_probor else value + m - value * m
-                    else:
-                        value = min(value, m) if not and_prod else value * m
-                firing[n, r] = value * weights[r]
+            _fire(x, n, lo, scale, last, samples, nterms, ante, weights, is_or, and_prod, or_probor, mu, firing, n)
+
+
+def _fire(x, n, lo, scale, last, samples, nterms, ante, weights, is_or, and_prod, or_probor, mu, firing, row):
+    """Every rule's firing for reading n of x into firing[row]; samples are (inputs, points, terms)."""
+    n_in = x.shape[1]
+    for i in range(n_in):
+        v = x[n, i]
+        if v != v:
+            for r in range(ante.shape[0]):
+                firing[row, r] = np.nan
+            return
+        pos = (v - lo[i]) * scale[i]
+        if pos <= 0.0:
+            j, t = 0, 0.0
+        elif pos >= last[i]:
+            j, t = last[i] - 1, 1.0
+        else:
+            j = int(pos)
+            t = pos - j
+        for k in range(nterms[i]):
+            a = samples[i, j, k]
+            mu[i, k] = a + t * (samples[i, j + 1, k] - a)
+    for r in range(ante.shape[0]):
+        value = -1.0
+        for i in range(n_in):
+            k = ante[r, i]
+            if k == 0:
+                continue
+            m = mu[i, k - 1] if k > 0 else 1.0 - mu[i, -k - 1]
+            if value < 0.0:
+                value = m
+            elif is_or[r]:
+                value = max(value, m) if not or_probor else value + m - value * m
+            else:
+                value = min(value, m) if not and_prod else value * m
+        firing[row, r] = value * weights[r]
 
 
 def _levels(firing, n, rule_unit, n_units, aggregate_max, s):
@@ -251,8 +253,7 @@ def _cell_integral(y, curves, s, n_units, j, imp_min, agg, pts):
 
 
 def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, coefficients, level_offsets, buckets,
-                     bucket_scale, shared, table, offsets, steps, run_unit, run_a, run_b, run_rising,
-                     run_steps, out):
+                     bucket_scale, shared, table, offsets, steps, run_unit, run_a, run_b, run_rising, run_steps, out):
     n_read = firing.shape[0]
     chunk = (n_read + _CHUNKS - 1) // _CHUNKS
     for c in _prange(_CHUNKS):
@@ -261,21 +262,48 @@ def _subset_centroid(firing, rule_unit, n_units, y, curves, levels, coefficients
         cells = np.empty(run_unit.shape[0] + 1, np.int64)
         pts = np.empty(n_units + 2)
         for n in range(c * chunk, min(n_read, (c + 1) * chunk)):
-            if not _levels(firing, n, rule_unit, n_units, True, s):
-                out[n] = np.nan
-                continue
-            area = moment = 0.0
-            for u in range(n_units):  # cells where one unit alone is non-zero
-                if s[u] > 0.0:
-                    a, m = _cubic(s[u], u, levels, coefficients, level_offsets, buckets, bucket_scale)
-                    area += a
-                    moment += m
-            if shared:
-                a, m = _shared_part(s, n_units, order, y, curves, table, offsets, steps, run_unit,
-                                    run_a, run_b, run_rising, run_steps, cells, pts)
-                area += a
-                moment += m
-            out[n] = moment / area if area > 0.0 else np.nan
+            out[n] = _subset_one(firing, n, rule_unit, n_units, y, curves, levels, coefficients, level_offsets,
+                                 buckets, bucket_scale, shared, table, offsets, steps, run_unit, run_a, run_b,
+                                 run_rising, run_steps, s, order, cells, pts)
+
+
+def _fused_subset(x, lo, scale, last, samples, nterms, ante, weights, is_or, and_prod, or_probor, rule_unit, n_units,
+                  y, curves, levels, coefficients, level_offsets, buckets, bucket_scale, shared, table, offsets, steps,
+                  run_unit, run_a, run_b, run_rising, run_steps, out):
+    """Firing and output in one pass per reading, for callers that do not keep the firing."""
+    n_read, n_in = x.shape
+    chunk = (n_read + _CHUNKS - 1) // _CHUNKS
+    for c in _prange(_CHUNKS):
+        mu = np.empty((n_in, samples.shape[2]))
+        firing = np.empty((1, ante.shape[0]))
+        s = np.empty(n_units)
+        order = np.empty(n_units, np.int64)
+        cells = np.empty(run_unit.shape[0] + 1, np.int64)
+        pts = np.empty(n_units + 2)
+        for n in range(c * chunk, min(n_read, (c + 1) * chunk)):
+            _fire(x, n, lo, scale, last, samples, nterms, ante, weights, is_or, and_prod, or_probor, mu, firing, 0)
+            out[n] = _subset_one(firing, 0, rule_unit, n_units, y, curves, levels, coefficients, level_offsets,
+                                 buckets, bucket_scale, shared, table, offsets, steps, run_unit, run_a, run_b,
+                                 run_rising, run_steps, s, order, cells, pts)
+
+
+def _subset_one(firing, n, rule_unit, n_units, y, curves, levels, coefficients, level_offsets, buckets, bucket_scale,
+                shared, table, offsets, steps, run_unit, run_a, run_b, run_rising, run_steps, s, order, cells, pts):
+    """The centroid of reading n (min implication, max aggregation) from the tables."""
+    if not _levels(firing, n, rule_unit, n_units, True, s):
+        return np.nan
+    area = moment = 0.0
+    for u in range(n_units):  # cells where one unit alone is non-zero
+        if s[u] > 0.0:
+            a, m = _cubic(s[u], u, levels, coefficients, level_offsets, buckets, bucket_scale)
+            area += a
+            moment += m
+    if shared:
+        a, m = _shared_part(s, n_units, order, y, curves, table, offsets, steps, run_unit, run_a, run_b,
+                            run_rising, run_steps, cells, pts)
+        area += a
+        moment += m
+    return moment / area if area > 0.0 else np.nan
 
 
 def _shared_part(s, n_units, order, y, curves, table, offsets, steps, run_unit, run_a, run_b,
@@ -402,9 +430,9 @@ def _prange(n):  # replaced by numba.prange inside compiled kernels
     return range(n)
 
 
-_HELPERS = ("_levels", "_table", "_crossing", "_cubic", "_shared_part", "_value", "_cell_points", "_cell_integral",
+_HELPERS = ("_fire", "_subset_one", "_levels", "_table", "_crossing", "_cubic", "_shared_part", "_value", "_cell_points", "_cell_integral",
             "_dense_bisector", "_dense_maximum")
-_PARALLEL = ("_firing", "_subset_centroid", "_dense")
+_PARALLEL = ("_firing", "_subset_centroid", "_fused_subset", "_dense")
 
 
 class _Kernel:
@@ -414,9 +442,9 @@ class _Kernel:
         spec = system.system
         n_in = spec.resolution[0]
         width = max(len(var.terms) for var in spec.inputs)
-        self.samples = np.zeros((len(spec.inputs), width, n_in))
+        self.samples = np.zeros((len(spec.inputs), n_in, width))  # (inputs, points, terms): one reading, one line
         for i, terms in enumerate(system.input_samples):
-            self.samples[i, :len(terms)] = terms
+            self.samples[i, :, :len(terms)] = np.transpose(terms)
         self.nterms = np.array([len(var.terms) for var in spec.inputs], np.int64)
         self.lo = np.array([var.universe[0] for var in spec.inputs])
         self.scale = np.array([(n_in - 1) / (var.universe[1] - var.universe[0]) for var in spec.inputs])
@@ -438,24 +466,26 @@ class _Kernel:
             self.outputs.append((np.ascontiguousarray(units, np.int64), stage.y, curves,
                                  _stage_tables(stage) if subset else None))
 
-    def evaluate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Every output (N, outputs) and every rule's firing (N, rules) of readings `x` (N, inputs)."""
+    def evaluate(self, x: np.ndarray, with_firing: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """Every output (N, outputs) and every rule's firing (N, rules; None unless `with_firing`)."""
         suffix = "" if len(x) >= PARALLEL_FROM else "_serial"  # the serial twins are made in `available`
         kernels = globals()
-        firing_kernel = kernels[f"_firing{suffix}"]
-        subset_kernel = kernels[f"_subset_centroid{suffix}"]
-        dense_kernel = kernels[f"_dense{suffix}"]
-        firing = np.empty((len(x), len(self.weights)))
-        firing_kernel(x, self.lo, self.scale, self.last, self.samples, self.nterms, self.ante, self.weights,
-                      self.is_or, self.and_prod, self.or_probor, firing)
+        inputs = (self.lo, self.scale, self.last, self.samples, self.nterms, self.ante, self.weights, self.is_or,
+                  self.and_prod, self.or_probor)
         out = np.empty((len(x), len(self.outputs)))
+        if not with_firing and len(self.outputs) == 1 and self.outputs[0][3] is not None:
+            units, y, curves, tables = self.outputs[0]
+            kernels[f"_fused_subset{suffix}"](x, *inputs, units, curves.shape[1], y, curves, *tables, out[:, 0])
+            return out, None
+        firing = np.empty((len(x), len(self.weights)))
+        kernels[f"_firing{suffix}"](x, *inputs, firing)
         for o, (units, y, curves, tables) in enumerate(self.outputs):
             value = np.empty(len(x))
             if tables is not None:
-                subset_kernel(firing, units, curves.shape[1], y, curves, *tables, value)
+                kernels[f"_subset_centroid{suffix}"](firing, units, curves.shape[1], y, curves, *tables, value)
             else:
-                dense_kernel(firing, units, curves.shape[1], self.agg == 0, y, curves, self.imp_min, self.agg,
-                             self.method, value)
+                kernels[f"_dense{suffix}"](firing, units, curves.shape[1], self.agg == 0, y, curves, self.imp_min,
+                                           self.agg, self.method, value)
             out[:, o] = value
         return out, firing
 

@@ -324,17 +324,23 @@ class CompiledSystem:
         return self.unit_levels(firing, 0)
 
 
-def evaluate_fast(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto") -> tuple[np.ndarray, np.ndarray]:
+def evaluate_fast(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto",
+                  with_firing: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
     """First output's values and every rule's firing strength for readings `x` (N, inputs).
 
     `engine`: ``auto`` (compiled when numba is installed), ``numba`` or ``numpy``.
     """
-    outputs, firing = evaluate(system, x, engine=engine)
+    outputs, firing = evaluate(system, x, engine=engine, with_firing=with_firing)
     return outputs[:, 0], firing
 
 
-def evaluate(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto") -> tuple[np.ndarray, np.ndarray]:
-    """Every output's value (N, outputs) and every rule's firing (N, rules) for readings `x`."""
+def evaluate(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto",
+             with_firing: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """Every output's value (N, outputs) and every rule's firing (N, rules) for readings `x`.
+
+    Without `with_firing` the compiled engine may skip storing the firing (None is returned
+    in its place), which saves a pass over memory.
+    """
     try:
         x = np.ascontiguousarray(x, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -350,7 +356,7 @@ def evaluate(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto") -> 
 
         kernel = compiled.kernel_for(system, required=engine == "numba")
         if kernel is not None:
-            outputs, firing = kernel.evaluate(x)
+            outputs, firing = kernel.evaluate(x, with_firing)
     if outputs is None:
         firing = system.firing(x)
         outputs = system.outputs(firing)
