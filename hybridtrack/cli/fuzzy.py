@@ -24,7 +24,8 @@ def _classify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", nargs="?", help="CSV of readings to classify (instead of --intensity/--variation)")
     parser.add_argument("--intensity", type=float, help="sensor photocurrent, mA")
     parser.add_argument("--variation", type=float, help="its variation over the window, mA")
-    parser.add_argument("--config", help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by default")
+    parser.add_argument("--config",
+                        help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by default")
     parser.add_argument("--json", action="store_true", help="print JSON: score, weather and each rule's firing")
     parser.add_argument("--intensity-col", default="intensity", help="file: column of the photocurrent (mA)")
     parser.add_argument("--variation-col", default="variation", help="file: column of the variation (mA)")

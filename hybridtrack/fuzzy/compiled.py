@@ -442,7 +442,8 @@ class _Kernel:
         spec = system.system
         n_in = spec.resolution[0]
         width = max(len(var.terms) for var in spec.inputs)
-        self.samples = np.zeros((len(spec.inputs), n_in, width))  # (inputs, points, terms): one reading, one line
+        # (inputs, points, terms): a reading's memberships of one input share a cache line
+        self.samples = np.zeros((len(spec.inputs), n_in, width))
         for i, terms in enumerate(system.input_samples):
             self.samples[i, :, :len(terms)] = np.transpose(terms)
         self.nterms = np.array([len(var.terms) for var in spec.inputs], np.int64)
