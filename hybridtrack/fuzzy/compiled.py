@@ -430,8 +430,8 @@ def _prange(n):  # replaced by numba.prange inside compiled kernels
     return range(n)
 
 
-_HELPERS = ("_fire", "_subset_one", "_levels", "_table", "_crossing", "_cubic", "_shared_part", "_value", "_cell_points", "_cell_integral",
-            "_dense_bisector", "_dense_maximum")
+_HELPERS = ("_fire", "_subset_one", "_levels", "_table", "_crossing", "_cubic", "_shared_part", "_value",
+            "_cell_points", "_cell_integral", "_dense_bisector", "_dense_maximum")
 _PARALLEL = ("_firing", "_subset_centroid", "_fused_subset", "_dense")
 
 
