@@ -3,8 +3,8 @@
 Run: ``python benchmarks/fuzzy.py [--repeats N] [--readings N]``. Three systems: the published
 sky classifier (2 inputs, 4 rules), ``mixed27`` (3 inputs, 27 rules, nine membership types,
 overlapping output terms) and MATLAB's ``tipper.fis``. For each, this project's compiled
-(numba) and numpy engines classify a year of minutes (525,600 readings); the peers, far
-slower, run on the first readings of the same set: scikit-fuzzy's control API with array
+(numba) engine evaluates a year of minutes (525,600 readings); its numpy fallback and the
+peers, slower, run on the first readings of the same set: scikit-fuzzy's control API with array
 inputs (the reference) and one reading at a time, simpful, and pyfuzzylite when installed
 (GPL-3.0; a benchmark peer only, never a dependency of this project). Rates are readings
 per second; "max |diff|" is the largest difference from scikit-fuzzy (arrays) over the
@@ -114,7 +114,7 @@ def measure(name, system, readings, args, rows, ours=None):
     reference = evaluate_skfuzzy(system, array_part)
     engines = {
         "hybridtrack, numba": (ours or (lambda x: evaluate(compiled, x, engine="numba")[0][:, 0]), len(readings)),
-        "hybridtrack, numpy": (lambda x: evaluate(compiled, x, engine="numpy")[0][:, 0], len(readings) // 4),
+        "hybridtrack, numpy": (lambda x: evaluate(compiled, x, engine="numpy")[0][:, 0], args.numpy_subset),
         "scikit-fuzzy, arrays": (lambda x: evaluate_skfuzzy(system, x), args.array_subset),
         "scikit-fuzzy, one at a time": (lambda x: evaluate_skfuzzy(system, x, one_at_a_time=True),
                                         args.scalar_subset),
@@ -143,6 +143,7 @@ def main() -> None:
     parser.add_argument("--readings", type=int, default=YEAR_OF_MINUTES)
     parser.add_argument("--array-subset", type=int, default=2000)
     parser.add_argument("--scalar-subset", type=int, default=200)
+    parser.add_argument("--numpy-subset", type=int, default=10_000)
     args = parser.parse_args()
     rng = np.random.default_rng(0)
     rows: list[list[str]] = []

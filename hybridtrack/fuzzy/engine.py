@@ -318,11 +318,6 @@ class CompiledSystem:
                 out[:, o] = value
         return out
 
-    # the classifier's single-output helpers
-    def strengths(self, firing: np.ndarray) -> np.ndarray:
-        """Levels of the single output's units, (N, units)."""
-        return self.unit_levels(firing, 0)
-
 
 def evaluate_fast(system: CompiledSystem, x: np.ndarray, *, engine: str = "auto",
                   with_firing: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
