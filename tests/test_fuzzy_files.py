@@ -250,3 +250,18 @@ def test_cli_mistakes_are_one_line(args, message, capsys, monkeypatch):
     assert main(["fuzzy", *args]) == 2
     err = capsys.readouterr().err
     assert err.startswith("hybridtrack: error:") and message in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[methods]\nimplication = 'lukasiewicz'\n", "methods.implication: unknown method 'lukasiewicz'"),
+    ("[methods]\naggregation = 3\n", "methods.aggregation: must be a string"),
+    ("[methods]\nhedges = 'very'\n", "unknown key 'hedges'"),
+    ("[[rules]]\nintensity = 'strong'\nweather = 'sunny'\nweight = 2\n", "rules\\[1\\]: weight must be between 0 and 1"),
+    ("[[rules]]\nintensity = 'strong'\nweather = 'sunny'\nconnection = 'xor'\n", "connection must be 'and' or 'or'"),
+    ("[[rules]]\nintensity = 'not blinding'\nweather = 'sunny'\n", "unknown term 'blinding' for intensity"),
+])
+def test_bad_methods_and_rule_options_in_toml_name_the_key(tmp_path, text, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(HybridtrackError, match=message):
+        FuzzyConfig.from_toml(path)
