@@ -256,7 +256,8 @@ def test_cli_mistakes_are_one_line(args, message, capsys, monkeypatch):
     ("[methods]\nimplication = 'lukasiewicz'\n", "methods.implication: unknown method 'lukasiewicz'"),
     ("[methods]\naggregation = 3\n", "methods.aggregation: must be a string"),
     ("[methods]\nhedges = 'very'\n", "unknown key 'hedges'"),
-    ("[[rules]]\nintensity = 'strong'\nweather = 'sunny'\nweight = 2\n", "rules\\[1\\]: weight must be between 0 and 1"),
+    ("[[rules]]\nintensity = 'strong'\nweather = 'sunny'\nweight = 2\n",
+     "rules\\[1\\]: weight must be between 0 and 1"),
     ("[[rules]]\nintensity = 'strong'\nweather = 'sunny'\nconnection = 'xor'\n", "connection must be 'and' or 'or'"),
     ("[[rules]]\nintensity = 'not blinding'\nweather = 'sunny'\n", "unknown term 'blinding' for intensity"),
 ])
