@@ -173,12 +173,15 @@ class Result:
     config: SimulationConfig
     memory: dict | None = None
 
-    def save(self, folder, *, plot: bool = True, log_format: str = "auto") -> dict[str, Path]:
-        """Write ``log.parquet`` (or ``log.csv``), ``events.csv``, ``summary.json`` and ``report.png``."""
+    def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
+        """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
+        and ``report.png``."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         written = {}
-        use_parquet = log_format == "parquet" or (log_format == "auto" and _has_parquet())
+        if log_format not in ("parquet", "csv"):
+            raise HybridtrackError(f"log_format {log_format!r}: choose 'parquet' or 'csv'")
+        use_parquet = log_format == "parquet"
         if use_parquet:
             written["log"] = folder / "log.parquet"
             self.log.to_parquet(written["log"])
@@ -224,14 +227,6 @@ class Result:
         from .report import explain_step
 
         return explain_step(self, time)
-
-
-def _has_parquet() -> bool:
-    try:
-        import pyarrow  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 def _drives(collector: Collector, config: SimulationConfig) -> list[Drive]:

@@ -220,10 +220,10 @@ def test_reads_a_matlab_fis_with_sigma_first_and_dont_care(tmp_path):
 
 @pytest.mark.parametrize("edit, message", [
     (("Type='mamdani'", "Type='sugeno'"), ":4: only Mamdani"),
-    (("DefuzzMethod='centroid'", "DefuzzMethod='bisector'"), ":13: DefuzzMethod must be 'centroid'"),
-    (("'gaussmf',[1.5 5]", "'gbellmf',[1 2 5]"), ":20: membership type 'gbellmf' is not supported"),
-    (("3 1, 3 (1) : 1", "3 1, 3 (1) : 2"), ":39: only AND rules"),
-    (("3 2, 2 (1) : 1", "3 2, 2 (0.5) : 1"), ":40: only rule weight 1"),
+    (("DefuzzMethod='centroid'", "DefuzzMethod='wtaver'"), ":13: DefuzzMethod 'wtaver' belongs to Sugeno"),
+    (("'gaussmf',[1.5 5]", "'linsmf',[1 5]"), ":20: membership type 'linsmf' is not supported"),
+    (("3 1, 3 (1) : 1", "3 1, 3 (1) : 3"), ":39: the connection must be 1 \\(AND\\) or 2 \\(OR\\)"),
+    (("3 2, 2 (1) : 1", "3 2, 2 (1.5) : 1"), ":40: the rule weight must be one number between 0 and 1"),
     (("2 2, 2 (1) : 1", "2 7, 2 (1) : 1"), ":41: change has no term 7"),
     (("MF1='small':'gaussmf',[2.5 0]", "MF1='small':'gaussmf',[-2.5 0]"), "sigma must be positive"),
 ])

@@ -35,6 +35,8 @@ def load_fuzzy_config(path):
         return FuzzyConfig.default()
     if str(path).lower().endswith(".fis"):
         return FuzzyConfig.from_fis(path)
+    if str(path).lower().endswith(".fcl"):
+        return FuzzyConfig.from_fcl(path)
     return FuzzyConfig.from_toml(path)
 
 
@@ -42,12 +44,14 @@ def _classify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", nargs="?", help="CSV of readings to classify (instead of --intensity/--variation)")
     parser.add_argument("--intensity", type=float, help="sensor photocurrent, mA")
     parser.add_argument("--variation", type=float, help="its variation over the window, mA")
-    parser.add_argument("--config", help="classifier config (.toml or MATLAB .fis); the published one by default")
+    parser.add_argument("--config",
+                        help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by default")
     parser.add_argument("--json", action="store_true", help="print JSON: score, weather and each rule's firing")
     parser.add_argument("--intensity-col", default="intensity", help="file: column of the photocurrent (mA)")
     parser.add_argument("--variation-col", default="variation", help="file: column of the variation (mA)")
     parser.add_argument("--out", help="file: write the readings with sky_score and sky columns here")
-    parser.add_argument("--engine", choices=("fast", "skfuzzy"), default="fast", help="inference engine")
+    parser.add_argument("--engine", choices=("fast", "numba", "numpy", "skfuzzy"), default="fast",
+                        help="inference engine: fast (numba, or numpy without it), numba, numpy or skfuzzy")
 
 
 @command("classify", "classify sky readings with the fuzzy classifier", _classify_arguments)

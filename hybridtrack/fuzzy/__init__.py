@@ -1,10 +1,15 @@
-"""The fuzzy sky classifier: config, two engines, files, tuning (``domain.md`` §4)."""
+"""Fuzzy inference: any Mamdani system (.fis, FCL), the sky classifier as one, engines, tuning.
+
+See docs/fuzzy-engine.md.
+"""
 
 from .classifier import UNKNOWN, Explanation, FuzzyWeatherClassifier
-from .config import LABELS, SHAPES, FuzzyConfig, Rule, Term, Variable
+from .config import LABELS, SHAPES, FuzzyConfig, Methods, Rule, Term, Variable
+from .files import read_system, write_system
+from .system import MamdaniSystem, SystemRule
 
 __all__ = ["FuzzyConfig", "FuzzyWeatherClassifier", "Explanation", "Rule", "Term", "Variable", "SHAPES",
-           "LABELS", "UNKNOWN", "tune"]
+           "LABELS", "UNKNOWN", "tune", "Methods", "MamdaniSystem", "SystemRule", "read_system", "write_system"]
 
 
 def tune(config, samples, **options):

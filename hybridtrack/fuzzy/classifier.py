@@ -15,7 +15,7 @@ __all__ = ["FuzzyWeatherClassifier", "Explanation", "UNKNOWN", "ENGINES"]
 
 #: The label given when no rule fires or an input is missing.
 UNKNOWN = "unknown"
-ENGINES = ("fast", "skfuzzy", "skfuzzy-scalar")
+ENGINES = ("fast", "numba", "numpy", "skfuzzy", "skfuzzy-scalar")
 
 
 @dataclass(frozen=True)
@@ -52,7 +52,7 @@ class Explanation:
 
 
 class FuzzyWeatherClassifier:
-    """Mamdani classifier of the sky from a sun sensor's light (``domain.md`` §4).
+    """Mamdani classifier of the sky from a sun sensor's light (docs/fuzzy-engine.md).
 
     Parameters
     ----------
@@ -117,9 +117,10 @@ class FuzzyWeatherClassifier:
             Sensor photocurrent and its variation: raw mA when `raw`, else normalised 0-10.
         raw : bool
             Whether the inputs are raw readings to normalise with the config's ranges.
-        engine : {"fast", "skfuzzy", "skfuzzy-scalar"}
-            ``fast``: vectorised numpy; ``skfuzzy``: scikit-fuzzy's control API with array
-            inputs (the reference); ``skfuzzy-scalar``: scikit-fuzzy one reading at a time.
+        engine : {"fast", "numba", "numpy", "skfuzzy", "skfuzzy-scalar"}
+            ``fast``: the compiled engine, or numpy where numba is missing; ``numba`` and
+            ``numpy``: that one; ``skfuzzy``: scikit-fuzzy's control API with array inputs
+            (the reference); ``skfuzzy-scalar``: scikit-fuzzy one reading at a time.
 
         Returns
         -------
@@ -127,8 +128,9 @@ class FuzzyWeatherClassifier:
             Shaped like the inputs; a Series keeps its index.
         """
         x, shape = self._prepare(intensity, variation, raw)
-        if engine == "fast":
-            scores, _ = evaluate_fast(self._system, x)
+        if engine in ("fast", "numba", "numpy"):
+            scores, _ = evaluate_fast(self._system, x, engine="auto" if engine == "fast" else engine,
+                                      with_firing=False)
         elif engine in ("skfuzzy", "skfuzzy-scalar"):
             scores = evaluate_skfuzzy(self.config, x, one_at_a_time=engine == "skfuzzy-scalar")
         else:
@@ -157,7 +159,7 @@ class FuzzyWeatherClassifier:
     def firing(self, intensity, variation, *, raw: bool = True) -> np.ndarray:
         """Firing strength of every rule, shape (N, rules)."""
         x, _ = self._prepare(intensity, variation, raw)
-        return self._system.firing(x)
+        return evaluate_fast(self._system, x)[1]
 
     def explain(self, intensity: float, variation: float, *, raw: bool = True) -> Explanation:
         """Take one reading apart: memberships, each rule's firing, score and label."""

@@ -4,7 +4,7 @@ Parameters follow scikit-fuzzy's argument order (``gaussmf``: mean, sigma; ``gau
 mean1, sigma1, mean2, sigma2; ``trimf``: a, b, c; ``trapmf``: a, b, c, d). MATLAB's ``.fis``
 order differs for the Gaussians; `hybridtrack.fuzzy.fis` converts.
 
-The default is the published system (``domain.md`` §4): intensity 30-300 mA and variation
+The default is the published system (docs/fuzzy-engine.md): intensity 30-300 mA and variation
 0-180 mA, each normalised onto 0-10; Gaussian terms; a triangular output on 0-30; four rules.
 The sigmas are a documented choice, since the publication gives only the shapes. Intensity
 terms use σ = 1.5: a term is down to 0.004 five units from its peak ("nothing left").
@@ -16,20 +16,50 @@ classes at least 1.1 score units inside the band.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import HybridtrackError
+from .membership import SHAPES, centre, check_params
 
-__all__ = ["Term", "Variable", "Rule", "FuzzyConfig", "SHAPES", "LABELS"]
-
-#: Membership shapes and their parameter counts.
-SHAPES = {"gaussmf": 2, "gauss2mf": 4, "trimf": 3, "trapmf": 4}
+__all__ = ["Term", "Variable", "Rule", "Methods", "FuzzyConfig", "SHAPES", "LABELS", "METHOD_CHOICES"]
 
 #: The weather labels the controller understands, in score order.
 LABELS = ("overcast", "cloudy", "sunny")
+
+#: The inference options of a Mamdani system and the choices of each.
+METHOD_CHOICES = {"and_method": ("min", "prod"), "or_method": ("max", "probor"), "implication": ("min", "prod"),
+                  "aggregation": ("max", "sum", "probor"),
+                  "defuzzification": ("centroid", "bisector", "mom", "som", "lom")}
+
+
+@dataclass(frozen=True)
+class Methods:
+    """How a Mamdani system combines: AND, OR, implication, aggregation, defuzzification.
+
+    The defaults are MATLAB's and scikit-fuzzy's (min, max, min, max, centroid). Rule
+    weights multiply the firing strength before implication; aggregation runs over the
+    rules' implied sets (MATLAB's definition; with max it is the same as scikit-fuzzy's
+    maximum per output term).
+    """
+
+    and_method: str = "min"
+    or_method: str = "max"
+    implication: str = "min"
+    aggregation: str = "max"
+    defuzzification: str = "centroid"
+
+    def check(self, where: str = "methods") -> None:
+        """Raise `HybridtrackError` naming an unknown method."""
+        for key, choices in METHOD_CHOICES.items():
+            value = getattr(self, key)
+            if value not in choices:
+                raise HybridtrackError(f"{where}.{key}: unknown method {value!r}; choose from {', '.join(choices)}")
+
+    def to_dict(self) -> dict[str, str]:
+        """Plain dict of the five choices."""
+        return {key: getattr(self, key) for key in METHOD_CHOICES}
 
 
 @dataclass(frozen=True)
@@ -45,37 +75,12 @@ class Term:
 
     @property
     def centre(self) -> float:
-        """Where the term peaks (the middle of its plateau for gauss2mf and trapmf)."""
-        p = self.params
-        if self.shape == "gaussmf":
-            return p[0]
-        if self.shape == "trimf":
-            return p[1]
-        return 0.5 * (p[0] + p[2]) if self.shape == "gauss2mf" else 0.5 * (p[1] + p[2])
+        """Where the term peaks (the middle of its plateau; an open sigmoid's 0.5 crossing)."""
+        return centre(self.shape, self.params)
 
     def check(self, where: str) -> None:
         """Raise `HybridtrackError` if the shape or its parameters are invalid."""
-        if self.shape not in SHAPES:
-            raise HybridtrackError(f"{where}: unknown membership type {self.shape!r}; choose from {', '.join(SHAPES)}")
-        if len(self.params) != SHAPES[self.shape]:
-            raise HybridtrackError(
-                f"{where}: {self.shape} takes {SHAPES[self.shape]} parameters, got {len(self.params)}"
-            )
-        if not all(math.isfinite(p) for p in self.params):
-            raise HybridtrackError(f"{where}: parameters must be finite numbers, got {list(self.params)}")
-        p = self.params
-        if self.shape == "gaussmf" and not p[1] > 0:
-            raise HybridtrackError(f"{where}: gaussmf sigma must be positive, got {p[1]}")
-        if self.shape == "gauss2mf":
-            if not (p[1] > 0 and p[3] > 0):
-                raise HybridtrackError(f"{where}: gauss2mf sigmas must be positive, got {p[1]} and {p[3]}")
-            if p[0] > p[2]:
-                raise HybridtrackError(f"{where}: gauss2mf means are inverted ({p[0]} > {p[2]})")
-        if self.shape in ("trimf", "trapmf"):
-            if any(a > b for a, b in zip(p, p[1:])):
-                raise HybridtrackError(f"{where}: {self.shape} parameters must be in order, got {list(p)}")
-            if p[0] == p[-1]:
-                raise HybridtrackError(f"{where}: {self.shape} has zero width, got {list(p)}")
+        check_params(self.shape, self.params, where)
 
 
 @dataclass(frozen=True)
@@ -141,7 +146,7 @@ class Variable:
 
 @dataclass(frozen=True)
 class Rule:
-    """IF every named input is its term THEN the output is `then` (AND = min).
+    """IF the named inputs are their terms THEN the output is `then`.
 
     Parameters
     ----------
@@ -149,13 +154,24 @@ class Rule:
         Input name to term name; an input left out does not matter to the rule.
     then : str
         Output term name.
+    weight : float
+        Multiplies the rule's firing strength, 0-1 (MATLAB's rule weight).
+    connection : {"and", "or"}
+        How the conditions combine, with the system's AND or OR method.
+    negated : iterable of str
+        Inputs whose condition reads "is not": their membership is taken as one minus it.
     """
 
     when: Mapping[str, str]
     then: str
+    weight: float = 1.0
+    connection: str = "and"
+    negated: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "when", tuple(sorted(dict(self.when).items())))
+        object.__setattr__(self, "negated", tuple(sorted(set(self.negated))))
+        object.__setattr__(self, "weight", float(self.weight))
 
     @property
     def conditions(self) -> dict[str, str]:
@@ -163,9 +179,21 @@ class Rule:
         return dict(self.when)
 
     def describe(self, inputs: tuple[str, ...]) -> str:
-        """``intensity is strong AND variation is small -> sunny``."""
-        parts = [f"{name} is {self.conditions[name]}" for name in inputs if name in self.conditions]
-        return f"{' AND '.join(parts)} -> {self.then}"
+        """``intensity is strong AND variation is not small -> sunny`` (with ``(weight 0.5)``)."""
+        parts = [f"{name} is {'not ' if name in self.negated else ''}{self.conditions[name]}"
+                 for name in inputs if name in self.conditions]
+        weight = f" (weight {self.weight:g})" if self.weight != 1.0 else ""
+        return f"{f' {self.connection.upper()} '.join(parts)} -> {self.then}{weight}"
+
+    def check(self, where: str) -> None:
+        """Raise `HybridtrackError` for a bad weight, connection or negation."""
+        if not 0.0 <= self.weight <= 1.0:
+            raise HybridtrackError(f"{where}: weight must be between 0 and 1, got {self.weight}")
+        if self.connection not in ("and", "or"):
+            raise HybridtrackError(f"{where}: connection must be 'and' or 'or', got {self.connection!r}")
+        stray = sorted(set(self.negated) - set(self.conditions))
+        if stray:
+            raise HybridtrackError(f"{where}: negates {stray[0]!r}, which the rule does not name")
 
 
 def _default_inputs() -> tuple[Variable, Variable]:
@@ -228,6 +256,9 @@ class FuzzyConfig:
         Set by tuning: the raw range of each input (in order) that the labelled readings
         covered. A classifier warns when it is applied outside it
         (`hybridtrack.fuzzy.tuning.OutsideLabelsWarning`). Written as ``[labelled_range]``.
+    methods : Methods
+        AND, OR, implication, aggregation and defuzzification (min, max, min, max and
+        centroid by default, as published).
     """
 
     inputs: tuple[Variable, ...] = field(default_factory=_default_inputs)
@@ -238,6 +269,7 @@ class FuzzyConfig:
     resolution: tuple[int, int] = (1001, 3001)
     name: str = "published"
     labelled_range: tuple[tuple[float, float], ...] | None = None
+    methods: Methods = Methods()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inputs", tuple(self.inputs))
@@ -252,7 +284,7 @@ class FuzzyConfig:
 
     @classmethod
     def default(cls) -> FuzzyConfig:
-        """The published system (``domain.md`` §4)."""
+        """The published system (docs/fuzzy-engine.md)."""
         return cls()
 
     @classmethod
@@ -287,7 +319,8 @@ class FuzzyConfig:
         for var in (*self.inputs, self.output):
             if var.name == name:
                 return var
-        raise HybridtrackError(f"no variable {name!r}; the config has {', '.join((*self.input_names, self.output.name))}")
+        names = ", ".join((*self.input_names, self.output.name))
+        raise HybridtrackError(f"no variable {name!r}; the config has {names}")
 
     def validate(self) -> None:
         """Raise `HybridtrackError` naming the first problem found."""
@@ -306,19 +339,20 @@ class FuzzyConfig:
             where = f"rules[{number}]"
             if not rule.conditions:
                 raise HybridtrackError(f"{where}: a rule needs at least one condition")
+            rule.check(where)
             for name, term in rule.conditions.items():
                 if name not in self.input_names:
                     raise HybridtrackError(f"{where}: unknown input {name!r}; inputs are {', '.join(self.input_names)}")
                 if term not in self.variable(name).term_names:
-                    raise HybridtrackError(
-                        f"{where}: unknown term {term!r} for {name}; terms are {', '.join(self.variable(name).term_names)}"
-                    )
+                    terms = ", ".join(self.variable(name).term_names)
+                    raise HybridtrackError(f"{where}: unknown term {term!r} for {name}; terms are {terms}")
             if rule.then not in self.output.term_names:
                 raise HybridtrackError(
                     f"{where}: unknown output term {rule.then!r}; terms are {', '.join(self.output.term_names)}"
                 )
-        if len({rule.when for rule in self.rules}) != len(self.rules):
+        if len({(rule.when, rule.connection, rule.negated) for rule in self.rules}) != len(self.rules):
             raise HybridtrackError("the rule table has two rules with the same conditions")
+        self.methods.check()
         self._validate_bands()
         if any(r < 3 for r in self.resolution) or len(self.resolution) != 2:
             raise HybridtrackError(f"resolution needs two sample counts of at least 3, got {list(self.resolution)}")
@@ -360,17 +394,27 @@ class FuzzyConfig:
             "inputs": inputs,
             "output": {"name": self.output.name, "universe": list(self.output.universe), "terms": terms(self.output)},
             "bands": {name: [low, high] for name, low, high in self.bands},
-            "rules": [{**rule.conditions, self.output.name: rule.then} for rule in self.rules],
+            "methods": self.methods.to_dict(),
+            "rules": [self._rule_dict(rule) for rule in self.rules],
         }
         if self.labelled_range is not None:
             data["labelled_range"] = {var.name: list(pair) for var, pair in zip(self.inputs, self.labelled_range)}
         return data
 
+    def _rule_dict(self, rule: Rule) -> dict:
+        spec = {name: f"not {term}" if name in rule.negated else term for name, term in rule.conditions.items()}
+        spec[self.output.name] = rule.then
+        if rule.weight != 1.0:
+            spec["weight"] = rule.weight
+        if rule.connection != "and":
+            spec["connection"] = rule.connection
+        return spec
+
     @classmethod
     def from_dict(cls, data: Mapping, *, source: str = "config") -> FuzzyConfig:
         """Build and validate a config from the TOML layout; unknown keys are refused."""
         reader = _Reader(source)
-        data = reader.table(data, "", {"name", "resolution", "inputs", "output", "bands", "rules", "labelled_range"})
+        data = reader.table(data, "", {"name", "resolution", "inputs", "output", "bands", "rules", "labelled_range", "methods"})
         default = cls()
         inputs = tuple(
             reader.variable(name, spec, f"inputs.{name}", is_input=True)
@@ -401,9 +445,16 @@ class FuzzyConfig:
             spans = reader.table(data["labelled_range"], "labelled_range", {var.name for var in inputs})
             labelled = tuple(reader.pair(spans[var.name], f"labelled_range.{var.name}") if var.name in spans
                              else reader.fail("labelled_range", f"{var.name} is missing") for var in inputs)
+        methods = Methods()
+        if "methods" in data:
+            spec = reader.table(data["methods"], "methods", set(METHOD_CHOICES))
+            for key, value in spec.items():
+                if not isinstance(value, str):
+                    reader.fail(f"methods.{key}", f"must be a string, got {value!r}")
+            methods = Methods(**spec)
         try:
             return cls(inputs=inputs, output=output, rules=rules, bands=bands, resolution=resolution, name=name,
-                       labelled_range=labelled)
+                       labelled_range=labelled, methods=methods)
         except HybridtrackError as exc:
             raise HybridtrackError(f"{source}: {exc}") from None
 
@@ -434,6 +485,29 @@ class FuzzyConfig:
         from .fis import write_fis
 
         return write_fis(self, path)
+
+    # -- IEC 61131-7 FCL ---------------------------------------------------------------------
+
+    @classmethod
+    def from_fcl(cls, path, *, raw_ranges=None, bands=None, resolution=None) -> FuzzyConfig:
+        """Load an FCL function block with two inputs and one output (see `hybridtrack.fuzzy.fcl`)."""
+        from .fcl import read_fcl
+        from .system import config_from_system
+
+        system = read_fcl(path, resolution=resolution)
+        return config_from_system(system, raw_ranges=raw_ranges, bands=bands, where=str(path))
+
+    def to_fcl(self, path) -> Path:
+        """Write the config as an IEC 61131-7 FCL function block."""
+        from .fcl import write_fcl
+
+        return write_fcl(self, path)
+
+    def system(self):
+        """The general `hybridtrack.fuzzy.system.MamdaniSystem` this classifier runs."""
+        from .system import system_of
+
+        return system_of(self)
 
 
 class _Reader:
@@ -496,10 +570,16 @@ class _Reader:
     def rule(self, spec, number: int, output_name: str) -> Rule:
         where = f"rules[{number}]"
         spec = self.table(spec, where)
+        weight = self.number(spec.pop("weight", 1.0), f"{where}.weight")
+        connection = spec.pop("connection", "and")
         for key, value in spec.items():
             if not isinstance(value, str):
                 self.fail(f"{where}.{key}", f"must be a term name, got {value!r}")
+        if not isinstance(connection, str):
+            self.fail(f"{where}.connection", f"must be 'and' or 'or', got {connection!r}")
         if output_name not in spec:
             self.fail(where, f"says nothing of the output {output_name!r}")
         then = spec.pop(output_name)
-        return Rule(spec, then)
+        negated = [name for name, term in spec.items() if term.lower().startswith("not ")]
+        when = {name: term[4:].strip() if name in negated else term for name, term in spec.items()}
+        return Rule(when, then, weight, connection, negated)
