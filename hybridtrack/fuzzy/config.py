@@ -16,6 +16,7 @@ classes at least 1.1 score units inside the band.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
