@@ -5,9 +5,10 @@ Two signals come from one sensor head on the collector:
 * **Intensity**: the photocurrent in mA, the dark current plus the responsivity times the
   light the cells see. That light is the direct beam (when the sun is inside the field of
   view, weighted by the cosine of the pointing offset) plus a share of the diffuse light.
-  The defaults put a clear noon at Lanzhou in June near 300 mA, a clear Nanjing noon near
-  250 mA (the published sunny reading is 246 mA), bright overcast near 80-110 mA and night
-  at the 30 mA dark current: the field range 30-300 mA of the published classifier (docs/physics.md).
+  The defaults put a clear noon at Lanzhou at 314-333 mA (above the published classifier's
+  30-300 mA range, where its intensity input saturates), a clear Nanjing noon at 264-270 mA (the
+  published sunny reading is 246 mA), bright overcast near 80-110 mA and night at the 30 mA dark
+  current (docs/physics.md §4).
   A recorded ``photocurrent`` column is used as it is.
 * **Variation**: how much the intensity moved over a trailing window (the range max − min),
   the classifier's second input. The default window, 20 minutes, was chosen by measurement.
