@@ -56,8 +56,11 @@ def commented_run_config() -> str:
     data = config.to_dict()
     lines = ["# hybridtrack run config: the defaults, each with what it means.",
              "# Use it with: hybridtrack simulate ... --config run.toml   (unknown keys are refused)", ""]
-    lines += _wrapped(parameter_notes(SimulationConfig).get("seed", "")) + [_value("seed", data["seed"]), ""]
-    for section in ("controller", "imperfections", "sensor", "drive"):
+    top = parameter_notes(SimulationConfig)
+    sections = [f.name for f in dataclasses.fields(config) if dataclasses.is_dataclass(getattr(config, f.name))]
+    for name in (f.name for f in dataclasses.fields(config) if f.name not in sections):
+        lines += _wrapped(top.get(name, "")) + [_value(name, data[name]), ""]
+    for section in sections:
         part = getattr(config, section)
         notes = parameter_notes(type(part))
         lines.append(f"[{section}]")
