@@ -22,11 +22,16 @@ def test_the_example_notebook_runs_and_pyplot_still_renders_afterwards():
     root = str(NOTEBOOK.parent.parent)
     env_path = os.environ.get("PYTHONPATH", "")
     os.environ["PYTHONPATH"] = root + (os.pathsep + env_path if env_path else "")  # this tree, in the kernel
+    # a backend forced from outside (MPLBACKEND=Agg, as headless CI sets) would silence every notebook
+    # plot whatever the project does; the kernel gets the notebook's own inline backend, as a user's would
+    forced = os.environ.pop("MPLBACKEND", None)
     try:
         nbclient.NotebookClient(notebook, timeout=300, kernel_name="python3",
                                 resources={"metadata": {"path": root}}).execute()
     finally:
         os.environ["PYTHONPATH"] = env_path
+        if forced is not None:
+            os.environ["MPLBACKEND"] = forced
     summary, figure, daily, explain, plain = notebook.cells[1:]
     assert "text/html" in outputs_of(summary) and "hybridtrack run" in summary.outputs[0]["data"]["text/plain"]
     assert "image/png" in outputs_of(figure)
