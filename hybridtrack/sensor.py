@@ -133,7 +133,8 @@ class SensorModel:
             if pd.Timedelta(self.window) <= pd.Timedelta(0):
                 raise ValueError
         except ValueError:
-            raise HybridtrackError(f"sensor: window {self.window!r} is not a positive duration such as '20min'") from None
+            raise HybridtrackError(f"sensor: window {self.window!r} is not a positive duration such as "
+                                   "'20min'") from None
 
     def direct_response(self, offset) -> np.ndarray:
         """Share of the direct beam the cells collect at a pointing offset (degrees)."""

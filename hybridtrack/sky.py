@@ -39,7 +39,8 @@ from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_range, parse_freq
 
-__all__ = ["synthetic", "clear_sky", "smooth_noise", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES",
+__all__ = ["synthetic", "clear_sky", "smooth_noise", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters",
+           "REGIMES",
            "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")

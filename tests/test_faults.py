@@ -72,17 +72,27 @@ def test_sensor_dropout_in_full_sun_hands_over_to_the_model():
     assert (log.loc[between(frame, "13:30", "16:00"), "mode"] == "sensor").mean() > 0.8  # and it comes back
 
 
-def test_a_stuck_sensor_is_recognised_and_not_followed():
+@pytest.mark.parametrize("noise", [0.0, 0.001])  # stuck exactly, and stuck with a little electronic noise
+def test_a_stuck_sensor_is_recognised_and_not_followed(noise):
     frame = sunny_day()
-    stuck = np.where(between(frame, "11:00", "14:00"), 0.0, np.nan)  # says "perfectly aligned", forever
+    window = between(frame, "11:00", "14:00")
+    jitter = noise * np.random.default_rng(3).standard_normal(len(frame))
+    stuck = np.where(window, 0.0 + jitter, np.nan)  # says "perfectly aligned", forever
     result = simulate(frame, "lanzhou", faults={"sensor": stuck})
     check_safety(result)
-    statuses = result.log.loc[between(frame, "11:05", "14:00"), "sensor_status"]
+    statuses = result.log.loc[between(frame, "11:10", "14:00"), "sensor_status"]
     assert (statuses == "stuck").all()
     assert "sensor lost (stuck)" in result.events["reason"].tolist()
-    assert tracked(result, between(frame, "11:00", "14:00")).abs().max() < 0.6
+    assert tracked(result, window).abs().max() < 0.6
     handover = result.events.loc[result.events["reason"] == "sensor lost (stuck)", "time"].iloc[0]
-    assert handover <= pd.Timestamp("2021-06-21 11:03", tz="Asia/Shanghai")  # at once, not after the loss time
+    assert handover <= pd.Timestamp("2021-06-21 11:10", tz="Asia/Shanghai")  # ten readings, then at once
+    assert (result.log.loc[between(frame, "11:10", "14:00"), "mode"] != "sensor").all()  # never returned to
+
+
+def test_a_healthy_sensor_is_never_judged_stuck():
+    for site, date in (("lanzhou", "2021-06-21"), ("nanjing", "2013-12-22")):
+        result = simulate(synthetic(site, date, weather="sunny", seed=8), site)
+        assert not (result.log["sensor_status"] == "stuck").any()
 
 
 def test_a_drifting_sensor_bias_is_bounded_by_the_plausibility_check():
@@ -208,7 +218,8 @@ def test_the_southern_hemisphere():
     runs = {s: simulate(frame, alice, strategy=s) for s in ("hybrid", "astronomical")}
     for result in runs.values():
         check_safety(result)
-    assert runs["hybrid"].summary["tracking_error_deg"]["rms"] < runs["astronomical"].summary["tracking_error_deg"]["rms"]
+    rms = {name: run.summary["tracking_error_deg"]["rms"] for name, run in runs.items()}
+    assert rms["hybrid"] < rms["astronomical"]
     assert runs["hybrid"].summary["tracking_error_deg"]["p95"] < 0.5
 
 
@@ -220,7 +231,8 @@ def test_replaying_a_file_across_a_dst_change(tmp_path, capsys):
     pd.DataFrame({"time": local.strftime("%Y-%m-%d %H:%M"), "ghi": frame["ghi"].round(1), "dni": frame["dni"].round(1),
                   "dhi": frame["dhi"].round(1), "wind_speed": frame["wind_speed"].round(2)}).to_csv(path, index=False)
     out = tmp_path / "out"
-    assert main(["replay", str(path), "--lat", "39.74", "--lon", "-104.99", "--tz", "America/Denver", "--out", str(out)]) == 0
+    assert main(["replay", str(path), "--lat", "39.74", "--lon", "-104.99", "--tz", "America/Denver",
+                 "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "naive stamps localised to America/Denver" in printed
     import json
@@ -232,8 +244,9 @@ def test_replaying_a_file_across_a_dst_change(tmp_path, capsys):
 def test_a_replay_interrupted_by_a_bad_stretch_reports_it_and_carries_on(tmp_path, capsys):
     frame = synthetic("nanjing", "2013-06-21", weather="mixed", seed=8)
     local = frame.index.strftime("%Y-%m-%dT%H:%M:%S+08:00")
-    table = pd.DataFrame({"time": local, "ghi": frame["ghi"].round(1).astype(str), "dni": frame["dni"].round(1).astype(str),
-                          "dhi": frame["dhi"].round(1).astype(str), "wind_speed": frame["wind_speed"].round(2).astype(str)})
+    table = pd.DataFrame({"time": local, "ghi": frame["ghi"].round(1).astype(str),
+                          "dni": frame["dni"].round(1).astype(str), "dhi": frame["dhi"].round(1).astype(str),
+                          "wind_speed": frame["wind_speed"].round(2).astype(str)})
     bad = slice(700, 720)  # twenty minutes of a logger writing garbage around noon
     table.loc[table.index[bad], ["ghi", "dni", "dhi"]] = "ERR#"
     path = tmp_path / "record.csv"
@@ -248,3 +261,66 @@ def test_a_replay_interrupted_by_a_bad_stretch_reports_it_and_carries_on(tmp_pat
     assert summary["steps"] == len(frame) and summary["tracking_error_deg"]["p95"] < 0.5
     log = pd.read_parquet(out / "log.parquet") if (out / "log.parquet").exists() else pd.read_csv(out / "log.csv")
     assert log["mode"].iloc[bad].isin(["astronomical", "stow_night"]).all()  # no sensor, no sky: the model
+
+
+def test_a_gust_while_the_encoder_is_judged_frozen_stows_by_a_timed_move_and_is_logged():
+    frame = synthetic("nanjing", "2013-06-21", weather="sunny", seed=3)
+    clock = frame.index.tz_convert("Asia/Shanghai")
+    frozen = np.asarray((clock.hour >= 12) & (clock.hour < 18))
+    wind = np.clip(frame["wind_speed"].to_numpy(), 0.0, 11.0)
+    storm = np.asarray((clock.hour == 14) & (clock.minute < 20))
+    wind[storm] = 29.0
+    result = simulate(frame.assign(wind_speed=wind), "nanjing", faults={"encoder_frozen": frozen})
+    check_safety(result)
+    log, events = result.log, result.events
+    first = int(np.flatnonzero(storm)[0])
+    assert log["mode"].iloc[first - 1] == "fault" and log["mode"].iloc[first] == "stow_wind"  # the same scan
+    reason = events.loc[events["to"] == "stow_wind", "reason"].iloc[0]
+    assert "29.0 m/s" in reason and "timed stow move" in reason
+    stowed = log["angle"].iloc[first + 3]
+    assert abs(stowed - 90.0) < 3.0  # a timed move from the last trusted reading: near stow, no encoder
+    released = events[(events["from"] == "stow_wind") & (events["to"] == "fault")]
+    assert len(released) == 1 and "encoder still judged frozen" in released["reason"].iloc[0]
+
+
+def test_an_anemometer_stuck_in_daylight_raises_an_alarm_and_counts_as_missing():
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=2)
+    clock = frame.index.tz_convert("Asia/Shanghai")
+    wind = frame["wind_speed"].to_numpy().copy()
+    wind[clock.hour >= 9] = 0.0  # stuck at zero from 09:00 on
+    result = simulate(frame.assign(wind_speed=wind), "lanzhou")
+    check_safety(result)
+    alarm = result.events[result.events["reason"].str.contains("anemometer stuck at 0.00 m/s")]
+    assert len(alarm) == 1 and alarm["time"].iloc[0].tz_convert("Asia/Shanghai").hour == 12  # 3 h of daylight
+    after = result.log.loc[alarm["time"].iloc[0]:]
+    assert (after.loc[after["target_true"].notna(), "mode"] == "stow_wind").all()  # missing wind: stow
+    track = SimulationConfig(controller=ControllerConfig(wind_missing="track"))
+    tracked_on = simulate(frame.assign(wind_speed=wind), "lanzhou", config=track)
+    assert tracked_on.events["reason"].str.contains("anemometer stuck").any()
+    assert tracked_on.summary["energy_capture"] > 0.95
+
+
+def test_a_clock_that_creeps_is_caught_with_its_rate_and_taken_out():
+    frame = sunny_day()
+    steps = np.arange(len(frame), dtype=float)
+    creep = np.where(steps >= 600, (steps - 600) * 4.0, 0.0)  # 4 s more every scan from 10:00: under the step detector
+    result = simulate(frame, "lanzhou", strategy="astronomical", faults={"clock": creep})
+    check_safety(result)
+    alarm = result.events[result.events["reason"].str.contains("clock creeping")]
+    assert len(alarm) == 1 and "+240 s an hour" in alarm["reason"].iloc[0]
+    assert alarm["time"].iloc[0] <= pd.Timestamp("2021-06-21 11:01", tz="Asia/Shanghai")
+    assert tracked(result).abs().max() < 1.0  # without the alarm the error would reach 17-20 degrees
+
+
+def test_a_replayed_file_without_wind_is_tracked_through_and_says_so(tmp_path, capsys):
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)[["ghi", "dni", "dhi"]]
+    path = tmp_path / "no-wind.csv"
+    frame.to_csv(path)
+    assert main(["replay", str(path), "--site", "lanzhou", "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "wind: MISSING" in out and "not as calm" in out
+    import json
+
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["wind_data"] == "missing" and summary["energy_capture"] > 0.95
+    assert simulate(frame, "lanzhou").summary["mode_share"]["stow_wind"] > 0.4  # a live controller stows instead

@@ -55,5 +55,6 @@ def _ablate(args: argparse.Namespace) -> int:
         folder.mkdir(parents=True, exist_ok=True)
         result.runs.to_csv(folder / "runs.csv", index=False, float_format="%.6g")
         result.table.to_csv(folder / "table.csv", float_format="%.6g")
-        print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {save_figure(result.plot(), folder / 'ablation.png')}")
+        picture = save_figure(result.plot(), folder / "ablation.png")
+        print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {picture}")
     return 0

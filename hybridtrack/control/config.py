@@ -61,7 +61,8 @@ class ControllerConfig:
     sensor_plausibility : float
         Degrees: a sensor reading further from the (calibrated) model is implausible.
     stuck_scans : int
-        Identical sensor readings in a row that mark the sensor stuck.
+        Scans over which a sun angle from the sensor that stays within a third of its datasheet
+        noise (`sensor_noise`), while the sun moved ten times that, marks the sensor stuck.
     encoder_confirm : int
         Scans a jumped encoder reading must persist before it is believed.
     calibration_max_rate : float
@@ -106,7 +107,7 @@ class ControllerConfig:
     reacquire: int = 3
     calibration_max_rate: float = 1.0
     sensor_plausibility: float = 2.0
-    stuck_scans: int = 3
+    stuck_scans: int = 4
     encoder_confirm: int = 3
     coast: str = "30min"
     dusk_current: float = 35.0
@@ -132,7 +133,8 @@ class ControllerConfig:
                 if pd.Timedelta(getattr(self, name)) <= pd.Timedelta(0):
                     raise ValueError
             except ValueError:
-                raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive duration") from None
+                raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive "
+                                       "duration") from None
         for name in ("wind_stow", "wind_release", "min_altitude", "process_noise", "gate", "calibration_max_rate",
                      "sensor_plausibility", "sensor_noise", "dusk_current", "disagreement"):
             value = getattr(self, name)
@@ -151,7 +153,7 @@ class ControllerConfig:
                                    "and sensor_noise (0-5] are out of range")
         if not -10 <= self.min_altitude <= 30:
             raise HybridtrackError(f"controller: min_altitude {self.min_altitude} is outside -10 to 30 degrees")
-        for name, least in (("reacquire", 1), ("stuck_scans", 2), ("encoder_confirm", 1)):
+        for name, least in (("reacquire", 1), ("stuck_scans", 3), ("encoder_confirm", 1)):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and least <= value <= 10_000):
                 raise HybridtrackError(f"controller: {name} must be a whole number of at least {least}, got {value!r}")

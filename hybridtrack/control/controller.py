@@ -115,6 +115,7 @@ class Controller:
         self.model = [plan.model[:, a].tolist() for a in range(self.axes)]
         self.awake = plan.awake.tolist()
         self.clock_steps = plan.clock_steps.tolist()
+        self.plan_alarms = plan.alarms
         n = len(self.awake)
         resolution = [d.resolution for d in drives]
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
@@ -123,7 +124,7 @@ class Controller:
         self.sky = SkyWatch(ClassifierTable(classifier), window_minutes)
         variance = [config.sensor_noise**2 + r * r / 12.0 for r in resolution]
         self.gates = [SensorGate(config.kalman, config.process_noise, v, config.stuck_scans, config.gate,
-                                 config.reacquire) for v in variance]
+                                 config.reacquire, config.sensor_noise) for v in variance]
         self.calibrators = [Calibrator(config.minutes("calibration_tau"), config.calibration_max_rate)
                             for _ in drives]
         self.jacobian, self.weight = plan.jacobian, plan.weight
@@ -149,6 +150,7 @@ class Controller:
         self.park = list(park)
         self.dark_since = math.nan
         self.was_awake = False
+        self.blind_stow: list[float] | None = None  # what is left of a timed stow move, per axis
         self.was_awake = False
         self.found_today = False
         self.events: list = []
@@ -229,10 +231,15 @@ class Controller:
         dt = t - self.previous_t if not math.isnan(self.previous_t) else 1.0
         self.previous_t = t
         awake = self.awake[i] and (not self.config.sensor_only or self._daylight(t, obs.intensity))
+        if i in self.plan_alarms:
+            self._alarm(i, self.plan_alarms[i])
         if self.clock_steps[i]:
             self._alarm(i, f"controller clock stepped by {self.clock_steps[i]:+.0f} s against the scan timer; "
                            "clock re-based")
         reading = self._read_encoders(i, t, obs)
+        stuck = self.wind.watch(t, obs.wind, awake)
+        if stuck:
+            self._alarm(i, stuck)
         gusty = self.wind.update(t, obs.wind)
         if self.resting and not awake and not gusty:
             self.was_awake = False
@@ -262,8 +269,9 @@ class Controller:
 
     def _read_encoders(self, i: int, t: float, obs: Observation) -> list[float]:
         reading = []
+        blind = self.mode == FAULT or self.blind_stow is not None
         for a, monitor in enumerate(self.encoders):
-            value, note, frozen = monitor.read(obs.encoder[a], self.mode == FAULT)
+            value, note, frozen = monitor.read(obs.encoder[a], blind)
             if frozen and self.mode != FAULT:
                 self._switch(i, FAULT, note, t)
             elif note:
@@ -274,11 +282,19 @@ class Controller:
     def _day_and_wind(self, i: int, t: float, awake: bool, gusty: bool, wind: float) -> None:
         mode, config = self.mode, self.config
         resume = SENSOR if config.sensor_only else ASTRONOMICAL
-        if gusty and mode not in (STOW_WIND, FAULT):
-            self._switch(i, STOW_WIND, "wind reading invalid" if math.isnan(wind)
-                         else f"wind {wind:.1f} m/s > {config.wind_stow}", t)
+        if gusty and mode != STOW_WIND:  # wind first, from every mode
+            reason = "wind reading missing" if math.isnan(wind) else f"wind {wind:.1f} m/s > {config.wind_stow}"
+            if mode == FAULT:  # the position is unknown: a timed move from the last trusted reading
+                self.blind_stow = [d.stow - m.believed for d, m in zip(self.drives, self.encoders)]
+                reason += "; encoder judged frozen: timed stow move from the last trusted reading"
+            self._switch(i, STOW_WIND, reason, t)
         elif mode == STOW_WIND and not gusty and self.wind.released(t):
-            self._switch(i, resume, f"wind at or below {config.wind_release} m/s for {config.wind_hold}", t)
+            released = f"wind at or below {config.wind_release} m/s for {config.wind_hold}"
+            if self.blind_stow is not None:
+                self.blind_stow = None
+                self._switch(i, FAULT, released + "; encoder still judged frozen: drive halted", t)
+            else:
+                self._switch(i, resume, released, t)
         mode = self.mode
         if mode == FAULT:
             if awake and not self.was_awake:
@@ -320,7 +336,8 @@ class Controller:
         status = OK
         trusted = config.calibrates and self._trusts_sensor(sky, obs)
         for a, gate in enumerate(self.gates):
-            verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a])
+            verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a],
+                                 self._turn(a, self._expected_sun(i, a, t) - reading[a]))
             if verdict == OK and obs.t < self.distrusted_until:
                 verdict = IMPLAUSIBLE
             if verdict == OK:
@@ -341,6 +358,14 @@ class Controller:
         elif math.isnan(self.invalid_since):
             self.invalid_since = t
         return status, valid
+
+    def _expected_sun(self, i: int, a: int, t: float) -> float:
+        """Where the sun should be on axis `a` for the stuck check: the computed sun, or for the
+        sensor-only tracker the filter's rate carried forward."""
+        if self.config.uses_model:
+            return self.model[a][i] + self._correction(i, a)
+        gate = self.gates[a]
+        return gate.filter.rate * t if gate.ready else math.nan
 
     def _plausibility_bound(self, i: int, a: int) -> float:
         limit = self.config.sensor_plausibility
@@ -513,6 +538,15 @@ class Controller:
             if mode == FAULT:  # position unknown: never move
                 targets.append(reading[a])
                 moves.append(0.0)
+                continue
+            if self.blind_stow is not None:  # a timed stow move: run at stow speed for the distance, then stop
+                left = self.blind_stow[a]
+                step = max(-drive.stow_speed * dt, min(drive.stow_speed * dt, left))
+                self.blind_stow[a] = left - step
+                self.travel[a] += abs(step)
+                self.moves[a] += 1 if step else 0
+                targets.append(drive.stow)
+                moves.append(step)
                 continue
             low, high = drive.limits
             target = min(max(self._target(i, a, t, dt, reading[a], valid[a], obs), low), high)

@@ -6,14 +6,17 @@ own per-scan computation would:
 
 * the controller's clock is compared with its scan timer; a jump of more than
   `CLOCK_STEP_SECONDS` between two scans is a clock step, logged and taken out (the clock is
-  re-based on the timer); a slow drift is not seen here;
+  re-based on the timer). A clock that creeps, gaining or losing more than `CREEP_LIMIT` seconds
+  an hour over the last hour (a healthy one drifts a second or two a day), is logged with its
+  rate and re-based on the timer from then on;
 * the computed sun at the (re-based) clock, the believed site and the controller's sun model;
 * the computed target of each axis on the mount as the controller believes it to be (nominal,
   or corrected by a commissioning fit), in encoder coordinates;
 * awake: with the computed sun up, or rising within 30 minutes (to pre-position), or set less
   than 15 minutes ago (to catch the last light), within the working hours, which by default span
-  the whole day: the day is set by the sun, and clock hours are an optional limit. The sensor-only tracker has no sun model and no working hours: it wakes and
-  sleeps by the light its sensor reads (`Controller`), so its plan is awake throughout.
+  the whole day: the day is set by the sun, and clock hours are an optional limit. The
+  sensor-only tracker has no sun model and no working hours: it wakes and sleeps by the light
+  its sensor reads (`Controller`), so its plan is awake throughout.
 """
 
 from __future__ import annotations
@@ -34,6 +37,9 @@ __all__ = ["MountEstimate", "ControllerPlan", "make_plan", "east_park", "CLOCK_S
 
 #: A jump of the controller's clock against its scan timer larger than this is a clock step.
 CLOCK_STEP_SECONDS = 5.0
+#: Seconds an hour: a clock creeping faster than this against the scan timer is faulty (a PLC's
+#: crystal drifts about 0.1 s an hour at worst; sixty times that is no temperature effect).
+CREEP_LIMIT = 5.0
 #: How long before its computed sunrise the controller wakes to pre-position.
 PRE_POSITION = pd.Timedelta(minutes=30)
 #: How long after its computed sunset the controller goes on before it stows.
@@ -86,15 +92,31 @@ class ControllerPlan:
     clock_steps: np.ndarray
     jacobian: np.ndarray | None = None
     weight: np.ndarray | None = None
+    alarms: dict = field(default_factory=dict)
 
 
-def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeIndex, np.ndarray]:
-    """The clock with its steps against the scan timer taken out, and the steps in seconds."""
+def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeIndex, np.ndarray, dict]:
+    """The clock with its steps and creep against the scan timer taken out, the steps in seconds,
+    and the alarms by scan."""
     elapsed = np.asarray((clock - clock[0]) / pd.Timedelta(seconds=1), float)
     drift = elapsed - 60.0 * minutes
     jumps = np.diff(drift, prepend=drift[0])
     steps = np.where(np.abs(jumps) > CLOCK_STEP_SECONDS, jumps, 0.0)
-    return clock - pd.to_timedelta(np.cumsum(steps), unit="s"), steps
+    drift = drift - np.cumsum(steps)
+    alarms = {}
+    hour_ago = np.searchsorted(minutes, minutes - 60.0)
+    span = minutes - minutes[hour_ago]
+    rate = np.divide(drift - drift[hour_ago], span / 60.0, out=np.zeros_like(drift), where=span >= 59.0)
+    creeping = np.flatnonzero(np.abs(rate) > CREEP_LIMIT)
+    if len(creeping):
+        i = int(creeping[0])
+        latest = (drift[i] - drift[i - 1]) / max(minutes[i] - minutes[i - 1], 1e-9) * 60.0 if i else rate[i]
+        alarms[i] = (f"controller clock creeping {latest:+.0f} s an hour against the scan timer "
+                     f"({drift[i] - drift[hour_ago[i]]:+.0f} s in the last hour); "
+                     "clock re-based on the timer from here")
+        drift[i:] = drift[i]  # from here the clock runs with the timer
+    rebased = clock[0] + pd.to_timedelta(60.0 * minutes + drift, unit="s")
+    return rebased, steps, alarms
 
 
 def _working(local: pd.DatetimeIndex, hours: tuple[str, str]) -> np.ndarray:
@@ -120,7 +142,7 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     mount : MountEstimate, optional
         The controller's belief about its mount; nominal by default.
     """
-    clock, steps = _rebased(clock, minutes)
+    clock, steps, alarms = _rebased(clock, minutes)
     working = _working(clock.tz_convert(site.tz), config.working_hours)
     sun = solar_position(clock, site, config.sun_model)
     altitude = sun["altitude"].to_numpy()
@@ -134,7 +156,7 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
         rising = (soon > config.min_altitude) & ~up & (soon > altitude)
         setting = (before > config.min_altitude) & ~up & (before > altitude)
         awake = working & (up | rising | setting)
-    plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps)
+    plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps, alarms=alarms)
     if config.calibrates:
         from .mountfit import jacobian
 

@@ -1,7 +1,10 @@
 """The sensor gate: which readings of the sun sensor the controller believes, and its filter.
 
-A reading is refused when the sensor says it sees no sun, when it repeats exactly for
-`stuck_scans` scans (a real one always has noise), when it is further from the calibrated model
+A reading is refused when the sensor says it sees no sun, when its offset stays put over
+`stuck_scans` scans while the offset it should read has moved (its range below a third of the
+sensor's datasheet σ while the expected offset, from the computed sun or the filtered rate less
+the encoder, moved ten times that: the sun and the drive never both stand still, so a sensor
+whose answer does is stuck, noise or no noise), when it is further from the calibrated model
 than the plausibility bound, or when it fails the Kalman filter's innovation gate. After
 `reacquire` gated readings in a row the filter restarts from the latest reading: a filter that
 drifted away from the sun must not go on rejecting it.
@@ -10,6 +13,7 @@ drifted away from the sun must not go on rejecting it.
 from __future__ import annotations
 
 import math
+from collections import deque
 
 from .kalman import make_filter
 from .modes import IMPLAUSIBLE, INVALID, LOW_LIGHT, OK, OUT_OF_VIEW, OUTLIER, STUCK
@@ -20,25 +24,31 @@ __all__ = ["SensorGate"]
 class SensorGate:
     """One axis: judge the reading, and keep the Kalman-filtered sun angle (encoder coordinates)."""
 
-    __slots__ = ("filter", "ready", "rejected", "repeats", "last_measured", "stuck_scans", "gate2", "reacquire")
+    __slots__ = ("filter", "ready", "rejected", "angles", "expected", "stuck_spread", "gate2", "reacquire")
 
     def __init__(self, engine: str, process_noise: float, variance: float, stuck_scans: int, gate: float,
-                 reacquire: int):
+                 reacquire: int, noise: float):
         self.filter = make_filter(engine, process_noise, variance)
         self.ready = False
         self.rejected = 0
-        self.repeats = 0
-        self.last_measured = math.nan
-        self.stuck_scans = stuck_scans
+        self.angles: deque = deque(maxlen=stuck_scans)
+        self.expected: deque = deque(maxlen=stuck_scans)
+        self.stuck_spread = noise / 3.0
         self.gate2 = gate * gate
         self.reacquire = reacquire
 
-    def judge(self, measured: float, valid: bool, coarse: float) -> int:
-        """The status of a raw reading before it meets the model and the filter."""
-        self.repeats = self.repeats + 1 if measured == self.last_measured else 0
-        self.last_measured = measured
-        if self.repeats >= self.stuck_scans - 1:
-            return STUCK
+    def judge(self, measured: float, valid: bool, coarse: float, expected: float) -> int:
+        """The status of a raw reading before it meets the model and the filter; `expected` is the
+        offset it should read (the expected sun less the encoder reading)."""
+        if math.isnan(measured) or math.isnan(expected):
+            self.angles.clear()
+            self.expected.clear()
+        else:
+            self.angles.append(measured)
+            self.expected.append(expected)
+            if len(self.angles) == self.angles.maxlen and max(self.angles) - min(self.angles) < self.stuck_spread \
+                    and max(self.expected) - min(self.expected) > 10.0 * self.stuck_spread:
+                return STUCK
         if not valid:
             return LOW_LIGHT if math.isnan(coarse) else OUT_OF_VIEW
         if math.isnan(measured) or abs(measured) > 90.0:

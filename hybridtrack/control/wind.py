@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["WindGuard"]
+__all__ = ["WindGuard", "STUCK_HOURS", "STUCK_SPREAD"]
+
+#: Hours of daylight readings within `STUCK_SPREAD` of each other that mark an anemometer stuck:
+#: the wind by day moves more than that within minutes (a calm night may read 0 for hours).
+STUCK_HOURS = 3.0
+#: m/s: the spread a working cup anemometer's readings exceed within `STUCK_HOURS` of daylight.
+STUCK_SPREAD = 0.05
 
 
 class WindGuard:
@@ -13,9 +19,11 @@ class WindGuard:
     A reading that is not a number is missing wind data, never calm: with ``missing="stow"``
     (a live controller's default) it counts as a gust; with ``missing="track"`` (replaying a
     file that has no wind at all) it counts as no gust, and the run says the wind was missing.
+    A reading stuck within `STUCK_SPREAD` for `STUCK_HOURS` of daylight is missing too.
     """
 
-    __slots__ = ("stow_above", "release_at", "hold", "calm_since", "stow_when_missing")
+    __slots__ = ("stow_above", "release_at", "hold", "calm_since", "stow_when_missing", "flat_value", "flat_since",
+                 "stuck")
 
     def __init__(self, stow_above: float, release_at: float, hold_minutes: float, missing: str = "stow"):
         self.stow_above = stow_above
@@ -23,6 +31,9 @@ class WindGuard:
         self.hold = hold_minutes
         self.calm_since = -math.inf
         self.stow_when_missing = missing == "stow"
+        self.flat_value = math.nan
+        self.flat_since = math.nan
+        self.stuck = False
 
     def gusty(self, wind: float) -> bool:
         """Whether this reading demands a stow."""
@@ -30,8 +41,27 @@ class WindGuard:
             return self.stow_when_missing
         return not wind <= self.stow_above
 
+    def watch(self, t: float, wind: float, daylight: bool) -> str | None:
+        """Watch for a stuck anemometer; return an alarm text when it sticks or comes back."""
+        if math.isnan(wind) or not daylight:
+            self.flat_value = math.nan  # the flat spell must be daylight without a break
+            return None
+        if math.isnan(self.flat_value) or abs(wind - self.flat_value) > STUCK_SPREAD:
+            self.flat_value, self.flat_since = wind, t
+            if self.stuck:
+                self.stuck = False
+                return f"anemometer moving again ({wind:.1f} m/s)"
+            return None
+        if not self.stuck and t - self.flat_since >= 60.0 * STUCK_HOURS:
+            self.stuck = True
+            return (f"anemometer stuck at {self.flat_value:.2f} m/s for {STUCK_HOURS:g} h of daylight; "
+                    "its readings count as missing")
+        return None
+
     def update(self, t: float, wind: float) -> bool:
         """Take a reading at scan time `t` (minutes); return whether it is a gust."""
+        if self.stuck and not math.isnan(wind) and abs(wind - self.flat_value) <= STUCK_SPREAD:
+            wind = math.nan
         if self.gusty(wind):
             self.calm_since = math.inf
             return True
