@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import HybridtrackError
-from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep  # noqa: F401, I001  (each registers its commands, in this order)
+from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
 from .base import _COMMANDS, _HELP, EXIT_USAGE
 
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
