@@ -25,10 +25,11 @@ from .control.mountfit import parameter_names
 from .control.plan import east_park
 from .drive import Drive
 from .errors import HybridtrackError
-from .fuzzy import FuzzyConfig, FuzzyWeatherClassifier
+from .fuzzy import FuzzyWeatherClassifier
 from .metrics import summarize
 from .mounting import incidence_cosine
 from .sensor import SensorModel
+from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
 from .world import Imperfections, World
 
 __all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
@@ -65,6 +66,10 @@ class SimulationConfig:
         the way round: limits -180° to 540° (a cable wrap of one turn either way), stow at 180°.
     seed : int
         Seeds the sensor noise.
+    sky : SkyInputConfig
+        How the controller turns its sensor's photocurrent into the classifier's inputs
+        (`hybridtrack.skyinputs`): by default the light relative to the clear sky it expects,
+        measured best on real records; ``SkyInputConfig.published()`` is the published system.
     truth : {"spa-fast", "spa"}
         How the world computes the true sun: SPA with its slow series interpolated from hourly
         knots (within 1e-5° of SPA, a tenth of its cost; ``hybridtrack.sun``) or SPA itself.
@@ -75,6 +80,7 @@ class SimulationConfig:
     sensor: SensorModel = field(default_factory=SensorModel)
     drive: Drive = field(default_factory=Drive)
     heliostat_drive: Drive = field(default_factory=lambda: Drive(deadband=0.05, encoder_bits=16))
+    sky: SkyInputConfig = field(default_factory=SkyInputConfig)
     seed: int = 0
     truth: str = "spa-fast"
 
@@ -87,6 +93,8 @@ class SimulationConfig:
         def plain(value):
             if dataclasses.is_dataclass(value):
                 return {f.name: plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+            if value is None:
+                return "none"  # TOML has no null (the sky inputs' smoothing)
             return list(value) if isinstance(value, tuple) else value
 
         return plain(self)
@@ -302,13 +310,18 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     mount, memory = _history(site, collector, config, frame.index[0], classifier, warm_start)
     plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
                      config.controller, mount)
-    clf = classifier or FuzzyWeatherClassifier(FuzzyConfig.default())
-    window = pd.Timedelta(config.sensor.window) / pd.Timedelta(minutes=1)
-    controller = Controller(config.controller, drives, plan, clf, window, east_park(collector), memory)
+    clf = classifier or FuzzyWeatherClassifier(fuzzy_config(config.sky))
+    clear = _expected_clear_sky(world, config)
+    if clear is not None:
+        plan.clear_light = (clear_sky_photocurrent(clear, config.sensor) - config.sensor.dark_current).to_numpy()
+        plan.apparent_altitude = clear["apparent_elevation"].to_numpy()
+    controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
+                            east_park(collector), memory)
     _run(world, controller, progress, bulk_nights and not faults)
     out = controller.outputs()
     index = frame.index
-    log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config.sensor))
+    log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
+                                                       world.controller_site()))
     events = pd.DataFrame([(index[i], a, b, why) for i, a, b, why in out.events],
                           columns=["time", "from", "to", "reason"])
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
@@ -437,13 +450,25 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
     return np.where(np.isnan(values), default, values) if not np.isnan(default) else values
 
 
-def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, sensor: SensorModel) -> pd.DataFrame:
-    """The sky as the exact classifier calls the controller's own readings (the log's ``sky``):
-    the photocurrent read (NaN while asleep), its variation over the sensor's window, the score."""
+def _expected_clear_sky(world: World, config: SimulationConfig) -> pd.DataFrame | None:
+    """The clear sky the controller expects at each scan (its clock, its site), on the scans' index."""
+    if config.sky.mode != "relative" or config.controller.sensor_only:
+        return None
+    return clear_sky(world.controller_clock(), world.controller_site()).set_axis(world.index)
+
+
+def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,
+              clear: pd.DataFrame | None, site: sites.Site) -> pd.DataFrame:
+    """The sky as the exact classifier calls the controller's own readings (the log's ``sky``): the
+    photocurrent read (NaN while asleep), the classifier's two inputs from it (`sky_inputs`, the
+    reference of the controller's scan-by-scan sky watch), the score and the label."""
     reading = pd.Series(intensity, index=index, name="intensity_ma")
-    variation = sensor.variation(reading).to_numpy(copy=True)
+    inputs = config.sky if clear is not None else dataclasses.replace(config.sky, mode="absolute")
+    level, variation = sky_inputs(pd.DataFrame(index=index), site, config.sensor, inputs, intensity=reading,
+                                  clear=clear)
+    variation = variation.to_numpy(copy=True)
     variation[np.isnan(intensity)] = np.nan
-    score = np.asarray(classifier.score(intensity, variation), float)
+    score = np.asarray(classifier.score(level.to_numpy(), variation), float)
     return pd.DataFrame({"intensity_ma": intensity, "variation_ma": variation, "sky_score": score,
                          "sky": classifier.label(score)}, index=index)
 

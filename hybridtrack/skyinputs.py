@@ -109,6 +109,8 @@ class SkyInputConfig:
     relative_floor: float = 0.3
 
     def __post_init__(self) -> None:
+        if isinstance(self.smoothing, str) and self.smoothing.lower() == "none":
+            object.__setattr__(self, "smoothing", None)
         for name, allowed in (("mode", MODES), ("rules", RULES), ("low_sun", LOW_SUN)):
             if getattr(self, name) not in allowed:
                 raise HybridtrackError(f"sky inputs: {name} {getattr(self, name)!r} is not one of {', '.join(allowed)}")

@@ -10,6 +10,7 @@ from hybridtrack.collectors import (
 )
 from hybridtrack.control import MODES, STRATEGIES, Controller, ControllerConfig, ControllerPlan, Observation
 from hybridtrack.drive import Drive
+from hybridtrack.skyinputs import SkyInputConfig
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
 
 altitude = st.floats(0.01, 90.0)
@@ -87,7 +88,7 @@ def test_the_controller_stays_in_limits_stows_on_gusts_and_moves_only_past_the_d
     plan, wind, intensity, offset, valid, strategy = case
     drive = Drive()
     config = ControllerConfig(strategy=strategy)
-    controller = Controller(config, [drive], plan, CLASSIFIER, 20.0, [10.0])
+    controller = Controller(config, [drive], plan, CLASSIFIER, SkyInputConfig.published(), 30.0, [10.0])
     obs, angle = Observation(1), drive.stow
     angles = []
     for i in range(len(wind)):  # a perfect plant: the encoder reads the angle, the sensor what it is given

@@ -51,7 +51,8 @@ def test_the_controller_cannot_reach_the_worlds_state():
     drives = _drives(collector, config)
     world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
     plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
-    controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), 20.0, east_park(collector))
+    controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
+                            east_park(collector))
     forbidden = (World, Imperfections, pd.DataFrame, SensorModel)
     assert not any(isinstance(thing, forbidden) for thing in reachable(controller))
     assert not any(thing is world.truth for thing in reachable(controller))
@@ -65,7 +66,7 @@ def test_the_kalman_filter_takes_its_noise_from_the_controllers_datasheet_not_th
         drives = _drives(Collector("trough-ns"), config)
         plan = make_plan(frame.index, np.arange(len(frame), dtype=float), sites.get("nanjing"),
                          Collector("trough-ns"), config.controller)
-        controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), 20.0, [90.0])
+        controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0, [90.0])
         expected = config.controller.sensor_noise ** 2 + drives[0].resolution ** 2 / 12.0
         assert controller.gates[0].filter.r == pytest.approx(expected)
 
@@ -146,3 +147,33 @@ def test_on_mixed_days_a_closed_loop_loses_and_the_log_says_why():
     assert mean.loc["hybrid-always", "rms"] > mean.loc["hybrid", "rms"]
     # the sensor-only tracker loses to both: pulled while it sees cloud, held while it sees nothing
     assert (runs.loc[runs["policy"] == "sensor", ["pull_loss_share", "lost_sun_loss_share"]] > 0.05).all().all()
+
+
+@pytest.mark.parametrize("inputs", ["relative", "published"])
+def test_the_controllers_own_sky_watch_matches_the_reference_inputs(inputs):
+    """Scan by scan the controller classifies its own readings; the log's sky is `sky_inputs` and the
+    exact engine on the same readings: the two agree to the table's error, and in label."""
+    from hybridtrack.skyinputs import SkyInputConfig
+
+    frame = synthetic("nanjing", "2013-06-21", weather="mixed", seed=2)
+    sky = SkyInputConfig() if inputs == "relative" else SkyInputConfig.published()
+    captured = {}
+    original = Controller.outputs
+
+    def keep(self):
+        captured["out"] = original(self)
+        return captured["out"]
+
+    Controller.outputs = keep
+    try:
+        result = simulate(frame, "nanjing", config=SimulationConfig(sky=sky), warm_start=False)
+    finally:
+        Controller.outputs = original
+    online = captured["out"].sky_score
+    exact = result.log["sky_score"].to_numpy()
+    both = np.isfinite(online) & np.isfinite(exact)
+    assert both.sum() > 500
+    assert np.max(np.abs(online[both] - exact[both])) < 0.05
+    edges = np.min(np.abs(exact[both, None] - np.array([10.0, 20.0])), axis=1) > 0.05
+    labels = np.asarray(control.SKY_CODES)[captured["out"].sky[both]]
+    assert (labels[edges] == result.log["sky"].astype(str).to_numpy()[both][edges]).all()

@@ -97,8 +97,10 @@ class Controller:
     plan : ControllerPlan
     classifier : FuzzyWeatherClassifier
         The sky classifier, run as a table (`skywatch.ClassifierTable`).
-    window_minutes : float
-        The trailing window of the photocurrent's variation.
+    sky_inputs : SkyInputConfig
+        How the photocurrent becomes the classifier's inputs (`hybridtrack.skyinputs`).
+    dark_current : float
+        mA: the sensor's datasheet dark current.
     park : list of float
         Where the sensor-only tracker waits before its first morning (toward the eastern
         horizon, as installers set such trackers); after that, where it first found the sun.
@@ -108,7 +110,7 @@ class Controller:
     """
 
     def __init__(self, config: ControllerConfig, drives: list[Drive], plan: ControllerPlan, classifier,
-                 window_minutes: float, park: list[float], memory: dict | None = None):
+                 sky_inputs, dark_current: float, park: list[float], memory: dict | None = None):
         self.config = config
         self.drives = drives
         self.axes = len(drives)
@@ -121,7 +123,11 @@ class Controller:
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.encoders = [EncoderMonitor(r, config.encoder_confirm) for r in resolution]
         self.wind = WindGuard(config.wind_stow, config.wind_release, config.minutes("wind_hold"), config.wind_missing)
-        self.sky = SkyWatch(ClassifierTable(classifier), window_minutes)
+        self.sky = SkyWatch(ClassifierTable(classifier), sky_inputs, dark_current)
+        n_scans = len(plan.awake)
+        self.clear_light = plan.clear_light.tolist() if plan.clear_light is not None else [math.nan] * n_scans
+        self.altitude = plan.apparent_altitude.tolist() if plan.apparent_altitude is not None \
+            else [math.nan] * n_scans
         variance = [config.sensor_noise**2 + r * r / 12.0 for r in resolution]
         self.gates = [SensorGate(config.kalman, config.process_noise, v, config.stuck_scans, config.gate,
                                  config.reacquire, config.sensor_noise) for v in variance]
@@ -312,7 +318,7 @@ class Controller:
         self.out["intensity"][i] = obs.intensity
         if self.config.strategy not in CLASSIFYING:
             return UNKNOWN
-        code, score, variation = self.sky.update(t, obs.intensity)
+        code, score, variation = self.sky.update(t, obs.intensity, self.clear_light[i], self.altitude[i])
         self.out["sky"][i] = code
         self.out["score"][i] = score
         self.out["variation"][i] = variation

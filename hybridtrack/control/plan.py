@@ -84,7 +84,9 @@ class MountEstimate:
 class ControllerPlan:
     """Per scan: timer (minutes), computed targets (N, axes), awake, clock steps (seconds, 0 if
     none), and for a controller that fits its mount the targets' derivatives by the mount's
-    parameters (N, axes, parameters) with each axis's weight in pointing terms (N, axes)."""
+    parameters (N, axes, parameters) with each axis's weight in pointing terms (N, axes), and for
+    the sky watch the photocurrent above dark the controller expects under a clear sky (mA) and
+    its computed sun's apparent altitude (degrees)."""
 
     minutes: np.ndarray
     model: np.ndarray
@@ -93,6 +95,8 @@ class ControllerPlan:
     jacobian: np.ndarray | None = None
     weight: np.ndarray | None = None
     alarms: dict = field(default_factory=dict)
+    clear_light: np.ndarray | None = None
+    apparent_altitude: np.ndarray | None = None
 
 
 def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeIndex, np.ndarray, dict]:

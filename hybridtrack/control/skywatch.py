@@ -1,8 +1,9 @@
 """The sky class, as the controller works it out from its own sensor's photocurrent.
 
 The photocurrent depends on where the collector points (the sensor rides on it), so the
-controller classifies it scan by scan: the variation is the range (max − min) over a trailing
-window, kept with two monotonic queues, and the classifier runs as a lookup table over its
+controller classifies it scan by scan, with the inputs `hybridtrack.skyinputs` defines (by
+default the light relative to the clear sky it expects, and its range over a trailing window,
+kept with two monotonic queues), and the classifier runs as a lookup table over its
 normalised inputs with bilinear interpolation. PLC fuzzy function blocks are commonly compiled
 to such tables (IEC 61131-7 leaves the inference method to the implementation); the table's
 largest score error against the exact engine is measured in the tests and stated in the docs.
@@ -17,7 +18,7 @@ import numpy as np
 
 from .modes import SKY_CODES, UNKNOWN
 
-__all__ = ["ClassifierTable", "SkyWatch"]
+__all__ = ["ClassifierTable", "SkyWatch", "TrailingRange", "TrailingMean"]
 
 #: Tables already made, by (classifier type, config, points): a year's run and its warm-up day share one.
 _TABLES: dict = {}
@@ -76,32 +77,111 @@ class ClassifierTable:
         return self.codes[-1]
 
 
-class SkyWatch:
-    """Photocurrent in, sky class out: a trailing-window range, then the tabulated classifier."""
+class TrailingRange:
+    """Max − min over a trailing window (t − window, t], NaN readings skipped: two monotonic queues."""
 
-    __slots__ = ("table", "window", "highs", "lows")
+    __slots__ = ("window", "highs", "lows")
 
-    def __init__(self, table: ClassifierTable, window_minutes: float):
-        self.table = table
-        self.window = window_minutes
+    def __init__(self, window: float):
+        self.window = window
         self.highs: deque = deque()
         self.lows: deque = deque()
 
-    def update(self, t: float, intensity: float) -> tuple[int, float, float]:
-        """Take the photocurrent at scan time `t`; return (sky code, score, variation)."""
+    def add(self, t: float, value: float) -> float:
+        """Take a value at time `t`; return the range over the window ending at `t` (NaN if empty)."""
         highs, lows = self.highs, self.lows
-        if not math.isnan(intensity):
-            while highs and highs[-1][1] <= intensity:
+        if not math.isnan(value):
+            while highs and highs[-1][1] <= value:
                 highs.pop()
-            highs.append((t, intensity))
-            while lows and lows[-1][1] >= intensity:
+            highs.append((t, value))
+            while lows and lows[-1][1] >= value:
                 lows.pop()
-            lows.append((t, intensity))
+            lows.append((t, value))
         start = t - self.window
         while highs and highs[0][0] <= start:
             highs.popleft()
         while lows and lows[0][0] <= start:
             lows.popleft()
-        variation = highs[0][1] - lows[0][1] if highs else math.nan
-        score = self.table.score(intensity, variation)
+        return highs[0][1] - lows[0][1] if highs else math.nan
+
+
+class TrailingMean:
+    """The mean over a trailing window (t − window, t], NaN readings skipped."""
+
+    __slots__ = ("window", "values", "total")
+
+    def __init__(self, window: float):
+        self.window = window
+        self.values: deque = deque()
+        self.total = 0.0
+
+    def add(self, t: float, value: float) -> float:
+        """Take a value at time `t`; return the mean over the window ending at `t` (NaN if empty)."""
+        values = self.values
+        if not math.isnan(value):
+            values.append((t, value))
+            self.total += value
+        start = t - self.window
+        while values and values[0][0] <= start:
+            self.total -= values.popleft()[1]
+        if not values:
+            self.total = 0.0
+            return math.nan
+        return self.total / len(values)
+
+
+class SkyWatch:
+    """Photocurrent in, sky class out, as `hybridtrack.skyinputs.sky_inputs` defines the inputs.
+
+    ``absolute`` mode: the photocurrent (its trailing `smoothing` mean) and its range over the
+    trailing window. ``relative`` mode: the light over the clear-sky light the controller expects
+    at that time and place (capped at 1), put on the classifier's mA scale, and its range; below
+    `min_altitude` of computed sun the absolute inputs (or no label) are used instead.
+
+    Parameters
+    ----------
+    table : ClassifierTable
+    inputs : SkyInputConfig
+        The input choices (mode, window, smoothing, low-sun rule, scales).
+    dark_current : float
+        mA: the sensor's datasheet dark current.
+    """
+
+    __slots__ = ("table", "inputs", "dark", "mean", "absolute_range", "relative_range", "window_minutes")
+
+    def __init__(self, table: ClassifierTable, inputs, dark_current: float):
+        import pandas as pd
+
+        self.table = table
+        self.inputs = inputs
+        self.dark = dark_current
+        window = pd.Timedelta(inputs.window) / pd.Timedelta(minutes=1)
+        smoothing = pd.Timedelta(inputs.smoothing) / pd.Timedelta(minutes=1) if inputs.smoothing else 0.0
+        self.mean = TrailingMean(smoothing) if smoothing else None
+        self.absolute_range = TrailingRange(window)
+        self.relative_range = TrailingRange(window)
+        self.window_minutes = window
+
+    def inputs_at(self, t: float, intensity: float, expected: float, altitude: float) -> tuple[float, float]:
+        """The classifier's two inputs (mA scale) for the photocurrent at scan time `t`, with the
+        clear-sky light above dark the controller `expected` and its computed sun's `altitude`."""
+        settings = self.inputs
+        absolute = self.mean.add(t, intensity) if self.mean is not None else intensity
+        absolute_variation = self.absolute_range.add(t, absolute)
+        if settings.mode == "absolute":
+            return absolute, absolute_variation
+        low = not (altitude >= settings.min_altitude) or not expected > 0
+        relative = math.nan if low else min((absolute - self.dark) / expected, 1.0)
+        relative_variation = self.relative_range.add(t, relative)
+        if low:
+            return (absolute, absolute_variation) if settings.low_sun == "absolute" else (math.nan, math.nan)
+        (lo, hi), (vlo, vhi) = self.table.ranges
+        floor = settings.relative_floor
+        share = min(max((relative - floor) / (1.0 - floor), 0.0), 1.0)
+        return lo + (hi - lo) * share, vlo + (vhi - vlo) * relative_variation / settings.full_variation
+
+    def update(self, t: float, intensity: float, expected: float, altitude: float) -> tuple[int, float, float]:
+        """Take the photocurrent at scan time `t`; return (sky code, score, variation input)."""
+        level, variation = self.inputs_at(t, intensity, expected, altitude)
+        score = self.table.score(level, variation)
         return self.table.code(score), score, variation
