@@ -26,6 +26,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .errors import HybridtrackError
 from .fuzzy import FuzzyWeatherClassifier
+from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
 from .mounting import incidence_cosine
 from .sensor import SensorModel
@@ -73,6 +74,10 @@ class SimulationConfig:
     truth : {"spa-fast", "spa"}
         How the world computes the true sun: SPA with its slow series interpolated from hourly
         knots (within 1e-5° of SPA, a tenth of its cost; ``hybridtrack.sun``) or SPA itself.
+    engine : {"auto", "compiled", "reference"}
+        How the scans are stepped: ``reference`` the readable Python controller and world,
+        ``compiled`` the numba kernel that restates them (`hybridtrack.kernel`, held equal by
+        tests), ``auto`` the kernel wherever it supports the run and numba is installed.
     """
 
     controller: ControllerConfig = field(default_factory=ControllerConfig)
@@ -83,10 +88,13 @@ class SimulationConfig:
     sky: SkyInputConfig = field(default_factory=SkyInputConfig)
     seed: int = 0
     truth: str = "spa-fast"
+    engine: str = "auto"
 
     def __post_init__(self) -> None:
         if self.truth not in ("spa-fast", "spa"):
             raise HybridtrackError(f"truth {self.truth!r}: choose 'spa-fast' or 'spa'")
+        if self.engine not in ENGINES:
+            raise HybridtrackError(f"engine {self.engine!r}: choose {', '.join(map(repr, ENGINES))}")
 
     def to_dict(self) -> dict:
         """A plain dict in the TOML layout."""
@@ -317,8 +325,11 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         plan.apparent_altitude = clear["apparent_elevation"].to_numpy()
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory)
-    _run(world, controller, progress, bulk_nights and not faults)
-    out = controller.outputs()
+    if uses_kernel(config):
+        out = run_compiled(world, controller, progress, bulk_nights and not faults)
+    else:
+        _run(world, controller, progress, bulk_nights and not faults)
+        out = controller.outputs()
     index = frame.index
     log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
                                                        world.controller_site()))
