@@ -19,6 +19,8 @@ from hybridtrack.errors import HybridtrackError
 from hybridtrack.faults import SCENARIOS
 from hybridtrack.simulation import FAULTS, SimulationConfig
 from hybridtrack.sky import synthetic
+from hybridtrack.skyinputs import SkyInputConfig
+from hybridtrack.world import Imperfections
 
 COLLECTORS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
 TOLERANCE = 1e-9
@@ -172,3 +174,56 @@ def test_without_numba_the_package_runs_the_reference_with_one_warning():
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=600)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().splitlines()[-1] == "1"
+
+
+def replaced(**parts):
+    """A config with some of its parts' fields changed: ``controller={"lead": False}``."""
+    config = SimulationConfig()
+    for part, values in parts.items():
+        current = getattr(config, part)
+        config = dataclasses.replace(config, **{part: dataclasses.replace(current, **values) if isinstance(values, dict)
+                                                else values})
+    return config
+
+
+@pytest.mark.parametrize("config", [
+    replaced(sky=SkyInputConfig.published()),
+    replaced(sky={"low_sun": "unknown", "smoothing": None}),
+    replaced(controller={"lead": False, "sun_model": "spa", "working_hours": ("07:00", "18:30")}),
+    replaced(controller={"wind_missing": "track"}, imperfections=Imperfections.none()),
+    replaced(drive={"deadband": 0.1, "encoder_bits": 16}, seed=7),
+], ids=["published-sky", "no-smoothing-no-low-sun-label", "no-lead-spa-hours", "track-missing-wind", "fine-drive"])
+@pytest.mark.parametrize("strategy", ["hybrid", "sensor"])
+def test_other_configs_run_the_same_compiled(mixed_day, config, strategy):
+    assert_same_run(*both(mixed_day, "lanzhou", config=config, strategy=strategy))
+
+
+def test_a_recorded_photocurrent_and_a_frame_without_wind_or_diffuse_run_the_same_compiled(mixed_day):
+    rng = np.random.default_rng(0)
+    recorded = mixed_day.drop(columns=["wind_speed", "dhi"]).assign(photocurrent=30.0 + rng.uniform(0, 300, len(mixed_day)))
+    config = replaced(controller={"wind_missing": "track"})
+    for strategy in ("hybrid", "sensor"):
+        assert_same_run(*both(recorded, "lanzhou", config=config, strategy=strategy))
+
+
+def test_irregular_scans_run_the_same_compiled(mixed_day):
+    keep = np.random.default_rng(1).random(len(mixed_day)) > 0.3
+    assert_same_run(*both(mixed_day[keep], "lanzhou"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_a_site_year_runs_the_same_compiled(collector):
+    year = synthetic("nanjing", "2013-01-01", "2013-12-31", weather="climate", seed=1, gusts_per_day=0.5)
+    assert_same_run(*both(year, "nanjing", collector=collector))
+
+
+def test_a_changed_source_empties_the_kernels_cache(tmp_path):
+    from hybridtrack.kernel import jit
+
+    (tmp_path / "controller.run_scans-1.py311.nbi").write_text("stale")
+    jit._empty_stale_cache(tmp_path)
+    assert not list(tmp_path.glob("*.nbi")) and (tmp_path / "kernel-sources.sha256").read_text() == jit._sources_hash()
+    (tmp_path / "controller.run_scans-1.py311.nbi").write_text("fresh")
+    jit._empty_stale_cache(tmp_path)
+    assert list(tmp_path.glob("*.nbi"))

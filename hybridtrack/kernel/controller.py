@@ -132,10 +132,11 @@ def _lead(rate, period, deadband):
 
 @kernel
 def _mount_correction(plan, state, i, a):
-    total = 0.0
-    for m in range(state.theta.shape[0]):
-        total += plan.jacobian[i, a, m] * state.theta[m]
-    return total
+    """Controller._mount_corrections of one scan and axis, by the same BLAS call numpy makes
+    (a dot product for one axis, a matrix-vector product for two), so the sums round alike."""
+    if plan.jacobian.shape[1] == 1:
+        return np.dot(plan.jacobian[i, 0], state.theta)
+    return (plan.jacobian[i] @ state.theta)[a]
 
 
 @kernel

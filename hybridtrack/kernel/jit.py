@@ -1,6 +1,11 @@
 """numba where it imports: `kernel` compiles a function with ``njit(cache=True)``, or leaves it
 plain Python where numba is missing (`available` then says so, warning once).
 
+numba's disk cache is keyed on each function's own file, not on the functions it calls or the
+constants it imports: a cached loop would keep an old controller after the controller's file
+changed. So the cache is stamped with a hash of every source the kernels are built from, and
+emptied when that changes.
+
 The compiled controller is only ever run when `available` is true; without numba the package
 runs the readable reference controller, as the fuzzy engine (`hybridtrack.fuzzy.compiled`) falls
 back to numpy.
@@ -8,7 +13,9 @@ back to numpy.
 
 from __future__ import annotations
 
+import hashlib
 import warnings
+from pathlib import Path
 
 __all__ = ["available", "kernel"]
 
@@ -18,12 +25,42 @@ except ImportError:  # pragma: no cover - numba is a dependency; the fallback is
     numba = None
 
 _WARNED: list = []
+_STAMPED: list = []
+_HERE = Path(__file__).parent
+#: The sources compiled into the kernels (their constants included).
+SOURCES = (*sorted(_HERE.glob("*.py")), *sorted((_HERE.parent / "control").glob("*.py")), _HERE.parent / "world.py")
+
+
+def _sources_hash() -> str:
+    digest = hashlib.sha256()
+    for path in SOURCES:
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _empty_stale_cache(folder: Path = _HERE / "__pycache__") -> None:
+    """Remove the cached kernels when any source they were built from has changed (numba's
+    default cache folder; one set by NUMBA_CACHE_DIR is left alone)."""
+    stamp = folder / "kernel-sources.sha256"
+    current = _sources_hash()
+    try:
+        if stamp.is_file() and stamp.read_text() == current:
+            return
+        folder.mkdir(exist_ok=True)
+        for cached in [*folder.glob("*.nbi"), *folder.glob("*.nbc")]:
+            cached.unlink(missing_ok=True)
+        stamp.write_text(current)
+    except OSError:  # a read-only install: numba caches elsewhere or not at all
+        pass
 
 
 def kernel(function):
     """Compile `function` with numba (cached on disk), or return it unchanged without numba."""
     if numba is None:  # pragma: no cover
         return function
+    if not _STAMPED:
+        _STAMPED.append(True)
+        _empty_stale_cache()
     return numba.njit(cache=True, error_model="numpy")(function)
 
 
