@@ -123,6 +123,7 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
     k[[kc.MODE, kc.RESTING, kc.WAS_AWAKE, kc.FOUND_TODAY, kc.WIND_STUCK]] = \
         [c.mode, c.resting, c.was_awake, c.found_today, c.wind.stuck]
     k[kc.BLIND_STOW] = c.blind_stow is not None
+    k[[kc.MOUNT_AT_SCAN, kc.MOUNT_AT_UPDATES]] = -1
     fit = c.fit
     p = 2 + axes if fit else 0
     if fit:
@@ -137,7 +138,7 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         np.zeros((axes, c.gates[0].angles.maxlen)), np.zeros((axes, c.gates[0].angles.maxlen)),
         np.zeros(axes, np.int64), np.array([[cal.offset, cal.learned] for cal in c.calibrators], float),
         np.array(c.fitted_at, float), np.zeros(axes), np.array(c.park, float), np.array(c.moves, np.int64),
-        np.array(c.travel, float),
+        np.array(c.travel, float), np.zeros(axes),
         np.array(fit.theta if fit else [], float), np.array(fit.p if fit else np.zeros((0, 0)), float),
         np.array(fit.information if fit else np.zeros((0, 0)), float),
         np.zeros(axes), np.zeros(p), np.zeros((p, p)), np.zeros((p, p)),

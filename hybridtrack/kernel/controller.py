@@ -60,7 +60,7 @@ ControllerPlanArrays = namedtuple("ControllerPlanArrays", [
 #: Every piece's state. `s` (floats) and `k` (integers) hold the scalars named below.
 ControllerState = namedtuple("ControllerState", [
     "s", "k", "encoder", "jumped", "kf", "gate", "stuck_angles", "stuck_expected", "stuck_fill",
-    "calibration", "fitted_at", "blind_stow", "park", "moves", "travel",
+    "calibration", "fitted_at", "blind_stow", "park", "moves", "travel", "mount",
     "theta", "p", "information", "checkpoint_offsets", "checkpoint_theta", "checkpoint_p",
     "checkpoint_information", "window_t", "window_v", "window_ends"])
 #: What the controller records per scan (`hybridtrack.control.controller.ControllerOutputs`).
@@ -76,8 +76,8 @@ EventLog = namedtuple("EventLog", ["scan", "before", "after", "code", "value"])
 FLOAT_SLOTS = 14
 # slots of ControllerState.k
 (MODE, RESTING, WAS_AWAKE, FOUND_TODAY, BLIND_STOW, WIND_STUCK, EVENTS, HAS_CHECKPOINT, UPDATES, FROZEN,
- CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN) = range(13)
-INT_SLOTS = 13
+ CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN, MOUNT_AT_SCAN, MOUNT_AT_UPDATES) = range(15)
+INT_SLOTS = 15
 # columns of ControllerState.encoder, .kf, .gate, .calibration
 BELIEVED, LAST, COMMANDED = range(3)
 X0, X1, P00, P01, P11 = range(5)
@@ -130,21 +130,27 @@ def _lead(rate, period, deadband):
     return math.copysign(min(step * (scans - 1) / 2.0, deadband / 2.0), rate)
 
 
-@kernel
-def _mount_correction(plan, state, i, a):
-    """Controller._mount_corrections of one scan and axis, by the same BLAS call numpy makes
+@kernel(allocates=True)
+def _mount_corrections(jacobian, theta, i, mount):
+    """Controller._mount_corrections of scan `i` into `mount`, by the same BLAS call numpy makes
     (a dot product for one axis, a matrix-vector product for two), so the sums round alike."""
-    if plan.jacobian.shape[1] == 1:
-        return np.dot(plan.jacobian[i, 0], state.theta)
-    return (plan.jacobian[i] @ state.theta)[a]
+    if jacobian.shape[1] == 1:
+        mount[0] = np.dot(jacobian[i, 0], theta)
+    else:
+        mount[:] = jacobian[i] @ theta
 
 
 @kernel
 def _correction(cfg, plan, state, i, a):
+    """Controller._correction, with its cache of the fitted mount's correction by (scan, updates)."""
     offset = state.calibration[a, OFFSET]
     if not cfg.has_fit:
         return offset
-    return _mount_correction(plan, state, i, a) + offset
+    k = state.k
+    if k[MOUNT_AT_SCAN] != i or k[MOUNT_AT_UPDATES] != k[UPDATES]:
+        k[MOUNT_AT_SCAN], k[MOUNT_AT_UPDATES] = i, k[UPDATES]
+        _mount_corrections(plan.jacobian, state.theta, i, state.mount)
+    return state.mount[a] + offset
 
 
 @kernel
@@ -406,6 +412,15 @@ def kalman_update(cfg, state, a, z):
 
 
 @kernel
+def _spread(values, a):
+    """max - min of row `a`."""
+    high = low = values[a, 0]
+    for value in values[a, 1:]:
+        high, low = max(high, value), min(low, value)
+    return high - low
+
+
+@kernel
 def gate_judge(cfg, state, a, measured, valid, coarse, expected):
     """SensorGate.judge (its two deques as rings of `stuck_scans`)."""
     if math.isnan(measured) or math.isnan(expected):
@@ -417,8 +432,8 @@ def gate_judge(cfg, state, a, measured, valid, coarse, expected):
         state.stuck_expected[a, slot] = expected
         state.stuck_fill[a] += 1
         if state.stuck_fill[a] >= scans:
-            angles, wanted = state.stuck_angles[a], state.stuck_expected[a]
-            if angles.max() - angles.min() < cfg.stuck_spread and wanted.max() - wanted.min() > 10.0 * cfg.stuck_spread:
+            if _spread(state.stuck_angles, a) < cfg.stuck_spread and \
+                    _spread(state.stuck_expected, a) > 10.0 * cfg.stuck_spread:
                 return STUCK
     if not valid:
         return LOW_LIGHT if math.isnan(coarse) else OUT_OF_VIEW
@@ -471,43 +486,41 @@ def calibrator_learn(cfg, state, a, dt, residual, model_step, bound):
     c[a, OFFSET] = max(-bound, min(bound, c[a, OFFSET]))
 
 
-@kernel
-def fit_forget(cfg, state, dt):
-    """MountEstimator.forget."""
-    factor = math.exp(-dt / cfg.fit_memory)
-    p = state.p / factor
-    scale = np.sqrt(np.minimum(1.0, cfg.prior / np.diag(p)))
-    state.p[:, :] = p * np.outer(scale, scale)
-    state.information[:, :] = state.information * factor
+@kernel(allocates=True)
+def fit_forget(p, information, memory, prior, dt):
+    """MountEstimator.forget (in place on `p` and `information`)."""
+    factor = math.exp(-dt / memory)
+    grown = p / factor
+    scale = np.sqrt(np.minimum(1.0, prior / np.diag(grown)))
+    p[:, :] = grown * np.outer(scale, scale)
+    information[:, :] = information * factor
 
 
-@kernel
-def fit_check(state):
-    """MountEstimator._check."""
-    singular = np.linalg.svd(state.information.copy())[1]
-    state.s[CONDITION] = singular[0] / max(singular[-1], 1e-300)
-    state.k[FROZEN] = state.s[CONDITION] > MAX_CONDITION
+@kernel(allocates=True)
+def fit_condition(information):
+    """MountEstimator._check's condition number of the information matrix."""
+    singular = np.linalg.svd(information.copy())[1]
+    return singular[0] / max(singular[-1], 1e-300)
 
 
-@kernel
-def fit_update(cfg, state, row, residual):
-    """MountEstimator.update (Joseph form; frozen pedestal terms as consider parameters)."""
+@kernel(allocates=True)
+def fit_update(theta, p, information, r, clip, frozen, derivatives, weight, residual):
+    """MountEstimator.update of the row `derivatives` · `weight` (Joseph form; frozen pedestal
+    terms as consider parameters), in place on `theta`, `p` and `information`."""
+    row = derivatives * weight
     n = row.shape[0]
-    state.information[:, :] = state.information + np.outer(row, row) / cfg.fit_r
-    pr = state.p @ row
-    s = cfg.fit_r + np.dot(row, pr)
+    information[:, :] = information + np.outer(row, row) / r
+    pr = p @ row
+    s = r + np.dot(row, pr)
     gain = pr / s
-    if state.k[FROZEN]:
+    if frozen:
         gain[:2] = 0.0
-    bound = cfg.clip * math.sqrt(s)
-    innovation = residual - np.dot(row, state.theta)
+    bound = clip * math.sqrt(s)
+    innovation = residual - np.dot(row, theta)
     error = max(-bound, min(bound, innovation))
-    state.theta[:] = state.theta + gain * error
+    theta[:] = theta + gain * error
     a = np.eye(n) - np.outer(gain, row)
-    state.p[:, :] = a @ state.p @ a.T + cfg.fit_r * np.outer(gain, gain)
-    state.k[UPDATES] += 1
-    if state.k[UPDATES] % cfg.check_every == 0:
-        fit_check(state)
+    p[:, :] = a @ p @ a.T + r * np.outer(gain, gain)
 
 
 @kernel
@@ -535,7 +548,7 @@ def _disagreement_reset(state):
     state.k[CUSUM_RUN], state.s[CUSUM_SUM] = 0, 0.0
 
 
-@kernel
+@kernel(allocates=True)
 def _checkpoint(state):
     """Controller.memory, kept as the checkpoint."""
     state.checkpoint_offsets[:] = state.calibration[:, OFFSET]
@@ -547,7 +560,7 @@ def _checkpoint(state):
     state.k[HAS_CHECKPOINT] = 1
 
 
-@kernel
+@kernel(allocates=True)
 def _recall(cfg, state):
     """Controller._recall of the checkpoint (Calibrator.carry: past the running-mean phase)."""
     state.calibration[:, OFFSET] = state.checkpoint_offsets
@@ -559,14 +572,10 @@ def _recall(cfg, state):
     state.k[UPDATES] = state.k[CHECKPOINT_UPDATES]
 
 
-@kernel
-def _against_checkpoint(cfg, plan, state, i, a, z, m0):
-    row = plan.jacobian[i, a]
-    has = state.k[HAS_CHECKPOINT]
-    theta = state.checkpoint_theta if has else state.theta
-    p = state.checkpoint_p if has else state.p
-    miss = _turn(cfg, a, z - m0 - np.dot(row, theta))
-    return miss, math.sqrt(cfg.fit_r + np.dot(row @ p, row))
+@kernel(allocates=True)
+def _against_checkpoint(row, theta, p, r):
+    """Controller._against_checkpoint: the fit's correction at `row` and its variance (row·p·row + r)."""
+    return np.dot(row, theta), math.sqrt(r + np.dot(row @ p, row))
 
 
 @kernel
@@ -592,11 +601,19 @@ def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound):
     t = state.s[PREVIOUS_T]
     if cfg.has_fit and t - state.fitted_at[a] >= FIT_EVERY:
         state.fitted_at[a] = t
-        fit_forget(cfg, state, t - state.s[FIT_SINCE])
+        fit_forget(state.p, state.information, cfg.fit_memory, cfg.prior, t - state.s[FIT_SINCE])
         state.s[FIT_SINCE] = t
-        miss, spread = _against_checkpoint(cfg, plan, state, i, a, z, m0)
+        has = state.k[HAS_CHECKPOINT]
+        fitted, spread = _against_checkpoint(plan.jacobian[i, a], state.checkpoint_theta if has else state.theta,
+                                             state.checkpoint_p if has else state.p, cfg.fit_r)
+        miss = _turn(cfg, a, z - m0 - fitted)
         w = plan.weight[i, a]
-        fit_update(cfg, state, plan.jacobian[i, a] * w, _turn(cfg, a, z - m0) * w)
+        fit_update(state.theta, state.p, state.information, cfg.fit_r, cfg.clip, state.k[FROZEN],
+                   plan.jacobian[i, a], w, _turn(cfg, a, z - m0) * w)
+        state.k[UPDATES] += 1
+        if state.k[UPDATES] % cfg.check_every == 0:
+            state.s[CONDITION] = fit_condition(state.information)
+            state.k[FROZEN] = state.s[CONDITION] > MAX_CONDITION
         if _disagrees(cfg, state, log, i, miss, spread):
             return
     mount = _correction(cfg, plan, state, i, a) - state.calibration[a, OFFSET]
@@ -671,7 +688,8 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
     if valid.all():
         state.s[INVALID_SINCE] = math.nan
         if cfg.sensor_only and not state.k[FOUND_TODAY]:
-            state.park[:] = state.kf[:, X0]
+            for a in range(axes):
+                state.park[a] = state.kf[a, X0]
             state.k[FOUND_TODAY] = 1
     elif math.isnan(state.s[INVALID_SINCE]):
         state.s[INVALID_SINCE] = t
@@ -731,7 +749,8 @@ def _day_and_wind(cfg, state, log, i, t, awake, gusty, wind):
     if gusty and mode != STOW_WIND:
         code = ev.WIND_MISSING if math.isnan(wind) else ev.WIND_HIGH
         if mode == FAULT:
-            state.blind_stow[:] = cfg.stow - state.encoder[:, BELIEVED]
+            for a in range(state.blind_stow.shape[0]):
+                state.blind_stow[a] = cfg.stow[a] - state.encoder[a, BELIEVED]
             state.k[BLIND_STOW] = 1
             code += ev.BLIND
         _switch(i, STOW_WIND, code, wind, t, state, log)
@@ -833,9 +852,10 @@ def _command(cfg, plan, state, awake_plan, i, t, dt, reading, valid, obs_axes, t
 
 
 @kernel
-def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves):
+def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading, targets, valid):
     """Controller.step: take scan `i`'s readings (`obs`: t, wind, valid, intensity, true sky;
-    `obs_axes`: encoder, offset, coarse per axis); write the move of each axis into `moves`."""
+    `obs_axes`: encoder, offset, coarse per axis); write the move of each axis into `moves`
+    (`reading`, `targets` and `valid` are scratch)."""
     axes = moves.shape[0]
     s, k = state.s, state.k
     t = obs[0]
@@ -846,13 +866,11 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves):
         _alarm(i, ev.PLAN_ALARM, 0.0, 0.0, state, log)
     if plan.clock_steps[i]:
         _alarm(i, ev.CLOCK_STEPPED, plan.clock_steps[i], 0.0, state, log)
-    reading = np.empty(axes)
     _read_encoders(cfg, state, log, i, t, obs_axes, reading)
     code, value = wind_watch(state, t, obs[1], awake)
     if code:
         _alarm(i, code, value, 0.0, state, log)
     gusty = wind_update(cfg, state, t, obs[1])
-    targets = np.empty(axes)
     if k[RESTING] and not awake and not gusty:
         k[WAS_AWAKE] = 0
         out.sky[i] = UNKNOWN
@@ -864,7 +882,6 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves):
     _day_and_wind(cfg, state, log, i, t, awake, gusty, obs[1])
     k[WAS_AWAKE] = awake
     sky = _watch_sky(cfg, plan, state, out, i, t, obs[3])
-    valid = np.zeros(axes, np.bool_)
     status = _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, sky, valid)
     _choose_mode(cfg, state, log, i, t, status, valid, sky, obs[4])
     _command(cfg, plan, state, plan.awake[i], i, t, dt, reading, valid, obs_axes, targets, moves)

@@ -54,14 +54,24 @@ def _empty_stale_cache(folder: Path = _HERE / "__pycache__") -> None:
         pass
 
 
-def kernel(function):
-    """Compile `function` with numba (cached on disk), or return it unchanged without numba."""
+def kernel(function=None, *, allocates: bool = False, entry: bool = False):
+    """Compile `function` with numba (cached on disk), or return it unchanged without numba.
+
+    The kernels pass tuples of many arrays from piece to piece. With numba's reference counting
+    every call would count a reference to each of those arrays, in and out, and cost more than
+    the piece itself; so the pieces are compiled without it (``_nrt=False``: they must not make
+    arrays). The few that make arrays (``allocates=True``: the mount fit's matrix algebra) are
+    given only the arrays they need, and the loop (``entry=True``) makes the scratch arrays
+    the pieces write into.
+    """
+    if function is None:
+        return lambda f: kernel(f, allocates=allocates, entry=entry)
     if numba is None:  # pragma: no cover
         return function
     if not _STAMPED:
         _STAMPED.append(True)
         _empty_stale_cache()
-    return numba.njit(cache=True, error_model="numpy")(function)
+    return numba.njit(cache=True, error_model="numpy", _nrt=allocates or entry)(function)
 
 
 def available() -> bool:

@@ -7,6 +7,8 @@ that the caller can grow it and report progress between calls.
 
 from __future__ import annotations
 
+import numpy as np
+
 from .controller import EVENTS, RESTING, controller_rest, controller_step, sleeps_until
 from .jit import kernel
 from .world import world_move, world_observe, world_rest
@@ -17,12 +19,15 @@ __all__ = ["run_scans", "EVENTS_PER_SCAN"]
 EVENTS_PER_SCAN = 32
 
 
-@kernel
+@kernel(entry=True)
 def run_scans(start, stop, bulk_nights, wind_ok, world, world_state, cfg, plan, state, out, log, obs, obs_axes,
               moves):
     """Step world and controller from scan `start` until `stop` (or a nearly full event log);
     return the next scan."""
     capacity = log.scan.shape[0]
+    axes = moves.shape[0]
+    offsets, reported = np.empty(axes), np.empty(axes)  # the world's scratch
+    reading, targets, valid = np.empty(axes), np.empty(axes), np.zeros(axes, np.bool_)  # the controller's
     i = start
     while i < stop:
         if state.k[EVENTS] + EVENTS_PER_SCAN > capacity:
@@ -34,8 +39,8 @@ def run_scans(start, stop, bulk_nights, wind_ok, world, world_state, cfg, plan, 
                 world_rest(world_state, i, j)
                 i = j
                 continue
-        world_observe(world, world_state, i, obs, obs_axes)
-        controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves)
+        world_observe(world, world_state, i, obs, obs_axes, offsets, reported)
+        controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading, targets, valid)
         world_move(world, world_state, i, moves)
         i += 1
     return i

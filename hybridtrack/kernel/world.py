@@ -103,14 +103,12 @@ def _sensor_faults(w, i, reported, obs, obs_axes):
 
 
 @kernel
-def world_observe(w, state, i, obs, obs_axes):
+def world_observe(w, state, i, obs, obs_axes, offsets, reported):
     """World.observe: fill the observation of scan `i` (`obs`: t, wind, valid, intensity, true sky;
-    `obs_axes`: encoder, offset, coarse per axis)."""
+    `obs_axes`: encoder, offset, coarse per axis); `offsets` and `reported` are scratch."""
     axes = state.actual.shape[0]
-    offsets = np.empty(axes)
     for a in range(axes):
         offsets[a] = _offset(w, state, a, i)
-    reported = np.empty(axes)
     obs[2] = 1.0 if read_pointing(w, i, offsets, reported) else 0.0
     _sensor_faults(w, i, reported, obs, obs_axes)
     obs[0], obs[1] = w.minutes[i], w.wind[i]
