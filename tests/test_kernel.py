@@ -227,3 +227,118 @@ def test_a_changed_source_empties_the_kernels_cache(tmp_path):
     (tmp_path / "controller.run_scans-1.py311.nbi").write_text("fresh")
     jit._empty_stale_cache(tmp_path)
     assert list(tmp_path.glob("*.nbi"))
+
+
+# -- piece by piece: each compiled piece against the reference class it restates --------------------
+
+@pytest.fixture(scope="module")
+def packed():
+    """A reference controller of a hybrid heliostat, and its settings and state as the kernel has them."""
+    from hybridtrack import sites
+    from hybridtrack.collectors import Collector
+    from hybridtrack.control import Controller, make_plan
+    from hybridtrack.control.plan import east_park
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+    from hybridtrack.kernel import bridge
+    from hybridtrack.simulation import _drives
+    from hybridtrack.world import World
+
+    frame = synthetic("lanzhou", "2021-06-21 10:00", "2021-06-21 12:00", weather="sunny", seed=1)
+    site, collector, config = sites.get("lanzhou"), Collector("heliostat"), SimulationConfig()
+    drives = _drives(collector, config)
+    world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
+    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
+    controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
+                            east_park(collector))
+    return controller, bridge._settings(controller), bridge._state(controller, world.minutes)
+
+
+def test_the_sky_table_compiled_scores_as_the_reference(packed):
+    from hybridtrack.kernel.controller import table_code, table_score
+
+    controller, cfg, _ = packed
+    table = controller.sky.table
+    rng = np.random.default_rng(0)
+    for intensity, variation in zip(rng.uniform(-50, 400, 2000), rng.uniform(-10, 250, 2000)):
+        score = table_score(cfg, intensity, variation)
+        assert score == table.score(intensity, variation)
+        assert table_code(cfg, score) == table.code(score)
+    assert np.isnan(table_score(cfg, np.nan, 1.0)) and table_code(cfg, np.nan) == table.code(np.nan)
+
+
+def test_the_trailing_windows_compiled_keep_the_reference_range_and_mean(packed):
+    from hybridtrack.control.skywatch import TrailingMean, TrailingRange
+    from hybridtrack.kernel.controller import ABSOLUTE_HIGHS, ABSOLUTE_LOWS, trailing_mean, trailing_range
+
+    _, _, state = packed
+    state.window_ends[:] = 0
+    rng = np.random.default_rng(1)
+    times = np.cumsum(rng.choice([0.5, 1.0, 1.0, 7.0], 5000))
+    values = np.where(rng.random(5000) < 0.1, np.nan, rng.normal(100.0, 30.0, 5000))
+    spread, mean = TrailingRange(20.0), TrailingMean(3.0)
+    for t, value in zip(times, values):
+        expected = spread.add(t, value)
+        assert trailing_range(state, ABSOLUTE_HIGHS, ABSOLUTE_LOWS, 20.0, t, value) == pytest.approx(expected, nan_ok=True)
+        assert trailing_mean(state, 3.0, t, value) == pytest.approx(mean.add(t, value), rel=0, abs=0, nan_ok=True)
+
+
+def test_the_gate_and_kalman_filter_compiled_take_readings_as_the_reference(packed):
+    from hybridtrack.control.sensing import SensorGate
+    from hybridtrack.kernel.controller import P00, P01, P11, READY, X0, X1, gate_take
+
+    controller, cfg, state = packed
+    config = controller.config
+    gate = SensorGate("fast", config.process_noise, controller.gates[0].filter.r, config.stuck_scans, config.gate,
+                      config.reacquire, config.sensor_noise)
+    state.gate[:] = 0
+    rng = np.random.default_rng(2)
+    for k in range(3000):
+        z = 0.25 * k + rng.normal(0, 0.05) + (3.0 if rng.random() < 0.05 else 0.0)
+        miss = rng.normal(0, 1.2) if rng.random() < 0.5 else np.nan
+        dt = float(rng.choice([1.0, 1.0, 2.0]))
+        assert gate_take(cfg, state, 0, z, dt, miss, 2.0, 0.25) == gate.take(z, dt, miss, 2.0, 0.25)
+        if k % 500 == 0:
+            gate.forget()
+            state.gate[0, READY] = 0
+    f = gate.filter
+    assert state.kf[0, [X0, X1, P00, P01, P11]].tolist() == [f.x0, f.x1, f.p00, f.p01, f.p11]
+
+
+def test_the_cusum_compiled_flags_as_the_reference():
+    from hybridtrack.control.disagreement import DisagreementMonitor
+    from hybridtrack.kernel.controller import (CUSUM_RUN, CUSUM_SUM, FLOAT_SLOTS, INT_SLOTS, ControllerState,
+                                               disagreement_add)
+
+    monitor, rng = DisagreementMonitor(), np.random.default_rng(3)
+    unused = [np.zeros(1)] * (len(ControllerState._fields) - 2)
+    compiled = ControllerState(np.zeros(FLOAT_SLOTS), np.zeros(INT_SLOTS, np.int64), *unused)
+    alarms = 0
+    for k in range(5000):
+        residual = rng.normal(0.3 if (k // 400) % 2 else 0.0, 0.1)
+        flagged = monitor.add(residual / 0.1, residual, 0.25)
+        assert disagreement_add(compiled, residual / 0.1, residual, 0.25) == flagged
+        alarms += flagged
+        if flagged:
+            monitor.reset()
+            compiled.s[:], compiled.k[:] = 0.0, 0
+        assert (compiled.k[CUSUM_RUN], compiled.s[CUSUM_SUM]) == (monitor.run, monitor.run_sum)
+    assert alarms > 0
+
+
+def test_the_mount_fit_compiled_updates_as_the_reference():
+    from hybridtrack.control.mountfit import MountEstimator
+    from hybridtrack.kernel.controller import fit_condition, fit_forget, fit_update
+
+    fit, rng = MountEstimator(2, 0.05), np.random.default_rng(4)
+    theta, p, information = fit.theta.copy(), fit.p.copy(), fit.information.copy()
+    for k in range(400):
+        derivatives, weight, residual = rng.normal(size=4), rng.uniform(0.2, 1.0), rng.normal(0, 0.3)
+        fit.forget(5.0)
+        fit_forget(p, information, fit.memory, fit.prior, 5.0)
+        frozen = fit.axis_frozen
+        fit.update(derivatives * weight, residual * weight)
+        fit_update(theta, p, information, fit.r, fit.clip, frozen, derivatives, weight, residual * weight)
+        assert np.array_equal(theta, fit.theta) and np.array_equal(p, fit.p)
+        assert np.array_equal(information, fit.information)
+        if fit.updates % fit.check_every == 0:
+            assert fit_condition(information) == pytest.approx(fit.condition, rel=1e-12)
