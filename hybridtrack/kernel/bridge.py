@@ -17,7 +17,7 @@ from ..control.controller import CLASSIFYING, Controller, ControllerOutputs
 from ..control.modes import MODES
 from ..world import World
 from . import controller as kc
-from .events import reason
+from .events import wording
 from .loop import EVENTS_PER_SCAN, run_scans
 from .world import WorldArrays, WorldState
 
@@ -165,11 +165,11 @@ def _grown(events: kc.EventLog) -> kc.EventLog:
 
 
 def _worded(controller: Controller, events: kc.EventLog, count: int) -> list:
-    worded = []
+    worded, reason = [], wording(controller.config, controller.plan_alarms)
     for i, before, after, code, (value, other) in zip(events.scan[:count].tolist(), events.before[:count].tolist(),
                                                      events.after[:count].tolist(), events.code[:count].tolist(),
                                                      events.value[:count].tolist()):
-        text = reason(code, value, other, controller.config, controller.plan_alarms, i)
+        text = reason(code, value, other, i)
         if before == after:
             log.info("scan %d: %s", i, text)
         else:
