@@ -152,8 +152,8 @@ def test_the_compiled_controller_imports_nothing_of_the_world():
     for node in ast.walk(ast.parse(source.read_text())):
         if isinstance(node, ast.ImportFrom):
             module = node.module or ""
-            assert not module.startswith("..") and module.split(".")[-1] not in ("world", "sensor", "sky", "simulation"), \
-                module
+            named = module.split(".")[-1]
+            assert not module.startswith("..") and named not in ("world", "sensor", "sky", "simulation"), module
             assert node.level < 2 or module.split(".")[0] == "control", module
 
 
@@ -200,7 +200,8 @@ def test_other_configs_run_the_same_compiled(mixed_day, config, strategy):
 
 def test_a_recorded_photocurrent_and_a_frame_without_wind_or_diffuse_run_the_same_compiled(mixed_day):
     rng = np.random.default_rng(0)
-    recorded = mixed_day.drop(columns=["wind_speed", "dhi"]).assign(photocurrent=30.0 + rng.uniform(0, 300, len(mixed_day)))
+    current = 30.0 + rng.uniform(0, 300, len(mixed_day))
+    recorded = mixed_day.drop(columns=["wind_speed", "dhi"]).assign(photocurrent=current)
     config = replaced(controller={"wind_missing": "track"})
     for strategy in ("hybrid", "sensor"):
         assert_same_run(*both(recorded, "lanzhou", config=config, strategy=strategy))
@@ -278,7 +279,8 @@ def test_the_trailing_windows_compiled_keep_the_reference_range_and_mean(packed)
     spread, mean = TrailingRange(20.0), TrailingMean(3.0)
     for t, value in zip(times, values):
         expected = spread.add(t, value)
-        assert trailing_range(state, ABSOLUTE_HIGHS, ABSOLUTE_LOWS, 20.0, t, value) == pytest.approx(expected, nan_ok=True)
+        ranged = trailing_range(state, ABSOLUTE_HIGHS, ABSOLUTE_LOWS, 20.0, t, value)
+        assert ranged == pytest.approx(expected, nan_ok=True)
         assert trailing_mean(state, 3.0, t, value) == pytest.approx(mean.add(t, value), rel=0, abs=0, nan_ok=True)
 
 

@@ -47,7 +47,8 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
     recorded = world._recorded_current
     arrays = WorldArrays(
         np.asarray(world._truth, float), beam, aureole, patch, patch_offset, diffuse,
-        np.asarray(world._noise, float), np.asarray(world._current_noise, float), np.asarray(world._coarse_noise, float),
+        np.asarray(world._noise, float), np.asarray(world._current_noise, float),
+        np.asarray(world._coarse_noise, float),
         np.asarray(recorded if recorded is not None else np.zeros(n), float), recorded is not None,
         np.asarray(world.wind, float), np.asarray(world.minutes, float),
         np.asarray(world._sky if world._sky is not None else np.full(n, -1), float),

@@ -30,8 +30,10 @@ def wording(config, plan_alarms: dict):
             f"controller clock stepped by {value:+.0f} s against the scan timer; clock re-based",
         ENCODER_FROZEN: lambda value, other, scan:
             f"encoder frozen: commanded {value:+.2f}°, reading unchanged; drive halted",
-        ENCODER_BELIEVED: lambda value, other, scan: f"encoder reading {value:.3f}° held for {int(other)} scans; believed",
-        ENCODER_GLITCH: lambda value, other, scan: f"encoder glitch: read {value:.3f}°, expected {other:.3f}°; ignored",
+        ENCODER_BELIEVED: lambda value, other, scan:
+            f"encoder reading {value:.3f}° held for {int(other)} scans; believed",
+        ENCODER_GLITCH: lambda value, other, scan:
+            f"encoder glitch: read {value:.3f}°, expected {other:.3f}°; ignored",
         ANEMOMETER_MOVING: lambda value, other, scan: f"anemometer moving again ({value:.1f} m/s)",
         ANEMOMETER_STUCK: lambda value, other, scan: (f"anemometer stuck at {value:.2f} m/s for {STUCK_HOURS:g} h of "
                                                       "daylight; its readings count as missing"),
