@@ -20,6 +20,7 @@ sun), and the share while searching or without a valid reading (a lost sun).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -159,14 +160,24 @@ class AblationResult:
         gap = mean["hybrid-always"] - mean["hybrid-oracle"]
         return float((mean["hybrid-always"] - mean["hybrid"]) / gap) if gap != 0 else float("nan")
 
+    def gap_note(self) -> str:
+        """`gap_recovered` in words, or why there is no share to give (a policy missing, no gap)."""
+        share = self.gap_recovered()
+        if not math.isnan(share):
+            return f"hybrid recovers {share:.0%} of the always→oracle RMS gap"
+        policies = set(self.runs["policy"])
+        if not {"hybrid", "hybrid-always", "hybrid-oracle"} <= policies:
+            return "no always→oracle gap: run hybrid, hybrid-always and hybrid-oracle to measure it"
+        return "no always→oracle gap: the true sky label changes nothing on these days"
+
     def __repr__(self) -> str:
         days = len(self.runs) // max(self.runs["policy"].nunique(), 1)
         return (f"AblationResult({days} day-runs × {self.runs['policy'].nunique()} policies; "
-                f"hybrid recovers {self.gap_recovered():.0%} of the always→oracle RMS gap)\n"
+                f"{self.gap_note()})\n"
                 + self.table.to_string(float_format=lambda v: f"{v:.4f}"))
 
     def _repr_html_(self) -> str:
-        return (f"<p>hybrid recovers <b>{self.gap_recovered():.0%}</b> of the always→oracle RMS gap</p>"
+        return (f"<p>{self.gap_note()}</p>"
                 + self.table.to_html(float_format=lambda v: f"{v:.4f}"))
 
     def plot(self):
@@ -187,8 +198,7 @@ class AblationResult:
             ax.grid(axis="y", alpha=0.3)
         axes[0].set_yscale("log")
         days = len(self.runs) // max(len(policies), 1)
-        figure.suptitle(f"Every policy on the same {days} seeded day-runs (bar: mean); hybrid recovers "
-                        f"{self.gap_recovered():.0%} of the always→oracle RMS gap")
+        figure.suptitle(f"Every policy on the same {days} seeded day-runs (bar: mean); {self.gap_note()}")
         return figure
 
 

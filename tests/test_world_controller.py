@@ -177,3 +177,17 @@ def test_the_controllers_own_sky_watch_matches_the_reference_inputs(inputs):
     edges = np.min(np.abs(exact[both, None] - np.array([10.0, 20.0])), axis=1) > 0.05
     labels = np.asarray(control.SKY_CODES)[captured["out"].sky[both]]
     assert (labels[edges] == result.log["sky"].astype(str).to_numpy()[both][edges]).all()
+
+
+def test_the_gap_the_hybrid_recovers_is_a_share_or_says_why_there_is_none():
+    from hybridtrack.ablation import AblationResult
+
+    def runs(always: float, oracle: float) -> pd.DataFrame:
+        rows = [("hybrid", 0.2), ("hybrid-always", always), ("hybrid-oracle", oracle)]
+        return pd.DataFrame([{"policy": p, "rms": r, "p95": r, "energy": 0.99, "pull_loss_share": 0.0,
+                              "lost_sun_loss_share": 0.0} for p, r in rows])
+
+    assert AblationResult(runs(0.4, 0.2)).gap_recovered() == pytest.approx(1.0)  # (0.4 - 0.2) / (0.4 - 0.2)
+    assert "recovers 100%" in AblationResult(runs(0.4, 0.2)).gap_note()
+    assert "no always→oracle gap" in AblationResult(runs(0.3, 0.3)).gap_note()  # sunny days: nothing to recover
+    assert "nan" not in repr(AblationResult(runs(0.3, 0.3)))

@@ -47,7 +47,7 @@ def _ablate(args: argparse.Namespace) -> int:
     print(f"{days} day-runs ({len(args.sites)} sites × {len(args.seasons)} seasons × {len(args.weather)} weather × "
           f"{args.seeds} seeds × {len(args.collectors)} collectors), every policy on the same world")
     print(result.table.to_string(float_format=lambda v: f"{v:.4f}"))
-    print(f"hybrid recovers {result.gap_recovered():.0%} of the RMS gap between hybrid-always and hybrid-oracle")
+    print(result.gap_note())
     if args.out:
         from ..report import save_figure
 
