@@ -331,6 +331,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                         sun_up=world.altitude > 0,
                         incidence=incidence_cosine(world.altitude, world.azimuth, collector))
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
+    summary["clock"] = controller.clock.state() if controller.clock is not None else None
     summary["wind_data"] = _wind_data(frame)
     summary["day_cycle"] = _day_cycle(events, site)
     return Result(log, summary, events, site, collector, config, controller.memory())

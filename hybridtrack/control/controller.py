@@ -17,6 +17,7 @@ import numpy as np
 
 from ..drive import Drive
 from .calibration import Calibrator
+from .clockwatch import ClockWatch
 from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import EncoderMonitor
@@ -135,6 +136,7 @@ class Controller:
                             for _ in drives]
         self.jacobian, self.weight = plan.jacobian, plan.weight
         self.fit = MountEstimator(self.axes, config.sensor_noise) if plan.jacobian is not None else None
+        self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise) if self.fit is not None else None
         self.theta = np.zeros(2 + self.axes)
         self.fit_since = 0.0
         self.fitted_at = [-math.inf] * self.axes
@@ -253,6 +255,9 @@ class Controller:
             self._record(i, NOT_READ, [self._night_target(a) for a in range(self.axes)], reading)
             return [0.0] * self.axes
         self._day_and_wind(i, t, awake, gusty, obs.wind)
+        if self.was_awake and not awake and self.clock is not None:  # the day's end: judge the clock
+            for alarm in self.clock.verdict():
+                self._alarm(i, alarm)
         self.was_awake = awake
         sky = self._watch_sky(i, t, obs)
         status, valid = self._sense(i, t, dt, obs, reading, awake, sky)
@@ -420,6 +425,9 @@ class Controller:
             self.theta = self.fit.theta
             if self._disagrees(i, miss, spread):
                 return
+            rate = self._turn(a, m0 - m1) / dt if dt > 0 else math.nan
+            if math.isfinite(rate):
+                self.clock.add(t, a, self.jacobian[i, a], rate, self._turn(a, z - m0), w)
         mount = self._correction(i, a) - self.calibrators[a].offset
         residual = self._turn(a, self.gates[a].filter.angle - m0 - mount)
         self.calibrators[a].learn(dt, residual, self._turn(a, m0 - m1), bound)
