@@ -66,7 +66,6 @@ def test_a_troughs_sensor_cannot_tell_a_clock_error_from_its_mount():
     assert result.summary["clock"]["error_std_s"] > 300.0  # the sun leaves it at its prior
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("collector,site,start,end", [("trough-ns", "nanjing", "2013-06-21", "2013-06-23"),
                                                       ("fresnel", "lanzhou", "2021-12-21", "2021-12-23"),
                                                       ("heliostat", "delingha", "2018-06-21", "2018-06-23")])
