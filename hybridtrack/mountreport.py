@@ -7,8 +7,9 @@ sensor can show of the mount, which is not always one field of `Imperfections` a
 
 * the sensor's mounting bias adds to every encoder zero (the sensor reads the sun at the true
   angle plus the encoder's zero plus its own bias, and no reading can tell the two apart);
-* a heliostat's pedestal turned about the vertical is an azimuth encoder offset (Stone 1986),
-  and the world's pedestal has no roll (its tilt is about the east-west line).
+* a heliostat's pedestal turned about the vertical is an azimuth encoder offset (Stone 1986);
+  its two tilts are the world's `axis_tilt_error` (about the east-west line) and
+  `axis_roll_error` (about the north-south line). A single axis's roll is an encoder offset.
 
 References
 ----------
@@ -46,10 +47,11 @@ def true_fit_parameters(imperfections, collector) -> dict[str, float]:
         By the names of `hybridtrack.control.mountfit.parameter_names`.
     """
     zero = imperfections.encoder_offset + imperfections.sensor_bias
-    if collector.single_axis:
+    if collector.single_axis:  # a roll about the axis is an encoder offset
         return {"axis_azimuth_error": imperfections.axis_azimuth_error,
-                "axis_tilt_error": imperfections.axis_tilt_error, "encoder_offset": zero}
-    return {"axis_tilt_error": imperfections.axis_tilt_error, "axis_roll_error": 0.0,
+                "axis_tilt_error": imperfections.axis_tilt_error,
+                "encoder_offset": zero + imperfections.axis_roll_error}
+    return {"axis_tilt_error": imperfections.axis_tilt_error, "axis_roll_error": imperfections.axis_roll_error,
             "encoder_offset_azimuth": zero + imperfections.axis_azimuth_error, "encoder_offset": zero}
 
 
