@@ -15,7 +15,6 @@ where the fit calls them identifiable (the pedestal terms unfrozen).
 """
 
 import argparse
-import dataclasses
 import sys
 from pathlib import Path
 
