@@ -34,7 +34,7 @@ from .control import STRATEGIES
 from .control.modes import LOW_LIGHT, OK, OUT_OF_VIEW, OUTLIER, SENSOR_STATUS
 from .errors import HybridtrackError
 
-__all__ = ["AblationPlan", "AblationResult", "ablate", "SEASONS", "SITE_YEARS"]
+__all__ = ["AblationPlan", "AblationResult", "ablate", "run_days", "SEASONS", "SITE_YEARS"]
 
 #: The typical days of each season (month-day) and the year each site's days are taken from.
 SEASONS = {"spring": "03-20", "summer": "06-21", "autumn": "09-23", "winter": "12-21"}
@@ -240,23 +240,28 @@ def ablate(plan: AblationPlan | None = None, *, config=None, workers: int = 1, p
         Called with 1 after each day.
     """
     plan = plan or AblationPlan()
-    days = plan.days()
+    return AblationResult(pd.DataFrame(run_days(_day, plan.days(), (plan.policies, config), workers, progress)), plan)
+
+
+def run_days(run, days: list[dict], arguments: tuple, workers: int, progress=None) -> list[dict]:
+    """``run(day, *arguments)`` (a list of rows) for every day, in `workers` processes; the rows in
+    the days' order."""
     if not 1 <= workers <= 64:
-        raise HybridtrackError(f"ablate: workers must be 1-64, got {workers}")
+        raise HybridtrackError(f"workers must be 1-64, got {workers}")
     if workers == 1:
         results = []
         for day in days:
-            results.append(_day(day, plan.policies, config))
+            results.append(run(day, *arguments))
             if progress is not None:
                 progress(1)
     else:
         from concurrent.futures import ProcessPoolExecutor
 
         with ProcessPoolExecutor(workers) as pool:
-            futures = [pool.submit(_day, day, plan.policies, config) for day in days]
+            futures = [pool.submit(run, day, *arguments) for day in days]
             results = []
             for future in futures:
                 results.append(future.result())
                 if progress is not None:
                     progress(1)
-    return AblationResult(pd.DataFrame([row for rows in results for row in rows]), plan)
+    return [row for rows in results for row in rows]
