@@ -13,22 +13,28 @@ Beside them: ``hybrid-nocal`` (no calibration), ``astronomical`` (open loop as i
 ``astronomical-commissioned`` (open loop after a commissioning fit) and ``sensor`` (closed loop
 as sold). Per run the table also says why a closed loop lost energy: the share of the direct
 energy it failed to intercept (through the acceptance model of `hybridtrack.metrics`) while
-following a sensor that read valid (cloud pull: the sensor saw something, and it was not the
-sun), and the share while searching or without a valid reading (a lost sun).
+following the sensor as it read (cloud pull: the sensor saw light, and it was not the sun's
+alone; the readings the Kalman gate rejected as outliers count here, since a pulled reading is
+rejected once the pull has dragged the filter), and the share while searching or while the sensor
+saw too little light or no sun in view (a lost sun). Running the same days in a world without
+pull (``[sensor] patch_distance = [0, 0]``: the bright patch sits on the sun) is the ablation
+that shows the first share is caused by the pull (docs/world.md).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from .control import STRATEGIES
+from .control.modes import LOW_LIGHT, OK, OUT_OF_VIEW, OUTLIER, SENSOR_STATUS
 from .errors import HybridtrackError
 
-__all__ = ["AblationPlan", "AblationResult", "ablate", "SEASONS", "SITE_YEARS"]
+__all__ = ["AblationPlan", "AblationResult", "ablate", "run_days", "SEASONS", "SITE_YEARS"]
 
 #: The typical days of each season (month-day) and the year each site's days are taken from.
 SEASONS = {"spring": "03-20", "summer": "06-21", "autumn": "09-23", "winter": "12-21"}
@@ -95,6 +101,12 @@ def _day(day: dict, policies: tuple[str, ...], config) -> list[dict]:
     return rows
 
 
+#: Sensor statuses under which the sensor read a pointing signal (followed, or gated out as an outlier).
+READ = tuple(SENSOR_STATUS[k] for k in (OK, OUTLIER))
+#: Sensor statuses under which it had none: too little light, or the sun outside its view.
+UNSEEN = tuple(SENSOR_STATUS[k] for k in (LOW_LIGHT, OUT_OF_VIEW))
+
+
 def _metrics(result) -> dict:
     """The headline numbers of a run and why a closed loop lost: shares of the energy it lost."""
     from .metrics import ACCEPTANCE_HALF_ANGLE, acceptance
@@ -104,18 +116,28 @@ def _metrics(result) -> dict:
     beam = np.nan_to_num(log["dni"].to_numpy(float))
     mode = log["mode"].astype(str).to_numpy()
     on_sensor = mode == "sensor"
-    valid = log["sensor_valid"].to_numpy()
+    status = log["sensor_status"].astype(str).to_numpy()
+    read = np.isin(status, READ)
+    unseen = np.isin(status, UNSEEN)
     gained = acceptance(np.nan_to_num(log["error"].to_numpy(float), nan=np.inf),
                         ACCEPTANCE_HALF_ANGLE[result.collector.kind])
     lost_energy = beam * (1.0 - gained) * np.isin(mode, ["sensor", "astronomical", "search"])
     total = lost_energy.sum()
+    hours = np.diff(log.index.asi8).mean() / 3.6e12 if len(log) > 1 else 0.0
 
     def share(mask):
         return float(lost_energy[mask].sum() / total) if total > 0 else float("nan")
 
     return {"rms": error["rms"], "p95": error["p95"], "energy": summary["energy_capture"],
-            "sensor_share": summary["mode_share"]["sensor"], "pull_loss_share": share(on_sensor & valid),
-            "lost_sun_loss_share": share((mode == "search") | (on_sensor & ~valid))}
+            "sensor_share": summary["mode_share"]["sensor"], "pull_loss_share": share(on_sensor & read),
+            "lost_sun_loss_share": share((mode == "search") | (on_sensor & unseen)),
+            "lost_kwh": float(total * hours / 1000.0)}
+
+
+def _pooled(shares: np.ndarray, lost: np.ndarray) -> float:
+    """Shares of each run's lost energy pooled over the runs: the share of all the energy lost."""
+    known = np.isfinite(shares) & (lost > 0)
+    return float((shares[known] * lost[known]).sum() / lost[known].sum()) if known.any() else float("nan")
 
 
 def _interval(values: np.ndarray, rng: np.random.Generator, draws: int = 2000) -> tuple[float, float]:
@@ -136,7 +158,9 @@ class AblationResult:
 
     @property
     def table(self) -> pd.DataFrame:
-        """Per policy: mean, 95 % interval of the mean and worst of RMS, p95 and energy capture."""
+        """Per policy: mean, 95 % interval of the mean and worst of RMS, p95 and energy capture, and
+        of all the direct energy the policy lost while tracking, the shares lost to pull and to a
+        lost sun."""
         rng = np.random.default_rng(0)
         rows = {}
         for policy, runs in self.runs.groupby("policy", sort=False):
@@ -146,8 +170,9 @@ class AblationResult:
                 low, high = _interval(values, rng)
                 row.update({f"{metric} mean": np.nanmean(values), f"{metric} 95% low": low,
                             f"{metric} 95% high": high, f"{metric} worst": worst(values)})
-            row["pull loss share"] = runs["pull_loss_share"].mean()
-            row["lost-sun loss share"] = runs["lost_sun_loss_share"].mean()
+            lost = runs["lost_kwh"].to_numpy(float)
+            for name, column in (("pull loss share", "pull_loss_share"), ("lost-sun loss share", "lost_sun_loss_share")):
+                row[name] = _pooled(runs[column].to_numpy(float), lost)
             rows[policy] = row
         return pd.DataFrame(rows).T
 
@@ -159,14 +184,24 @@ class AblationResult:
         gap = mean["hybrid-always"] - mean["hybrid-oracle"]
         return float((mean["hybrid-always"] - mean["hybrid"]) / gap) if gap != 0 else float("nan")
 
+    def gap_note(self) -> str:
+        """`gap_recovered` in words, or why there is no share to give (a policy missing, no gap)."""
+        share = self.gap_recovered()
+        if not math.isnan(share):
+            return f"hybrid recovers {share:.0%} of the always→oracle RMS gap"
+        policies = set(self.runs["policy"])
+        if not {"hybrid", "hybrid-always", "hybrid-oracle"} <= policies:
+            return "no always→oracle gap: run hybrid, hybrid-always and hybrid-oracle to measure it"
+        return "no always→oracle gap: the true sky label changes nothing on these days"
+
     def __repr__(self) -> str:
         days = len(self.runs) // max(self.runs["policy"].nunique(), 1)
         return (f"AblationResult({days} day-runs × {self.runs['policy'].nunique()} policies; "
-                f"hybrid recovers {self.gap_recovered():.0%} of the always→oracle RMS gap)\n"
+                f"{self.gap_note()})\n"
                 + self.table.to_string(float_format=lambda v: f"{v:.4f}"))
 
     def _repr_html_(self) -> str:
-        return (f"<p>hybrid recovers <b>{self.gap_recovered():.0%}</b> of the always→oracle RMS gap</p>"
+        return (f"<p>{self.gap_note()}</p>"
                 + self.table.to_html(float_format=lambda v: f"{v:.4f}"))
 
     def plot(self):
@@ -187,8 +222,7 @@ class AblationResult:
             ax.grid(axis="y", alpha=0.3)
         axes[0].set_yscale("log")
         days = len(self.runs) // max(len(policies), 1)
-        figure.suptitle(f"Every policy on the same {days} seeded day-runs (bar: mean); hybrid recovers "
-                        f"{self.gap_recovered():.0%} of the always→oracle RMS gap")
+        figure.suptitle(f"Every policy on the same {days} seeded day-runs (bar: mean); {self.gap_note()}")
         return figure
 
 
@@ -206,23 +240,28 @@ def ablate(plan: AblationPlan | None = None, *, config=None, workers: int = 1, p
         Called with 1 after each day.
     """
     plan = plan or AblationPlan()
-    days = plan.days()
+    return AblationResult(pd.DataFrame(run_days(_day, plan.days(), (plan.policies, config), workers, progress)), plan)
+
+
+def run_days(run, days: list[dict], arguments: tuple, workers: int, progress=None) -> list[dict]:
+    """``run(day, *arguments)`` (a list of rows) for every day, in `workers` processes; the rows in
+    the days' order."""
     if not 1 <= workers <= 64:
-        raise HybridtrackError(f"ablate: workers must be 1-64, got {workers}")
+        raise HybridtrackError(f"workers must be 1-64, got {workers}")
     if workers == 1:
         results = []
         for day in days:
-            results.append(_day(day, plan.policies, config))
+            results.append(run(day, *arguments))
             if progress is not None:
                 progress(1)
     else:
         from concurrent.futures import ProcessPoolExecutor
 
         with ProcessPoolExecutor(workers) as pool:
-            futures = [pool.submit(_day, day, plan.policies, config) for day in days]
+            futures = [pool.submit(run, day, *arguments) for day in days]
             results = []
             for future in futures:
                 results.append(future.result())
                 if progress is not None:
                     progress(1)
-    return AblationResult(pd.DataFrame([row for rows in results for row in rows]), plan)
+    return [row for rows in results for row in rows]

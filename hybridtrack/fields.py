@@ -71,6 +71,7 @@ class ImperfectionSpread:
     sensor_noise: float = 0.0
     clock_drift: float = 0.0
     commissioned_days_ago: float = 0.0
+    axis_roll_error: float = 0.0
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):

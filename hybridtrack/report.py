@@ -13,6 +13,8 @@ from pathlib import Path
 import pandas as pd
 from matplotlib.figure import Figure
 
+from .mountreport import FIT_PREFIX, draw_mount_fit, fitted_parameters, true_fit_parameters
+
 __all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_days", "plot_compare", "plot_rules",
            "Comparison",
            "plot_tuning", "plot_confusion", "save_figure", "figure", "ReportFigure", "describe", "describe_html",
@@ -504,6 +506,9 @@ def plot_run(result, *, day=None, title: str | None = None):
     error (clipped and marked as clipped) and wind with its stow threshold, with gaps in the data
     hatched. The overview of a longer run shows pointing error, mode and sky by hour and day,
     the energy capture of each day and each day's highest wind against the stow threshold.
+    A run whose controller fits its mount adds the fit converging: each parameter with its ±1σ
+    band and the world's true value dashed (`hybridtrack.mountreport`), by step on the
+    timeline and as it stood at each day's end on the overview.
     """
     log = result.log
     if day is not None:
@@ -568,8 +573,9 @@ def _plot_timeline(result, log: pd.DataFrame, title: str):
     gaps = _gaps(log.index)
     step = _step(log.index)
     sun_up = np.isfinite(log["target_true"].to_numpy())
-    fig = figure(figsize=(13, 11), layout="constrained")
-    axes = fig.subplots(6, 1, sharex=True, height_ratios=[1.6, 0.35, 0.35, 2.2, 1.8, 1.2])
+    fitted = bool(fitted_parameters(log))
+    fig = figure(figsize=(13, 12.6 if fitted else 11), layout="constrained")
+    axes = fig.subplots(6 + fitted, 1, sharex=True, height_ratios=[1.6, 0.35, 0.35, 2.2, 1.8, 1.2] + [1.6] * fitted)
     ax = axes[0]
     ax.plot(*_broken(local, log["dni"], gaps), color="tab:red", lw=0.9, label="DNI")
     ax.set_ylabel("DNI (W/m²)")
@@ -607,6 +613,8 @@ def _plot_timeline(result, log: pd.DataFrame, title: str):
             transform=ax.get_yaxis_transform(), color="tab:green", fontsize="x-small", va="center")
     ax.set_ylabel("wind (m/s)")
     ax.set_ylim(0, max(controller.wind_stow * 1.15, float(np.nanmax(log["wind_speed"], initial=0)) * 1.05))
+    if fitted:
+        draw_mount_fit(axes[6], local, log, true_fit_parameters(result.config.imperfections, result.collector))
     for ax in axes:
         _shade_gaps(ax, local, gaps)
     axes[-1].set_xlabel(f"local time ({tz})")
@@ -728,8 +736,9 @@ def _plot_overview(result, title: str):
     sun_up = np.isfinite(log["target_true"].to_numpy())
     extent = days.extent()
 
-    fig = figure(figsize=(13, 13), layout="constrained")
-    axes = fig.subplots(5, 1, sharex=True, height_ratios=[2.2, 1.6, 1.6, 1.2, 1.0])
+    fitted = bool(fitted_parameters(log))
+    fig = figure(figsize=(13, 14.6 if fitted else 13), layout="constrained")
+    axes = fig.subplots(5 + fitted, 1, sharex=True, height_ratios=[2.2, 1.6, 1.6, 1.2, 1.0] + [1.6] * fitted)
     fig.suptitle(f"{title}\n{_metrics_line(result.summary)}")
 
     # pointing error by hour and day, over a background of night / not tracking / no data
@@ -790,6 +799,10 @@ def _plot_overview(result, title: str):
     ax.text(1.005, controller.wind_stow, f"stow > {controller.wind_stow:g} m/s", transform=ax.get_yaxis_transform(),
             color="tab:red", fontsize="x-small", va="center")
     ax.set_ylabel("highest wind\nper day (m/s)")
+    if fitted:  # each day's fit as it stood at the day's end
+        at_end = log.filter(like=FIT_PREFIX).groupby(log.index.tz_convert(tz).date).last()
+        draw_mount_fit(axes[5], days.centres(at_end.index), at_end,
+                       true_fit_parameters(result.config.imperfections, result.collector))
     days.decorate(axes)
     axes[-1].set_xlabel(f"local date ({tz})" + (", days with data only" if days.compact else ""))
     return fig

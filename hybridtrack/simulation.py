@@ -29,6 +29,7 @@ from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
 from .mounting import incidence_cosine
+from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
 from .world import Imperfections, World
@@ -172,7 +173,8 @@ class Result:
     ----------
     log : pandas.DataFrame
         One row per step, indexed like the frame (see `LOG_COLUMNS`; a heliostat adds the
-        ``*_azimuth`` columns of its second axis).
+        ``*_azimuth`` columns of its second axis; a controller that fits its mount adds each
+        fitted parameter and its 1σ, ``fit_<name>`` and ``fit_<name>_std``, degrees).
     summary : dict
         The metrics written to ``summary.json`` (`hybridtrack.metrics`).
     events : pandas.DataFrame
@@ -340,6 +342,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                         sun_up=world.altitude > 0,
                         incidence=incidence_cosine(world.altitude, world.azimuth, collector))
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
+    summary["clock"] = controller.clock.state() if controller.clock is not None else None
     summary["wind_data"] = _wind_data(frame)
     summary["day_cycle"] = _day_cycle(events, site)
     return Result(log, summary, events, site, collector, config, controller.memory())
@@ -505,6 +508,9 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
         "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(), "wind_speed": world.wind,
         "dni": world.frame_dni, "calibration": out.calibration[:, main], "sensor_sun": out.sun[:, main],
     }, index=index)
+    for k, name in enumerate(parameter_names(collector)[:out.fit.shape[1]]):
+        log[f"{FIT_PREFIX}{name}"] = out.fit[:, k]
+        log[f"{FIT_PREFIX}{name}_std"] = out.fit_std[:, k]
     if not collector.single_axis:
         log["target_true_azimuth"] = truth[:, 0]
         log["target_azimuth"] = out.target[:, 0] % 360.0  # the axis may have wound past a turn

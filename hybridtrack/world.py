@@ -71,6 +71,11 @@ class Imperfections:
         Degrees the sun sensor is mounted off the collector's axis.
     sensor_noise : float
         Degrees, 1σ of the sensor's reading at 1000 W/m² in view.
+    axis_roll_error : float
+        Degrees the mount is rolled about its nominal axis direction
+        (`hybridtrack.mounting.mounting_rotation`): a heliostat pedestal's tilt about the
+        north-south line, beside `axis_tilt_error` about the east-west line. For a single-axis
+        collector a roll about its own axis is an encoder offset.
     """
 
     axis_azimuth_error: float = 0.3
@@ -83,11 +88,12 @@ class Imperfections:
     longitude_error: float = 0.01
     sensor_bias: float = 0.06
     sensor_noise: float = 0.03
+    axis_roll_error: float = 0.0
 
     def __post_init__(self) -> None:
         limits = {"axis_azimuth_error": 10.0, "axis_tilt_error": 10.0, "encoder_offset": 10.0, "clock_error": 3600.0,
                   "clock_drift": 100.0, "commissioned_days_ago": 3660.0, "latitude_error": 1.0,
-                  "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0}
+                  "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0, "axis_roll_error": 10.0}
         for f in fields(self):
             value = getattr(self, f.name)
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
@@ -144,7 +150,8 @@ class World:
         rng = np.random.default_rng(seed)
         position = self._true_sun(truth)
         self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
-        rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis)
+        rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
+                                     imperfections.axis_roll_error)
         self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation)
         clear_dni, clear_dhi = self._clear_sky(frame, position)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)

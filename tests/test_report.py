@@ -139,7 +139,8 @@ def test_scattered_days_get_a_column_each_and_the_gap_is_marked():
     fig = result.plot()
     texts = [t.get_text() for ax in fig.axes for t in ax.texts]
     assert "92 days without data" in texts  # 2013-03-21 to 2013-06-20
-    assert [t.get_text() for t in fig.axes[4].get_xticklabels()] == ["2013-03-20", "2013-06-21"]
+    bottom = fig.axes[5]  # the hybrid fits its mount: its panel is the bottom row
+    assert [t.get_text() for t in bottom.get_xticklabels()] == ["2013-03-20", "2013-06-21"]
     assert len(result.daily()) == 2
 
 
@@ -148,3 +149,43 @@ def test_a_run_without_events_still_shows_itself():
     result = hybridtrack.simulate(frame, "delingha", collector="trough-ew")  # three steps of night
     assert "no events" in result._repr_html_() and "night 100.0%" in repr(result)
     assert result.plot()._repr_png_()[:4] == b"\x89PNG" and len(result.daily()) == 1
+
+
+def _fit_lines(fig):
+    """The mount-fit panel's lines by parameter, and its dashed truths."""
+    lines = [line for ax in fig.axes for line in ax.get_lines() if (line.get_gid() or "").startswith("fit:")]
+    truths = [line for ax in fig.axes for line in ax.get_lines() if (line.get_gid() or "").startswith("truth:")]
+    return {line.get_gid()[4:]: line for line in lines}, {line.get_gid()[6:]: line for line in truths}
+
+
+def test_the_mount_fit_panel_draws_the_logs_fit_and_the_worlds_truth(two_days):
+    from hybridtrack.control.mountfit import parameter_names
+
+    lines, truths = _fit_lines(two_days.plot())
+    names = parameter_names(two_days.collector)
+    assert sorted(lines) == sorted(names)
+    imperfections = two_days.config.imperfections
+    expected = {"axis_azimuth_error": imperfections.axis_azimuth_error,
+                "axis_tilt_error": imperfections.axis_tilt_error,
+                "encoder_offset": imperfections.encoder_offset + imperfections.sensor_bias}  # the sensor adds its bias
+    for name in names:
+        np.testing.assert_array_equal(lines[name].get_ydata(), two_days.log[f"fit_{name}"].to_numpy())
+        assert truths[name].get_ydata()[0] == pytest.approx(expected[name])
+    assert len(lines[names[0]].axes.collections) == len(names)  # one ±1σ band each
+
+
+def test_the_overview_draws_each_days_fit_as_it_stood_at_its_end():
+    frame = synthetic("lanzhou", "2021-06-21", "2021-06-27", weather="sunny", seed=3, freq="10min")
+    result = hybridtrack.simulate(frame, "lanzhou")
+    lines, _ = _fit_lines(result.plot())
+    local = result.log.index.tz_convert(result.site.tz)
+    at_end = result.log.groupby(local.date)["fit_encoder_offset"].last().to_numpy()
+    np.testing.assert_array_equal(lines["encoder_offset"].get_ydata(), at_end)
+    assert len(at_end) == 7
+
+
+def test_runs_without_a_fit_have_no_fit_panel():
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=3, freq="10min")
+    result = hybridtrack.simulate(frame, "lanzhou", strategy="astronomical")
+    assert not result.log.filter(like="fit_").columns.size
+    assert _fit_lines(result.plot()) == ({}, {})

@@ -2,43 +2,28 @@
 
     python data/real/tracking_table.py
 
-`simulate` does not yet take sky-input choices, so the relative inputs are passed through a
-classifier whose `score` turns the photocurrent simulate hands it into the relative inputs
-(`RelativeInputs`), exactly the call `simulate` is to make (docs/sky-validation.md).
+The controller's sky watch takes its inputs from `SimulationConfig.sky`: the default relative
+inputs, or `SkyInputConfig.published()` (docs/sky-validation.md). The records carry no wind, so
+they are replayed as `hybridtrack replay` does: tracking through (`wind_missing = "track"`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 from pathlib import Path
 
-import pandas as pd
-
-from hybridtrack.fuzzy import FuzzyWeatherClassifier
 from hybridtrack.io import read_weather
 from hybridtrack.simulation import SimulationConfig, simulate
 from hybridtrack.sites import Site
-from hybridtrack.skyinputs import SkyInputConfig, fuzzy_config, sky_inputs
+from hybridtrack.skyinputs import SkyInputConfig
 
 HERE = Path(__file__).parent
 
 
-class RelativeInputs(FuzzyWeatherClassifier):
-    """Scores the relative inputs of the photocurrent it is given, for one frame and site."""
-
-    def __init__(self, frame: pd.DataFrame, site: Site, sensor, config: SkyInputConfig):
-        super().__init__(fuzzy_config(config))
-        self.frame, self.site, self.sensor, self.sky = frame, site, sensor, config
-
-    def score(self, intensity, variation, **options):
-        current = pd.Series(intensity, index=self.frame.index)
-        inputs = sky_inputs(self.frame, self.site, self.sensor, self.sky, intensity=current)
-        return super().score(inputs[0].to_numpy(), inputs[1].to_numpy(), **options)
-
-
 def main() -> None:
     meta = tomllib.loads((HERE / "stations.toml").read_text())
-    config = SimulationConfig()
+    controller = dataclasses.replace(SimulationConfig().controller, wind_missing="track")
     print("| record | inputs | energy capture | pointing error RMS (°) | p95 (°) | mode switches |")
     print("|---|---|---|---|---|---|")
     for file, spec in meta["files"].items():
@@ -46,9 +31,8 @@ def main() -> None:
         site = Site(spec["station"], s["latitude"], s["longitude"], s["altitude"], s["tz"])
         frame = read_weather(HERE / file).fillna(0.0)
         frame = frame[~frame.index.duplicated()]
-        for name, classifier in (("published", None),
-                                 ("relative (default)", RelativeInputs(frame, site, config.sensor, SkyInputConfig()))):
-            summary = simulate(frame, site, config=config, classifier=classifier).summary
+        for name, sky in (("published", SkyInputConfig.published()), ("relative (default)", SkyInputConfig())):
+            summary = simulate(frame, site, config=SimulationConfig(controller=controller, sky=sky)).summary
             error = summary["tracking_error_deg"]
             print(f"| {file} | {name} | {summary['energy_capture']:.4f} | {error['rms']:.3f} | {error['p95']:.3f} | "
                   f"{summary['mode_switches']} |")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from ..errors import HybridtrackError
@@ -20,10 +21,18 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", type=int, default=5, help="seeds per site, season and weather (default 5)")
     parser.add_argument("--collectors", nargs="+", default=["trough-ns", "fresnel"],
                         help="collectors (default trough-ns fresnel)")
-    parser.add_argument("--policies", nargs="+", default=list(STRATEGIES), help="policies (default all)")
+    parser.add_argument("--policies", nargs="+", choices=list(STRATEGIES),
+                        help="policies (default all; with --tradeoff, the first, default hybrid)")
     parser.add_argument("--workers", type=int, default=1, help="processes (default 1; the table is the same)")
     parser.add_argument("--config", help="simulation config (TOML) every policy shares")
-    parser.add_argument("--out", help="folder for runs.csv, table.csv and ablation.png")
+    parser.add_argument("--out", help="folder for runs.csv, table.csv and ablation.png (tradeoff.png)")
+    parser.add_argument("--tradeoff", action="store_true",
+                        help="instead of every policy: one policy over a grid of drive deadbands and scan periods, "
+                             "pointing error against moves a day")
+    parser.add_argument("--deadbands", default="0.1,0.2,0.4,0.8",
+                        help="with --tradeoff: deadbands, degrees, comma-separated (default 0.1,0.2,0.4,0.8)")
+    parser.add_argument("--periods", default="1min",
+                        help="with --tradeoff: scan periods, comma-separated (default 1min; e.g. 1min,2min,5min)")
 
 
 @command("ablate", "run every policy over a seeded set of days: what the classifier is worth, and why",
@@ -34,12 +43,15 @@ def _ablate(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from ..ablation import AblationPlan, ablate
+    from ..control import STRATEGIES
     from ..simulation import SimulationConfig
 
     if not 1 <= args.seeds <= 1000:
         raise HybridtrackError(f"--seeds must be between 1 and 1000, got {args.seeds}")
+    if args.tradeoff:
+        return _tradeoff(args)
     plan = AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
-                        tuple(args.collectors), tuple(args.policies))
+                        tuple(args.collectors), tuple(args.policies or STRATEGIES))
     config = SimulationConfig.from_toml(args.config) if args.config else None
     days = len(plan.days())
     with tqdm(total=days, unit="day", desc="ablate", file=sys.stderr) as bar:
@@ -47,7 +59,7 @@ def _ablate(args: argparse.Namespace) -> int:
     print(f"{days} day-runs ({len(args.sites)} sites × {len(args.seasons)} seasons × {len(args.weather)} weather × "
           f"{args.seeds} seeds × {len(args.collectors)} collectors), every policy on the same world")
     print(result.table.to_string(float_format=lambda v: f"{v:.4f}"))
-    print(f"hybrid recovers {result.gap_recovered():.0%} of the RMS gap between hybrid-always and hybrid-oracle")
+    print(result.gap_note())
     if args.out:
         from ..report import save_figure
 
@@ -56,5 +68,45 @@ def _ablate(args: argparse.Namespace) -> int:
         result.runs.to_csv(folder / "runs.csv", index=False, float_format="%.6g")
         result.table.to_csv(folder / "table.csv", float_format="%.6g")
         picture = save_figure(result.plot(), folder / "ablation.png")
+        print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {picture}")
+    return 0
+
+
+def _deadbands(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise HybridtrackError(f"--deadbands {text!r}: give degrees separated by commas, e.g. 0.1,0.2,0.4") from None
+    if not all(math.isfinite(v) for v in values):
+        raise HybridtrackError(f"--deadbands {text!r}: every deadband must be a finite number")
+    return values
+
+
+def _tradeoff(args: argparse.Namespace) -> int:
+    """``ablate --tradeoff``: one policy over deadbands and scan periods."""
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from ..simulation import SimulationConfig
+    from ..tradeoff import TradeoffPlan, tradeoff
+
+    plan = TradeoffPlan(_deadbands(args.deadbands), tuple(p.strip() for p in args.periods.split(",")),
+                        tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
+                        tuple(args.collectors), (args.policies or ["hybrid"])[0])
+    config = SimulationConfig.from_toml(args.config) if args.config else None
+    with tqdm(total=len(plan.days()), unit="day", desc="tradeoff", file=sys.stderr) as bar:
+        result = tradeoff(plan, config=config, workers=args.workers, progress=bar.update)
+    print(f"{plan.policy} over {len(plan.deadbands)} deadbands × {len(plan.periods)} scan periods on "
+          f"{len(plan.days()) // len(plan.periods)} day(s); held: the error between scans")
+    print(result.table.to_string(float_format=lambda v: f"{v:.4g}"))
+    if args.out:
+        from ..report import save_figure
+
+        folder = Path(args.out)
+        folder.mkdir(parents=True, exist_ok=True)
+        result.runs.to_csv(folder / "runs.csv", index=False, float_format="%.6g")
+        result.table.to_csv(folder / "table.csv", float_format="%.6g")
+        picture = save_figure(result.plot(), folder / "tradeoff.png")
         print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {picture}")
     return 0

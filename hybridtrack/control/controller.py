@@ -17,6 +17,7 @@ import numpy as np
 
 from ..drive import Drive
 from .calibration import Calibrator
+from .clockwatch import ClockWatch
 from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import EncoderMonitor
@@ -135,6 +136,7 @@ class Controller:
                             for _ in drives]
         self.jacobian, self.weight = plan.jacobian, plan.weight
         self.fit = MountEstimator(self.axes, config.sensor_noise) if plan.jacobian is not None else None
+        self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise) if self.fit is not None else None
         self.theta = np.zeros(2 + self.axes)
         self.fit_since = 0.0
         self.fitted_at = [-math.inf] * self.axes
@@ -253,6 +255,9 @@ class Controller:
             self._record(i, NOT_READ, [self._night_target(a) for a in range(self.axes)], reading)
             return [0.0] * self.axes
         self._day_and_wind(i, t, awake, gusty, obs.wind)
+        if self.was_awake and not awake and self.clock is not None:  # the day's end: judge the clock
+            for alarm in self.clock.verdict():
+                self._alarm(i, alarm)
         self.was_awake = awake
         sky = self._watch_sky(i, t, obs)
         status, valid = self._sense(i, t, dt, obs, reading, awake, sky)
@@ -401,7 +406,10 @@ class Controller:
         bound = self._plausibility_bound(i, a)
         has_model = config.uses_model and not math.isnan(m0)
         miss = self._turn(a, z - m0 - self._correction(i, a)) if has_model else math.nan
-        rate = self._turn(a, m0 - m1) / dt if has_model and dt > 0 and not math.isnan(m1) else 0.0
+        if has_model and dt > 0 and not math.isnan(m1):
+            rate = self._turn(a, m0 - m1) / dt
+        else:  # no computed sun: the filter's own rate, once it has one
+            rate = gate.filter.rate if gate.ready else 0.0
         verdict = gate.take(z, dt, miss, bound, rate)
         if verdict == OK and trusted and has_model:
             self._learn(i, a, dt, z, m0, m1, bound)
@@ -414,25 +422,30 @@ class Controller:
             self.fitted_at[a] = t
             self.fit.forget(t - self.fit_since)
             self.fit_since = t
-            miss, spread = self._against_checkpoint(i, a, z, m0)
             w = self.weight[i, a]
+            miss, spread = self._against_checkpoint(i, a, z, m0, w)
             self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w)
             self.theta = self.fit.theta
             if self._disagrees(i, miss, spread):
                 return
+            rate = self._turn(a, m0 - m1) / dt if dt > 0 else math.nan
+            if math.isfinite(rate):
+                self.clock.add(t, a, self.jacobian[i, a], rate, self._turn(a, z - m0), w)
         mount = self._correction(i, a) - self.calibrators[a].offset
         residual = self._turn(a, self.gates[a].filter.angle - m0 - mount)
         self.calibrators[a].learn(dt, residual, self._turn(a, m0 - m1), bound)
 
-    def _against_checkpoint(self, i: int, a: int, z: float, m0: float) -> tuple[float, float]:
+    def _against_checkpoint(self, i: int, a: int, z: float, m0: float, w: float) -> tuple[float, float]:
         """The sensor's sun angle less the mount as fitted at the last checkpoint, and the spread that
-        difference should have: the sensor's noise and the checkpoint's own uncertainty. A calibration
-        that follows a drifting sensor must not hide the drift; the residual offset is left out, as
-        it follows the time of day and a checkpoint's offset belongs to another hour."""
+        difference should have: the sensor's noise and the checkpoint's own uncertainty, both in
+        pointing terms as the fit takes them (axis degrees times the axis's weight `w`: a heliostat's
+        azimuth degree near the zenith is a small pointing error). A calibration that follows a
+        drifting sensor must not hide the drift; the residual offset is left out, as it follows the
+        time of day and a checkpoint's offset belongs to another hour."""
         fit = self.checkpoint if self.checkpoint is not None else {"theta": self.theta, "p": self.fit.p}
         row = self.jacobian[i, a]
-        miss = self._turn(a, z - m0 - float(row @ fit["theta"]))
-        return miss, math.sqrt(self.fit.r + float(row @ fit["p"] @ row))
+        miss = self._turn(a, z - m0 - float(row @ fit["theta"])) * w
+        return miss, math.sqrt(self.fit.r + w * w * float(row @ fit["p"] @ row))
 
     def _disagrees(self, i: int, miss: float, spread: float) -> bool:
         """Watch the sensor against the checkpointed calibration (`miss`, degrees, with its expected

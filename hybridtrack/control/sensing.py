@@ -6,8 +6,11 @@ sensor's datasheet σ while the expected offset, from the computed sun or the fi
 the encoder, moved ten times that: the sun and the drive never both stand still, so a sensor
 whose answer does is stuck, noise or no noise), when it is further from the calibrated model
 than the plausibility bound, or when it fails the Kalman filter's innovation gate. After
-`reacquire` gated readings in a row the filter restarts from the latest reading: a filter that
-drifted away from the sun must not go on rejecting it.
+`reacquire` gated readings in a row the filter restarts from the latest reading at the rate it
+is given (the computed sun's, where there is one): a filter that drifted away from the sun must
+not go on rejecting it, nor restart with the rate that drifted (a heliostat's azimuth near the
+zenith speeds up faster than the filter's process noise allows, and a filter that kept its own
+rate there was rejected again at once and coasted the drive away).
 """
 
 from __future__ import annotations
@@ -56,7 +59,8 @@ class SensorGate:
         return OK
 
     def take(self, z: float, dt: float, miss: float, bound: float, rate: float) -> int:
-        """Offer the sun angle `z` (reading plus offset); `miss` is z less the calibrated model (NaN: none)."""
+        """Offer the sun angle `z` (reading plus offset); `miss` is z less the calibrated model (NaN:
+        none); `rate` (degrees a minute) is the sun's to start the filter at."""
         if abs(miss) > bound:
             return IMPLAUSIBLE
         kf = self.filter
@@ -70,7 +74,7 @@ class SensorGate:
             self.rejected += 1
             if self.rejected < self.reacquire:
                 return OUTLIER
-            kf.reset(z, kf.rate)
+            kf.reset(z, rate)
         else:
             kf.update(z)
         self.rejected = 0

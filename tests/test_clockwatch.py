@@ -1,0 +1,77 @@
+"""The clock against the sun the sensor shows: a drift on any collector, an error where it can be seen."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import sites
+from hybridtrack.collectors import Collector
+from hybridtrack.control.mountfit import jacobian
+from hybridtrack.control.plan import MountEstimate
+from hybridtrack.simulation import SimulationConfig, simulate
+from hybridtrack.sky import synthetic
+from hybridtrack.sun import solar_position
+from hybridtrack.world import Imperfections
+
+#: Seconds of clock error a degree of site longitude makes (the sun's 15° an hour).
+SECONDS_PER_DEGREE = 240.0
+
+
+def _run(site, start, end, collector, weather="sunny", seed=1, **imperfections):
+    frame = synthetic(site, start, end, weather=weather, seed=seed)
+    config = SimulationConfig(imperfections=Imperfections(**imperfections), seed=seed)
+    return simulate(frame, site, collector=collector, config=config)
+
+
+def _clock_alarms(result):
+    return [r for r in result.events["reason"] if "against the sun the sensor shows" in r]
+
+
+def test_a_clock_gaining_a_minute_a_day_is_alarmed_with_its_drift_on_a_trough():
+    result = _run("lanzhou", "2021-06-21", "2021-06-23", "trough-ns", clock_drift=60.0, clock_error=0.0,
+                  commissioned_days_ago=0.0)
+    assert any("clock drifting" in r for r in _clock_alarms(result))
+    clock = result.summary["clock"]
+    assert clock["drift_s_per_day"] == pytest.approx(60.0, abs=6.0)  # within 10 % of the world's drift
+    assert clock["drift_s_per_day"] == pytest.approx(60.0, abs=4 * clock["drift_std_s_per_day"])
+
+
+def test_a_heliostat_shows_a_clock_set_five_minutes_wrong_in_one_sunny_day():
+    imperfections = Imperfections(clock_error=300.0, clock_drift=0.0)
+    result = _run("delingha", "2018-06-21", "2018-06-21", "heliostat", clock_error=300.0, clock_drift=0.0)
+    truth = imperfections.clock_error + imperfections.longitude_error * SECONDS_PER_DEGREE
+    assert any("clock off by" in r for r in _clock_alarms(result))
+    clock = result.summary["clock"]
+    assert clock["error_s"] == pytest.approx(truth, abs=4 * clock["error_std_s"])
+
+
+def test_a_troughs_sensor_cannot_tell_a_clock_error_from_its_mount():
+    """A clock error turns the sky about the polar axis: for a north-south trough, to first order an
+    encoder zero of ω·τ·cos(latitude) and an axis azimuth error of ω·τ·sin(latitude) in size."""
+    site, collector, tau = sites.get("lanzhou"), Collector("trough-ns"), 60.0
+    index = pd.date_range("2021-06-21 07:00", "2021-06-21 19:00", freq="10min", tz=site.tz)
+    sun, later = (solar_position(index + pd.Timedelta(seconds=s), site, "spa") for s in (0.0, tau))
+    nominal = MountEstimate()
+    shift = (nominal.targets(later["altitude"], later["azimuth"], collector)
+             - nominal.targets(sun["altitude"], sun["azimuth"], collector))[:, 0]
+    rows = jacobian(sun["altitude"].to_numpy(), sun["azimuth"].to_numpy(), collector)[:, 0, :]
+    fit, *_ = np.linalg.lstsq(rows, shift, rcond=None)
+    turn = 15.0 * tau / 3600.0
+    assert np.abs(rows @ fit - shift).max() < 0.01 * np.abs(shift).max()  # the mount mimics the clock
+    latitude = np.radians(site.latitude)
+    assert abs(fit[0]) == pytest.approx(turn * np.sin(latitude), rel=0.05)  # axis azimuth error
+    assert abs(fit[2]) == pytest.approx(turn * np.cos(latitude), rel=0.05)  # encoder zero
+    result = _run("lanzhou", "2021-06-21", "2021-06-21", "trough-ns", clock_error=60.0, clock_drift=0.0)
+    assert not _clock_alarms(result)
+    assert result.summary["clock"]["error_std_s"] > 300.0  # the sun leaves it at its prior
+
+
+@pytest.mark.parametrize("collector,site,start,end", [("trough-ns", "nanjing", "2013-06-21", "2013-06-23"),
+                                                      ("fresnel", "lanzhou", "2021-12-21", "2021-12-23"),
+                                                      ("heliostat", "delingha", "2018-06-21", "2018-06-23")])
+@pytest.mark.parametrize("weather", ["sunny", "mixed"])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_no_clock_alarm_on_a_healthy_clock(collector, site, start, end, weather, seed):
+    """Default imperfections: a clock 15 s behind and gaining a second a day, as a PLC's does."""
+    result = _run(site, start, end, collector, weather=weather, seed=seed)
+    assert not _clock_alarms(result)
