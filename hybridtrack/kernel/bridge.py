@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..control.controller import CLASSIFYING, Controller, ControllerOutputs
+from ..control.controller import CLASSIFYING, FIT_EVERY, Controller, ControllerOutputs
 from ..control.modes import MODES
 from ..world import World
 from . import controller as kc
@@ -67,6 +67,7 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
 def _settings(controller: Controller) -> kc.ControllerSettings:
     config, drives, sky, gate, fit = controller.config, controller.drives, controller.sky, controller.gates[0], \
         controller.fit
+    clock = controller.clock
     table, inputs = sky.table, sky.inputs
     calibrator = controller.calibrators[0]
     return kc.ControllerSettings(
@@ -81,6 +82,8 @@ def _settings(controller: Controller) -> kc.ControllerSettings:
         float(calibrator.max_rate),
         fit is not None, float(fit.r) if fit else 1.0, float(fit.prior) if fit else 1.0,
         float(fit.memory) if fit else 1.0, float(fit.clip) if fit else 1.0, int(fit.check_every) if fit else 1,
+        float(clock.r) if clock else 1.0,
+        np.array(np.diag(clock.prior_information) if clock else [], float),
         inputs.mode == "relative", float(sky.mean.window) if sky.mean is not None else 0.0, float(sky.window_minutes),
         float(inputs.min_altitude), inputs.low_sun == "absolute", float(inputs.relative_floor),
         float(inputs.full_variation), float(sky.dark),
@@ -113,6 +116,13 @@ def _window_capacity(minutes: np.ndarray, windows: list[float]) -> int:
     return most + 2
 
 
+def _clock_capacity(controller: Controller, minutes: np.ndarray) -> int:
+    """The most readings the clock watch can take: one per axis every `FIT_EVERY` minutes."""
+    if controller.clock is None or len(minutes) == 0:
+        return 0
+    return controller.axes * (int((minutes[-1] - minutes[0]) / FIT_EVERY) + 2)
+
+
 def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
     c, axes = controller, controller.axes
     s = np.zeros(kc.FLOAT_SLOTS)
@@ -120,6 +130,8 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         [c.mode_since, c.invalid_since, c.previous_t, c.dark_since, c.distrusted_until, c.fit_since]
     s[[kc.CALM_SINCE, kc.FLAT_VALUE, kc.FLAT_SINCE]] = [c.wind.calm_since, c.wind.flat_value, c.wind.flat_since]
     s[kc.CONDITION] = c.fit.condition if c.fit else math.inf
+    clock = c.clock
+    s[[kc.SPELL_START, kc.SPELL_LAST]] = [clock.spell_start, clock.spell_last] if clock else [math.nan, math.nan]
     k = np.zeros(kc.INT_SLOTS, np.int64)
     k[[kc.MODE, kc.RESTING, kc.WAS_AWAKE, kc.FOUND_TODAY, kc.WIND_STUCK]] = \
         [c.mode, c.resting, c.was_awake, c.found_today, c.wind.stuck]
@@ -131,6 +143,8 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         k[[kc.UPDATES, kc.FROZEN]] = [fit.updates, fit.axis_frozen]
     windows = [c.sky.window_minutes] + ([c.sky.mean.window] if c.sky.mean is not None else [])
     capacity = _window_capacity(minutes, windows)
+    readings = _clock_capacity(c, minutes)
+    columns = c.clock.n - 1 if c.clock else 0
     return kc.ControllerState(
         s, k, np.array([[m.believed, m.last, m.commanded] for m in c.encoders], float),
         np.array([m.jumped for m in c.encoders], np.int64),
@@ -143,7 +157,8 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         np.array(fit.theta if fit else [], float), np.array(fit.p if fit else np.zeros((0, 0)), float),
         np.array(fit.information if fit else np.zeros((0, 0)), float),
         np.zeros(axes), np.zeros(p), np.zeros((p, p)), np.zeros((p, p)),
-        np.zeros((5, capacity)), np.zeros((5, capacity)), np.zeros((5, 2), np.int64))
+        np.zeros((5, capacity)), np.zeros((5, capacity)), np.zeros((5, 2), np.int64),
+        np.zeros(readings), np.zeros(readings, np.int64), np.zeros((readings, columns)), np.zeros(readings))
 
 
 def _record(n: int, axes: int, parameters: int) -> kc.ControllerRecord:
@@ -155,7 +170,7 @@ def _record(n: int, axes: int, parameters: int) -> kc.ControllerRecord:
 
 def _events(capacity: int) -> kc.EventLog:
     return kc.EventLog(np.zeros(capacity, np.int64), np.zeros(capacity, np.int64), np.zeros(capacity, np.int64),
-                       np.zeros(capacity, np.int64), np.zeros((capacity, 2)))
+                       np.zeros(capacity, np.int64), np.zeros((capacity, 3)))
 
 
 def _grown(events: kc.EventLog) -> kc.EventLog:
@@ -167,10 +182,10 @@ def _grown(events: kc.EventLog) -> kc.EventLog:
 
 def _worded(controller: Controller, events: kc.EventLog, count: int) -> list:
     worded, reason = [], wording(controller.config, controller.plan_alarms)
-    for i, before, after, code, (value, other) in zip(events.scan[:count].tolist(), events.before[:count].tolist(),
+    for i, before, after, code, (value, other, third) in zip(events.scan[:count].tolist(), events.before[:count].tolist(),
                                                      events.after[:count].tolist(), events.code[:count].tolist(),
                                                      events.value[:count].tolist()):
-        text = reason(code, value, other, i)
+        text = reason(code, value, other, i, third)
         if before == after:
             log.info("scan %d: %s", i, text)
         else:
@@ -189,6 +204,17 @@ def _write_back(controller: Controller, state: kc.ControllerState) -> None:
         fit.updates, fit.axis_frozen = int(state.k[kc.UPDATES]), bool(state.k[kc.FROZEN])
         fit.condition = float(state.s[kc.CONDITION])
         controller.theta = fit.theta.copy()
+    clock = controller.clock
+    if clock is not None:
+        counted, pending = int(state.k[kc.CLOCK_ROWS]), int(state.k[kc.CLOCK_PENDING])
+        rows = [(t, a, x.copy(), y) for t, a, x, y in zip(state.clock_t[:counted + pending].tolist(),
+                                                          state.clock_axis[:counted + pending].tolist(),
+                                                          state.clock_x[:counted + pending],
+                                                          state.clock_y[:counted + pending].tolist())]
+        clock.rows, clock.pending = rows[:counted], rows[counted:]
+        clock.spell_start, clock.spell_last = float(state.s[kc.SPELL_START]), float(state.s[kc.SPELL_LAST])
+        clock.raised = {name for name, slot in (("clock", kc.CLOCK_RAISED), ("drift", kc.DRIFT_RAISED))
+                        if state.k[slot]}
 
 
 def run_compiled(world: World, controller: Controller, progress, bulk_nights: bool) -> ControllerOutputs:

@@ -16,6 +16,7 @@ SensorGate + Kalman     `gate_judge`, `gate_take`, `kalman_*`
 Calibrator.learn        `calibrator_learn`
 MountEstimator          `fit_forget`, `fit_update`, `fit_check`
 DisagreementMonitor     `disagreement_add`
+ClockWatch              `clock_add`, `clock_solve`, `clock_verdict`
 Controller.step         `controller_step` and its `_`-named helpers
 Controller.rest         `controller_rest`
 =====================  ===================================================
@@ -32,6 +33,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..control.clockwatch import ALARM_SIGMAS, CLOCK_TOLERANCE, DRIFT_DAYS, DRIFT_TOLERANCE, SPELL, SPELL_GAP
 from ..control.controller import DISTRUST_MINUTES, DUSK_MINUTES, FIT_EVERY, SETTLE_UPDATES
 from ..control.disagreement import ALLOWANCE, MIN_RUN, THRESHOLD
 from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGHT, NOT_READ, OK, OUT_OF_VIEW,
@@ -50,7 +52,7 @@ ControllerSettings = namedtuple("ControllerSettings", [
     "dwell", "loss", "coast_for", "dusk_current", "plausibility", "disagreement",
     "wind_stow", "wind_release", "wind_hold", "stow_when_missing", "encoder_confirm",
     "q", "r", "stuck_scans", "stuck_spread", "gate2", "reacquire", "tau", "max_rate",
-    "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every",
+    "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "clock_r", "clock_prior",
     "sky_relative", "smoothing", "window", "min_altitude", "low_sun_absolute", "relative_floor", "full_variation",
     "dark", "table", "table_step", "table_last", "ranges", "edges", "codes",
     "deadband", "speed", "stow_speed", "low", "high", "stow", "resolution", "circular"])
@@ -62,22 +64,23 @@ ControllerState = namedtuple("ControllerState", [
     "s", "k", "encoder", "jumped", "kf", "gate", "stuck_angles", "stuck_expected", "stuck_fill",
     "calibration", "fitted_at", "blind_stow", "park", "moves", "travel", "mount",
     "theta", "p", "information", "checkpoint_offsets", "checkpoint_theta", "checkpoint_p",
-    "checkpoint_information", "window_t", "window_v", "window_ends"])
+    "checkpoint_information", "window_t", "window_v", "window_ends", "clock_t", "clock_axis", "clock_x", "clock_y"])
 #: What the controller records per scan (`hybridtrack.control.controller.ControllerOutputs`).
 ControllerRecord = namedtuple("ControllerRecord", [
     "mode", "status", "sky", "score", "intensity", "variation", "target", "reading", "calibration", "sun",
     "fit_value", "fit_std"])
-#: Events as codes (`hybridtrack.kernel.events`); `k[EVENTS]` counts them.
+#: Events as codes and up to three numbers (`hybridtrack.kernel.events`); `k[EVENTS]` counts them.
 EventLog = namedtuple("EventLog", ["scan", "before", "after", "code", "value"])
 
 # slots of ControllerState.s
 (MODE_SINCE, INVALID_SINCE, PREVIOUS_T, DARK_SINCE, DISTRUSTED_UNTIL, FIT_SINCE, CALM_SINCE, FLAT_VALUE, FLAT_SINCE,
- MEAN_TOTAL, CONDITION, CUSUM_HIGH, CUSUM_LOW, CUSUM_SUM) = range(14)
-FLOAT_SLOTS = 14
+ MEAN_TOTAL, CONDITION, CUSUM_HIGH, CUSUM_LOW, CUSUM_SUM, SPELL_START, SPELL_LAST) = range(16)
+FLOAT_SLOTS = 16
 # slots of ControllerState.k
 (MODE, RESTING, WAS_AWAKE, FOUND_TODAY, BLIND_STOW, WIND_STUCK, EVENTS, HAS_CHECKPOINT, UPDATES, FROZEN,
- CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN, MOUNT_AT_SCAN, MOUNT_AT_UPDATES) = range(15)
-INT_SLOTS = 15
+ CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN, MOUNT_AT_SCAN, MOUNT_AT_UPDATES, CLOCK_ROWS, CLOCK_PENDING,
+ CLOCK_RAISED, DRIFT_RAISED) = range(19)
+INT_SLOTS = 19
 # columns of ControllerState.encoder, .kf, .gate, .calibration
 BELIEVED, LAST, COMMANDED = range(3)
 X0, X1, P00, P01, P11 = range(5)
@@ -99,6 +102,7 @@ def _event(i, before, after, code, value, other, state, log):
     log.code[n] = code
     log.value[n, 0] = value
     log.value[n, 1] = other
+    log.value[n, 2] = 0.0
     state.k[EVENTS] = n + 1
 
 
@@ -112,6 +116,13 @@ def _switch(i, new, code, value, t, state, log):
 @kernel
 def _alarm(i, code, value, other, state, log):
     _event(i, state.k[MODE], state.k[MODE], code, value, other, state, log)
+
+
+@kernel
+def _alarm3(i, code, value, other, third, state, log):
+    """An alarm worded from three numbers."""
+    _event(i, state.k[MODE], state.k[MODE], code, value, other, state, log)
+    log.value[state.k[EVENTS] - 1, 2] = third
 
 
 @kernel
@@ -458,7 +469,7 @@ def gate_take(cfg, state, a, z, dt, miss, bound, rate):
         gate[a, REJECTED] += 1
         if gate[a, REJECTED] < cfg.reacquire:
             return OUTLIER
-        kalman_reset(state, a, z, state.kf[a, X1])
+        kalman_reset(state, a, z, rate)
     else:
         kalman_update(cfg, state, a, z)
     gate[a, REJECTED] = 0
@@ -573,9 +584,10 @@ def _recall(cfg, state):
 
 
 @kernel(allocates=True)
-def _against_checkpoint(row, theta, p, r):
-    """Controller._against_checkpoint: the fit's correction at `row` and its variance (row·p·row + r)."""
-    return np.dot(row, theta), math.sqrt(r + np.dot(row @ p, row))
+def _against_checkpoint(row, theta, p, r, w):
+    """Controller._against_checkpoint: the fit's correction at `row` and the spread in pointing
+    terms (sqrt(r + w²·row·p·row))."""
+    return np.dot(row, theta), math.sqrt(r + w * w * np.dot(row @ p, row))
 
 
 @kernel
@@ -604,10 +616,10 @@ def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound):
         fit_forget(state.p, state.information, cfg.fit_memory, cfg.prior, t - state.s[FIT_SINCE])
         state.s[FIT_SINCE] = t
         has = state.k[HAS_CHECKPOINT]
-        fitted, spread = _against_checkpoint(plan.jacobian[i, a], state.checkpoint_theta if has else state.theta,
-                                             state.checkpoint_p if has else state.p, cfg.fit_r)
-        miss = _turn(cfg, a, z - m0 - fitted)
         w = plan.weight[i, a]
+        fitted, spread = _against_checkpoint(plan.jacobian[i, a], state.checkpoint_theta if has else state.theta,
+                                             state.checkpoint_p if has else state.p, cfg.fit_r, w)
+        miss = _turn(cfg, a, z - m0 - fitted) * w
         fit_update(state.theta, state.p, state.information, cfg.fit_r, cfg.clip, state.k[FROZEN],
                    plan.jacobian[i, a], w, _turn(cfg, a, z - m0) * w)
         state.k[UPDATES] += 1
@@ -616,9 +628,115 @@ def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound):
             state.k[FROZEN] = state.s[CONDITION] > MAX_CONDITION
         if _disagrees(cfg, state, log, i, miss, spread):
             return
+        rate = _turn(cfg, a, m0 - m1) / dt if dt > 0 else math.nan
+        if math.isfinite(rate):
+            clock_add(state, t, a, plan.jacobian[i, a], rate, _turn(cfg, a, z - m0), w)
     mount = _correction(cfg, plan, state, i, a) - state.calibration[a, OFFSET]
     residual = _turn(cfg, a, state.kf[a, X0] - m0 - mount)
     calibrator_learn(cfg, state, a, dt, residual, _turn(cfg, a, m0 - m1), bound)
+
+
+# -- the clock watch ------------------------------------------------------------------------------
+
+@kernel
+def clock_add(state, t, a, row, rate, residual, weight):
+    """ClockWatch.add: rows [0, k[CLOCK_ROWS]) are counted, the current spell's follow them."""
+    s, k = state.s, state.k
+    if not t - s[SPELL_LAST] <= SPELL_GAP:  # a new spell
+        k[CLOCK_PENDING] = 0
+        s[SPELL_START] = t
+    s[SPELL_LAST] = t
+    n = k[CLOCK_ROWS] + k[CLOCK_PENDING]
+    if n >= state.clock_t.shape[0]:  # pragma: no cover - sized for one reading per axis per FIT_EVERY
+        return
+    per_second = -rate / 60.0
+    m = row.shape[0]
+    state.clock_t[n] = t
+    state.clock_axis[n] = a
+    for j in range(m):
+        state.clock_x[n, j] = row[j] * weight
+    state.clock_x[n, m] = per_second * weight
+    state.clock_y[n] = residual * weight
+    k[CLOCK_PENDING] += 1
+    if t - s[SPELL_START] >= SPELL:
+        k[CLOCK_ROWS] += k[CLOCK_PENDING]
+        k[CLOCK_PENDING] = 0
+
+
+@kernel(allocates=True)
+def clock_solve(times, axis, rows, values, count, prior, r):
+    """ClockWatch.solve over the first `count` rows: (estimate, 1σ), each of the mount's
+    parameters, the clock's error and its drift (held at zero, 1σ infinite, under DRIFT_DAYS)."""
+    n = prior.shape[0]
+    t = times[:count]
+    span = (t[count - 1] - t[0]) / 1440.0
+    k = n if span >= DRIFT_DAYS else n - 1
+    x = np.empty((count, k))
+    for row in range(count):
+        for j in range(n - 1):
+            x[row, j] = rows[row, j]
+        if k == n:
+            x[row, n - 1] = rows[row, n - 2] * (t[row] - t[0]) / 1440.0
+    y = values[:count].copy()
+    information = x.T @ x / r
+    for j in range(k):
+        information[j, j] += prior[j]
+    covariance = np.linalg.inv(information)
+    estimate = covariance @ (x.T @ y) / r
+    error = y - x @ estimate
+    unit_variance = max(1.0, np.dot(error, error) / r / max(count - k, 1))
+    factor = _correlation_factor(t, axis[:count], error)
+    estimates, std = np.zeros(n), np.full(n, np.inf)
+    for j in range(k):
+        estimates[j] = estimate[j]
+        std[j] = math.sqrt(covariance[j, j] * unit_variance * factor)
+    return estimates, std
+
+
+@kernel(allocates=True)
+def _correlation_factor(t, axis, error):
+    """clockwatch._correlation_factor: readings sorted by axis, then time."""
+    count = t.shape[0]
+    order = np.empty(count, np.int64)
+    m = 0
+    for a in range(axis.max() + 1):
+        for row in range(count):
+            if axis[row] == a:
+                order[m] = row
+                m += 1
+    first, second = np.empty(count), np.empty(count)
+    linked = 0
+    for j in range(count - 1):
+        p, q = order[j], order[j + 1]
+        if t[q] - t[p] <= SPELL_GAP and axis[q] == axis[p]:
+            first[linked], second[linked] = error[p], error[q]
+            linked += 1
+    if linked < 2:
+        return 1.0
+    a, b = first[:linked], second[:linked]
+    rho = min(max(np.dot(a, b) / max(math.sqrt(np.dot(a, a) * np.dot(b, b)), 1e-300), 0.0), 0.95)
+    return (1.0 + rho) / (1.0 - rho)
+
+
+@kernel(allocates=True)
+def clock_verdict(cfg, state, log, i):
+    """ClockWatch.verdict: each alarm raised once, as an event."""
+    k = state.k
+    count = k[CLOCK_ROWS]
+    n = cfg.clock_prior.shape[0]
+    if count < n:
+        return
+    estimate, std = clock_solve(state.clock_t, state.clock_axis, state.clock_x, state.clock_y, count,
+                                cfg.clock_prior, cfg.clock_r)
+    clock, drift = estimate[n - 2], estimate[n - 1]
+    clock_std, drift_std = std[n - 2], std[n - 1]
+    span = (state.clock_t[count - 1] - state.clock_t[0]) / 1440.0
+    if not k[CLOCK_RAISED] and abs(clock) >= max(ALARM_SIGMAS * clock_std, CLOCK_TOLERANCE):
+        k[CLOCK_RAISED] = 1
+        _alarm3(i, ev.CLOCK_OFF, clock, clock_std, float(count), state, log)
+    if not k[DRIFT_RAISED] and span >= DRIFT_DAYS and abs(drift) >= max(ALARM_SIGMAS * drift_std, DRIFT_TOLERANCE):
+        k[DRIFT_RAISED] = 1
+        _alarm3(i, ev.CLOCK_DRIFTING, drift, drift_std, span, state, log)
 
 
 # -- one scan -------------------------------------------------------------------------------------
@@ -637,7 +755,10 @@ def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes):
     bound = _plausibility_bound(cfg, plan, i, a, axes)
     has_model = cfg.uses_model and not math.isnan(m0)
     miss = _turn(cfg, a, z - m0 - _correction(cfg, plan, state, i, a)) if has_model else math.nan
-    rate = _turn(cfg, a, m0 - m1) / dt if has_model and dt > 0 and not math.isnan(m1) else 0.0
+    if has_model and dt > 0 and not math.isnan(m1):
+        rate = _turn(cfg, a, m0 - m1) / dt
+    else:  # no computed sun: the filter's own rate, once it has one
+        rate = state.kf[a, X1] if state.gate[a, READY] else 0.0
     verdict = gate_take(cfg, state, a, z, dt, miss, bound, rate)
     if verdict == OK and trusted and has_model:
         _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound)
@@ -880,6 +1001,8 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading
         moves[:] = 0.0
         return
     _day_and_wind(cfg, state, log, i, t, awake, gusty, obs[1])
+    if k[WAS_AWAKE] and not awake and cfg.has_fit:  # the day's end: judge the clock
+        clock_verdict(cfg, state, log, i)
     k[WAS_AWAKE] = awake
     sky = _watch_sky(cfg, plan, state, out, i, t, obs[3])
     status = _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, sky, valid)
