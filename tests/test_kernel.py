@@ -207,6 +207,31 @@ def test_a_recorded_photocurrent_and_a_frame_without_wind_or_diffuse_run_the_sam
         assert_same_run(*both(recorded, "lanzhou", config=config, strategy=strategy))
 
 
+def test_the_clock_watch_alarms_the_same_compiled():
+    """Both of the clock watch's alarms, worded by the kernel as the reference words them, and the
+    summary's clock fit (a trough drifting a minute a day, a heliostat five minutes wrong)."""
+    drifting = replaced(imperfections={"clock_drift": 60.0, "clock_error": 0.0, "commissioned_days_ago": 0.0}, seed=1)
+    runs = both(synthetic("lanzhou", "2021-06-21", "2021-06-23", weather="sunny", seed=1), "lanzhou",
+                config=drifting, collector="trough-ns")
+    assert any("clock drifting" in reason for reason in runs[1].events["reason"])
+    assert "drift_s_per_day" in runs[1].summary["clock"]
+    assert_same_run(*runs)
+    wrong = replaced(imperfections={"clock_error": 300.0, "clock_drift": 0.0}, seed=1)
+    runs = both(synthetic("delingha", "2018-06-21", "2018-06-21", weather="sunny", seed=1), "delingha",
+                config=wrong, collector="heliostat")
+    assert any("clock off by" in reason for reason in runs[1].events["reason"])
+    assert_same_run(*runs)
+
+
+def test_a_rolled_heliostat_pedestal_runs_the_same_compiled(mixed_day):
+    rolled = replaced(imperfections={"axis_roll_error": 0.4})
+    runs = both(mixed_day, "lanzhou", config=rolled, collector="heliostat")
+    plain = simulate(mixed_day, "lanzhou", collector="heliostat", config=replaced(engine="compiled"))
+    assert not np.array_equal(runs[1].log["target_true"], plain.log["target_true"])  # the roll reaches the world
+    assert any(column.startswith("fit_") for column in runs[1].log.columns)
+    assert_same_run(*runs)
+
+
 def test_irregular_scans_run_the_same_compiled(mixed_day):
     keep = np.random.default_rng(1).random(len(mixed_day)) > 0.3
     assert_same_run(*both(mixed_day[keep], "lanzhou"))
