@@ -78,7 +78,9 @@ class SimulationConfig:
     engine : {"auto", "compiled", "reference"}
         How the scans are stepped: ``reference`` the readable Python controller and world,
         ``compiled`` the numba kernel that restates them (`hybridtrack.kernel`, held equal by
-        tests), ``auto`` the kernel wherever it supports the run and numba is installed.
+        tests), ``auto`` the kernel where it supports the run, numba is installed and the kernel
+        is compiled already (its disk cache) or the run is long enough to pay for compiling it
+        (`hybridtrack.kernel.COMPILE_PAYS_AT` scans), else the reference: the same results.
     """
 
     controller: ControllerConfig = field(default_factory=ControllerConfig)
@@ -327,7 +329,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         plan.apparent_altitude = clear["apparent_elevation"].to_numpy()
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory)
-    if uses_kernel(config):
+    if uses_kernel(config, world.n):
         out = run_compiled(world, controller, progress, bulk_nights and not faults)
     else:
         _run(world, controller, progress, bulk_nights and not faults)

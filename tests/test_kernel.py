@@ -141,10 +141,42 @@ def test_the_engine_round_trips_through_toml_and_unknown_ones_are_refused(tmp_pa
 
 def test_auto_takes_the_reference_path_for_what_the_kernel_does_not_run(mixed_day):
     filterpy = SimulationConfig(controller=dataclasses.replace(SimulationConfig().controller, kalman="filterpy"))
-    assert kernel.unsupported(filterpy) and not kernel.uses_kernel(filterpy)
-    assert kernel.uses_kernel(SimulationConfig())
+    assert kernel.unsupported(filterpy) and not kernel.uses_kernel(filterpy, kernel.COMPILE_PAYS_AT)
+    assert kernel.uses_kernel(SimulationConfig(), kernel.COMPILE_PAYS_AT)
     with pytest.raises(HybridtrackError, match="fast"):
         kernel.uses_kernel(dataclasses.replace(filterpy, engine="compiled"))
+
+
+def test_auto_takes_the_kernel_only_where_it_is_quicker(monkeypatch, mixed_day):
+    """Compiled in this process: always; loaded from the disk cache: from LOAD_PAYS_AT scans;
+    compiled afresh: from COMPILE_PAYS_AT scans; otherwise the reference (the same results)."""
+    config, day = SimulationConfig(), len(mixed_day)
+    simulate(mixed_day, "lanzhou", config=dataclasses.replace(config, engine="compiled"))
+    assert kernel.compiled() and kernel.cached()  # a compiled run leaves the loop in numba's disk cache
+    assert kernel.uses_kernel(config, day)
+    monkeypatch.setattr(kernel, "compiled", lambda: False)
+    monkeypatch.setattr(kernel, "cached", lambda: True)
+    assert not kernel.uses_kernel(config, day) and kernel.uses_kernel(config, kernel.LOAD_PAYS_AT)
+    monkeypatch.setattr(kernel, "cached", lambda: False)
+    assert not kernel.uses_kernel(config, kernel.COMPILE_PAYS_AT - 1)
+    assert kernel.uses_kernel(config, kernel.COMPILE_PAYS_AT)
+    assert kernel.uses_kernel(dataclasses.replace(config, engine="compiled"), day)
+    assert not kernel.uses_kernel(dataclasses.replace(config, engine="reference"), kernel.COMPILE_PAYS_AT)
+
+
+def test_a_fresh_install_runs_a_day_on_auto_without_compiling(tmp_path):
+    script = (
+        "import hybridtrack.kernel as kernel\n"
+        "from hybridtrack import simulate\n"
+        "from hybridtrack.kernel.loop import run_scans\n"
+        "from hybridtrack.sky import synthetic\n"
+        "assert not kernel.cached()\n"
+        "simulate(synthetic('lanzhou', '2021-06-21', weather='mixed', seed=1), 'lanzhou')\n"
+        "print(len(run_scans.signatures))\n")
+    env = dict(os.environ, PYTHONPATH=str(Path(kernel.__file__).parents[2]), NUMBA_CACHE_DIR=str(tmp_path))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "0"
 
 
 def test_the_compiled_controller_imports_nothing_of_the_world():
