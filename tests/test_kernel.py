@@ -73,8 +73,17 @@ def mixed_day():
     return synthetic("lanzhou", "2021-06-21", weather="mixed", seed=3, gusts_per_day=2.0)
 
 
-@pytest.mark.parametrize("collector", COLLECTORS)
-@pytest.mark.parametrize("strategy", STRATEGIES)
+def _strategies_on_collectors():
+    """Every strategy on every collector; the default run keeps every strategy on the heliostat
+    (two axes, the most of the controller) and the hybrid on each collector, the rest are slow."""
+    for collector in COLLECTORS:
+        for strategy in STRATEGIES:
+            quick = collector == "heliostat" or strategy == "hybrid"
+            yield pytest.param(strategy, collector, marks=() if quick else pytest.mark.slow,
+                               id=f"{strategy}-{collector}")
+
+
+@pytest.mark.parametrize("strategy,collector", _strategies_on_collectors())
 def test_every_strategy_on_every_collector_runs_the_same_compiled(mixed_day, strategy, collector):
     assert_same_run(*both(mixed_day, "lanzhou", strategy=strategy, collector=collector))
 
