@@ -20,11 +20,13 @@ __all__ = ["ENGINES", "COMPILE_PAYS_AT", "LOAD_PAYS_AT", "available", "cached", 
 #: The choices of `SimulationConfig.engine`.
 ENGINES = ("auto", "compiled", "reference")
 #: Scans from which ``auto`` compiles the kernel when it is not compiled yet: compiling into an
-#: empty cache takes 70-115 s on a 2-core machine and the compiled loop saves about 17 µs a scan
-#: against the reference loop, so it pays from about 4 million scans (docs/kernel.md, measured).
+#: empty cache took 76 s on a 2-core machine (115 s with the other core busy) and the compiled
+#: loop saves about 20 µs a scan against the reference loop, so it pays from about 4 million
+#: scans (docs/kernel.md, measured).
 COMPILE_PAYS_AT = 4_000_000
-#: Scans from which ``auto`` loads the kernel from its disk cache: loading takes about 0.9 s, so
-#: it pays from about 50,000 scans (35 days at 1 minute).
+#: Scans from which ``auto`` loads the kernel from its disk cache: loading took 0.9-1.5 s, so it
+#: pays from 45,000-75,000 scans by the loop's saving alone (fewer end to end): 50,000, 35 days
+#: at 1 minute.
 LOAD_PAYS_AT = 50_000
 
 
