@@ -31,6 +31,7 @@ from .mounting import incidence_cosine
 from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
+from .sun import solar_position
 from .world import Imperfections, World
 
 __all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
@@ -454,10 +455,12 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
 
 
 def _expected_clear_sky(world: World, config: SimulationConfig) -> pd.DataFrame | None:
-    """The clear sky the controller expects at each scan (its clock, its site), on the scans' index."""
+    """The clear sky the controller expects at each scan, from what a PLC has: its clock, its site
+    and its own sun model; on the scans' index."""
     if config.sky.mode != "relative" or config.controller.sensor_only:
         return None
-    return clear_sky(world.controller_clock(), world.controller_site()).set_axis(world.index)
+    clock, site = world.controller_clock(), world.controller_site()
+    return clear_sky(clock, site, solar_position(clock, site, config.controller.sun_model)).set_axis(world.index)
 
 
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,

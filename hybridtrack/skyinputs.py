@@ -190,8 +190,16 @@ def fuzzy_config(config: SkyInputConfig):
     return FuzzyConfig.from_toml(COMPLETE_RULES) if config.rules == "complete" else FuzzyConfig.default()
 
 
-def clear_sky(index: pd.DatetimeIndex, site: Site | str) -> pd.DataFrame:
+def clear_sky(index: pd.DatetimeIndex, site: Site | str, position: pd.DataFrame | None = None) -> pd.DataFrame:
     """Sun altitude and Ineichen clear-sky irradiance at each stamp.
+
+    Parameters
+    ----------
+    index : pandas.DatetimeIndex
+    site : Site or str
+    position : pandas.DataFrame, optional
+        The sun's position at each stamp (``hybridtrack.sun.solar_position``: ``apparent_zenith``
+        and ``apparent_altitude``), e.g. a controller's own sun model; pvlib's SPA by default.
 
     Returns
     -------
@@ -210,7 +218,12 @@ def clear_sky(index: pd.DatetimeIndex, site: Site | str) -> pd.DataFrame:
     if not isinstance(index, pd.DatetimeIndex) or index.tz is None:
         raise HybridtrackError("the clear sky needs a time-zone-aware DatetimeIndex")
     location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
-    position = location.get_solarposition(index)
+    if position is None:
+        position = location.get_solarposition(index)
+    else:
+        position = pd.DataFrame({"apparent_zenith": np.asarray(position["apparent_zenith"], float),
+                                 "apparent_elevation": np.asarray(position["apparent_altitude"], float)},
+                                index=index)
     clear = location.get_clearsky(index, model="ineichen", solar_position=position)
     clear["apparent_elevation"] = position["apparent_elevation"]
     return clear[["apparent_elevation", "ghi", "dni", "dhi"]]
