@@ -33,6 +33,7 @@ from .collectors import (
     normal_angles,
     trough_angle,
 )
+from .budget import BYTES_PER_STEP, check_steps
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
 from .world import Imperfections
@@ -45,6 +46,8 @@ LOG_VARIABLES = ("target_true", "target", "angle", "error", "mode", "sky", "sens
                  "calibration")
 #: Log columns every collector shares (the weather and the sky class); kept once, over time.
 SHARED_VARIABLES = ("dni", "wind_speed")
+#: Bytes a kept log takes per collector and step, at most (a heliostat's two axes).
+LOG_BYTES = 80
 
 
 @dataclass(frozen=True)
@@ -526,6 +529,10 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     frame = _check_frame(frame)
     config = config or SimulationConfig()
     collectors = field.collectors()
+    if keep_log:
+        first, last = frame.index[0], frame.index[-1]
+        check_steps(first, last, (last - first) / (len(frame) - 1), what=f"a field of {len(collectors)} collectors",
+                    bytes_per_step=BYTES_PER_STEP + LOG_BYTES * len(collectors))
     imperfections = field.spread.draw(config.imperfections, len(collectors), int(seed))
     rows, events, store = [], [], None
     with reuse_positions():

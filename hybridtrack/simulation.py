@@ -24,6 +24,7 @@ from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerCon
 from .control.mountfit import parameter_names
 from .control.plan import east_park
 from .drive import Drive
+from .budget import check_steps
 from .errors import HybridtrackError
 from .fuzzy import FuzzyWeatherClassifier
 from .metrics import summarize
@@ -257,6 +258,8 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
                                "(read files with hybridtrack.io.read_weather, which sorts and de-duplicates)")
     if "dni" not in frame.columns:
         raise HybridtrackError(f"the weather frame has no 'dni' column; it has {', '.join(map(str, frame.columns))}")
+    first, last = frame.index[0], frame.index[-1]
+    check_steps(first, last, (last - first) / (len(frame) - 1), what="the weather frame")
     return frame
 
 

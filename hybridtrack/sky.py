@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .budget import check_steps
 from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_range, parse_freq
@@ -160,6 +161,7 @@ def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
         last = local_range(end if end is not None else first.date(), site.tz, freq=freq)[-1]
     if last < first:
         raise HybridtrackError(f"the period ends ({last}) before it starts ({first})")
+    check_steps(first, last, parse_freq(freq), what=f"{first} to {last}")
     return pd.date_range(first, last, freq=parse_freq(freq))
 
 
