@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import sites
+from . import params, sites
 from .collectors import (
     AXIS_AZIMUTH,
     Collector,
@@ -523,8 +523,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
                                f"got {type(field).__name__}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise HybridtrackError(f"seed must be a whole number >= 0, got {seed!r}")
+    seed = params.seed(seed)
     site = sites.get(site)
     frame = _check_frame(frame)
     config = config or SimulationConfig()

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import sites
+from . import params, sites
 from .collectors import Collector
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
@@ -88,6 +88,7 @@ class SimulationConfig:
     def __post_init__(self) -> None:
         if self.truth not in ("spa-fast", "spa"):
             raise HybridtrackError(f"truth {self.truth!r}: choose 'spa-fast' or 'spa'")
+        params.seed(self.seed, "seed")
 
     def to_dict(self) -> dict:
         """A plain dict in the TOML layout."""
@@ -139,7 +140,10 @@ class SimulationConfig:
             try:
                 return dataclasses.replace(default, **changes)
             except HybridtrackError as exc:
-                raise HybridtrackError(f"{source}: {where}: {exc}" if where else f"{source}: {exc}") from None
+                said = str(exc)
+                if where and not said.startswith(f"{where}: "):
+                    said = f"{where}: {said}"
+                raise HybridtrackError(f"{source}: {said}") from None
 
         return build(cls(), dict(data), "")
 

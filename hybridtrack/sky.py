@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from . import params
 from .budget import check_steps
 from .errors import HybridtrackError
 from .sites import Site, get
@@ -292,8 +293,8 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     index = _period(site, start, end, freq)
     if len(index) == 0:
         raise HybridtrackError("the period holds no time steps")
-    if not 0 <= gusts_per_day <= 200:
-        raise HybridtrackError(f"gusts_per_day must be within 0-200, got {gusts_per_day!r}")
+    params.number(gusts_per_day, "gusts_per_day", 0, 200)
+    seed = params.seed(seed)
     rng = np.random.default_rng(seed)
     local = index.tz_convert(site.tz)
     days = sorted(set(local.date))

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
-from .. import sites
+from .. import params, sites
 from ..errors import HybridtrackError
 
 EXIT_USAGE = 2
@@ -194,6 +194,8 @@ def synthetic_frame(args: argparse.Namespace, site):
 
     if not 1 <= args.days <= 3660:
         raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    params.seed(args.seed, "--seed")
+    params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
     first = parse_date(args.date)
     weather = args.weather.split(",") if "," in args.weather else args.weather
     return synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather, freq=args.freq,
