@@ -15,7 +15,6 @@ every step in one call of the broadcasting functions of `hybridtrack.collectors`
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,6 +35,7 @@ from .collectors import (
 from .budget import BYTES_PER_STEP, check_steps
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
+from .outputs import claim, strict_json
 from .world import Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -409,19 +409,24 @@ class FieldResult:
         ax.set_title(f"{self.summary['field']} at {self.site.name}: {_METRIC_LABELS.get(metric, metric)}")
         return fig
 
-    def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
-        """Write ``collectors.csv``, ``events.csv``, ``summary.json``, ``field_map.png`` and, when
-        the logs were kept, ``log.nc`` (netCDF, the `dataset`)."""
+    @staticmethod
+    def files(folder, *, log: bool = True) -> dict[str, Path]:
+        """The files `save` writes into `folder`, by role (`log`: the logs were kept)."""
         folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        written = {"collectors": folder / "collectors.csv", "events": folder / "events.csv",
-                   "summary": folder / "summary.json", "map": folder / "field_map.png"}
+        files = {"collectors": folder / "collectors.csv", "events": folder / "events.csv",
+                 "summary": folder / "summary.json", "map": folder / "field_map.png"}
+        return {**files, "log": folder / "log.nc"} if log else files
+
+    def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
+        """Write ``collectors.csv``, ``events.csv``, ``summary.json`` (strict JSON), ``field_map.png``
+        and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`."""
+        written = self.files(folder, log=self.dataset is not None)
+        claim(written.values())
         self.collectors.to_csv(written["collectors"], index_label="collector", float_format="%.6g")
         self.events.to_csv(written["events"], index=False)
-        written["summary"].write_text(json.dumps(self.summary, indent=2) + "\n")
+        written["summary"].write_text(strict_json(self.summary, indent=2) + "\n")
         self.plot_map(metric).savefig(written["map"], dpi=120)
         if self.dataset is not None:
-            written["log"] = folder / "log.nc"
             self.dataset.to_netcdf(written["log"], engine="scipy")
         return written
 

@@ -41,8 +41,9 @@ def figure(**options) -> ReportFigure:
 
 def save_figure(fig, path) -> Path:
     """Write a figure to `path` (PNG, SVG or PDF by suffix), creating folders."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from .outputs import claim
+
+    path, = claim([path])
     fig.savefig(path, dpi=120, bbox_inches="tight")
     return path
 

@@ -10,7 +10,6 @@ observes, the controller decides and the world moves; the log is scored (`hybrid
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
+from .outputs import claim, strict_json
 from .fuzzy import FuzzyWeatherClassifier
 from .metrics import summarize
 from .mounting import incidence_cosine
@@ -186,29 +186,32 @@ class Result:
     config: SimulationConfig
     memory: dict | None = None
 
-    def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
-        """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
-        and ``report.png``."""
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        written = {}
+    @staticmethod
+    def files(folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
+        """The files `save` writes into `folder`, by role."""
         if log_format not in ("parquet", "csv"):
             raise HybridtrackError(f"log_format {log_format!r}: choose 'parquet' or 'csv'")
-        use_parquet = log_format == "parquet"
-        if use_parquet:
-            written["log"] = folder / "log.parquet"
+        folder = Path(folder)
+        files = {"log": folder / f"log.{log_format}", "events": folder / "events.csv",
+                 "summary": folder / "summary.json"}
+        return {**files, "report": folder / "report.png"} if plot else files
+
+    def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
+        """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
+        (strict JSON: ``null`` for a missing number) and ``report.png``; see `hybridtrack.outputs`
+        for what is refused."""
+        written = self.files(folder, plot=plot, log_format=log_format)
+        claim(written.values())
+        if log_format == "parquet":
             self.log.to_parquet(written["log"])
         else:
-            written["log"] = folder / "log.csv"
             self.log.to_csv(written["log"], float_format="%.5f", index_label="time")
-        written["events"] = folder / "events.csv"
         self.events.to_csv(written["events"], index=False)
-        written["summary"] = folder / "summary.json"
-        written["summary"].write_text(json.dumps(self.summary, indent=2) + "\n")
+        written["summary"].write_text(strict_json(self.summary, indent=2) + "\n")
         if plot:
             from .report import plot_run, save_figure
 
-            written["report"] = save_figure(plot_run(self), folder / "report.png")
+            save_figure(plot_run(self), written["report"])
         return written
 
     # -- for people (hybridtrack.report): a short repr, an HTML repr, pictures, a daily table --

@@ -43,6 +43,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
+from .outputs import claim
 
 __all__ = ["Sweep", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
@@ -350,12 +351,17 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
     return fig
 
 
+def sweep_files(folder) -> dict[str, Path]:
+    """The files `save_sweep` writes into `folder`, by role."""
+    folder = Path(folder)
+    return {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png", "sweep": folder / "sweep.toml"}
+
+
 def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
     """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them)."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png",
-               "sweep": sweep.to_toml(folder / "sweep.toml")}
+    written = sweep_files(folder)
+    claim(written.values())
+    sweep.to_toml(written["sweep"])
     table.to_parquet(written["table"], index=False)
     colour = next(iter(sweep.grid))
     plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem).savefig(written["plot"],

@@ -6,7 +6,8 @@ import argparse
 import sys
 
 from ..errors import HybridtrackError
-from .base import command
+from ..outputs import claim
+from .base import add_force_argument, command
 
 
 def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,6 +25,7 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=int, default=1, help="processes (default 1; the table is the same)")
     parser.add_argument("--config", help="simulation config (TOML) every policy shares")
     parser.add_argument("--out", help="folder for runs.csv, table.csv and ablation.png")
+    add_force_argument(parser)
 
 
 @command("ablate", "run every policy over a seeded set of days: what the classifier is worth, and why",
@@ -41,6 +43,8 @@ def _ablate(args: argparse.Namespace) -> int:
     plan = AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), tuple(args.policies))
     config = SimulationConfig.from_toml(args.config) if args.config else None
+    files = [Path(args.out) / name for name in ("runs.csv", "table.csv", "ablation.png")] if args.out else []
+    claim(files)  # before the runs, not after them
     days = len(plan.days())
     with tqdm(total=days, unit="day", desc="ablate", file=sys.stderr) as bar:
         result = ablate(plan, config=config, workers=args.workers, progress=bar.update)
@@ -51,10 +55,9 @@ def _ablate(args: argparse.Namespace) -> int:
     if args.out:
         from ..report import save_figure
 
-        folder = Path(args.out)
-        folder.mkdir(parents=True, exist_ok=True)
-        result.runs.to_csv(folder / "runs.csv", index=False, float_format="%.6g")
-        result.table.to_csv(folder / "table.csv", float_format="%.6g")
-        picture = save_figure(result.plot(), folder / "ablation.png")
-        print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {picture}")
+        runs, table, picture = claim(files)
+        result.runs.to_csv(runs, index=False, float_format="%.6g")
+        result.table.to_csv(table, float_format="%.6g")
+        save_figure(result.plot(), picture)
+        print(f"wrote {runs}, {table} and {picture}")
     return 0

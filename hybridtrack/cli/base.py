@@ -147,6 +147,12 @@ def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | N
                         strict=args.strict, dayfirst=args.dayfirst, lenient=args.lenient)
 
 
+def add_force_argument(parser: argparse.ArgumentParser) -> None:
+    """``--force``: replace existing output files (and say which); without it they are refused."""
+    parser.add_argument("--force", action="store_true",
+                        help="replace output files that exist already (default: refuse, naming them)")
+
+
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """Collector, strategy, config and output flags shared by simulate, replay and compare."""
     from ..control import STRATEGIES
@@ -157,6 +163,7 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
     group.add_argument("--perfect", action="store_true", help="no imperfections: a perfectly built and set-up field")
     group.add_argument("--out", help="folder for log, events.csv, summary.json and report.png")
+    add_force_argument(group)
 
 
 def simulation_config(args: argparse.Namespace, seed: int | None = None):

@@ -6,7 +6,9 @@ import argparse
 
 import pandas as pd
 
+from ..outputs import claim
 from .base import (
+    add_force_argument,
     add_record_arguments,
     add_site_arguments,
     add_synthetic_arguments,
@@ -23,6 +25,7 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
     add_record_arguments(parser)
     parser.add_argument("--freq", help="resample to this step, e.g. 1min")
     parser.add_argument("--out", metavar="FILE", help="write the checked (cleaned) frame as CSV")
+    add_force_argument(parser)
 
 
 @command("check", "read a recorded weather file and print its validation summary; with a site (--site or "
@@ -48,6 +51,7 @@ def write_frame(frame: pd.DataFrame, path: str) -> None:
     target = Path(path)
     if target.is_dir():
         raise HybridtrackError(f"{path}: is a folder; --out takes a file name")
+    claim([target])
     out = frame.copy()
     out.index = out.index.strftime("%Y-%m-%dT%H:%M:%S%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2", regex=True)
     try:
@@ -60,6 +64,7 @@ def _sky_arguments(parser: argparse.ArgumentParser) -> None:
     add_synthetic_arguments(parser)
     parser.add_argument("--out", help="write the weather frame (with sensor readings) as CSV")
     parser.add_argument("--plot", metavar="PNG", help="draw irradiance, sensor readings and wind")
+    add_force_argument(parser)
 
 
 @command("sky", "make a synthetic weather frame and show its sensor's view", _sky_arguments)
@@ -70,7 +75,7 @@ def _sky(args: argparse.Namespace) -> int:
     frame = sensor_view(synthetic_frame(args, site), seed=args.seed)
     print(_sky_table(frame, site).to_string(float_format=lambda v: f"{v:.2f}"))
     if args.out:
-        frame.to_csv(args.out, float_format="%.3f", index_label="time")
+        frame.to_csv(claim([args.out])[0], float_format="%.3f", index_label="time")
         print(f"wrote {len(frame)} rows to {args.out}")
     if args.plot:
         from ..report import plot_sky, save_figure
