@@ -35,7 +35,7 @@ from .collectors import (
 from .budget import BYTES_PER_STEP, check_steps
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
-from .outputs import claim, strict_json
+from .outputs import claim, strict_json, write
 from .world import Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -422,12 +422,13 @@ class FieldResult:
         and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`."""
         written = self.files(folder, log=self.dataset is not None)
         claim(written.values())
-        self.collectors.to_csv(written["collectors"], index_label="collector", float_format="%.6g")
-        self.events.to_csv(written["events"], index=False)
-        written["summary"].write_text(strict_json(self.summary, indent=2) + "\n")
-        self.plot_map(metric).savefig(written["map"], dpi=120)
+        write(written["collectors"],
+              lambda path: self.collectors.to_csv(path, index_label="collector", float_format="%.6g"))
+        write(written["events"], lambda path: self.events.to_csv(path, index=False))
+        write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
+        write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
         if self.dataset is not None:
-            self.dataset.to_netcdf(written["log"], engine="scipy")
+            write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
         return written
 
 

@@ -22,14 +22,14 @@ import json
 import math
 import os
 import sys
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
 
 from .errors import HybridtrackError
 
-__all__ = ["claim", "replacing", "strict_json", "plain_numbers", "reader_may_leave"]
+__all__ = ["claim", "replacing", "write", "strict_json", "plain_numbers", "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
 _REPLACED: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_replaced", default=None)
@@ -90,6 +90,17 @@ def claim(paths: Iterable) -> list[Path]:
     for folder in dict.fromkeys(path.parent for path in paths):
         folder.mkdir(parents=True, exist_ok=True)
     return paths
+
+
+def write(path, writer: Callable[[Path], object]) -> Path:
+    """Call ``writer(path)``; a failure to write (a full disk, no permission) becomes a
+    `HybridtrackError` that names `path`."""
+    path = Path(path)
+    try:
+        writer(path)
+    except OSError as exc:
+        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    return path
 
 
 def plain_numbers(value):

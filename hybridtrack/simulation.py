@@ -25,7 +25,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
-from .outputs import claim, strict_json
+from .outputs import claim, strict_json, write
 from .fuzzy import FuzzyWeatherClassifier
 from .metrics import summarize
 from .mounting import incidence_cosine
@@ -203,11 +203,11 @@ class Result:
         written = self.files(folder, plot=plot, log_format=log_format)
         claim(written.values())
         if log_format == "parquet":
-            self.log.to_parquet(written["log"])
+            write(written["log"], self.log.to_parquet)
         else:
-            self.log.to_csv(written["log"], float_format="%.5f", index_label="time")
-        self.events.to_csv(written["events"], index=False)
-        written["summary"].write_text(strict_json(self.summary, indent=2) + "\n")
+            write(written["log"], lambda path: self.log.to_csv(path, float_format="%.5f", index_label="time"))
+        write(written["events"], lambda path: self.events.to_csv(path, index=False))
+        write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
         if plot:
             from .report import plot_run, save_figure
 

@@ -43,7 +43,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
-from .outputs import claim
+from .outputs import claim, write
 
 __all__ = ["Sweep", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
@@ -362,8 +362,8 @@ def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
     written = sweep_files(folder)
     claim(written.values())
     sweep.to_toml(written["sweep"])
-    table.to_parquet(written["table"], index=False)
+    write(written["table"], lambda path: table.to_parquet(path, index=False))
     colour = next(iter(sweep.grid))
-    plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem).savefig(written["plot"],
-                                                                                              dpi=120)
+    figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
+    write(written["plot"], lambda path: figure.savefig(path, dpi=120))
     return written

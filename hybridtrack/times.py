@@ -64,6 +64,8 @@ def parse_freq(text: str) -> pd.Timedelta:
         step = pd.Timedelta(str(text))
     except ValueError:
         raise HybridtrackError(f"step {text!r} is not a duration such as '1min' or '10s'") from None
+    if pd.isna(step):
+        raise HybridtrackError(f"step {text!r} is not a duration such as '1min' or '10s'")
     if step <= pd.Timedelta(0):
         raise HybridtrackError(f"step {text!r} must be positive")
     return step

@@ -5,15 +5,26 @@ the command line (which must print one line naming the problem and exit with sta
 and checks both say the same thing.
 """
 
+import dataclasses
+import math
+
 import pytest
 
 from hybridtrack import HybridtrackError, sites
 from hybridtrack.cli import main
+from hybridtrack.collectors import Collector
+from hybridtrack.control import ControllerConfig
+from hybridtrack.drive import Drive
 from hybridtrack.fuzzy import FuzzyConfig
 from hybridtrack.io import read_weather
+from hybridtrack.outputs import replacing
+from hybridtrack.sensor import SensorModel
 from hybridtrack.simulation import SimulationConfig
+from hybridtrack.sky import synthetic
+from hybridtrack.skyinputs import SkyInputConfig
 from hybridtrack.sun import solar_position
 from hybridtrack.times import local_range
+from hybridtrack.world import Imperfections
 
 GOOD_ROWS = "2021-06-21 12:00,900,800,100,3\n2021-06-21 12:01,901,801,101,3\n2021-06-21 12:02,902,802,102,3\n"
 HEADER = "time,ghi,dni,dhi,wind_speed\n"
@@ -34,6 +45,41 @@ def config_file(text, name="config.toml"):
         path.write_text(text)
         return path
     return make
+
+
+SIMULATE = ["simulate", "--site", "lanzhou", "--date", "2021-06-21"]
+
+
+def planted_link(name):
+    """An output folder ``out`` holding a link `name` to a file outside it (or, for None, a link
+    ``out`` to another folder)."""
+    def make(tmp):
+        victim = tmp / "victim"
+        victim.mkdir()
+        out = tmp / "out"
+        if name is None:
+            out.symlink_to(victim, target_is_directory=True)
+        else:
+            out.mkdir()
+            (out / name).symlink_to(victim / name)
+        return out
+    return make
+
+
+def existing_files(*names):
+    def make(tmp):
+        out = tmp / "out"
+        out.mkdir()
+        for name in names:
+            (out / name).write_text("the user's own\n")
+        return out
+    return make
+
+
+def refusing(write):
+    """Call `write` under the command line's policy: existing files are not replaced."""
+    with replacing(False):
+        write()
 
 
 # (id, make the input, API call, CLI args, message both must contain)
@@ -107,6 +153,65 @@ MATRIX = [
     ("naive times to the sun model", lambda tmp: None,
      lambda p: solar_position(__import__("pandas").date_range("2021-06-21", periods=2, freq="h"), "nanjing"),
      None, "naive"),
+    # parameters at the door (issue 11, item 4)
+    ("axis azimuth NaN", lambda tmp: None, lambda p: Collector("trough-ns", float("nan")),
+     lambda p: SIMULATE + ["--axis-azimuth", "nan"],
+     "collector: axis_azimuth (degrees from north) must be a finite number within [-360, 360], got nan"),
+    ("negative seed", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", seed=-1),
+     lambda p: SIMULATE + ["--seed=-1"], "seed must be a whole number within [0, 9,223,372,036,854,775,807], got -1"),
+    ("negative seed in a run config", config_file("seed = -1\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "config.toml: seed must be a whole number within [0, "),
+    # 86,400 s x 1e9 steps a second; x 2,000 bytes a step = 1.728e17 bytes
+    ("a step of 1 ns", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq="1ns"),
+     lambda p: SIMULATE + ["--freq", "1ns"],
+     "2021-06-21 to 2021-06-21: 86,400,000,000,000 steps of 1ns would need about 172,800,000.0 GB of memory"),
+    # 365 x 86,400 = 31,536,000 steps x 2,000 bytes = 63.1 GB, over the 16 GiB cap on any machine
+    ("a year at 1 s", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-01-01", "2021-12-31", freq="1s"),
+     lambda p: ["simulate", "--site", "lanzhou", "--date", "2021-01-01", "--days", "365", "--freq", "1s"],
+     "2021-01-01 to 2021-12-31: 31,536,000 steps of 1s would need about 63.1 GB of memory"),
+    ("a sun table at 1 ns", lambda tmp: None, lambda p: local_range("2021-06-21", "UTC", freq="1ns"),
+     lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "1ns"], "steps of 1ns would need about"),
+    ("an empty step", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq=""),
+     lambda p: SIMULATE + ["--freq", ""], "step '' is not a duration"),
+    ("reversed working hours", config_file("[controller]\nworking_hours = ['20:00', '05:00']\n"),
+     lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
+     "controller: working_hours ['20:00', '05:00'] must end after they start on the same day"),
+    ("drive limits of 1e308", config_file("[drive]\nlimits = [0.0, 1e308]\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "config.toml: drive: limits (degrees) = 1e+308 is outside [-360, 720]"),
+    ("heliostat limits beyond two turns", config_file("[heliostat_drive]\nlimits = [-360.0, 720.0]\n"),
+     lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
+     "heliostat_drive: drive: limits [-360.0, 720.0] span more than 720° (two turns)"),
+    ("process noise of 1e308", config_file("[controller]\nprocess_noise = 1e308\n"),
+     lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
+     "controller: process_noise = 1e+308 is outside (0, 10]"),
+    ("one stuck scan", config_file("[controller]\nstuck_scans = 1\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "controller: stuck_scans must be a whole number within [3, 10,000]"),
+    ("fuzzy config: infinite raw_range", config_file(
+        "[inputs.intensity]\nraw_range = [30, inf]\nterms.weak = {shape='gaussmf', params=[0, 1]}\n"
+        "[inputs.variation]\nraw_range = [0, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)],
+     "inputs.intensity: raw_range must be two finite numbers [low, high] with low < high, got [30.0, inf]"),
+    ("fuzzy config: NaN membership parameter", config_file(
+        "[output]\nterms.overcast = {shape='trimf', params=[0, nan, 10]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)],
+     "output.weather.terms.overcast: parameters must be finite numbers"),
+    # outputs kept (issue 11, item 5)
+    ("an output through a symlink", planted_link("run.toml"),
+     lambda p: SimulationConfig().to_toml(p / "run.toml"), lambda p: ["init", str(p)],
+     "run.toml is a symbolic link; results are never written through one"),
+    ("an output folder that is a symlink", planted_link(None),
+     lambda p: SimulationConfig().to_toml(p / "run.toml"), lambda p: ["init", str(p)],
+     "out is a symbolic link; results are never written through one"),
+    ("an existing output without --force", existing_files("run.toml"),
+     lambda p: refusing(lambda: SimulationConfig().to_toml(p / "run.toml")), lambda p: ["init", str(p)],
+     "run.toml; give --force to replace them"),
+    ("a full disk", lambda tmp: None, lambda p: SimulationConfig().to_toml("/dev/full"),
+     lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--csv", "/dev/full", "--force"],
+     "/dev/full: cannot write (No space left on device)"),
+    ("an image kind matplotlib cannot draw", lambda tmp: None,
+     lambda p: __import__("hybridtrack.report").report.save_figure(__import__("matplotlib.figure").figure.Figure(),
+                                                                    "x.xyz"),
+     lambda p: ["surface", "--out", "x.xyz"], "x.xyz: cannot draw a .xyz image"),
 ]
 
 

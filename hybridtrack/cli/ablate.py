@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .. import params
 from ..errors import HybridtrackError
-from ..outputs import claim
+from ..outputs import claim, write
 from .base import add_force_argument, command
 
 
@@ -40,6 +41,7 @@ def _ablate(args: argparse.Namespace) -> int:
 
     if not 1 <= args.seeds <= 1000:
         raise HybridtrackError(f"--seeds must be between 1 and 1000, got {args.seeds}")
+    params.whole(args.workers, "--workers", 1, 64)
     plan = AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), tuple(args.policies))
     config = SimulationConfig.from_toml(args.config) if args.config else None
@@ -56,8 +58,8 @@ def _ablate(args: argparse.Namespace) -> int:
         from ..report import save_figure
 
         runs, table, picture = claim(files)
-        result.runs.to_csv(runs, index=False, float_format="%.6g")
-        result.table.to_csv(table, float_format="%.6g")
+        write(runs, lambda file: result.runs.to_csv(file, index=False, float_format="%.6g"))
+        write(table, lambda file: result.table.to_csv(file, float_format="%.6g"))
         save_figure(result.plot(), picture)
         print(f"wrote {runs}, {table} and {picture}")
     return 0

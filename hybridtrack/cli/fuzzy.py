@@ -9,7 +9,7 @@ import warnings
 
 from .. import params
 from ..errors import HybridtrackError
-from ..outputs import claim, strict_json
+from ..outputs import claim, strict_json, write
 from .base import add_force_argument, command
 
 
@@ -84,7 +84,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
     table["sky_score"] = clf.score(readings[wanted[0]].to_numpy(), readings[wanted[1]].to_numpy(), engine=args.engine)
     table["sky"] = clf.label(table["sky_score"].to_numpy())
     if args.out:
-        table.to_csv(claim([args.out])[0], index=False, float_format="%.6g")
+        write(claim([args.out])[0], lambda file: table.to_csv(file, index=False, float_format="%.6g"))
         print(f"wrote {len(table)} rows to {args.out}")
     counts = table["sky"].value_counts()
     print(", ".join(f"{label} {counts.get(label, 0)}" for label in [b[0] for b in clf.config.bands] + ["unknown"]))
@@ -117,10 +117,11 @@ def _tune(args: argparse.Namespace) -> int:
     if args.folds == 1 or args.folds < 0:
         raise HybridtrackError(f"--folds must be 0 (none) or at least 2, got {args.folds}")
     params.seed(args.seed, "--seed")
-    report_files = [Path(args.report) / name for name in ("report.json", "surfaces.png", "confusion.png")]
-    claim([args.out] + (report_files if args.report else []))  # before the fit, not after it
     start = load_fuzzy_config(args.config)
     samples = read_samples(args.labels)
+    report_files = [Path(args.report) / name for name in ("report.json", "surfaces.png", "confusion.png")] \
+        if args.report else []
+    claim([args.out, *report_files])  # before the fit, not after it
     from tqdm import tqdm
 
     fits = 1 + args.folds + max(args.seeds - 1, 0)
@@ -137,7 +138,7 @@ def _tune(args: argparse.Namespace) -> int:
         from ..report import plot_confusion, plot_tuning, save_figure
 
         folder = Path(args.report)
-        (folder / "report.json").write_text(strict_json(report.to_dict(), indent=2) + "\n")
+        write(folder / "report.json", lambda file: file.write_text(strict_json(report.to_dict(), indent=2) + "\n"))
         surfaces = save_figure(plot_tuning(start, tuned, samples), folder / "surfaces.png")
         confusion = save_figure(plot_confusion(start, tuned, samples), folder / "confusion.png")
         print(f"wrote {folder / 'report.json'}, {surfaces}, {confusion}")

@@ -8,7 +8,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
-from ..outputs import claim
+from ..outputs import claim, write
 from .base import add_force_argument, command
 
 RUN, FUZZY, RULES = "run.toml", "fuzzy.toml", "test_site.rules.csv"
@@ -113,7 +113,7 @@ def _init(args: argparse.Namespace) -> int:
         raise HybridtrackError(f"{folder} is a file, not a folder")
     claim(folder / name for name in files)
     for name, text in files.items():
-        (folder / name).write_text(text, encoding="utf-8")
+        write(folder / name, lambda file, text=text: file.write_text(text, encoding="utf-8"))
     print(f"wrote {', '.join(str(folder / name) for name in files)}")
     print(f"try: hybridtrack simulate --site lanzhou --date 2021-06-21 --config {folder / RUN}")
     return 0

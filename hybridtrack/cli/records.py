@@ -6,7 +6,7 @@ import argparse
 
 import pandas as pd
 
-from ..outputs import claim
+from ..outputs import claim, write
 from .base import (
     add_force_argument,
     add_record_arguments,
@@ -54,10 +54,7 @@ def write_frame(frame: pd.DataFrame, path: str) -> None:
     claim([target])
     out = frame.copy()
     out.index = out.index.strftime("%Y-%m-%dT%H:%M:%S%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2", regex=True)
-    try:
-        out.to_csv(target, index_label="time", float_format="%.6g")
-    except OSError as exc:
-        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    write(target, lambda file: out.to_csv(file, index_label="time", float_format="%.6g"))
 
 
 def _sky_arguments(parser: argparse.ArgumentParser) -> None:
@@ -75,7 +72,7 @@ def _sky(args: argparse.Namespace) -> int:
     frame = sensor_view(synthetic_frame(args, site), seed=args.seed)
     print(_sky_table(frame, site).to_string(float_format=lambda v: f"{v:.2f}"))
     if args.out:
-        frame.to_csv(claim([args.out])[0], float_format="%.3f", index_label="time")
+        write(claim([args.out])[0], lambda file: frame.to_csv(file, float_format="%.3f", index_label="time"))
         print(f"wrote {len(frame)} rows to {args.out}")
     if args.plot:
         from ..report import plot_sky, save_figure

@@ -10,7 +10,7 @@ import pandas as pd
 
 from .. import sites
 from ..errors import HybridtrackError
-from ..outputs import claim, strict_json
+from ..outputs import claim, strict_json, write
 from .base import (
     add_force_argument,
     add_record_arguments,
@@ -219,8 +219,8 @@ def _compare(args: argparse.Namespace) -> int:
         folder = Path(args.out)
         for name, result in results.items():
             result.save(folder / name, plot=False)
-        (folder / "comparison.json").write_text(strict_json({n: r.summary for n, r in results.items()}, indent=2)
-                                                + "\n")
+        summaries = strict_json({n: r.summary for n, r in results.items()}, indent=2) + "\n"
+        write(folder / "comparison.json", lambda file: file.write_text(summaries))
         print(f"wrote {save_figure(plot_compare(results), folder / 'comparison.png')}, {folder / 'comparison.json'} "
               f"and one folder per strategy")
     return 0

@@ -7,7 +7,7 @@ import argparse
 import numpy as np
 import pandas as pd
 
-from ..outputs import claim
+from ..outputs import claim, write
 from .base import (
     add_collector_arguments,
     add_force_argument,
@@ -49,7 +49,7 @@ def _sun(args: argparse.Namespace) -> int:
     table = pd.concat([position[["altitude", "apparent_altitude", "azimuth", "declination",
                                  "hour_angle", "equation_of_time"]], angles], axis=1)
     if args.csv:
-        table.to_csv(claim([args.csv])[0], float_format="%.6f", index_label="time")
+        write(claim([args.csv])[0], lambda file: table.to_csv(file, float_format="%.6f", index_label="time"))
         print(f"wrote {len(table)} rows to {args.csv}")
     else:
         shown = table.copy()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import HybridtrackError
-from ..outputs import claim, strict_json
+from ..outputs import claim, strict_json, write
 from .base import (
     add_force_argument, add_record_arguments, add_site_arguments, command, read_record, site_from_arguments,
 )
@@ -61,10 +61,10 @@ def _validate(args: argparse.Namespace) -> int:
           f"{config.rules} rules")
     print(result)
     if args.json:
-        claim([args.json])[0].write_text(strict_json(result.to_dict(), indent=2))
+        write(claim([args.json])[0], lambda file: file.write_text(strict_json(result.to_dict(), indent=2) + "\n"))
         print(f"wrote {args.json}")
     if args.out:
-        result.samples.to_csv(claim([args.out])[0], float_format="%.6g")
+        write(claim([args.out])[0], lambda file: result.samples.to_csv(file, float_format="%.6g"))
         print(f"wrote {args.out}")
     if args.plot:
         from ..report import save_figure

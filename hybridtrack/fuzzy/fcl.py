@@ -47,7 +47,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
-from ..outputs import claim
+from ..outputs import claim, write
 from .config import FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
 from .system import MamdaniSystem, SystemRule, format_number, system_of
@@ -124,7 +124,7 @@ def write_fcl(config: FuzzyConfig | MamdaniSystem, path) -> Path:
     system = system_of(config) if isinstance(config, FuzzyConfig) else config
     text = fcl_text(system)
     path, = claim([path])
-    path.write_text(text)
+    write(path, lambda target: target.write_text(text))
     return path
 
 

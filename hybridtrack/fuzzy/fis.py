@@ -27,7 +27,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
-from ..outputs import claim
+from ..outputs import claim, write
 from .config import METHOD_CHOICES, FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
 from .system import MamdaniSystem, SystemRule, config_from_system, format_number, system_of
@@ -82,7 +82,7 @@ def write_fis(config: FuzzyConfig | MamdaniSystem, path) -> Path:
     system = system_of(config) if isinstance(config, FuzzyConfig) else config
     text = fis_text(system)
     path, = claim([path])
-    path.write_text(text)
+    write(path, lambda target: target.write_text(text))
     return path
 
 

@@ -139,8 +139,8 @@ def write_toml(data: dict, path) -> Path:
     """Write a dict as TOML, creating folders; `read_toml` reads it back equal."""
     import tomli_w
 
-    from ..outputs import claim
+    from ..outputs import claim, write
 
     path, = claim([path])
-    path.write_text(tomli_w.dumps(data), encoding="utf-8")
+    write(path, lambda target: target.write_text(tomli_w.dumps(data), encoding="utf-8"))
     return path
