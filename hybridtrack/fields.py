@@ -23,8 +23,10 @@ import numpy as np
 import pandas as pd
 
 from . import params, sites
+from .budget import BYTES_PER_STEP, check_steps
 from .collectors import (
     AXIS_AZIMUTH,
+    MAX_DISTANCE,
     Collector,
     fresnel_angle,
     fresnel_end_loss,
@@ -32,11 +34,10 @@ from .collectors import (
     normal_angles,
     trough_angle,
 )
-from .budget import BYTES_PER_STEP, check_steps
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
 from .outputs import claim, strict_json, write
-from .world import Imperfections
+from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
            "collector_columns", "FIELD_KINDS", "LOG_VARIABLES", "COLLECTOR_METRICS"]
@@ -81,6 +82,9 @@ class ImperfectionSpread:
             number = isinstance(value, (int, float)) and not isinstance(value, bool)
             if not number or not (np.isfinite(value) and value >= 0):
                 raise HybridtrackError(f"imperfection spread: {f.name} must be a finite number >= 0, got {value!r}")
+            if value > IMPERFECTION_LIMITS[f.name]:
+                raise HybridtrackError(f"imperfection spread: {f.name} = {value!r} is beyond the imperfection's own "
+                                       f"limit of {IMPERFECTION_LIMITS[f.name]:g}")
 
     @classmethod
     def none(cls) -> ImperfectionSpread:
@@ -119,7 +123,8 @@ def _across_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
     return _along_axis(offsets, axis_azimuth + 90.0)
 
 
-def _finite_vector(values, name: str, *, positive: bool = False) -> np.ndarray:
+def _finite_vector(values, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> np.ndarray:
+    """`values` as a 1-D float array, refused unless finite, within ±`bound` (and positive)."""
     try:
         array = np.atleast_1d(np.asarray(values, float))
     except (TypeError, ValueError):
@@ -128,11 +133,13 @@ def _finite_vector(values, name: str, *, positive: bool = False) -> np.ndarray:
         raise HybridtrackError(f"{name} must be a non-empty list of numbers, got shape {array.shape}")
     if not np.all(np.isfinite(array)) or (positive and not np.all(array > 0)):
         raise HybridtrackError(f"{name} must be finite{' and positive' if positive else ''}, got {array.tolist()}")
+    if np.any(np.abs(array) > bound):
+        raise HybridtrackError(f"{name} must be within ±{bound:g}, got {array.tolist()}")
     return array
 
 
-def _finite_number(value, name: str, *, positive: bool = False) -> float:
-    return float(_finite_vector([value], name, positive=positive)[0])
+def _finite_number(value, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> float:
+    return float(_finite_vector([value], name, positive=positive, bound=bound)[0])
 
 
 @dataclass(frozen=True)
@@ -166,7 +173,7 @@ class FresnelField:
         object.__setattr__(self, "row_distances", tuple(_finite_vector(self.row_distances, "row distances").tolist()))
         for name in ("receiver_height", "row_length"):
             object.__setattr__(self, name, _finite_number(getattr(self, name), name.replace("_", " "), positive=True))
-        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth"))
+        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
 
     @property
     def names(self) -> list[str]:
@@ -219,7 +226,7 @@ class TroughLoop:
             raise HybridtrackError(f"trough loop: count must be a whole number from 1 to 100000, got {self.count!r}")
         object.__setattr__(self, "collector_length",
                            _finite_number(self.collector_length, "collector length", positive=True))
-        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth"))
+        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
 
     @property
     def kind(self) -> str:
@@ -279,6 +286,10 @@ class HeliostatField:
         aims = np.asarray(aims, float) if _is_numeric(aims) else None
         if aims is None or aims.shape != xyz.shape:
             raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
+        far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
+        if far.any():
+            raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
+                                   f"beyond {MAX_DISTANCE:g} m")
         relative = aims - xyz
         bad = ~np.isfinite(relative).all(axis=1) | (np.linalg.norm(relative, axis=1) == 0)
         if bad.any():

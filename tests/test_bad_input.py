@@ -237,3 +237,59 @@ def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):
     report = frame.attrs["validation"]
     assert {"unsorted", "duplicates", "impossible", "unreadable"} <= set(report)
     assert report["unreadable"]["ghi"]["lines"] == [5] and len(frame) == 5
+
+
+# -- every numeric field of every config class: NaN, inf, -1 and 1e308 ---------------------------
+
+from hybridtrack.fields import FresnelField, HeliostatField, ImperfectionSpread, TroughLoop  # noqa: E402
+
+CONFIG_CLASSES = (ControllerConfig, Imperfections, SensorModel, Drive, SkyInputConfig, SimulationConfig, Collector,
+                  ImperfectionSpread, FresnelField, TroughLoop, HeliostatField)
+BAD_NUMBERS = (math.nan, math.inf, -1, 1e308)
+#: Fields where -1 is a real value: signed angles, offsets, errors and distances. Every other
+#: numeric field, including any added later, must refuse it.
+SIGNED = {("ControllerConfig", "min_altitude"), ("SkyInputConfig", "min_altitude"), ("SensorModel", "bias"),
+          ("Drive", "limits"), ("Collector", "axis_azimuth"), ("Collector", "row_distance"), ("Collector", "aim"),
+          ("FresnelField", "row_distances"), ("FresnelField", "axis_azimuth"), ("TroughLoop", "axis_azimuth"),
+          ("HeliostatField", "aim")} | {("Imperfections", name) for name in (
+              "axis_azimuth_error", "axis_tilt_error", "encoder_offset", "clock_error", "clock_drift",
+              "latitude_error", "longitude_error", "sensor_bias")}
+
+
+def _numeric_fields():
+    """(class, field name, default) of every field whose default is a number or a tuple of numbers."""
+    for cls in CONFIG_CLASSES:
+        default = cls()
+        for field in dataclasses.fields(cls):
+            value = getattr(default, field.name)
+            plain = isinstance(value, (int, float)) and not isinstance(value, bool)
+            numbers = isinstance(value, tuple) and value and all(isinstance(v, (int, float)) for v in value)
+            if plain or numbers or (cls is Collector and field.name == "axis_azimuth"):
+                yield cls, field.name, value
+
+
+def _with_bad(value, bad):
+    """`bad` in place of a number, or in each place of a tuple in turn."""
+    if isinstance(value, tuple):
+        return [tuple(bad if j == i else v for j, v in enumerate(value)) for i in range(len(value))]
+    return [bad]
+
+
+NUMERIC_FIELDS = list(_numeric_fields())
+
+
+def test_the_sweep_covers_every_config_class():
+    assert {cls for cls, _, _ in NUMERIC_FIELDS} == set(CONFIG_CLASSES) and len(NUMERIC_FIELDS) >= 60
+
+
+@pytest.mark.parametrize("bad", BAD_NUMBERS, ids=["nan", "inf", "minus-one", "1e308"])
+@pytest.mark.parametrize("cls, name, value", NUMERIC_FIELDS, ids=[f"{c.__name__}.{n}" for c, n, _ in NUMERIC_FIELDS])
+def test_every_numeric_field_refuses_nan_inf_negative_and_absurd(cls, name, value, bad):
+    for given in _with_bad(value, bad):
+        try:
+            cls(**{name: given})
+        except HybridtrackError as error:
+            said = str(error)
+            assert (name in said or name.replace("_", " ") in said or "heliostat 1" in said) and "\n" not in said
+        else:  # a real value (a limit's low end of -1°, say) may be accepted only where the field is signed
+            assert bad == -1 and (cls.__name__, name) in SIGNED, f"{cls.__name__}({name}={given!r}) was accepted"
