@@ -53,7 +53,9 @@ def memory_budget() -> int:
 
 
 def _gigabytes(size: float) -> str:
-    return f"{size / 1e9:,.1f} GB" if size >= 1e8 else f"{size / 1e6:,.0f} MB"
+    if size >= 1e8:
+        return f"{size / 1e9:,.1f} GB"
+    return f"{size / 1e6:,.0f} MB" if size >= 1e6 else f"{size / 1e3:,.0f} kB"
 
 
 def check_steps(first, last, step, *, bytes_per_step: int = BYTES_PER_STEP, what: str = "the run") -> int:
@@ -97,6 +99,6 @@ def check_steps(first, last, step, *, bytes_per_step: int = BYTES_PER_STEP, what
         at_most = f"at most {longest / pd.Timedelta(days=1):,.1f} days"
     else:
         at_most = f"at most {duration(longest.floor('s'))}" if longest >= pd.Timedelta(seconds=1) else "under a second"
-    raise HybridtrackError(f"{what}: {steps:,} steps of {duration(step)} would need about {_gigabytes(steps * per_step)} of "
-                           f"memory, over the {_gigabytes(budget)} a run may use; use {coarser} or a span of {at_most} "
-                           "at this step")
+    raise HybridtrackError(f"{what}: {steps:,} steps of {duration(step)} would need about "
+                           f"{_gigabytes(steps * per_step)} of memory, over the {_gigabytes(budget)} a run may use; "
+                           f"use {coarser} or a span of {at_most} at this step")

@@ -122,7 +122,6 @@ class SensorModel:
                   ("field_of_view", 0, 90, True), ("coarse_field_of_view", self.field_of_view, 90, False),
                   ("coarse_accuracy", 0, 45, False), ("noise", 0, 5, False), ("bias", -5, 5, False),
                   ("view_share", 0, 1, False)]
-        number(self.field_of_view, "sensor: field_of_view", 0, 90, above=True)
         for name, low, high, above in ranges:
             number(getattr(self, name), f"sensor: {name}", low, high, above=above)
         patch = tuple(self.patch_distance)

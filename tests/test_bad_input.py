@@ -48,6 +48,7 @@ def config_file(text, name="config.toml"):
 
 
 SIMULATE = ["simulate", "--site", "lanzhou", "--date", "2021-06-21"]
+CLASSIFY = ["classify", "--intensity", "1", "--variation", "1"]
 
 
 def planted_link(name):
@@ -189,11 +190,11 @@ MATRIX = [
     ("fuzzy config: infinite raw_range", config_file(
         "[inputs.intensity]\nraw_range = [30, inf]\nterms.weak = {shape='gaussmf', params=[0, 1]}\n"
         "[inputs.variation]\nraw_range = [0, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n"),
-     lambda p: FuzzyConfig.from_toml(p), lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)],
+     lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
      "inputs.intensity: raw_range must be two finite numbers [low, high] with low < high, got [30.0, inf]"),
     ("fuzzy config: NaN membership parameter", config_file(
         "[output]\nterms.overcast = {shape='trimf', params=[0, nan, 10]}\n"),
-     lambda p: FuzzyConfig.from_toml(p), lambda p: ["classify", "--intensity", "1", "--variation", "1", "--config", str(p)],
+     lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
      "output.weather.terms.overcast: parameters must be finite numbers"),
     # outputs kept (issue 11, item 5)
     ("an output through a symlink", planted_link("run.toml"),

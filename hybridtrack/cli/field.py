@@ -10,7 +10,8 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from .base import (
-    add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config, site_from_arguments, synthetic_frame,
+    add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config, site_from_arguments,
+    synthetic_frame,
 )
 
 
