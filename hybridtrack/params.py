@@ -1,4 +1,5 @@
-"""Numbers checked at the door: finite, within a physical range, whole where they count.
+"""Numbers checked at the door: finite, within a physical range, whole where they count;
+durations positive.
 
 Each helper returns the value in its plain Python type, or raises `HybridtrackError` naming
 the parameter, its range and the value given; config classes, CLI flags and API arguments
@@ -10,9 +11,11 @@ from __future__ import annotations
 import math
 import numbers
 
+import pandas as pd
+
 from .errors import HybridtrackError
 
-__all__ = ["number", "whole", "seed", "angle_pair"]
+__all__ = ["number", "whole", "seed", "duration", "angle_pair"]
 
 #: The largest seed: numpy's generators take any non-negative integer; this keeps it in 64 bits.
 MAX_SEED = 2**63 - 1
@@ -57,6 +60,17 @@ def whole(value, name: str, least: int = 0, most: int = 10_000) -> int:
 def seed(value, name: str = "seed") -> int:
     """A random seed: a whole number from 0 to 2**63 - 1."""
     return whole(value, name, 0, MAX_SEED)
+
+
+def duration(text, name: str) -> pd.Timedelta:
+    """A positive, finite duration such as ``"20min"``."""
+    try:
+        value = pd.Timedelta(text)
+    except (TypeError, ValueError):
+        value = None
+    if value is None or value is pd.NaT or value <= pd.Timedelta(0):
+        raise HybridtrackError(f"{name} {text!r} is not a positive duration such as '20min'")
+    return value
 
 
 def angle_pair(values, name: str, low: float, high: float) -> tuple[float, float]:

@@ -50,7 +50,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
-from .params import number
+from .params import duration, number
 
 __all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "SensorScene", "sensor_scene", "read_pointing",
            "read_photocurrent", "coarse_offset"]
@@ -129,12 +129,7 @@ class SensorModel:
                 <= number(patch[1], "sensor: patch_distance", 0, 30):
             raise HybridtrackError(f"sensor: patch_distance {list(patch)} must be [low, high] within 0-30 degrees")
         object.__setattr__(self, "patch_distance", tuple(float(v) for v in patch))
-        try:
-            if pd.Timedelta(self.window) <= pd.Timedelta(0):
-                raise ValueError
-        except ValueError:
-            raise HybridtrackError(f"sensor: window {self.window!r} is not a positive duration such as "
-                                   "'20min'") from None
+        duration(self.window, "sensor: window")
 
     def direct_response(self, offset) -> np.ndarray:
         """Share of the direct beam the cells collect at a pointing offset (degrees)."""

@@ -185,6 +185,8 @@ MATRIX = [
     ("process noise of 1e308", config_file("[controller]\nprocess_noise = 1e308\n"),
      lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
      "controller: process_noise = 1e+308 is outside (0, 10]"),
+    ("a duration of nan", config_file("[controller]\ndwell = 'nan'\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "controller: dwell 'nan' is not a positive duration such as '20min'"),
     ("one stuck scan", config_file("[controller]\nstuck_scans = 1\n"), lambda p: SimulationConfig.from_toml(p),
      lambda p: SIMULATE + ["--config", str(p)], "controller: stuck_scans must be a whole number within [3, 10,000]"),
     ("fuzzy config: infinite raw_range", config_file(

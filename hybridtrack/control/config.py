@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from ..errors import HybridtrackError
-from ..params import number, whole
+from ..params import duration, number, whole
 
 __all__ = ["ControllerConfig", "STRATEGIES"]
 
@@ -148,12 +148,7 @@ class ControllerConfig:
         if self.kalman not in ("fast", "filterpy"):
             raise HybridtrackError(f"unknown Kalman engine {self.kalman!r}; choose 'fast' or 'filterpy'")
         for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast"):
-            try:
-                if pd.Timedelta(getattr(self, name)) <= pd.Timedelta(0):
-                    raise ValueError
-            except ValueError:
-                raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive "
-                                       "duration") from None
+            duration(getattr(self, name), f"controller: {name}")
         for name, low, high, above in _RANGES:
             number(getattr(self, name), f"controller: {name}", low, high, above=above)
         if not self.wind_release <= self.wind_stow:
