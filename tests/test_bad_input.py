@@ -198,6 +198,11 @@ MATRIX = [
         "[output]\nterms.overcast = {shape='trimf', params=[0, nan, 10]}\n"),
      lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
      "output.weather.terms.overcast: parameters must be finite numbers"),
+    ("an infinite tuning margin", config_file("intensity,variation,weather\n100,20,sunny\n50,100,cloudy\n",
+                                              "labels.csv"),
+     lambda p: __import__("hybridtrack.fuzzy.tuning").fuzzy.tuning.tune(None, p, margin=math.inf),
+     lambda p: ["tune", str(p), "--out", str(p) + ".toml", "--margin", "inf"],
+     "margin (score units) must be a finite number within [0, 30], got inf"),
     # outputs kept (issue 11, item 5)
     ("an output through a symlink", planted_link("run.toml"),
      lambda p: SimulationConfig().to_toml(p / "run.toml"), lambda p: ["init", str(p)],
@@ -296,3 +301,9 @@ def test_every_numeric_field_refuses_nan_inf_negative_and_absurd(cls, name, valu
             assert (name in said or name.replace("_", " ") in said or "heliostat 1" in said) and "\n" not in said
         else:  # a real value (a limit's low end of -1°, say) may be accepted only where the field is signed
             assert bad == -1 and (cls.__name__, name) in SIGNED, f"{cls.__name__}({name}={given!r}) was accepted"
+
+
+def test_a_day_that_does_not_exist_to_draw_is_refused(tmp_path, capsys):
+    assert main(["validate-sky", "data/nanjing-2013-cloudy.csv", "--site", "nanjing", "--day", "2021-13-01",
+                 "--plot", str(tmp_path / "day.png")]) == 2
+    assert capsys.readouterr().err == "hybridtrack: error: date '2021-13-01' does not exist or is not YYYY-MM-DD\n"

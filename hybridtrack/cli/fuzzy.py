@@ -18,16 +18,17 @@ def tuned_config_warnings():
     """Print a tuned config's `OutsideLabelsWarning` as one ``hybridtrack: warning:`` line each."""
     from ..fuzzy.tuning import OutsideLabelsWarning
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", OutsideLabelsWarning)
-        try:
+    caught: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", OutsideLabelsWarning)
             yield
-        finally:
-            for warning in caught:
-                if issubclass(warning.category, OutsideLabelsWarning):
-                    print(f"hybridtrack: warning: {warning.message}", file=sys.stderr)
-                else:
-                    warnings.showwarning(warning.message, warning.category, warning.filename, warning.lineno)
+    finally:  # outside catch_warnings: re-shown there, a warning would be caught again, for ever
+        for warning in caught:
+            if issubclass(warning.category, OutsideLabelsWarning):
+                print(f"hybridtrack: warning: {warning.message}", file=sys.stderr)
+            else:
+                warnings.showwarning(warning.message, warning.category, warning.filename, warning.lineno)
 
 
 def load_fuzzy_config(path):
@@ -112,12 +113,13 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
 def _tune(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..fuzzy.tuning import read_samples, tune
+    from ..fuzzy.tuning import check_margin, read_samples, tune
 
     if args.folds == 1 or args.folds < 0:
         raise HybridtrackError(f"--folds must be 0 (none) or at least 2, got {args.folds}")
     params.seed(args.seed, "--seed")
     start = load_fuzzy_config(args.config)
+    check_margin(args.margin, start)  # before the progress bar
     samples = read_samples(args.labels)
     report_files = [Path(args.report) / name for name in ("report.json", "surfaces.png", "confusion.png")] \
         if args.report else []
