@@ -43,8 +43,9 @@ from ..params import number
 from .classifier import FuzzyWeatherClassifier
 from .config import FuzzyConfig, Term
 
-__all__ = ["tune", "check_margin", "TuningReport", "read_samples", "evaluate", "cross_validate", "constraint_violations",
-           "labelled_range", "outside_labels", "warn_outside_labels", "OutsideLabelsWarning", "MONOTONE_TOLERANCE"]
+__all__ = ["tune", "check_margin", "TuningReport", "read_samples", "evaluate", "cross_validate",
+           "constraint_violations", "labelled_range", "outside_labels", "warn_outside_labels", "OutsideLabelsWarning",
+           "MONOTONE_TOLERANCE"]
 
 #: How far (score units) the score may dip below its running maximum as intensity rises at
 #: constant variation: the discretised centroid of the published system wobbles by 0.26 on this grid.
