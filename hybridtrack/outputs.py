@@ -88,8 +88,17 @@ def claim(paths: Iterable) -> list[Path]:
     if replaced is not None:
         replaced.extend(p for p in existing if p not in replaced)
     for folder in dict.fromkeys(path.parent for path in paths):
-        folder.mkdir(parents=True, exist_ok=True)
+        _make_folder(folder)
     return paths
+
+
+def _make_folder(folder: Path) -> None:
+    if folder.exists() and not folder.is_dir():
+        raise HybridtrackError(f"{folder} is a file, not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise HybridtrackError(f"{folder}: cannot make the folder ({exc.strerror or exc})") from None
 
 
 def write(path, writer: Callable[[Path], object]) -> Path:

@@ -226,3 +226,13 @@ def test_bytes_per_step_covers_the_measured_peak_of_a_run():
     for collector in ("trough-ns", "heliostat"):
         (n1, p1), (n2, p2) = peak(2, collector), peak(8, collector)
         assert 0 < (p2 - p1) / (n2 - n1) <= budget.BYTES_PER_STEP
+
+
+def test_an_out_that_is_a_file_or_under_one_is_one_line(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("the user's own\n")
+    assert main(SHORT + ["--out", str(afile)]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {afile} is a file, not a folder\n"
+    assert main(SHORT + ["--out", str(afile / "sub")]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {afile / 'sub'}: cannot make the folder (Not a directory)\n"
+    assert afile.read_text() == "the user's own\n"
