@@ -76,14 +76,13 @@ def claim(paths: Iterable) -> list[Path]:
         for candidate in (path.parent, path):
             if candidate.is_symlink():
                 raise HybridtrackError(f"{candidate} is a symbolic link; results are never written through one "
-                                       "(remove it or choose another --out)")
+                                       "(remove it or write elsewhere)")
         if path.is_dir():
             raise HybridtrackError(f"{path} is a folder; a result file would go there")
     existing = [path for path in paths if path.exists()]
     if existing and not _FORCE.get():
         raise HybridtrackError(f"would replace {len(existing)} existing file{'s' if len(existing) > 1 else ''}: "
-                               f"{', '.join(map(str, existing))}; give --force to replace them, or choose another "
-                               "--out")
+                               f"{', '.join(map(str, existing))}; give --force to replace them, or write elsewhere")
     replaced = _REPLACED.get()
     if replaced is not None:
         replaced.extend(p for p in existing if p not in replaced)

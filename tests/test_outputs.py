@@ -107,7 +107,7 @@ def test_existing_results_are_refused_without_force_and_named(tmp_path, capsys):
     assert main(SHORT + ["--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err == (f"hybridtrack: error: would replace 1 existing file: {out / 'summary.json'}; give --force to "
-                   "replace them, or choose another --out\n")
+                   "replace them, or write elsewhere\n")
     assert (out / "summary.json").read_text() == "the user's own\n" and not (out / "log.parquet").exists()
 
 
@@ -154,7 +154,7 @@ def test_a_link_planted_in_out_is_refused_and_nothing_is_written(tmp_path, capsy
     (out / "summary.json").symlink_to(victim)
     assert main(SHORT + ["--out", str(out), "--force"]) == 2
     assert capsys.readouterr().err == (f"hybridtrack: error: {out / 'summary.json'} is a symbolic link; results are "
-                                       "never written through one (remove it or choose another --out)\n")
+                                       "never written through one (remove it or write elsewhere)\n")
     assert not victim.exists() and not (out / "log.parquet").exists()
 
 
