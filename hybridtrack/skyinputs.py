@@ -54,6 +54,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
+from .params import duration
 from .sensor import SensorModel
 from .sites import Site, get
 
@@ -114,9 +115,9 @@ class SkyInputConfig:
         for name, allowed in (("mode", MODES), ("rules", RULES), ("low_sun", LOW_SUN)):
             if getattr(self, name) not in allowed:
                 raise HybridtrackError(f"sky inputs: {name} {getattr(self, name)!r} is not one of {', '.join(allowed)}")
-        _duration(self.window, "window")
+        duration(self.window, "sky inputs: window")
         if self.smoothing is not None:
-            _duration(self.smoothing, "smoothing")
+            duration(self.smoothing, "sky inputs: smoothing")
         if isinstance(self.min_altitude, bool) or not isinstance(self.min_altitude, (int, float)) \
                 or not math.isfinite(self.min_altitude) or not -5.0 <= self.min_altitude <= 45.0:
             raise HybridtrackError(f"sky inputs: min_altitude {self.min_altitude!r} must be a number of degrees "
@@ -171,16 +172,6 @@ class SkyInputConfig:
         from .io import write_toml
 
         return write_toml({"sky": self.to_dict()}, path)
-
-
-def _duration(text, name: str) -> pd.Timedelta:
-    try:
-        value = pd.Timedelta(text)
-    except (TypeError, ValueError):
-        value = None
-    if value is None or value is pd.NaT or value <= pd.Timedelta(0):
-        raise HybridtrackError(f"sky inputs: {name} {text!r} is not a positive duration such as '20min'")
-    return value
 
 
 def fuzzy_config(config: SkyInputConfig):

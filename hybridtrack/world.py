@@ -45,6 +45,13 @@ __all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
 HARD_STOP_MARGIN = 1.0
 
 
+#: The largest size of each imperfection (degrees; seconds; seconds a day; days).
+IMPERFECTION_LIMITS = {"axis_azimuth_error": 10.0, "axis_tilt_error": 10.0, "encoder_offset": 10.0,
+                       "clock_error": 3600.0, "clock_drift": 100.0, "commissioned_days_ago": 3660.0,
+                       "latitude_error": 1.0, "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0,
+                       "axis_roll_error": 10.0}
+
+
 @dataclass(frozen=True)
 class Imperfections:
     """What is wrong with the real installation, unknown to the controller.
@@ -91,9 +98,7 @@ class Imperfections:
     axis_roll_error: float = 0.0
 
     def __post_init__(self) -> None:
-        limits = {"axis_azimuth_error": 10.0, "axis_tilt_error": 10.0, "encoder_offset": 10.0, "clock_error": 3600.0,
-                  "clock_drift": 100.0, "commissioned_days_ago": 3660.0, "latitude_error": 1.0,
-                  "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0, "axis_roll_error": 10.0}
+        limits = IMPERFECTION_LIMITS
         for f in fields(self):
             value = getattr(self, f.name)
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):

@@ -3,6 +3,10 @@
 Every command has ``--help``. A mistake a user can make (bad file, column, site, date or
 parameter) prints one line, ``hybridtrack: error: ...``, and exits with status 2.
 
+Results are written as `hybridtrack.outputs` says: never through a symbolic link, never over an
+existing file without ``--force``, and in full even when the reader of the printout has gone
+(``| head``).
+
 Each module of this package registers the commands of one concern with `base.command`;
 importing them here is what puts them on the command line.
 """
@@ -15,6 +19,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import HybridtrackError
+from ..outputs import reader_may_leave, replacing
 from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
 from .base import _COMMANDS, _HELP, EXIT_USAGE
 
@@ -40,8 +45,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
     try:
-        return args._run(args)
-    except BrokenPipeError:  # the reader went away (`| head`): not a mistake, just stop
+        with reader_may_leave(), replacing(getattr(args, "force", False)) as replaced:
+            status = args._run(args)
+            if replaced:
+                print("replaced (--force): " + ", ".join(map(str, replaced)))
+            return status
+    except BrokenPipeError:  # the reader went away outside the printing (`| head`): not a mistake, just stop
         import os
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
