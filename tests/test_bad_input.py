@@ -203,6 +203,9 @@ MATRIX = [
      lambda p: __import__("hybridtrack.fuzzy.tuning").fuzzy.tuning.tune(None, p, margin=math.inf),
      lambda p: ["tune", str(p), "--out", str(p) + ".toml", "--margin", "inf"],
      "margin (score units) must be a finite number within [0, 30], got inf"),
+    ("an unknown ablation policy", lambda tmp: None,
+     lambda p: __import__("hybridtrack.ablation").ablation.AblationPlan(policies=("bogus",)),
+     lambda p: ["ablate", "--policies", "bogus"], "'bogus'"),
     # outputs kept (issue 11, item 5)
     ("an output through a symlink", planted_link("run.toml"),
      lambda p: SimulationConfig().to_toml(p / "run.toml"), lambda p: ["init", str(p)],
@@ -235,6 +238,14 @@ def test_bad_input_is_one_clear_line_from_api_and_cli(tmp_path, capsys, make, ap
     captured = capsys.readouterr()
     assert captured.err.count("\n") == 1 and message in captured.err
     assert captured.err.startswith("hybridtrack: error: ") and "Traceback" not in captured.err
+
+
+@pytest.mark.parametrize("argv", [["ablate", "--policies", "bogus"], ["simulate", "--date", "2021-06-21", "--freq"],
+                                  ["sun", "--variation"], [], ["classify", "--intensity", "--variation", "1"]])
+def test_a_command_line_argparse_refuses_is_one_line_too(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("hybridtrack: error: hybridtrack")
 
 
 def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):

@@ -26,9 +26,17 @@ from .base import _COMMANDS, _HELP, EXIT_USAGE
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse's parser, whose refusals are one line (``hybridtrack: error: ...``) and status 2,
+    like every other refusal, instead of the usage block and the error."""
+
+    def error(self, message: str):
+        raise HybridtrackError(f"{self.prog}: {message} (see {self.prog} --help)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The parser with every registered command."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="hybridtrack",
         description="Weather-aware hybrid sun tracking for concentrating solar collectors.",
     )
@@ -43,8 +51,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
     try:
+        args = build_parser().parse_args(argv)
         with reader_may_leave(), replacing(getattr(args, "force", False)) as replaced:
             status = args._run(args)
             if replaced:
