@@ -52,11 +52,14 @@ import pandas as pd
 from .errors import HybridtrackError
 from .params import duration, number
 
-__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "SensorScene", "sensor_scene", "read_pointing",
+__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "sensor_scene", "read_pointing",
            "read_photocurrent", "coarse_offset"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
+#: Weather frame columns holding the sensor's recorded pointing signal, degrees, one per axis it
+#: serves (a single axis; a heliostat's azimuth and elevation), used instead of the model.
+RECORDED_POINTING = ("pointing", "pointing_2")
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
 from .mounting import mount_targets, mounting_rotation
-from .sensor import RECORDED_COLUMN, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
+from .sensor import RECORDED_COLUMN, RECORDED_POINTING, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
 from .sun import solar_position
 
 __all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
@@ -129,8 +129,10 @@ class World:
     Parameters
     ----------
     frame : pandas.DataFrame
-        The weather (``dni``, ``dhi``, ``wind_speed``; a recorded ``photocurrent`` is used as
-        recorded; a ``sky`` column is the true sky, for the oracle policy only).
+        The weather (``dni``, ``dhi``, ``wind_speed``; a recorded ``photocurrent``, and a
+        recorded pointing signal ``pointing`` (and ``pointing_2`` for a heliostat's elevation),
+        degrees, NaN where the sensor had no reading, are used as recorded; a ``sky`` column is
+        the true sky, for the oracle policy only).
     site : Site
     collector : Collector
     imperfections : Imperfections
@@ -169,6 +171,7 @@ class World:
         self._coarse_noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
         recorded = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
         self._recorded_current = recorded.tolist() if recorded is not None else None
+        self._recorded_pointing = self._recorded_pointing_columns(frame)
         self.frame_dni = frame["dni"].to_numpy(float)
         self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
         self._wind = self.wind.tolist()
@@ -184,6 +187,17 @@ class World:
                         for name, v in faults.items() if name != "clock"}
 
     # -- set up ----------------------------------------------------------------------------------
+
+    def _recorded_pointing_columns(self, frame: pd.DataFrame) -> list | None:
+        """The sensor's recorded pointing signal per axis (NaN: no reading), or None without one."""
+        names = RECORDED_POINTING[:self.axes]
+        present = [name for name in names if name in frame.columns]
+        if not present:
+            return None
+        if len(present) < len(names):
+            raise HybridtrackError(f"a recorded pointing signal needs a column per axis: {', '.join(names)}; "
+                                   f"the frame has {', '.join(present)}")
+        return [frame[name].to_numpy(float).tolist() for name in names]
 
     def _true_sun(self, model: str) -> pd.DataFrame:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
@@ -254,8 +268,12 @@ class World:
         beam, aureole, patch, patch_offset, diffuse = self._scene
         offsets = [self._offset(a, i) for a in range(self.axes)]
         noise = [self._noise[a][i] for a in range(self.axes)]
-        reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
-                                        [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
+        if self._recorded_pointing is not None:  # as recorded: what the logger's sensor said
+            reported = [self._recorded_pointing[a][i] for a in range(self.axes)]
+            valid = not any(math.isnan(value) for value in reported)
+        else:
+            reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
+                                            [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
         obs.valid = valid
         self._sensor_faults(i, reported, obs)
         obs.i, obs.t, obs.wind = i, self._minutes[i], self._wind[i]
