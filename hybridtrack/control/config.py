@@ -107,6 +107,17 @@ class ControllerConfig:
         Degrees: a persistent residual between the sensor and the calibrated model at least this
         large is a sensor (or mount) fault; a smaller one is the model's own misfit. Half the
         0.5° whole-system error that trough fields are built to.
+    on_disagreement : {"model", "sensor"}
+        Whom to trust when they disagree so. ``model`` (default): the sensor is suspect (a bias,
+        a drift, a knock to its bracket); the calibration goes back to the checkpoint taken while
+        the two agreed and the sensor is not trusted for `distrust`, then judged again. ``sensor``:
+        the mount is suspect (a shifted pedestal, a slipped coupling); the calibration keeps what
+        it learned and the sensor stays trusted. Either way the alarm is logged with its size.
+        ``model`` is the safe default: a sensor fault is the likelier one, and with ``sensor``
+        a biased sensor drags the calibration with it.
+    distrust : str
+        How long a sensor judged against the model is not trusted (``on_disagreement = "model"``):
+        an hour, long enough for the sun to move about 15° and show a bias again from another angle.
     kalman : {"fast", "filterpy"}
         ``filterpy`` runs filterpy's KalmanFilter, the reference; ``fast`` the same
         equations in plain floats (a test keeps them equal).
@@ -135,6 +146,8 @@ class ControllerConfig:
     lead: bool = True
     sensor_noise: float = 0.05
     disagreement: float = 0.25
+    on_disagreement: str = "model"
+    distrust: str = "60min"
     kalman: str = "fast"
 
     def __post_init__(self) -> None:
@@ -147,7 +160,9 @@ class ControllerConfig:
             raise HybridtrackError(f"controller: wind_missing {self.wind_missing!r}; choose 'stow' or 'track'")
         if self.kalman not in ("fast", "filterpy"):
             raise HybridtrackError(f"unknown Kalman engine {self.kalman!r}; choose 'fast' or 'filterpy'")
-        for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast"):
+        if self.on_disagreement not in ("model", "sensor"):
+            raise HybridtrackError(f"controller: on_disagreement {self.on_disagreement!r}; choose 'model' or 'sensor'")
+        for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast", "distrust"):
             duration(getattr(self, name), f"controller: {name}")
         for name, low, high, above in _RANGES:
             number(getattr(self, name), f"controller: {name}", low, high, above=above)
