@@ -59,13 +59,12 @@ class AblationPlan:
         from .collectors import KINDS
         from .sky import DAY_TYPES
 
-        checks = [("seasons", self.seasons, tuple(SEASONS)), ("weather", self.weather, (*DAY_TYPES, "mixed")),
-                  ("collectors", self.collectors, KINDS), ("policies", self.policies, STRATEGIES)]
-        for name, values, known in checks:
+        checks = [("season", self.seasons, tuple(SEASONS)), ("weather", self.weather, (*DAY_TYPES, "mixed")),
+                  ("collector", self.collectors, KINDS), ("policy", self.policies, STRATEGIES)]
+        for what, values, known in checks:
             for value in values:
                 if value not in known:
-                    raise HybridtrackError(f"ablate: unknown {name[:-1] if name != 'weather' else name} "
-                                           f"{value!r}; choose from {', '.join(known)}")
+                    raise HybridtrackError(f"ablate: unknown {what} {value!r}; choose from {', '.join(known)}")
         for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
             if not getattr(self, name):
                 raise HybridtrackError(f"ablate: no {name} to run")

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
+from .params import number
 
 __all__ = [
     "Collector",
@@ -292,6 +293,11 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
 KINDS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
 
 
+#: Metres: the farthest a row, receiver or aim point may lie from a collector (a large tower
+#: field's outer heliostats are about 1.5 km from the tower).
+MAX_DISTANCE = 5_000.0
+
+
 @dataclass(frozen=True)
 class Collector:
     """A collector's kind and geometry: everything needed to turn a sun position into targets.
@@ -320,8 +326,12 @@ class Collector:
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise HybridtrackError(f"unknown collector {self.kind!r}; choose from {', '.join(KINDS)}")
-        if self.kind == "fresnel" and not self.receiver_height > 0:
-            raise HybridtrackError(f"receiver height must be positive, got {self.receiver_height!r} m")
+        if self.axis_azimuth is not None:
+            number(self.axis_azimuth, "collector: axis_azimuth (degrees from north)", -360, 360)
+        number(self.row_distance, "collector: row_distance (m)", -MAX_DISTANCE, MAX_DISTANCE)
+        number(self.receiver_height, "collector: receiver_height (m)", 0, MAX_DISTANCE, above=True)
+        for value in self.aim:
+            number(value, "collector: aim (m)", -MAX_DISTANCE, MAX_DISTANCE)
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import HybridtrackError
+from .params import angle_pair, number, whole
 
 __all__ = ["Drive", "gray_encode", "gray_decode", "encoder_reading"]
 
@@ -37,6 +38,16 @@ def gray_decode(code):
 def encoder_reading(angle: float, resolution: float) -> float:
     """What an absolute encoder of `resolution` degrees a count reads at `angle` (degrees)."""
     return round(angle / resolution) * resolution
+
+
+#: Degrees any axis limit may lie within: a heliostat's azimuth with a cable wrap of one turn
+#: either way of south runs -180° to 540°; one more half turn either way is still a mechanism.
+LIMIT_RANGE = (-360.0, 720.0)
+#: Degrees the limits may span at most: two full turns (the cable wrap above).
+MAX_TRAVEL = 720.0
+#: Degrees per minute a drive may turn at most: a full turn a minute, six times the fastest
+#: stow move of the collectors modelled here (60°/min).
+MAX_SPEED = 360.0
 
 
 @dataclass(frozen=True)
@@ -67,17 +78,14 @@ class Drive:
     encoder_bits: int = 12
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "limits", tuple(float(v) for v in self.limits))
-        if not 0 <= self.deadband <= 10:
-            raise HybridtrackError(f"drive: deadband {self.deadband!r}° is outside 0-10°")
-        if not (self.speed > 0 and self.stow_speed > 0):
-            raise HybridtrackError("drive: speeds must be positive")
-        if len(self.limits) != 2 or not self.limits[0] < self.limits[1]:
-            raise HybridtrackError(f"drive: limits must be [low, high] with low < high, got {list(self.limits)}")
-        if not self.limits[0] <= self.stow <= self.limits[1]:
-            raise HybridtrackError(f"drive: stow {self.stow}° is outside the limits {list(self.limits)}")
-        if not 8 <= self.encoder_bits <= 24:
-            raise HybridtrackError(f"drive: encoder_bits {self.encoder_bits!r} is outside 8-24")
+        object.__setattr__(self, "limits", angle_pair(self.limits, "drive: limits (degrees)", *LIMIT_RANGE))
+        if self.limits[1] - self.limits[0] > MAX_TRAVEL:
+            raise HybridtrackError(f"drive: limits {list(self.limits)} span more than {MAX_TRAVEL:g}° (two turns)")
+        number(self.deadband, "drive: deadband (degrees)", 0, 10)
+        for name in ("speed", "stow_speed"):
+            number(getattr(self, name), f"drive: {name} (degrees per minute)", 0, MAX_SPEED, above=True)
+        number(self.stow, "drive: stow (degrees)", *self.limits)
+        whole(self.encoder_bits, "drive: encoder_bits", 8, 24)
 
     @property
     def resolution(self) -> float:

@@ -15,7 +15,6 @@ every step in one call of the broadcasting functions of `hybridtrack.collectors`
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,9 +22,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import sites
+from . import params, sites
+from .budget import BYTES_PER_STEP, check_steps
 from .collectors import (
     AXIS_AZIMUTH,
+    MAX_DISTANCE,
     Collector,
     fresnel_angle,
     fresnel_end_loss,
@@ -35,7 +36,8 @@ from .collectors import (
 )
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
-from .world import Imperfections
+from .outputs import claim, strict_json, write
+from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
            "collector_columns", "FIELD_KINDS", "LOG_VARIABLES", "COLLECTOR_METRICS"]
@@ -45,6 +47,8 @@ LOG_VARIABLES = ("target_true", "target", "angle", "error", "mode", "sky", "sens
                  "calibration")
 #: Log columns every collector shares (the weather and the sky class); kept once, over time.
 SHARED_VARIABLES = ("dni", "wind_speed")
+#: Bytes a kept log takes per collector and step, at most (a heliostat's two axes).
+LOG_BYTES = 80
 
 
 @dataclass(frozen=True)
@@ -79,6 +83,9 @@ class ImperfectionSpread:
             number = isinstance(value, (int, float)) and not isinstance(value, bool)
             if not number or not (np.isfinite(value) and value >= 0):
                 raise HybridtrackError(f"imperfection spread: {f.name} must be a finite number >= 0, got {value!r}")
+            if value > IMPERFECTION_LIMITS[f.name]:
+                raise HybridtrackError(f"imperfection spread: {f.name} = {value!r} is beyond the imperfection's own "
+                                       f"limit of {IMPERFECTION_LIMITS[f.name]:g}")
 
     @classmethod
     def none(cls) -> ImperfectionSpread:
@@ -117,7 +124,8 @@ def _across_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
     return _along_axis(offsets, axis_azimuth + 90.0)
 
 
-def _finite_vector(values, name: str, *, positive: bool = False) -> np.ndarray:
+def _finite_vector(values, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> np.ndarray:
+    """`values` as a 1-D float array, refused unless finite, within ±`bound` (and positive)."""
     try:
         array = np.atleast_1d(np.asarray(values, float))
     except (TypeError, ValueError):
@@ -126,11 +134,13 @@ def _finite_vector(values, name: str, *, positive: bool = False) -> np.ndarray:
         raise HybridtrackError(f"{name} must be a non-empty list of numbers, got shape {array.shape}")
     if not np.all(np.isfinite(array)) or (positive and not np.all(array > 0)):
         raise HybridtrackError(f"{name} must be finite{' and positive' if positive else ''}, got {array.tolist()}")
+    if np.any(np.abs(array) > bound):
+        raise HybridtrackError(f"{name} must be within ±{bound:g}, got {array.tolist()}")
     return array
 
 
-def _finite_number(value, name: str, *, positive: bool = False) -> float:
-    return float(_finite_vector([value], name, positive=positive)[0])
+def _finite_number(value, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> float:
+    return float(_finite_vector([value], name, positive=positive, bound=bound)[0])
 
 
 @dataclass(frozen=True)
@@ -164,7 +174,7 @@ class FresnelField:
         object.__setattr__(self, "row_distances", tuple(_finite_vector(self.row_distances, "row distances").tolist()))
         for name in ("receiver_height", "row_length"):
             object.__setattr__(self, name, _finite_number(getattr(self, name), name.replace("_", " "), positive=True))
-        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth"))
+        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
 
     @property
     def names(self) -> list[str]:
@@ -217,7 +227,7 @@ class TroughLoop:
             raise HybridtrackError(f"trough loop: count must be a whole number from 1 to 100000, got {self.count!r}")
         object.__setattr__(self, "collector_length",
                            _finite_number(self.collector_length, "collector length", positive=True))
-        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth"))
+        object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
 
     @property
     def kind(self) -> str:
@@ -277,6 +287,10 @@ class HeliostatField:
         aims = np.asarray(aims, float) if _is_numeric(aims) else None
         if aims is None or aims.shape != xyz.shape:
             raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
+        far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
+        if far.any():
+            raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
+                                   f"beyond {MAX_DISTANCE:g} m")
         relative = aims - xyz
         bad = ~np.isfinite(relative).all(axis=1) | (np.linalg.norm(relative, axis=1) == 0)
         if bad.any():
@@ -407,20 +421,26 @@ class FieldResult:
         ax.set_title(f"{self.summary['field']} at {self.site.name}: {_METRIC_LABELS.get(metric, metric)}")
         return fig
 
-    def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
-        """Write ``collectors.csv``, ``events.csv``, ``summary.json``, ``field_map.png`` and, when
-        the logs were kept, ``log.nc`` (netCDF, the `dataset`)."""
+    @staticmethod
+    def files(folder, *, log: bool = True) -> dict[str, Path]:
+        """The files `save` writes into `folder`, by role (`log`: the logs were kept)."""
         folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        written = {"collectors": folder / "collectors.csv", "events": folder / "events.csv",
-                   "summary": folder / "summary.json", "map": folder / "field_map.png"}
-        self.collectors.to_csv(written["collectors"], index_label="collector", float_format="%.6g")
-        self.events.to_csv(written["events"], index=False)
-        written["summary"].write_text(json.dumps(self.summary, indent=2) + "\n")
-        self.plot_map(metric).savefig(written["map"], dpi=120)
+        files = {"collectors": folder / "collectors.csv", "events": folder / "events.csv",
+                 "summary": folder / "summary.json", "map": folder / "field_map.png"}
+        return {**files, "log": folder / "log.nc"} if log else files
+
+    def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
+        """Write ``collectors.csv``, ``events.csv``, ``summary.json`` (strict JSON), ``field_map.png``
+        and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`."""
+        written = self.files(folder, log=self.dataset is not None)
+        claim(written.values())
+        write(written["collectors"],
+              lambda path: self.collectors.to_csv(path, index_label="collector", float_format="%.6g"))
+        write(written["events"], lambda path: self.events.to_csv(path, index=False))
+        write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
+        write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
         if self.dataset is not None:
-            written["log"] = folder / "log.nc"
-            self.dataset.to_netcdf(written["log"], engine="scipy")
+            write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
         return written
 
 
@@ -521,12 +541,15 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
                                f"got {type(field).__name__}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise HybridtrackError(f"seed must be a whole number >= 0, got {seed!r}")
+    seed = params.seed(seed)
     site = sites.get(site)
     frame = _check_frame(frame)
     config = config or SimulationConfig()
     collectors = field.collectors()
+    if keep_log:
+        first, last = frame.index[0], frame.index[-1]
+        check_steps(first, last, (last - first) / (len(frame) - 1), what=f"a field of {len(collectors)} collectors",
+                    bytes_per_step=BYTES_PER_STEP + LOG_BYTES * len(collectors))
     imperfections = field.spread.draw(config.imperfections, len(collectors), int(seed))
     rows, events, store = [], [], None
     with reuse_positions():

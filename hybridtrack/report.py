@@ -13,6 +13,7 @@ from pathlib import Path
 import pandas as pd
 from matplotlib.figure import Figure
 
+from .errors import HybridtrackError
 from .mountreport import FIT_PREFIX, draw_mount_fit, fitted_parameters, true_fit_parameters
 
 __all__ = ["plot_sun_path", "plot_fuzzy_surface", "plot_sky", "plot_run", "plot_days", "plot_compare", "plot_rules",
@@ -42,10 +43,22 @@ def figure(**options) -> ReportFigure:
 
 
 def save_figure(fig, path) -> Path:
-    """Write a figure to `path` (PNG, SVG or PDF by suffix), creating folders."""
+    """Write a figure to `path` (PNG, SVG or PDF by suffix), creating folders.
+
+    The image is drawn in memory and then written, so a failed write (a full disk) is an error
+    naming `path`, never a silently empty file."""
+    import io
+
+    from .outputs import claim, write
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
+    kind = path.suffix.lstrip(".").lower() or "png"
+    if kind not in fig.canvas.get_supported_filetypes():
+        raise HybridtrackError(f"{path}: cannot draw a .{kind} image; name a .png, .svg or .pdf file")
+    path, = claim([path])
+    image = io.BytesIO()
+    fig.savefig(image, format=kind, dpi=120, bbox_inches="tight")
+    write(path, lambda target: target.write_bytes(image.getvalue()))
     return path
 
 

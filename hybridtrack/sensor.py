@@ -50,12 +50,16 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
+from .params import duration, number
 
-__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "SensorScene", "sensor_scene", "read_pointing",
+__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "sensor_scene", "read_pointing",
            "read_photocurrent", "coarse_offset"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
+#: Weather frame columns holding the sensor's recorded pointing signal, degrees, one per axis it
+#: serves (a single axis; a heliostat's azimuth and elevation), used instead of the model.
+RECORDED_POINTING = ("pointing", "pointing_2")
 
 
 @dataclass(frozen=True)
@@ -115,26 +119,20 @@ class SensorModel:
     view_share: float = 0.8
 
     def __post_init__(self) -> None:
-        checks = [("dark_current", self.dark_current >= 0), ("responsivity", self.responsivity > 0),
-                  ("diffuse_share", 0 <= self.diffuse_share <= 1), ("current_noise", self.current_noise >= 0),
-                  ("direct_threshold", 0 < self.direct_threshold <= 1500),
-                  ("field_of_view", 0 < self.field_of_view <= 90),
-                  ("coarse_field_of_view", self.field_of_view <= self.coarse_field_of_view <= 90),
-                  ("noise", 0 <= self.noise <= 5), ("bias", abs(self.bias) <= 5),
-                  ("view_share", 0 <= self.view_share <= 1)]
-        object.__setattr__(self, "patch_distance", tuple(float(v) for v in self.patch_distance))
-        for name, ok in checks:
-            if not ok or not np.all(np.isfinite(getattr(self, name))):
-                raise HybridtrackError(f"sensor: {name} = {getattr(self, name)!r} is out of range")
-        if not (len(self.patch_distance) == 2 and 0 <= self.patch_distance[0] <= self.patch_distance[1] <= 30):
-            raise HybridtrackError(f"sensor: patch_distance {list(self.patch_distance)} must be [low, high] "
-                                   "within 0-30 degrees")
-        try:
-            if pd.Timedelta(self.window) <= pd.Timedelta(0):
-                raise ValueError
-        except ValueError:
-            raise HybridtrackError(f"sensor: window {self.window!r} is not a positive duration such as "
-                                   "'20min'") from None
+        # (name, low, high, low excluded): mA, mA per W/m², shares, W/m², degrees
+        ranges = [("dark_current", 0, 1000, False), ("responsivity", 0, 10, True), ("diffuse_share", 0, 1, False),
+                  ("current_noise", 0, 100, False), ("direct_threshold", 0, 1500, True),
+                  ("field_of_view", 0, 90, True), ("coarse_field_of_view", self.field_of_view, 90, False),
+                  ("coarse_accuracy", 0, 45, False), ("noise", 0, 5, False), ("bias", -5, 5, False),
+                  ("view_share", 0, 1, False)]
+        for name, low, high, above in ranges:
+            number(getattr(self, name), f"sensor: {name}", low, high, above=above)
+        patch = tuple(self.patch_distance)
+        if len(patch) != 2 or not number(patch[0], "sensor: patch_distance", 0, 30) \
+                <= number(patch[1], "sensor: patch_distance", 0, 30):
+            raise HybridtrackError(f"sensor: patch_distance {list(patch)} must be [low, high] within 0-30 degrees")
+        object.__setattr__(self, "patch_distance", tuple(float(v) for v in patch))
+        duration(self.window, "sensor: window")
 
     def direct_response(self, offset) -> np.ndarray:
         """Share of the direct beam the cells collect at a pointing offset (degrees)."""

@@ -10,21 +10,22 @@ observes, the controller decides and the world moves; the log is scored (`hybrid
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from . import sites
+from . import params, sites
 from .collectors import Collector
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
 from .control.mountfit import parameter_names
 from .control.plan import east_park
 from .drive import Drive
+from .budget import check_steps
 from .errors import HybridtrackError
+from .outputs import claim, strict_json, write
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
@@ -32,6 +33,7 @@ from .mounting import incidence_cosine
 from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
+from .sun import solar_position
 from .world import Imperfections, World
 
 __all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
@@ -96,6 +98,7 @@ class SimulationConfig:
     def __post_init__(self) -> None:
         if self.truth not in ("spa-fast", "spa"):
             raise HybridtrackError(f"truth {self.truth!r}: choose 'spa-fast' or 'spa'")
+        params.seed(self.seed, "seed")
         if self.engine not in ENGINES:
             raise HybridtrackError(f"engine {self.engine!r}: choose {', '.join(map(repr, ENGINES))}")
 
@@ -149,7 +152,10 @@ class SimulationConfig:
             try:
                 return dataclasses.replace(default, **changes)
             except HybridtrackError as exc:
-                raise HybridtrackError(f"{source}: {where}: {exc}" if where else f"{source}: {exc}") from None
+                said = str(exc)
+                if where and not said.startswith(f"{where}: "):
+                    said = f"{where}: {said}"
+                raise HybridtrackError(f"{source}: {said}") from None
 
         return build(cls(), dict(data), "")
 
@@ -193,29 +199,32 @@ class Result:
     config: SimulationConfig
     memory: dict | None = None
 
-    def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
-        """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
-        and ``report.png``."""
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        written = {}
+    @staticmethod
+    def files(folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
+        """The files `save` writes into `folder`, by role."""
         if log_format not in ("parquet", "csv"):
             raise HybridtrackError(f"log_format {log_format!r}: choose 'parquet' or 'csv'")
-        use_parquet = log_format == "parquet"
-        if use_parquet:
-            written["log"] = folder / "log.parquet"
-            self.log.to_parquet(written["log"])
+        folder = Path(folder)
+        files = {"log": folder / f"log.{log_format}", "events": folder / "events.csv",
+                 "summary": folder / "summary.json"}
+        return {**files, "report": folder / "report.png"} if plot else files
+
+    def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
+        """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
+        (strict JSON: ``null`` for a missing number) and ``report.png``; see `hybridtrack.outputs`
+        for what is refused."""
+        written = self.files(folder, plot=plot, log_format=log_format)
+        claim(written.values())
+        if log_format == "parquet":
+            write(written["log"], self.log.to_parquet)
         else:
-            written["log"] = folder / "log.csv"
-            self.log.to_csv(written["log"], float_format="%.5f", index_label="time")
-        written["events"] = folder / "events.csv"
-        self.events.to_csv(written["events"], index=False)
-        written["summary"] = folder / "summary.json"
-        written["summary"].write_text(json.dumps(self.summary, indent=2) + "\n")
+            write(written["log"], lambda path: self.log.to_csv(path, float_format="%.5f", index_label="time"))
+        write(written["events"], lambda path: self.events.to_csv(path, index=False))
+        write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
         if plot:
             from .report import plot_run, save_figure
 
-            written["report"] = save_figure(plot_run(self), folder / "report.png")
+            save_figure(plot_run(self), written["report"])
         return written
 
     # -- for people (hybridtrack.report): a short repr, an HTML repr, pictures, a daily table --
@@ -269,6 +278,8 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
                                "(read files with hybridtrack.io.read_weather, which sorts and de-duplicates)")
     if "dni" not in frame.columns:
         raise HybridtrackError(f"the weather frame has no 'dni' column; it has {', '.join(map(str, frame.columns))}")
+    first, last = frame.index[0], frame.index[-1]
+    check_steps(first, last, (last - first) / (len(frame) - 1), what="the weather frame")
     return frame
 
 
@@ -467,10 +478,12 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
 
 
 def _expected_clear_sky(world: World, config: SimulationConfig) -> pd.DataFrame | None:
-    """The clear sky the controller expects at each scan (its clock, its site), on the scans' index."""
+    """The clear sky the controller expects at each scan, from what a PLC has: its clock, its site
+    and its own sun model; on the scans' index."""
     if config.sky.mode != "relative" or config.controller.sensor_only:
         return None
-    return clear_sky(world.controller_clock(), world.controller_site()).set_axis(world.index)
+    clock, site = world.controller_clock(), world.controller_site()
+    return clear_sky(clock, site, solar_position(clock, site, config.controller.sun_model)).set_axis(world.index)
 
 
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,

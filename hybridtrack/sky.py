@@ -35,6 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from . import params
+from .budget import check_steps
 from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_range, parse_freq
@@ -160,6 +162,7 @@ def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
         last = local_range(end if end is not None else first.date(), site.tz, freq=freq)[-1]
     if last < first:
         raise HybridtrackError(f"the period ends ({last}) before it starts ({first})")
+    check_steps(first, last, parse_freq(freq), what=f"{first} to {last}")
     return pd.date_range(first, last, freq=parse_freq(freq))
 
 
@@ -290,8 +293,8 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     index = _period(site, start, end, freq)
     if len(index) == 0:
         raise HybridtrackError("the period holds no time steps")
-    if not 0 <= gusts_per_day <= 200:
-        raise HybridtrackError(f"gusts_per_day must be within 0-200, got {gusts_per_day!r}")
+    params.number(gusts_per_day, "gusts_per_day", 0, 200)
+    seed = params.seed(seed)
     rng = np.random.default_rng(seed)
     local = index.tz_convert(site.tz)
     days = sorted(set(local.date))

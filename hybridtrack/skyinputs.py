@@ -54,6 +54,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
+from .params import duration
 from .sensor import SensorModel
 from .sites import Site, get
 
@@ -114,9 +115,9 @@ class SkyInputConfig:
         for name, allowed in (("mode", MODES), ("rules", RULES), ("low_sun", LOW_SUN)):
             if getattr(self, name) not in allowed:
                 raise HybridtrackError(f"sky inputs: {name} {getattr(self, name)!r} is not one of {', '.join(allowed)}")
-        _duration(self.window, "window")
+        duration(self.window, "sky inputs: window")
         if self.smoothing is not None:
-            _duration(self.smoothing, "smoothing")
+            duration(self.smoothing, "sky inputs: smoothing")
         if isinstance(self.min_altitude, bool) or not isinstance(self.min_altitude, (int, float)) \
                 or not math.isfinite(self.min_altitude) or not -5.0 <= self.min_altitude <= 45.0:
             raise HybridtrackError(f"sky inputs: min_altitude {self.min_altitude!r} must be a number of degrees "
@@ -173,16 +174,6 @@ class SkyInputConfig:
         return write_toml({"sky": self.to_dict()}, path)
 
 
-def _duration(text, name: str) -> pd.Timedelta:
-    try:
-        value = pd.Timedelta(text)
-    except (TypeError, ValueError):
-        value = None
-    if value is None or value is pd.NaT or value <= pd.Timedelta(0):
-        raise HybridtrackError(f"sky inputs: {name} {text!r} is not a positive duration such as '20min'")
-    return value
-
-
 def fuzzy_config(config: SkyInputConfig):
     """The `FuzzyConfig` of the chosen rule table."""
     from .fuzzy import FuzzyConfig
@@ -190,8 +181,16 @@ def fuzzy_config(config: SkyInputConfig):
     return FuzzyConfig.from_toml(COMPLETE_RULES) if config.rules == "complete" else FuzzyConfig.default()
 
 
-def clear_sky(index: pd.DatetimeIndex, site: Site | str) -> pd.DataFrame:
+def clear_sky(index: pd.DatetimeIndex, site: Site | str, position: pd.DataFrame | None = None) -> pd.DataFrame:
     """Sun altitude and Ineichen clear-sky irradiance at each stamp.
+
+    Parameters
+    ----------
+    index : pandas.DatetimeIndex
+    site : Site or str
+    position : pandas.DataFrame, optional
+        The sun's position at each stamp (``hybridtrack.sun.solar_position``: ``apparent_zenith``
+        and ``apparent_altitude``), e.g. a controller's own sun model; pvlib's SPA by default.
 
     Returns
     -------
@@ -210,7 +209,12 @@ def clear_sky(index: pd.DatetimeIndex, site: Site | str) -> pd.DataFrame:
     if not isinstance(index, pd.DatetimeIndex) or index.tz is None:
         raise HybridtrackError("the clear sky needs a time-zone-aware DatetimeIndex")
     location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
-    position = location.get_solarposition(index)
+    if position is None:
+        position = location.get_solarposition(index)
+    else:
+        position = pd.DataFrame({"apparent_zenith": np.asarray(position["apparent_zenith"], float),
+                                 "apparent_elevation": np.asarray(position["apparent_altitude"], float)},
+                                index=index)
     clear = location.get_clearsky(index, model="ineichen", solar_position=position)
     clear["apparent_elevation"] = position["apparent_elevation"]
     return clear[["apparent_elevation", "ghi", "dni", "dhi"]]

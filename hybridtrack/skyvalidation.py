@@ -50,6 +50,7 @@ from .fuzzy.config import LABELS
 from .sensor import SensorModel
 from .sites import Site, get
 from .skyinputs import SkyInputConfig, classify_sky, clear_sky
+from .times import parse_date
 
 __all__ = ["BEAM_SUNNY", "BEAM_OVERCAST", "MIN_ALTITUDE", "beam_ratio", "beam_labels", "window_labels",
            "clearsky_detected", "caelus_labels", "agreement", "confusion", "SkyValidation", "validate_sky",
@@ -316,7 +317,7 @@ def plot_day(validation: SkyValidation, day=None):
     if day is None:
         scored = days["beam_window"].dropna()
         day = scored.idxmin() if len(scored) else days.index[0]
-    day = pd.Timestamp(str(day)).date()
+    day = parse_date(day)
     if day not in set(days.index):
         raise HybridtrackError(f"no day {day} in the validation; days are {', '.join(map(str, days.index))}")
     samples = validation.samples

@@ -43,6 +43,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
+from .outputs import claim, write
 
 __all__ = ["Sweep", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
@@ -350,14 +351,19 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
     return fig
 
 
+def sweep_files(folder) -> dict[str, Path]:
+    """The files `save_sweep` writes into `folder`, by role."""
+    folder = Path(folder)
+    return {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png", "sweep": folder / "sweep.toml"}
+
+
 def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
     """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them)."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png",
-               "sweep": sweep.to_toml(folder / "sweep.toml")}
-    table.to_parquet(written["table"], index=False)
+    written = sweep_files(folder)
+    claim(written.values())
+    sweep.to_toml(written["sweep"])
+    write(written["table"], lambda path: table.to_parquet(path, index=False))
     colour = next(iter(sweep.grid))
-    plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem).savefig(written["plot"],
-                                                                                              dpi=120)
+    figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
+    write(written["plot"], lambda path: figure.savefig(path, dpi=120))
     return written

@@ -6,6 +6,7 @@ import datetime as dt
 
 import pandas as pd
 
+from .budget import check_steps
 from .errors import HybridtrackError
 
 __all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "check_tz", "clock_hours"]
@@ -63,6 +64,8 @@ def parse_freq(text: str) -> pd.Timedelta:
         step = pd.Timedelta(str(text))
     except ValueError:
         raise HybridtrackError(f"step {text!r} is not a duration such as '1min' or '10s'") from None
+    if pd.isna(step):
+        raise HybridtrackError(f"step {text!r} is not a duration such as '1min' or '10s'")
     if step <= pd.Timedelta(0):
         raise HybridtrackError(f"step {text!r} must be positive")
     return step
@@ -92,4 +95,5 @@ def local_range(start_date, tz: str, *, end_date=None, start: str = "00:00", end
         t1 = _localise(last_day, parse_clock(end), tz)
     if t1 < t0:
         raise HybridtrackError(f"the range ends ({t1}) before it starts ({t0})")
+    check_steps(t0, t1, step, what=f"{first_day} to {last_day}")
     return pd.date_range(t0, t1, freq=step)

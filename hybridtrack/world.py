@@ -36,13 +36,20 @@ from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
 from .mounting import mount_targets, mounting_rotation
-from .sensor import RECORDED_COLUMN, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
+from .sensor import RECORDED_COLUMN, RECORDED_POINTING, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
 from .sun import solar_position
 
 __all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
 
 #: Degrees the mechanism's hard stops lie beyond the drive's software limits.
 HARD_STOP_MARGIN = 1.0
+
+
+#: The largest size of each imperfection (degrees; seconds; seconds a day; days).
+IMPERFECTION_LIMITS = {"axis_azimuth_error": 10.0, "axis_tilt_error": 10.0, "encoder_offset": 10.0,
+                       "clock_error": 3600.0, "clock_drift": 100.0, "commissioned_days_ago": 3660.0,
+                       "latitude_error": 1.0, "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0,
+                       "axis_roll_error": 10.0}
 
 
 @dataclass(frozen=True)
@@ -91,9 +98,7 @@ class Imperfections:
     axis_roll_error: float = 0.0
 
     def __post_init__(self) -> None:
-        limits = {"axis_azimuth_error": 10.0, "axis_tilt_error": 10.0, "encoder_offset": 10.0, "clock_error": 3600.0,
-                  "clock_drift": 100.0, "commissioned_days_ago": 3660.0, "latitude_error": 1.0,
-                  "longitude_error": 1.0, "sensor_bias": 2.0, "sensor_noise": 2.0, "axis_roll_error": 10.0}
+        limits = IMPERFECTION_LIMITS
         for f in fields(self):
             value = getattr(self, f.name)
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
@@ -124,8 +129,10 @@ class World:
     Parameters
     ----------
     frame : pandas.DataFrame
-        The weather (``dni``, ``dhi``, ``wind_speed``; a recorded ``photocurrent`` is used as
-        recorded; a ``sky`` column is the true sky, for the oracle policy only).
+        The weather (``dni``, ``dhi``, ``wind_speed``; a recorded ``photocurrent``, and a
+        recorded pointing signal ``pointing`` (and ``pointing_2`` for a heliostat's elevation),
+        degrees, NaN where the sensor had no reading, are used as recorded; a ``sky`` column is
+        the true sky, for the oracle policy only).
     site : Site
     collector : Collector
     imperfections : Imperfections
@@ -164,6 +171,7 @@ class World:
         self._coarse_noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
         recorded = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
         self._recorded_current = recorded.tolist() if recorded is not None else None
+        self._recorded_pointing = self._recorded_pointing_columns(frame)
         self.frame_dni = frame["dni"].to_numpy(float)
         self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
         self._wind = self.wind.tolist()
@@ -179,6 +187,17 @@ class World:
                         for name, v in faults.items() if name != "clock"}
 
     # -- set up ----------------------------------------------------------------------------------
+
+    def _recorded_pointing_columns(self, frame: pd.DataFrame) -> list | None:
+        """The sensor's recorded pointing signal per axis (NaN: no reading), or None without one."""
+        names = RECORDED_POINTING[:self.axes]
+        present = [name for name in names if name in frame.columns]
+        if not present:
+            return None
+        if len(present) < len(names):
+            raise HybridtrackError(f"a recorded pointing signal needs a column per axis: {', '.join(names)}; "
+                                   f"the frame has {', '.join(present)}")
+        return [frame[name].to_numpy(float).tolist() for name in names]
 
     def _true_sun(self, model: str) -> pd.DataFrame:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
@@ -249,8 +268,12 @@ class World:
         beam, aureole, patch, patch_offset, diffuse = self._scene
         offsets = [self._offset(a, i) for a in range(self.axes)]
         noise = [self._noise[a][i] for a in range(self.axes)]
-        reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
-                                        [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
+        if self._recorded_pointing is not None:  # as recorded: what the logger's sensor said
+            reported = [self._recorded_pointing[a][i] for a in range(self.axes)]
+            valid = not any(math.isnan(value) for value in reported)
+        else:
+            reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
+                                            [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
         obs.valid = valid
         self._sensor_faults(i, reported, obs)
         obs.i, obs.t, obs.wind = i, self._minutes[i], self._wind[i]

@@ -5,15 +5,26 @@ the command line (which must print one line naming the problem and exit with sta
 and checks both say the same thing.
 """
 
+import dataclasses
+import math
+
 import pytest
 
 from hybridtrack import HybridtrackError, sites
 from hybridtrack.cli import main
+from hybridtrack.collectors import Collector
+from hybridtrack.control import ControllerConfig
+from hybridtrack.drive import Drive
 from hybridtrack.fuzzy import FuzzyConfig
 from hybridtrack.io import read_weather
+from hybridtrack.outputs import replacing
+from hybridtrack.sensor import SensorModel
 from hybridtrack.simulation import SimulationConfig
+from hybridtrack.sky import synthetic
+from hybridtrack.skyinputs import SkyInputConfig
 from hybridtrack.sun import solar_position
 from hybridtrack.times import local_range
+from hybridtrack.world import Imperfections
 
 GOOD_ROWS = "2021-06-21 12:00,900,800,100,3\n2021-06-21 12:01,901,801,101,3\n2021-06-21 12:02,902,802,102,3\n"
 HEADER = "time,ghi,dni,dhi,wind_speed\n"
@@ -34,6 +45,42 @@ def config_file(text, name="config.toml"):
         path.write_text(text)
         return path
     return make
+
+
+SIMULATE = ["simulate", "--site", "lanzhou", "--date", "2021-06-21"]
+CLASSIFY = ["classify", "--intensity", "1", "--variation", "1"]
+
+
+def planted_link(name):
+    """An output folder ``out`` holding a link `name` to a file outside it (or, for None, a link
+    ``out`` to another folder)."""
+    def make(tmp):
+        victim = tmp / "victim"
+        victim.mkdir()
+        out = tmp / "out"
+        if name is None:
+            out.symlink_to(victim, target_is_directory=True)
+        else:
+            out.mkdir()
+            (out / name).symlink_to(victim / name)
+        return out
+    return make
+
+
+def existing_files(*names):
+    def make(tmp):
+        out = tmp / "out"
+        out.mkdir()
+        for name in names:
+            (out / name).write_text("the user's own\n")
+        return out
+    return make
+
+
+def refusing(write):
+    """Call `write` under the command line's policy: existing files are not replaced."""
+    with replacing(False):
+        write()
 
 
 # (id, make the input, API call, CLI args, message both must contain)
@@ -107,6 +154,75 @@ MATRIX = [
     ("naive times to the sun model", lambda tmp: None,
      lambda p: solar_position(__import__("pandas").date_range("2021-06-21", periods=2, freq="h"), "nanjing"),
      None, "naive"),
+    # parameters at the door (issue 11, item 4)
+    ("axis azimuth NaN", lambda tmp: None, lambda p: Collector("trough-ns", float("nan")),
+     lambda p: SIMULATE + ["--axis-azimuth", "nan"],
+     "collector: axis_azimuth (degrees from north) must be a finite number within [-360, 360], got nan"),
+    ("negative seed", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", seed=-1),
+     lambda p: SIMULATE + ["--seed=-1"], "seed must be a whole number within [0, 9,223,372,036,854,775,807], got -1"),
+    ("negative seed in a run config", config_file("seed = -1\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "config.toml: seed must be a whole number within [0, "),
+    # 86,400 s x 1e9 steps a second; x 2,000 bytes a step = 1.728e17 bytes
+    ("a step of 1 ns", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq="1ns"),
+     lambda p: SIMULATE + ["--freq", "1ns"],
+     "2021-06-21 to 2021-06-21: 86,400,000,000,000 steps of 1ns would need about 172,800,000.0 GB of memory"),
+    # 365 x 86,400 = 31,536,000 steps x 2,000 bytes = 63.1 GB, over the 16 GiB cap on any machine
+    ("a year at 1 s", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-01-01", "2021-12-31", freq="1s"),
+     lambda p: ["simulate", "--site", "lanzhou", "--date", "2021-01-01", "--days", "365", "--freq", "1s"],
+     "2021-01-01 to 2021-12-31: 31,536,000 steps of 1s would need about 63.1 GB of memory"),
+    ("a sun table at 1 ns", lambda tmp: None, lambda p: local_range("2021-06-21", "UTC", freq="1ns"),
+     lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "1ns"], "steps of 1ns would need about"),
+    ("an empty step", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq=""),
+     lambda p: SIMULATE + ["--freq", ""], "step '' is not a duration"),
+    ("reversed working hours", config_file("[controller]\nworking_hours = ['20:00', '05:00']\n"),
+     lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
+     "controller: working_hours ['20:00', '05:00'] must end after they start on the same day"),
+    ("drive limits of 1e308", config_file("[drive]\nlimits = [0.0, 1e308]\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "config.toml: drive: limits (degrees) = 1e+308 is outside [-360, 720]"),
+    ("heliostat limits beyond two turns", config_file("[heliostat_drive]\nlimits = [-360.0, 720.0]\n"),
+     lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
+     "heliostat_drive: drive: limits [-360.0, 720.0] span more than 720° (two turns)"),
+    ("process noise of 1e308", config_file("[controller]\nprocess_noise = 1e308\n"),
+     lambda p: SimulationConfig.from_toml(p), lambda p: SIMULATE + ["--config", str(p)],
+     "controller: process_noise = 1e+308 is outside (0, 10]"),
+    ("a duration of nan", config_file("[controller]\ndwell = 'nan'\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "controller: dwell 'nan' is not a positive duration such as '20min'"),
+    ("one stuck scan", config_file("[controller]\nstuck_scans = 1\n"), lambda p: SimulationConfig.from_toml(p),
+     lambda p: SIMULATE + ["--config", str(p)], "controller: stuck_scans must be a whole number within [3, 10,000]"),
+    ("fuzzy config: infinite raw_range", config_file(
+        "[inputs.intensity]\nraw_range = [30, inf]\nterms.weak = {shape='gaussmf', params=[0, 1]}\n"
+        "[inputs.variation]\nraw_range = [0, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
+     "inputs.intensity: raw_range must be two finite numbers [low, high] with low < high, got [30.0, inf]"),
+    ("fuzzy config: NaN membership parameter", config_file(
+        "[output]\nterms.overcast = {shape='trimf', params=[0, nan, 10]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
+     "output.weather.terms.overcast: parameters must be finite numbers"),
+    ("an infinite tuning margin", config_file("intensity,variation,weather\n100,20,sunny\n50,100,cloudy\n",
+                                              "labels.csv"),
+     lambda p: __import__("hybridtrack.fuzzy.tuning").fuzzy.tuning.tune(None, p, margin=math.inf),
+     lambda p: ["tune", str(p), "--out", str(p) + ".toml", "--margin", "inf"],
+     "margin (score units) must be a finite number within [0, 30], got inf"),
+    ("an unknown ablation policy", lambda tmp: None,
+     lambda p: __import__("hybridtrack.ablation").ablation.AblationPlan(policies=("bogus",)),
+     lambda p: ["ablate", "--policies", "bogus"], "'bogus'"),
+    # outputs kept (issue 11, item 5)
+    ("an output through a symlink", planted_link("run.toml"),
+     lambda p: SimulationConfig().to_toml(p / "run.toml"), lambda p: ["init", str(p)],
+     "run.toml is a symbolic link; results are never written through one"),
+    ("an output folder that is a symlink", planted_link(None),
+     lambda p: SimulationConfig().to_toml(p / "run.toml"), lambda p: ["init", str(p)],
+     "out is a symbolic link; results are never written through one"),
+    ("an existing output without --force", existing_files("run.toml"),
+     lambda p: refusing(lambda: SimulationConfig().to_toml(p / "run.toml")), lambda p: ["init", str(p)],
+     "run.toml; give --force to replace them"),
+    ("a full disk", lambda tmp: None, lambda p: SimulationConfig().to_toml("/dev/full"),
+     lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--csv", "/dev/full", "--force"],
+     "/dev/full: cannot write (No space left on device)"),
+    ("an image kind matplotlib cannot draw", lambda tmp: None,
+     lambda p: __import__("hybridtrack.report").report.save_figure(__import__("matplotlib.figure").figure.Figure(),
+                                                                    "x.xyz"),
+     lambda p: ["surface", "--out", "x.xyz"], "x.xyz: cannot draw a .xyz image"),
 ]
 
 
@@ -124,6 +240,14 @@ def test_bad_input_is_one_clear_line_from_api_and_cli(tmp_path, capsys, make, ap
     assert captured.err.startswith("hybridtrack: error: ") and "Traceback" not in captured.err
 
 
+@pytest.mark.parametrize("argv", [["ablate", "--policies", "bogus"], ["simulate", "--date", "2021-06-21", "--freq"],
+                                  ["sun", "--variation"], [], ["classify", "--intensity", "--variation", "1"]])
+def test_a_command_line_argparse_refuses_is_one_line_too(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("hybridtrack: error: hybridtrack")
+
+
 def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):
     path = tmp_path / "messy.csv"
     path.write_text(HEADER + "2021-06-21 12:01,1,1,1,1\n2021-06-21 12:00,1,1,1,-4\n2021-06-21 12:00,1,1,1,1\n"
@@ -132,3 +256,65 @@ def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):
     report = frame.attrs["validation"]
     assert {"unsorted", "duplicates", "impossible", "unreadable"} <= set(report)
     assert report["unreadable"]["ghi"]["lines"] == [5] and len(frame) == 5
+
+
+# -- every numeric field of every config class: NaN, inf, -1 and 1e308 ---------------------------
+
+from hybridtrack.fields import FresnelField, HeliostatField, ImperfectionSpread, TroughLoop  # noqa: E402
+
+CONFIG_CLASSES = (ControllerConfig, Imperfections, SensorModel, Drive, SkyInputConfig, SimulationConfig, Collector,
+                  ImperfectionSpread, FresnelField, TroughLoop, HeliostatField)
+BAD_NUMBERS = (math.nan, math.inf, -1, 1e308)
+#: Fields where -1 is a real value: signed angles, offsets, errors and distances. Every other
+#: numeric field, including any added later, must refuse it.
+SIGNED = {("ControllerConfig", "min_altitude"), ("SkyInputConfig", "min_altitude"), ("SensorModel", "bias"),
+          ("Drive", "limits"), ("Collector", "axis_azimuth"), ("Collector", "row_distance"), ("Collector", "aim"),
+          ("FresnelField", "row_distances"), ("FresnelField", "axis_azimuth"), ("TroughLoop", "axis_azimuth"),
+          ("HeliostatField", "aim")} | {("Imperfections", name) for name in (
+              "axis_azimuth_error", "axis_tilt_error", "encoder_offset", "clock_error", "clock_drift",
+              "latitude_error", "longitude_error", "sensor_bias", "axis_roll_error")}
+
+
+def _numeric_fields():
+    """(class, field name, default) of every field whose default is a number or a tuple of numbers."""
+    for cls in CONFIG_CLASSES:
+        default = cls()
+        for field in dataclasses.fields(cls):
+            value = getattr(default, field.name)
+            plain = isinstance(value, (int, float)) and not isinstance(value, bool)
+            numbers = isinstance(value, tuple) and value and all(isinstance(v, (int, float)) for v in value)
+            if plain or numbers or (cls is Collector and field.name == "axis_azimuth"):
+                yield cls, field.name, value
+
+
+def _with_bad(value, bad):
+    """`bad` in place of a number, or in each place of a tuple in turn."""
+    if isinstance(value, tuple):
+        return [tuple(bad if j == i else v for j, v in enumerate(value)) for i in range(len(value))]
+    return [bad]
+
+
+NUMERIC_FIELDS = list(_numeric_fields())
+
+
+def test_the_sweep_covers_every_config_class():
+    assert {cls for cls, _, _ in NUMERIC_FIELDS} == set(CONFIG_CLASSES) and len(NUMERIC_FIELDS) >= 60
+
+
+@pytest.mark.parametrize("bad", BAD_NUMBERS, ids=["nan", "inf", "minus-one", "1e308"])
+@pytest.mark.parametrize("cls, name, value", NUMERIC_FIELDS, ids=[f"{c.__name__}.{n}" for c, n, _ in NUMERIC_FIELDS])
+def test_every_numeric_field_refuses_nan_inf_negative_and_absurd(cls, name, value, bad):
+    for given in _with_bad(value, bad):
+        try:
+            cls(**{name: given})
+        except HybridtrackError as error:
+            said = str(error)
+            assert (name in said or name.replace("_", " ") in said or "heliostat 1" in said) and "\n" not in said
+        else:  # a real value (a limit's low end of -1°, say) may be accepted only where the field is signed
+            assert bad == -1 and (cls.__name__, name) in SIGNED, f"{cls.__name__}({name}={given!r}) was accepted"
+
+
+def test_a_day_that_does_not_exist_to_draw_is_refused(tmp_path, capsys):
+    assert main(["validate-sky", "data/nanjing-2013-cloudy.csv", "--site", "nanjing", "--day", "2021-13-01",
+                 "--plot", str(tmp_path / "day.png")]) == 2
+    assert capsys.readouterr().err == "hybridtrack: error: date '2021-13-01' does not exist or is not YYYY-MM-DD\n"

@@ -80,3 +80,21 @@ def test_classify_file_missing_column(tmp_path, capsys):
     src.write_text("a,b\n1,2\n")
     assert main(["classify", str(src)]) == 2
     assert "no column 'intensity'; columns are a, b" in capsys.readouterr().err
+
+
+def test_an_absurd_reading_is_clipped_to_its_range_not_overflowed(capsys):
+    assert main(["rules", "--intensity", "1e308", "--variation", "0"]) == 0
+    captured = capsys.readouterr()
+    assert "-> sunny" in captured.out and "overflow" not in captured.err  # the strongest light: sunny
+
+
+def test_a_warning_that_is_not_a_tuning_one_is_shown_once(monkeypatch):
+    import warnings
+
+    from hybridtrack.cli.fuzzy import tuned_config_warnings
+
+    shown = []
+    monkeypatch.setattr(warnings, "showwarning", lambda message, *rest, **kw: shown.append(str(message)))
+    with tuned_config_warnings():
+        warnings.warn("a plain warning", RuntimeWarning)
+    assert shown == ["a plain warning"]

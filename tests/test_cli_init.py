@@ -27,8 +27,10 @@ def test_init_writes_a_run_config_a_fuzzy_config_and_a_rule_table_that_load(tmp_
 def test_init_refuses_to_overwrite_without_force(tmp_path, capsys):
     assert main(["init", str(tmp_path)]) == 0
     assert main(["init", str(tmp_path)]) == 2
-    assert "run.toml exists; use --force to overwrite" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f"would replace 3 existing files: {tmp_path / 'run.toml'}, " in err and "give --force" in err
     assert main(["init", str(tmp_path), "--force"]) == 0
+    assert f"replaced (--force): {tmp_path / 'run.toml'}, " in capsys.readouterr().out
 
 
 def test_init_into_a_file_is_an_error(tmp_path, capsys):

@@ -159,7 +159,7 @@ def test_collector_spec_gives_targets_for_each_kind():
 
 
 @pytest.mark.parametrize("kwargs, message", [({"kind": "dish"}, "unknown collector 'dish'"),
-                                             ({"kind": "fresnel", "receiver_height": 0}, "receiver height"),
+                                             ({"kind": "fresnel", "receiver_height": 0}, "receiver_height"),
                                              ({"kind": "heliostat", "aim": (0, 0, 0)}, "aim point")])
 def test_bad_collector_geometry_is_refused(kwargs, message):
     with pytest.raises(HybridtrackError, match=message):

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hybridtrack import simulate, sites
+from hybridtrack import HybridtrackError, simulate, sites
 from hybridtrack.cli import main
 from hybridtrack.control import ControllerConfig
 from hybridtrack.drive import gray_decode, gray_encode
@@ -303,3 +303,30 @@ def test_a_replayed_file_without_wind_is_tracked_through_and_says_so(tmp_path, c
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["wind_data"] == "missing" and summary["energy_capture"] > 0.95
     assert simulate(frame, "lanzhou").summary["mode_share"]["stow_wind"] > 0.4  # a live controller stows instead
+
+
+@pytest.mark.parametrize("scenario, better", [("sensor-bias", "model"), ("sensor-drift", "model"),
+                                              ("encoder-step", "sensor")])
+def test_whom_to_trust_on_a_disagreement_is_a_policy_and_each_wins_where_it_should(scenario, better):
+    """A biased or drifting sensor is caught by trusting the model; a slipped encoder coupling (the
+    mount moved, the sensor is right) by trusting the sensor. Both log the disagreement."""
+    from hybridtrack.faults import SCENARIOS
+
+    case = SCENARIOS[scenario]
+    frame, faults, _, onset = case.build(case.site)
+    rms = {}
+    for policy in ("model", "sensor"):
+        config = SimulationConfig(controller=ControllerConfig(on_disagreement=policy))
+        result = simulate(frame, case.site, config=config, faults=faults)
+        after = result.log["error"][result.log.index >= result.log.index[0].normalize() + pd.Timedelta(onset + ":00")]
+        rms[policy] = float(np.sqrt(np.nanmean(after.to_numpy() ** 2)))
+        reasons = result.events["reason"]
+        assert reasons.str.contains("disagree").any()
+        assert reasons.str.contains("rolled back" if policy == "model" else "sensor trusted").any()
+    other = "sensor" if better == "model" else "model"
+    assert rms[better] < 0.6 * rms[other], rms
+
+
+def test_an_unknown_trust_policy_is_refused():
+    with pytest.raises(HybridtrackError, match="on_disagreement 'both'; choose 'model' or 'sensor'"):
+        ControllerConfig(on_disagreement="both")

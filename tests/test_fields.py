@@ -92,8 +92,10 @@ def test_imperfection_draws_are_seeded_per_collector_and_spread_as_asked():
     assert azimuth.std() == pytest.approx(0.2, rel=0.05)
     assert all(m.sensor_noise >= 0 for m in many)
     assert {m.clock_error for m in many} == {mean.clock_error}  # no spread: every collector gets the config's
-    with pytest.raises(HybridtrackError, match="collector 0: the drawn imperfections"):
-        ImperfectionSpread(axis_tilt_error=1e4).draw(mean, 1, seed=0)
+    with pytest.raises(HybridtrackError, match="axis_tilt_error = 10000.0 is beyond the imperfection's own limit"):
+        ImperfectionSpread(axis_tilt_error=1e4)  # refused at the door: no collector could be that far off
+    with pytest.raises(HybridtrackError, match=r"collector \d+: the drawn imperfections"):
+        ImperfectionSpread(axis_tilt_error=9.0).draw(mean, 100, seed=0)  # 1σ = 9°: some draw passes the 10° limit
 
 
 def test_a_field_run_is_each_collectors_own_run(day):

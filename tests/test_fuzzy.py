@@ -239,7 +239,7 @@ def test_bad_fis_files_name_the_line(tmp_path, edit, message):
     ("colour = 'blue'\n", "unknown key 'colour'"),
     ("[inputs.intensity]\nraw_range = [300, 30]\nterms.weak = {shape='gaussmf', params=[0, 1]}\n"
      "[inputs.variation]\nraw_range = [0, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n",
-     "raw_range must be \\[min, max\\]"),
+     "raw_range must be two finite numbers \\[low, high\\]"),
     ("[[rules]]\nintensity = 'strong'\nvariation = 'small'\n", "rules\\[1\\]: says nothing of the output"),
     ("[[rules]]\nintensity = 'strong'\nweather = 3\n", "rules\\[1\\].weather: must be a term name"),
     ("[resolution]\ninput = 'fine'\n", "resolution.input: must be a whole number"),

@@ -274,3 +274,15 @@ def test_packed_station_files_go_through_pvlib_decoded(tmp_path):
         frame = read_weather(path)
         pd.testing.assert_frame_equal(frame, plain, check_like=True)
         assert frame.attrs["validation"]["format"] == "epw"
+
+
+def test_a_loggers_sensor_pointing_column_is_read_in_degrees(tmp_path):
+    """'Sensor offset [mrad]' is the sun sensor's pointing signal: read as ``pointing`` in degrees
+    (1 mrad = 0.0572958°), its gaps kept as NaN (no reading), and the conversion reported."""
+    path = tmp_path / "logger.csv"
+    path.write_text("Timestamp,GHI [W/m2],DNI [W/m2],DHI [W/m2],Sensor offset [mrad]\n"
+                    "2021-06-21 12:00,1000,900,100,1.0\n2021-06-21 12:01,1000,900,100,\n"
+                    "2021-06-21 12:02,1000,900,100,-2.5\n")
+    frame = read_weather(path, tz="Asia/Shanghai")
+    np.testing.assert_allclose(frame["pointing"].to_numpy(), [0.0572958, np.nan, -0.1432394], rtol=1e-6)
+    assert frame.attrs["validation"]["units_converted"]["pointing"] == "mrad -> °"

@@ -102,3 +102,37 @@ def test_photocurrent_falls_with_the_offset_and_the_coarse_cells_find_the_sun():
 def test_bad_sensor_parameters(kwargs, message):
     with pytest.raises(HybridtrackError, match=message):
         SensorModel(**kwargs)
+
+
+def test_a_recorded_pointing_signal_is_what_the_controller_reads():
+    """A logger's own sensor signal is replayed as recorded: the observation carries it, and a
+    missing reading is no reading."""
+    import math
+
+    import numpy as np
+
+    from hybridtrack import sites
+    from hybridtrack.collectors import Collector
+    from hybridtrack.control import Observation
+    from hybridtrack.drive import Drive
+    from hybridtrack.sky import synthetic
+    from hybridtrack.world import Imperfections, World
+
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
+    recorded = np.where(np.arange(len(frame)) % 7 == 0, np.nan, np.linspace(-0.3, 0.3, len(frame)))
+    world = World(frame.assign(pointing=recorded), sites.get("lanzhou"), Collector("trough-ns"), Imperfections(),
+                  SensorModel(), [Drive()], 0, {})
+    obs = Observation(1)
+    for i in (700, 701, 707):
+        world.observe(i, obs)
+        assert (math.isnan(obs.offset[0]) and not obs.valid) if i % 7 == 0 else \
+            (obs.offset[0] == recorded[i] and obs.valid)
+
+
+def test_a_heliostat_needs_a_recorded_pointing_signal_per_axis():
+    from hybridtrack import HybridtrackError, simulate
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1).assign(pointing=0.0)
+    with pytest.raises(HybridtrackError, match="a column per axis: pointing, pointing_2"):
+        simulate(frame, "lanzhou", collector="heliostat")

@@ -125,7 +125,7 @@ def test_custom_climate_and_any_site():
 @pytest.mark.parametrize("kwargs, message", [
     ({"weather": "stormy"}, "unknown weather 'stormy'"),
     ({"weather": ["sunny", "cloudy"]}, "2 weathers given for 1 days"),
-    ({"gusts_per_day": -1}, "gusts_per_day must be within"),
+    ({"gusts_per_day": -1}, "gusts_per_day = -1 is outside"),
     ({"freq": "0s"}, "must be positive"),
 ])
 def test_bad_sky_requests(kwargs, message):

@@ -210,3 +210,20 @@ def test_the_gap_the_hybrid_recovers_is_a_share_or_says_why_there_is_none():
     assert "recovers 100%" in AblationResult(runs(0.4, 0.2)).gap_note()
     assert "no always→oracle gap" in AblationResult(runs(0.3, 0.3)).gap_note()  # sunny days: nothing to recover
     assert "nan" not in repr(AblationResult(runs(0.3, 0.3)))
+
+
+def test_the_clear_sky_the_controller_expects_comes_from_its_own_sun_model():
+    """Given a sun position, `clear_sky` uses it; SPA's gives pvlib's own clear sky, and the PLC
+    model's (what the controller has) is within a watt or two of it while the sun is up."""
+    from hybridtrack.skyinputs import clear_sky
+    from hybridtrack.sun import solar_position
+
+    site = sites.get("lanzhou")
+    index = pd.date_range("2021-06-21 06:30", "2021-06-21 20:00", freq="10min", tz=site.tz)
+    reference = clear_sky(index, site)  # pvlib's SPA inside
+    spa = clear_sky(index, site, solar_position(index, site, "spa"))
+    plc = clear_sky(index, site, solar_position(index, site, "plc"))
+    up = reference["apparent_elevation"] > 5.0
+    np.testing.assert_allclose(spa.loc[up, "dni"], reference.loc[up, "dni"], atol=0.5)
+    assert (plc.loc[up, "dni"] - reference.loc[up, "dni"]).abs().max() < 3.0
+    assert (plc.loc[up, "apparent_elevation"] - reference.loc[up, "apparent_elevation"]).abs().max() < 0.3

@@ -3,6 +3,10 @@
 Every command has ``--help``. A mistake a user can make (bad file, column, site, date or
 parameter) prints one line, ``hybridtrack: error: ...``, and exits with status 2.
 
+Results are written as `hybridtrack.outputs` says: never through a symbolic link, never over an
+existing file without ``--force``, and in full even when the reader of the printout has gone
+(``| head``).
+
 Each module of this package registers the commands of one concern with `base.command`;
 importing them here is what puts them on the command line.
 """
@@ -15,15 +19,24 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import HybridtrackError
+from ..outputs import reader_may_leave, replacing
 from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
 from .base import _COMMANDS, _HELP, EXIT_USAGE
 
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse's parser, whose refusals are one line (``hybridtrack: error: ...``) and status 2,
+    like every other refusal, instead of the usage block and the error."""
+
+    def error(self, message: str):
+        raise HybridtrackError(f"{self.prog}: {message} (see {self.prog} --help)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The parser with every registered command."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="hybridtrack",
         description="Weather-aware hybrid sun tracking for concentrating solar collectors.",
     )
@@ -38,10 +51,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
     try:
-        return args._run(args)
-    except BrokenPipeError:  # the reader went away (`| head`): not a mistake, just stop
+        args = build_parser().parse_args(argv)
+        with reader_may_leave(), replacing(getattr(args, "force", False)) as replaced:
+            status = args._run(args)
+            if replaced:
+                print("replaced (--force): " + ", ".join(map(str, replaced)))
+            return status
+    except BrokenPipeError:  # the reader went away outside the printing (`| head`): not a mistake, just stop
         import os
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -6,8 +6,10 @@ import argparse
 import math
 import sys
 
+from .. import params
 from ..errors import HybridtrackError
-from .base import command
+from ..outputs import claim, write
+from .base import add_force_argument, command
 
 
 def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,6 +35,7 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --tradeoff: deadbands, degrees, comma-separated (default 0.1,0.2,0.4,0.8)")
     parser.add_argument("--periods", default="1min",
                         help="with --tradeoff: scan periods, comma-separated (default 1min; e.g. 1min,2min,5min)")
+    add_force_argument(parser)
 
 
 @command("ablate", "run every policy over a seeded set of days: what the classifier is worth, and why",
@@ -48,11 +51,14 @@ def _ablate(args: argparse.Namespace) -> int:
 
     if not 1 <= args.seeds <= 1000:
         raise HybridtrackError(f"--seeds must be between 1 and 1000, got {args.seeds}")
+    params.whole(args.workers, "--workers", 1, 64)
     if args.tradeoff:
         return _tradeoff(args)
     plan = AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), tuple(args.policies or STRATEGIES))
     config = SimulationConfig.from_toml(args.config) if args.config else None
+    files = [Path(args.out) / name for name in ("runs.csv", "table.csv", "ablation.png")] if args.out else []
+    claim(files)  # before the runs, not after them
     days = len(plan.days())
     with tqdm(total=days, unit="day", desc="ablate", file=sys.stderr) as bar:
         result = ablate(plan, config=config, workers=args.workers, progress=bar.update)
@@ -63,12 +69,11 @@ def _ablate(args: argparse.Namespace) -> int:
     if args.out:
         from ..report import save_figure
 
-        folder = Path(args.out)
-        folder.mkdir(parents=True, exist_ok=True)
-        result.runs.to_csv(folder / "runs.csv", index=False, float_format="%.6g")
-        result.table.to_csv(folder / "table.csv", float_format="%.6g")
-        picture = save_figure(result.plot(), folder / "ablation.png")
-        print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {picture}")
+        runs, table, picture = claim(files)
+        write(runs, lambda file: result.runs.to_csv(file, index=False, float_format="%.6g"))
+        write(table, lambda file: result.table.to_csv(file, float_format="%.6g"))
+        save_figure(result.plot(), picture)
+        print(f"wrote {runs}, {table} and {picture}")
     return 0
 
 
@@ -95,6 +100,8 @@ def _tradeoff(args: argparse.Namespace) -> int:
                         tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), (args.policies or ["hybrid"])[0])
     config = SimulationConfig.from_toml(args.config) if args.config else None
+    files = [Path(args.out) / name for name in ("runs.csv", "table.csv", "tradeoff.png")] if args.out else []
+    claim(files)  # before the runs, not after them
     with tqdm(total=len(plan.days()), unit="day", desc="tradeoff", file=sys.stderr) as bar:
         result = tradeoff(plan, config=config, workers=args.workers, progress=bar.update)
     print(f"{plan.policy} over {len(plan.deadbands)} deadbands × {len(plan.periods)} scan periods on "
@@ -103,10 +110,9 @@ def _tradeoff(args: argparse.Namespace) -> int:
     if args.out:
         from ..report import save_figure
 
-        folder = Path(args.out)
-        folder.mkdir(parents=True, exist_ok=True)
-        result.runs.to_csv(folder / "runs.csv", index=False, float_format="%.6g")
-        result.table.to_csv(folder / "table.csv", float_format="%.6g")
-        picture = save_figure(result.plot(), folder / "tradeoff.png")
-        print(f"wrote {folder / 'runs.csv'}, {folder / 'table.csv'} and {picture}")
+        runs, table, picture = claim(files)
+        write(runs, lambda file: result.runs.to_csv(file, index=False, float_format="%.6g"))
+        write(table, lambda file: result.table.to_csv(file, float_format="%.6g"))
+        save_figure(result.plot(), picture)
+        print(f"wrote {runs}, {table} and {picture}")
     return 0

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
-from .. import sites
+from .. import params, sites
 from ..errors import HybridtrackError
 
 EXIT_USAGE = 2
@@ -147,6 +147,12 @@ def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | N
                         strict=args.strict, dayfirst=args.dayfirst, lenient=args.lenient)
 
 
+def add_force_argument(parser: argparse.ArgumentParser) -> None:
+    """``--force``: replace existing output files (and say which); without it they are refused."""
+    parser.add_argument("--force", action="store_true",
+                        help="replace output files that exist already (default: refuse, naming them)")
+
+
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """Collector, strategy, config and output flags shared by simulate, replay and compare."""
     from ..control import STRATEGIES
@@ -157,6 +163,7 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
     group.add_argument("--perfect", action="store_true", help="no imperfections: a perfectly built and set-up field")
     group.add_argument("--out", help="folder for log, events.csv, summary.json and report.png")
+    add_force_argument(group)
 
 
 def simulation_config(args: argparse.Namespace, seed: int | None = None):
@@ -194,6 +201,8 @@ def synthetic_frame(args: argparse.Namespace, site):
 
     if not 1 <= args.days <= 3660:
         raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    params.seed(args.seed, "--seed")
+    params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
     first = parse_date(args.date)
     weather = args.weather.split(",") if "," in args.weather else args.weather
     return synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather, freq=args.freq,

@@ -10,7 +10,8 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from .base import (
-    add_synthetic_arguments, command, parse_mapping, simulation_config, site_from_arguments, synthetic_frame,
+    add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config, site_from_arguments,
+    synthetic_frame,
 )
 
 
@@ -49,6 +50,7 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
                                                      "energy_capture, moves, p95, end_loss_share, ...)")
     run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
     run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
+    add_force_argument(run)
 
 
 def _spread(args: argparse.Namespace):
@@ -148,7 +150,8 @@ def _format(value) -> str:
 @command("field", "run a tracker for every collector of a Fresnel field, a trough loop or a heliostat field",
          _field_arguments)
 def _field(args: argparse.Namespace) -> int:
-    from ..fields import collector_columns, simulate_field
+    from ..fields import FieldResult, collector_columns, simulate_field
+    from ..outputs import claim
 
     site = site_from_arguments(args)
     field = field_from_arguments(args)
@@ -156,6 +159,8 @@ def _field(args: argparse.Namespace) -> int:
         raise HybridtrackError(f"--metric: no collector metric {args.metric!r}; "
                                f"choose from {', '.join(collector_columns(field))}")
     frame = synthetic_frame(args, site)
+    if args.out:
+        claim(FieldResult.files(args.out, log=not args.no_log).values())
     result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
                             seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True)
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "

@@ -7,8 +7,10 @@ import contextlib
 import sys
 import warnings
 
+from .. import params
 from ..errors import HybridtrackError
-from .base import command
+from ..outputs import claim, strict_json, write
+from .base import add_force_argument, command
 
 
 @contextlib.contextmanager
@@ -16,16 +18,17 @@ def tuned_config_warnings():
     """Print a tuned config's `OutsideLabelsWarning` as one ``hybridtrack: warning:`` line each."""
     from ..fuzzy.tuning import OutsideLabelsWarning
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", OutsideLabelsWarning)
-        try:
+    caught: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", OutsideLabelsWarning)
             yield
-        finally:
-            for warning in caught:
-                if issubclass(warning.category, OutsideLabelsWarning):
-                    print(f"hybridtrack: warning: {warning.message}", file=sys.stderr)
-                else:
-                    warnings.showwarning(warning.message, warning.category, warning.filename, warning.lineno)
+    finally:  # outside catch_warnings: re-shown there, a warning would be caught again, for ever
+        for warning in caught:
+            if issubclass(warning.category, OutsideLabelsWarning):
+                print(f"hybridtrack: warning: {warning.message}", file=sys.stderr)
+            else:
+                warnings.showwarning(warning.message, warning.category, warning.filename, warning.lineno)
 
 
 def load_fuzzy_config(path):
@@ -50,6 +53,7 @@ def _classify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--intensity-col", default="intensity", help="file: column of the photocurrent (mA)")
     parser.add_argument("--variation-col", default="variation", help="file: column of the variation (mA)")
     parser.add_argument("--out", help="file: write the readings with sky_score and sky columns here")
+    add_force_argument(parser)
     parser.add_argument("--engine", choices=("fast", "numba", "numpy", "skfuzzy"), default="fast",
                         help="inference engine: fast (numba, or numpy without it), numba, numpy or skfuzzy")
 
@@ -61,8 +65,6 @@ def _classify(args: argparse.Namespace) -> int:
 
 
 def _classify_readings(args: argparse.Namespace) -> int:
-    import json
-
     from ..fuzzy import FuzzyWeatherClassifier
 
     clf = FuzzyWeatherClassifier(load_fuzzy_config(args.config))
@@ -70,7 +72,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
         if args.intensity is None or args.variation is None:
             raise HybridtrackError("give --intensity and --variation, or a CSV file of readings")
         explanation = clf.explain(args.intensity, args.variation)
-        print(json.dumps(explanation.to_dict(), indent=2) if args.json else explanation)
+        print(strict_json(explanation.to_dict(), indent=2) if args.json else explanation)
         return 0
     from ..io import numeric_columns, read_table
 
@@ -83,7 +85,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
     table["sky_score"] = clf.score(readings[wanted[0]].to_numpy(), readings[wanted[1]].to_numpy(), engine=args.engine)
     table["sky"] = clf.label(table["sky_score"].to_numpy())
     if args.out:
-        table.to_csv(args.out, index=False, float_format="%.6g")
+        write(claim([args.out])[0], lambda file: table.to_csv(file, index=False, float_format="%.6g"))
         print(f"wrote {len(table)} rows to {args.out}")
     counts = table["sky"].value_counts()
     print(", ".join(f"{label} {counts.get(label, 0)}" for label in [b[0] for b in clf.config.bands] + ["unknown"]))
@@ -104,19 +106,24 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
                         help="fit from this many seeds and report how far the fits spread (default 3; 1 skips it)")
     parser.add_argument("--report", metavar="DIR",
                         help="also write report.json, surfaces.png (before/after) and confusion.png here")
+    add_force_argument(parser)
 
 
 @command("tune", "fit the classifier's membership functions to labelled readings", _tune_arguments)
 def _tune(args: argparse.Namespace) -> int:
-    import json
     from pathlib import Path
 
-    from ..fuzzy.tuning import read_samples, tune
+    from ..fuzzy.tuning import check_margin, read_samples, tune
 
     if args.folds == 1 or args.folds < 0:
         raise HybridtrackError(f"--folds must be 0 (none) or at least 2, got {args.folds}")
+    params.seed(args.seed, "--seed")
     start = load_fuzzy_config(args.config)
+    check_margin(args.margin, start)  # before the progress bar
     samples = read_samples(args.labels)
+    report_files = [Path(args.report) / name for name in ("report.json", "surfaces.png", "confusion.png")] \
+        if args.report else []
+    claim([args.out, *report_files])  # before the fit, not after it
     from tqdm import tqdm
 
     fits = 1 + args.folds + max(args.seeds - 1, 0)
@@ -133,8 +140,7 @@ def _tune(args: argparse.Namespace) -> int:
         from ..report import plot_confusion, plot_tuning, save_figure
 
         folder = Path(args.report)
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2) + "\n")
+        write(folder / "report.json", lambda file: file.write_text(strict_json(report.to_dict(), indent=2) + "\n"))
         surfaces = save_figure(plot_tuning(start, tuned, samples), folder / "surfaces.png")
         confusion = save_figure(plot_confusion(start, tuned, samples), folder / "confusion.png")
         print(f"wrote {folder / 'report.json'}, {surfaces}, {confusion}")
@@ -144,6 +150,7 @@ def _tune(args: argparse.Namespace) -> int:
 def _surface_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", help="classifier config (.toml or .fis); the published one by default")
     parser.add_argument("--out", default="surface.png", help="image to write (default surface.png)")
+    add_force_argument(parser)
     parser.add_argument("--points", type=int, default=121, help="grid points along each input (default 121)")
 
 

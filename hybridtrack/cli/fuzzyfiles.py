@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import HybridtrackError
-from .base import command
+from .base import add_force_argument, command
 
 
 def _arguments(parser: argparse.ArgumentParser) -> None:
@@ -15,6 +15,7 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
                                              "the sky classifier's .toml (two inputs, one output), by file suffix.")
     convert.add_argument("source", metavar="IN", help="system to read (.fis, .fcl or .toml)")
     convert.add_argument("target", metavar="OUT", help="file to write (.fis, .fcl or .toml)")
+    add_force_argument(convert)
     evaluate = actions.add_parser("eval", help="evaluate a system file at some inputs",
                                   description="Evaluate a Mamdani system file (.fis, .fcl or .toml) at one reading.")
     evaluate.add_argument("source", metavar="FILE", help="system to read (.fis, .fcl or .toml)")

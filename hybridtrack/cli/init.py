@@ -8,7 +8,8 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
-from .base import command
+from ..outputs import claim, write
+from .base import add_force_argument, command
 
 RUN, FUZZY, RULES = "run.toml", "fuzzy.toml", "test_site.rules.csv"
 
@@ -100,7 +101,7 @@ def example_rule_table() -> str:
 
 def _init_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("dir", nargs="?", default=".", help="folder to write into (default: here)")
-    parser.add_argument("--force", action="store_true", help="overwrite files that are already there")
+    add_force_argument(parser)
 
 
 @command("init", "write a commented run config, a fuzzy config and an example rule table to start from",
@@ -108,14 +109,11 @@ def _init_arguments(parser: argparse.ArgumentParser) -> None:
 def _init(args: argparse.Namespace) -> int:
     folder = Path(args.dir)
     files = {RUN: commented_run_config(), FUZZY: commented_fuzzy_config(), RULES: example_rule_table()}
-    existing = [name for name in files if (folder / name).exists()]
-    if existing and not args.force:
-        raise HybridtrackError(f"{folder / existing[0]} exists; use --force to overwrite")
     if folder.exists() and not folder.is_dir():
         raise HybridtrackError(f"{folder} is a file, not a folder")
-    folder.mkdir(parents=True, exist_ok=True)
+    claim(folder / name for name in files)
     for name, text in files.items():
-        (folder / name).write_text(text, encoding="utf-8")
+        write(folder / name, lambda file, text=text: file.write_text(text, encoding="utf-8"))
     print(f"wrote {', '.join(str(folder / name) for name in files)}")
     print(f"try: hybridtrack simulate --site lanzhou --date 2021-06-21 --config {folder / RUN}")
     return 0

@@ -6,7 +6,9 @@ import argparse
 
 import pandas as pd
 
+from ..outputs import claim, write
 from .base import (
+    add_force_argument,
     add_record_arguments,
     add_site_arguments,
     add_synthetic_arguments,
@@ -23,6 +25,7 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
     add_record_arguments(parser)
     parser.add_argument("--freq", help="resample to this step, e.g. 1min")
     parser.add_argument("--out", metavar="FILE", help="write the checked (cleaned) frame as CSV")
+    add_force_argument(parser)
 
 
 @command("check", "read a recorded weather file and print its validation summary; with a site (--site or "
@@ -48,18 +51,17 @@ def write_frame(frame: pd.DataFrame, path: str) -> None:
     target = Path(path)
     if target.is_dir():
         raise HybridtrackError(f"{path}: is a folder; --out takes a file name")
+    claim([target])
     out = frame.copy()
     out.index = out.index.strftime("%Y-%m-%dT%H:%M:%S%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2", regex=True)
-    try:
-        out.to_csv(target, index_label="time", float_format="%.6g")
-    except OSError as exc:
-        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    write(target, lambda file: out.to_csv(file, index_label="time", float_format="%.6g"))
 
 
 def _sky_arguments(parser: argparse.ArgumentParser) -> None:
     add_synthetic_arguments(parser)
     parser.add_argument("--out", help="write the weather frame (with sensor readings) as CSV")
     parser.add_argument("--plot", metavar="PNG", help="draw irradiance, sensor readings and wind")
+    add_force_argument(parser)
 
 
 @command("sky", "make a synthetic weather frame and show its sensor's view", _sky_arguments)
@@ -70,7 +72,7 @@ def _sky(args: argparse.Namespace) -> int:
     frame = sensor_view(synthetic_frame(args, site), seed=args.seed)
     print(_sky_table(frame, site).to_string(float_format=lambda v: f"{v:.2f}"))
     if args.out:
-        frame.to_csv(args.out, float_format="%.3f", index_label="time")
+        write(claim([args.out])[0], lambda file: frame.to_csv(file, float_format="%.3f", index_label="time"))
         print(f"wrote {len(frame)} rows to {args.out}")
     if args.plot:
         from ..report import plot_sky, save_figure

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import HybridtrackError
-from .base import command
+from .base import add_force_argument, command
 from .fuzzy import load_fuzzy_config, tuned_config_warnings
 
 
@@ -14,6 +14,7 @@ def _rules_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--variation", type=float, required=True, help="its variation over the window, mA")
     parser.add_argument("--config", help="classifier config (.toml or MATLAB .fis); the published one by default")
     parser.add_argument("--plot", metavar="FILE", help="also draw the rule viewer (PNG, SVG or PDF)")
+    add_force_argument(parser)
 
 
 def rule_table(explanation, config) -> str:

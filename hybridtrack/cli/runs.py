@@ -10,7 +10,9 @@ import pandas as pd
 
 from .. import sites
 from ..errors import HybridtrackError
+from ..outputs import claim, strict_json, write
 from .base import (
+    add_force_argument,
     add_record_arguments,
     add_run_arguments,
     add_site_arguments,
@@ -61,6 +63,15 @@ def _fmt(value, spec: str) -> str:
     return "-" if value is None else format(value, spec)
 
 
+def _claim_run_folder(args: argparse.Namespace) -> None:
+    """Refuse a bad ``--out`` before the run rather than after it."""
+    from ..outputs import claim
+    from ..simulation import Result
+
+    if args.out:
+        claim(Result.files(args.out).values())
+
+
 def _finish(result, args, *, heading: str) -> None:
     print(heading)
     print(summary_table({result.summary["strategy"]: result.summary}))
@@ -69,26 +80,35 @@ def _finish(result, args, *, heading: str) -> None:
         print("wrote " + ", ".join(str(p) for p in written.values()))
 
 
+DEMO_FOLDER = "hybridtrack-demo"
+
+
 def _demo_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--out", default="hybridtrack-demo", help="folder for the results (default hybridtrack-demo)")
+    parser.add_argument("--out", default=DEMO_FOLDER, help=f"folder for the results (default {DEMO_FOLDER}; a demo "
+                                                           "run again replaces its own files there)")
+    add_force_argument(parser)
 
 
 @command("demo", "a built-in mixed-sky day at Lanzhou: run the hybrid tracker, print the summary, "
                  "write the report", _demo_arguments)
 def _demo(args: argparse.Namespace) -> int:
     from ..collectors import Collector
+    from ..outputs import replacing
     from ..simulation import simulate
     from ..sky import synthetic
 
+    with replacing(args.force or args.out == DEMO_FOLDER) as replaced:  # the same day each time: its own files
+        _claim_run_folder(args)
     site = sites.get("lanzhou")
     frame = synthetic(site, "2021-06-21", weather="mixed", seed=5, gusts_per_day=2.0)
     result = simulate(frame, site, collector=Collector("fresnel"), strategy="hybrid")
     print("demo: Lanzhou linear Fresnel row, 2021-06-21, mixed sky with gusts (seed 5), hybrid strategy, default "
           "imperfections")
     print(summary_table({"hybrid": result.summary}))
-    written = result.save(args.out)
+    with replacing(True):
+        written = result.save(args.out)
     print(f"wrote {written['report']} (the day at a glance), {written['summary']}, {written['log']}, "
-          f"{written['events']}")
+          f"{written['events']}" + (" (replacing those of an earlier run)" if replaced else ""))
     return 0
 
 
@@ -101,6 +121,7 @@ def _simulate_arguments(parser: argparse.ArgumentParser) -> None:
 def _simulate(args: argparse.Namespace) -> int:
     site = site_from_arguments(args)
     frame = synthetic_frame(args, site)
+    _claim_run_folder(args)
     result = _run(frame, site, args, args.strategy, simulation_config(args, args.seed))
     _finish(result, args, heading=f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, "
                                   f"{args.weather}), {result.collector.kind}, {args.strategy}")
@@ -141,6 +162,7 @@ def replay_config(args: argparse.Namespace, frame):
 @command("replay", "run a tracker over a recorded weather file", _replay_arguments)
 def _replay(args: argparse.Namespace) -> int:
     site, frame = _replay_frame(args)
+    _claim_run_folder(args)
     result = _run(frame, site, args, args.strategy, replay_config(args, frame))
     _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, {args.strategy}")
     return 0
@@ -152,6 +174,16 @@ def _compare_arguments(parser: argparse.ArgumentParser) -> None:
     add_record_arguments(parser)
     parser.add_argument("--step", default="1min", help="control step a record is resampled to (default 1min)")
     add_run_arguments(parser)
+
+
+def _compare_files(folder, policies) -> list:
+    """Every file ``compare --out`` writes: one run folder per strategy and the comparison."""
+    from pathlib import Path
+
+    from ..simulation import Result
+
+    files = [path for name in policies for path in Result.files(Path(folder) / name, plot=False).values()]
+    return files + [Path(folder) / "comparison.json", Path(folder) / "comparison.png"]
 
 
 @command("compare", "run every strategy on the same weather and compare them", _compare_arguments)
@@ -172,13 +204,14 @@ def _compare(args: argparse.Namespace) -> int:
     policies = [s for s in STRATEGIES if s != "hybrid-oracle" or "sky" in frame.columns]
     if len(policies) < len(STRATEGIES):
         print("hybrid-oracle left out: the frame has no true 'sky' column")
+    if args.out:
+        claim(_compare_files(args.out, policies))
     results = {strategy: _run(frame, site, args, strategy, config) for strategy in policies}
     first = next(iter(results.values()))
     print(f"{site.name}, {first.summary['start'][:10]} to {first.summary['end'][:10]}, {first.collector.kind}: "
           "every strategy on the same weather and world")
     print(summary_table({name: r.summary for name, r in results.items()}))
     if args.out:
-        import json
         from pathlib import Path
 
         from ..report import plot_compare, save_figure
@@ -186,7 +219,8 @@ def _compare(args: argparse.Namespace) -> int:
         folder = Path(args.out)
         for name, result in results.items():
             result.save(folder / name, plot=False)
-        (folder / "comparison.json").write_text(json.dumps({n: r.summary for n, r in results.items()}, indent=2) + "\n")
+        summaries = strict_json({n: r.summary for n, r in results.items()}, indent=2) + "\n"
+        write(folder / "comparison.json", lambda file: file.write_text(summaries))
         print(f"wrote {save_figure(plot_compare(results), folder / 'comparison.png')}, {folder / 'comparison.json'} "
               f"and one folder per strategy")
     return 0

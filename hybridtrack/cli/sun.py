@@ -7,8 +7,10 @@ import argparse
 import numpy as np
 import pandas as pd
 
+from ..outputs import claim, write
 from .base import (
     add_collector_arguments,
+    add_force_argument,
     add_site_arguments,
     collector_from_arguments,
     command,
@@ -30,6 +32,7 @@ def _sun_arguments(parser: argparse.ArgumentParser) -> None:
     add_collector_arguments(parser)
     parser.add_argument("--csv", metavar="OUT", help="write the table as CSV instead of printing it")
     parser.add_argument("--plot", metavar="PNG", help="also draw the sun path and targets")
+    add_force_argument(parser)
 
 
 @command("sun", "sun position and collector target angles over a day", _sun_arguments)
@@ -46,7 +49,7 @@ def _sun(args: argparse.Namespace) -> int:
     table = pd.concat([position[["altitude", "apparent_altitude", "azimuth", "declination",
                                  "hour_angle", "equation_of_time"]], angles], axis=1)
     if args.csv:
-        table.to_csv(args.csv, float_format="%.6f", index_label="time")
+        write(claim([args.csv])[0], lambda file: table.to_csv(file, float_format="%.6f", index_label="time"))
         print(f"wrote {len(table)} rows to {args.csv}")
     else:
         shown = table.copy()

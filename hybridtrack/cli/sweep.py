@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import HybridtrackError
-from .base import command
+from .base import add_force_argument, command
 
 
 def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
@@ -13,6 +13,7 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
                                                            "(see examples/sweep-deadband.toml)")
     parser.add_argument("--out", required=True,
                         help="folder for runs.parquet (one row per run), tradeoff.png and sweep.toml")
+    add_force_argument(parser)
     parser.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
                                                                "(default: a local cluster on this machine's cores)")
     parser.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
@@ -21,12 +22,11 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
 @command("sweep", "run a grid of runs (config fields, sites, dates, weather, seeds, strategies, collectors) on Dask",
          _sweep_arguments)
 def _sweep(args: argparse.Namespace) -> int:
-    from ..sweep import Sweep, pareto_front, run_sweep, save_sweep
-
-    from pathlib import Path
+    from ..outputs import claim
+    from ..sweep import Sweep, pareto_front, run_sweep, save_sweep, sweep_files
 
     sweep = Sweep.from_toml(args.file)
-    Path(args.out).mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails now, not after the runs
+    claim(sweep_files(args.out).values())  # a folder that cannot be used fails now, not after the runs
     runs = len(sweep.runs())
     print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
     table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)

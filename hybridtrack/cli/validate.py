@@ -5,7 +5,10 @@ from __future__ import annotations
 import argparse
 
 from ..errors import HybridtrackError
-from .base import add_record_arguments, add_site_arguments, command, read_record, site_from_arguments
+from ..outputs import claim, strict_json, write
+from .base import (
+    add_force_argument, add_record_arguments, add_site_arguments, command, read_record, site_from_arguments,
+)
 
 
 def _validate_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,6 +27,7 @@ def _validate_arguments(parser: argparse.ArgumentParser) -> None:
     out.add_argument("--day", help="the day to draw, YYYY-MM-DD (default: the day that agrees least)")
     out.add_argument("--json", metavar="FILE", help="also write the scores as JSON here")
     out.add_argument("--out", metavar="CSV", help="write every sample's inputs, labels and references here")
+    add_force_argument(out)
 
 
 def _sky_config(args: argparse.Namespace):
@@ -39,8 +43,6 @@ def _sky_config(args: argparse.Namespace):
 @command("validate-sky", "score the sky classifier on a recorded file against beam-ratio and clear-sky references",
          _validate_arguments)
 def _validate(args: argparse.Namespace) -> int:
-    import json
-
     from ..skyvalidation import plot_day, validate_sky
     from .fuzzy import load_fuzzy_config
 
@@ -59,11 +61,10 @@ def _validate(args: argparse.Namespace) -> int:
           f"{config.rules} rules")
     print(result)
     if args.json:
-        with open(args.json, "w") as handle:
-            json.dump(result.to_dict(), handle, indent=2, allow_nan=False)
+        write(claim([args.json])[0], lambda file: file.write_text(strict_json(result.to_dict(), indent=2) + "\n"))
         print(f"wrote {args.json}")
     if args.out:
-        result.samples.to_csv(args.out, float_format="%.6g")
+        write(claim([args.out])[0], lambda file: result.samples.to_csv(file, float_format="%.6g"))
         print(f"wrote {args.out}")
     if args.plot:
         from ..report import save_figure

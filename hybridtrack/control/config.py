@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import pandas as pd
 
 from ..errors import HybridtrackError
+from ..params import duration, number, whole
 
 __all__ = ["ControllerConfig", "STRATEGIES"]
 
@@ -15,6 +15,27 @@ __all__ = ["ControllerConfig", "STRATEGIES"]
 #: ``hybrid-always`` trusts the sensor whenever it reads valid, ``hybrid-oracle`` knows the true sky.
 STRATEGIES = ("hybrid", "hybrid-nocal", "astronomical", "astronomical-commissioned", "sensor",
               "hybrid-always", "hybrid-oracle")
+
+
+#: (field, low, high, low excluded): m/s, degrees, deg²/min³, standard deviations, degrees per
+#: minute, mA.
+_RANGES = (("wind_stow", 0, 60, True), ("wind_release", 0, 60, True), ("min_altitude", -10, 30, False),
+           ("process_noise", 0, 10, True), ("gate", 0, 100, True), ("calibration_max_rate", 0, 100, True),
+           ("sensor_plausibility", 0, 45, True), ("sensor_noise", 0, 5, True), ("dusk_current", 0, 1000, True),
+           ("disagreement", 0, 45, True))
+
+
+def _check_working_hours(hours) -> None:
+    """Refuse working hours that are not a start and a later end on the same day (there is no
+    overnight shift: the controller works by day)."""
+    from ..times import parse_clock
+
+    if len(hours) != 2:
+        raise HybridtrackError("controller: working_hours needs a start and an end")
+    start, end = (parse_clock(clock) for clock in hours)
+    if not start < end:
+        raise HybridtrackError(f"controller: working_hours {list(hours)} must end after they start on the same day "
+                               "(a controller works by day; there is no overnight shift)")
 
 
 @dataclass(frozen=True)
@@ -86,6 +107,17 @@ class ControllerConfig:
         Degrees: a persistent residual between the sensor and the calibrated model at least this
         large is a sensor (or mount) fault; a smaller one is the model's own misfit. Half the
         0.5° whole-system error that trough fields are built to.
+    on_disagreement : {"model", "sensor"}
+        Whom to trust when they disagree so. ``model`` (default): the sensor is suspect (a bias,
+        a drift, a knock to its bracket); the calibration goes back to the checkpoint taken while
+        the two agreed and the sensor is not trusted for `distrust`, then judged again. ``sensor``:
+        the mount is suspect (a shifted pedestal, a slipped coupling); the calibration keeps what
+        it learned and the sensor stays trusted. Either way the alarm is logged with its size.
+        ``model`` is the safe default: a sensor fault is the likelier one, and with ``sensor``
+        a biased sensor drags the calibration with it.
+    distrust : str
+        How long a sensor judged against the model is not trusted (``on_disagreement = "model"``):
+        an hour, long enough for the sun to move about 15° and show a bias again from another angle.
     kalman : {"fast", "filterpy"}
         ``filterpy`` runs filterpy's KalmanFilter, the reference; ``fast`` the same
         equations in plain floats (a test keeps them equal).
@@ -114,11 +146,11 @@ class ControllerConfig:
     lead: bool = True
     sensor_noise: float = 0.05
     disagreement: float = 0.25
+    on_disagreement: str = "model"
+    distrust: str = "60min"
     kalman: str = "fast"
 
     def __post_init__(self) -> None:
-        from ..times import parse_clock
-
         object.__setattr__(self, "working_hours", tuple(self.working_hours))
         if self.strategy not in STRATEGIES:
             raise HybridtrackError(f"unknown strategy {self.strategy!r}; choose from {', '.join(STRATEGIES)}")
@@ -128,40 +160,21 @@ class ControllerConfig:
             raise HybridtrackError(f"controller: wind_missing {self.wind_missing!r}; choose 'stow' or 'track'")
         if self.kalman not in ("fast", "filterpy"):
             raise HybridtrackError(f"unknown Kalman engine {self.kalman!r}; choose 'fast' or 'filterpy'")
-        for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast"):
-            try:
-                if pd.Timedelta(getattr(self, name)) <= pd.Timedelta(0):
-                    raise ValueError
-            except ValueError:
-                raise HybridtrackError(f"controller: {name} {getattr(self, name)!r} is not a positive "
-                                       "duration") from None
-        for name in ("wind_stow", "wind_release", "min_altitude", "process_noise", "gate", "calibration_max_rate",
-                     "sensor_plausibility", "sensor_noise", "dusk_current", "disagreement"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise HybridtrackError(f"controller: {name} must be a finite number, got {value!r}")
-        if not 0 < self.wind_release <= self.wind_stow <= 60:
-            raise HybridtrackError(f"controller: wind_release {self.wind_release} must be positive and at most "
-                                   f"wind_stow {self.wind_stow} (at most 60 m/s)")
-        if len(self.working_hours) != 2:
-            raise HybridtrackError("controller: working_hours needs a start and an end")
-        for clock in self.working_hours:
-            parse_clock(clock)
-        if not (0 < self.process_noise <= 10 and 0 < self.gate <= 100 and 0 < self.calibration_max_rate <= 100
-                and 0 < self.sensor_noise <= 5):
-            raise HybridtrackError("controller: process_noise (0-10], gate (0-100], calibration_max_rate (0-100] "
-                                   "and sensor_noise (0-5] are out of range")
-        if not -10 <= self.min_altitude <= 30:
-            raise HybridtrackError(f"controller: min_altitude {self.min_altitude} is outside -10 to 30 degrees")
+        if self.on_disagreement not in ("model", "sensor"):
+            raise HybridtrackError(f"controller: on_disagreement {self.on_disagreement!r}; choose 'model' or 'sensor'")
+        for name in ("dwell", "wind_hold", "calibration_tau", "sensor_loss", "coast", "distrust"):
+            duration(getattr(self, name), f"controller: {name}")
+        for name, low, high, above in _RANGES:
+            number(getattr(self, name), f"controller: {name}", low, high, above=above)
+        if not self.wind_release <= self.wind_stow:
+            raise HybridtrackError(f"controller: wind_release {self.wind_release} must be at most "
+                                   f"wind_stow {self.wind_stow}")
+        _check_working_hours(self.working_hours)
         for name, least in (("reacquire", 1), ("stuck_scans", 3), ("encoder_confirm", 1)):
-            value = getattr(self, name)
-            if not (isinstance(value, int) and not isinstance(value, bool) and least <= value <= 10_000):
-                raise HybridtrackError(f"controller: {name} must be a whole number of at least {least}, got {value!r}")
-        if not 0 < self.disagreement <= self.sensor_plausibility:
-            raise HybridtrackError(f"controller: disagreement {self.disagreement} must be positive and at most "
+            whole(getattr(self, name), f"controller: {name}", least, 10_000)
+        if not self.disagreement <= self.sensor_plausibility:
+            raise HybridtrackError(f"controller: disagreement {self.disagreement} must be at most "
                                    f"sensor_plausibility {self.sensor_plausibility}")
-        if not 0 < self.sensor_plausibility <= 45:
-            raise HybridtrackError("controller: sensor_plausibility must be within (0, 45] degrees")
 
     @property
     def uses_sensor(self) -> bool:

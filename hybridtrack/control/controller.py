@@ -39,8 +39,6 @@ DUSK_MINUTES = 30.0
 #: Minutes between the readings the mount fit takes: readings a minute apart are correlated
 #: through the filter and the sun has hardly moved, so more would add time, not information.
 FIT_EVERY = 5.0
-#: Minutes a sensor that disagreed with the calibrated model is not trusted; then it is judged again.
-DISTRUST_MINUTES = 60.0
 #: Fit readings (an hour at one every five minutes) before the sensor is judged against the fit.
 SETTLE_UPDATES = 12
 #: The policies that decide on the fuzzy classifier's sky.
@@ -449,7 +447,8 @@ class Controller:
 
     def _disagrees(self, i: int, miss: float, spread: float) -> bool:
         """Watch the sensor against the checkpointed calibration (`miss`, degrees, with its expected
-        `spread`); on a persistent disagreement roll the calibration back and distrust the sensor."""
+        `spread`); on a persistent disagreement act as `ControllerConfig.on_disagreement` says: roll
+        the calibration back and distrust the sensor (and return True), or keep both and go on."""
         if self.fit.updates < SETTLE_UPDATES:  # a fit still finding its feet is not evidence against the sensor
             return False
         if self.disagreement.calm:
@@ -457,12 +456,17 @@ class Controller:
         if not self.disagreement.add(miss / spread, miss, self.config.disagreement):
             return False
         mean, count = self.disagreement.mean_residual(), self.disagreement.run
+        self.disagreement.reset()
+        found = f"sensor and calibrated model disagree: mean residual {mean:+.3f}° over {count} readings; "
+        if self.config.on_disagreement == "sensor":  # the mount moved: the fit follows the sensor
+            self.checkpoint = self.memory()
+            self._alarm(i, found + "sensor trusted, calibration follows it (on_disagreement = 'sensor')")
+            return False
         if self.checkpoint is not None:
             self._recall(self.checkpoint)
-        self.disagreement.reset()
-        self.distrusted_until = self.previous_t + DISTRUST_MINUTES
-        self._alarm(i, f"sensor and calibrated model disagree: mean residual {mean:+.3f}° over {count} readings; "
-                       f"calibration rolled back, sensor not trusted for {DISTRUST_MINUTES:.0f} min")
+        distrust = self.config.minutes("distrust")
+        self.distrusted_until = self.previous_t + distrust
+        self._alarm(i, found + f"calibration rolled back, sensor not trusted for {distrust:.0f} min")
         return True
 
     def memory(self) -> dict:

@@ -162,13 +162,23 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
         awake = working & (up | rising | setting)
     plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps, alarms=alarms)
     if config.calibrates:
-        from .mountfit import jacobian
-
-        plan.jacobian = jacobian(altitude, sun["azimuth"].to_numpy(), collector)
+        plan.jacobian = _lit_jacobian(altitude, sun["azimuth"].to_numpy(), model, collector)
         plan.weight = np.ones(model.shape)
         if not collector.single_axis:  # an azimuth error counts cos(elevation) in pointing terms
             plan.weight[:, 0] = np.cos(np.radians(np.clip(model[:, 1], 0.0, 90.0)))
     return plan
+
+
+def _lit_jacobian(altitude: np.ndarray, azimuth: np.ndarray, model: np.ndarray, collector: Collector) -> np.ndarray:
+    """`mountfit.jacobian` where the computed target exists; zero elsewhere, as it comes out there
+    anyway (no target, no derivative): a year's nights are half its scans, not worth four mounts."""
+    from .mountfit import jacobian
+
+    lit = np.isfinite(model).all(axis=1)
+    derivatives = jacobian(altitude[lit], azimuth[lit], collector)
+    out = np.zeros((len(altitude), *derivatives.shape[1:]))
+    out[lit] = derivatives
+    return out
 
 
 def east_park(collector: Collector) -> list[float]:

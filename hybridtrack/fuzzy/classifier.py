@@ -78,7 +78,8 @@ class FuzzyWeatherClassifier:
         for var, values in zip(self.config.inputs, (intensity, variation)):
             lo, hi = var.raw_range
             u0, u1 = var.universe
-            columns.append(np.clip(u0 + (u1 - u0) * (np.asarray(values, float) - lo) / (hi - lo), u0, u1))
+            raw = np.clip(np.asarray(values, float), lo, hi)  # first, so 1e308 mA cannot overflow the scaling
+            columns.append(np.clip(u0 + (u1 - u0) * (raw - lo) / (hi - lo), u0, u1))
         return np.stack(np.broadcast_arrays(*columns), axis=-1)
 
     def _prepare(self, intensity, variation, raw: bool) -> tuple[np.ndarray, tuple]:

@@ -63,6 +63,11 @@ class Methods:
         return {key: getattr(self, key) for key in METHOD_CHOICES}
 
 
+def _finite_interval(bounds) -> bool:
+    """Two finite numbers in increasing order whose width is finite too."""
+    return len(bounds) == 2 and bounds[0] < bounds[1] and math.isfinite(bounds[1] - bounds[0])
+
+
 @dataclass(frozen=True)
 class Term:
     """A linguistic term: a name and a membership function on its variable's universe."""
@@ -127,11 +132,11 @@ class Variable:
 
     def check(self, where: str) -> None:
         """Raise `HybridtrackError` if the variable is not usable."""
-        lo, hi = self.universe
-        if len(self.universe) != 2 or not lo < hi:
-            raise HybridtrackError(f"{where}: universe must be [low, high] with low < high, got {list(self.universe)}")
-        if self.raw_range is not None and (len(self.raw_range) != 2 or not self.raw_range[0] < self.raw_range[1]):
-            raise HybridtrackError(f"{where}: raw_range must be [min, max] with min < max, got {list(self.raw_range)}")
+        for name in ("universe", "raw_range"):
+            bounds = getattr(self, name)
+            if bounds is not None and not _finite_interval(bounds):
+                raise HybridtrackError(f"{where}: {name} must be two finite numbers [low, high] with low < high, "
+                                       f"got {list(bounds)}")
         if not self.terms:
             raise HybridtrackError(f"{where}: no terms")
         if len(set(self.term_names)) != len(self.terms):

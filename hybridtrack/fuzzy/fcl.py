@@ -47,6 +47,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
+from ..outputs import claim, write
 from .config import FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
 from .system import MamdaniSystem, SystemRule, format_number, system_of
@@ -122,9 +123,8 @@ def write_fcl(config: FuzzyConfig | MamdaniSystem, path) -> Path:
     """Write a classifier config or a system as an FCL file and return its path."""
     system = system_of(config) if isinstance(config, FuzzyConfig) else config
     text = fcl_text(system)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
+    path, = claim([path])
+    write(path, lambda target: target.write_text(text))
     return path
 
 

@@ -27,6 +27,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
+from ..outputs import claim, write
 from .config import METHOD_CHOICES, FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
 from .system import MamdaniSystem, SystemRule, config_from_system, format_number, system_of
@@ -79,10 +80,9 @@ def fis_text(system: MamdaniSystem) -> str:
 def write_fis(config: FuzzyConfig | MamdaniSystem, path) -> Path:
     """Write a classifier config or a system as a MATLAB ``.fis`` file and return its path."""
     system = system_of(config) if isinstance(config, FuzzyConfig) else config
-    path = Path(path)
     text = fis_text(system)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
+    path, = claim([path])
+    write(path, lambda target: target.write_text(text))
     return path
 
 

@@ -39,11 +39,13 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
+from ..params import number
 from .classifier import FuzzyWeatherClassifier
 from .config import FuzzyConfig, Term
 
-__all__ = ["tune", "TuningReport", "read_samples", "evaluate", "cross_validate", "constraint_violations",
-           "labelled_range", "outside_labels", "warn_outside_labels", "OutsideLabelsWarning", "MONOTONE_TOLERANCE"]
+__all__ = ["tune", "check_margin", "TuningReport", "read_samples", "evaluate", "cross_validate",
+           "constraint_violations", "labelled_range", "outside_labels", "warn_outside_labels", "OutsideLabelsWarning",
+           "MONOTONE_TOLERANCE"]
 
 #: How far (score units) the score may dip below its running maximum as intensity rises at
 #: constant variation: the discretised centroid of the published system wobbles by 0.26 on this grid.
@@ -424,6 +426,12 @@ def _centre_spread(fits: list[FuzzyConfig]) -> dict[str, float]:
     return spread
 
 
+def check_margin(margin, config: FuzzyConfig) -> float:
+    """`margin` as a float, refused unless finite and within the width of the output universe."""
+    low, high = config.output.universe
+    return number(margin, "margin (score units)", 0, high - low)
+
+
 def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin: float = 0.5,
          maxiter: int = 60, popsize: int = 8, restarts: int = 8, seed: int = 0, folds: int = 0,
          seeds: int = 1, progress=None) -> tuple[FuzzyConfig, TuningReport]:
@@ -476,8 +484,7 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     """
     config = config if config is not None else FuzzyConfig.default()
     samples = read_samples(samples)
-    if not margin >= 0:
-        raise HybridtrackError(f"margin must be non-negative, got {margin!r}")
+    check_margin(margin, config)
     if method not in ("global", "local"):
         raise HybridtrackError(f"unknown tuning method {method!r}; choose 'global' or 'local'")
     if not 1 <= seeds <= 20:

@@ -32,12 +32,14 @@ __all__ = ["LIMITS", "CALM_OFFSET", "first_lines", "span", "check_frame", "check
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
 LIMITS = {"ghi": (-50.0, 1500.0), "dni": (-50.0, 1400.0), "dhi": (-50.0, 1000.0), "wind_speed": (-0.5, 75.0),
-          "temp_air": (-90.0, 65.0), "photocurrent": (0.0, 10_000.0)}
+          "temp_air": (-90.0, 65.0), "photocurrent": (0.0, 10_000.0), "pointing": (-90.0, 90.0),
+          "pointing_2": (-90.0, 90.0)}
 
 #: m/s: negative wind down to this is an anemometer's zero offset in calm air, read as 0.
 CALM_OFFSET = -0.5
 
-_HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "temp_air": "K", "photocurrent": "A"}
+_HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "temp_air": "K", "photocurrent": "A",
+         "pointing": "rad", "pointing_2": "rad"}
 
 #: What each repair did, for strict mode's refusal.
 REPAIRS = {

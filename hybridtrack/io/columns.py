@@ -21,7 +21,7 @@ __all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED"
            "check_names"]
 
 #: The columns of a weather frame, in order.
-WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent")
+WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent", "pointing", "pointing_2")
 IRRADIANCE = ("ghi", "dni", "dhi")
 
 #: A column of true sky labels (e.g. in synthetic records), kept as text for scoring.
@@ -50,6 +50,10 @@ ALIASES = {
                  "air_temp", "tamb", "t_amb", "ambient temperature", "dry bulb", "drybulb", "temp_c", "t2m",
                  "dry bulb temp", "tower dry bulb temp", "temperatur", "température", "temperatura", "lufttemperatur"),
     "photocurrent": ("photocurrent", "photocurrent_ma", "intensity", "intensity_ma", "sensor current"),
+    # the sun sensor's pointing signal: the sun's offset from its axis, on each axis it serves
+    "pointing": ("pointing", "pointing_deg", "sensor_offset", "sensor offset", "sun sensor offset", "pointing_1",
+                 "sensor_offset_1"),
+    "pointing_2": ("pointing_2", "sensor_offset_2"),
 }
 
 #: Statistics suffixes loggers append to a measurement's name (Campbell: _Avg, _Smp, _S_WVT ...).

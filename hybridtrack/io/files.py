@@ -139,7 +139,8 @@ def write_toml(data: dict, path) -> Path:
     """Write a dict as TOML, creating folders; `read_toml` reads it back equal."""
     import tomli_w
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(tomli_w.dumps(data), encoding="utf-8")
+    from ..outputs import claim, write
+
+    path, = claim([path])
+    write(path, lambda target: target.write_text(tomli_w.dumps(data), encoding="utf-8"))
     return path

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..budget import check_steps
 from ..errors import HybridtrackError
 from .checks import span
 from .columns import LABEL_COLUMN, WEATHER_COLUMNS
@@ -56,10 +57,8 @@ def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -
     if regular and target == native:
         attrs["resampling"] = f"none (regular {span(native)} steps)"
         return frame
-    rows = (frame.index[-1] - frame.index[0]) / target
-    if rows > 50_000_000:
-        raise HybridtrackError(f"resampling {span(frame.index[-1] - frame.index[0])} of data to {span(target)} steps "
-                               f"would make {rows:,.0f} rows (over 50 million); choose a longer step")
+    check_steps(frame.index[0], frame.index[-1], target,
+                what=f"resampling {span(frame.index[-1] - frame.index[0])} of data to {span(target)}")
     columns = [c for c in frame.columns if c in WEATHER_COLUMNS]
     grid, origin = _grid(frame.index, native, target)
     if target >= native:

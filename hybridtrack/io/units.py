@@ -1,6 +1,7 @@
 """Units: the common spellings of each quantity's units, and conversion to the frame's units.
 
-The frame holds W/m² (irradiance), m/s (wind), °C (air temperature) and mA (photocurrent).
+The frame holds W/m² (irradiance), m/s (wind), °C (air temperature), mA (photocurrent) and
+degrees (the sun sensor's recorded pointing signal).
 Spellings are compared after `normalise_unit`: lower case, no spaces, ``²`` and ``^2`` as
 ``2``, ``m-2`` as ``/m2`` and ``deg``/``°`` dropped before ``c``, ``f`` and ``k``, so
 ``W/m²``, ``W/m^2``, ``W m-2``, ``Wm-2`` and ``W/m2`` are one unit.
@@ -8,6 +9,7 @@ Spellings are compared after `normalise_unit`: lower case, no spaces, ``²`` and
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
@@ -18,7 +20,7 @@ __all__ = ["UNITS", "FRAME_UNITS", "normalise_unit", "known_unit", "to_frame_uni
 
 #: Each quantity's unit in a weather frame.
 FRAME_UNITS = {"ghi": "W/m²", "dni": "W/m²", "dhi": "W/m²", "wind_speed": "m/s", "temp_air": "°C",
-               "photocurrent": "mA"}
+               "photocurrent": "mA", "pointing": "°", "pointing_2": "°"}
 
 #: (scale, offset) taking each normalised spelling to the frame's unit: frame = value * scale + offset.
 UNITS = {
@@ -28,10 +30,12 @@ UNITS = {
                    "mph": (0.44704, 0.0)},
     "temp_air": {"c": (1.0, 0.0), "k": (1.0, -273.15), "f": (5.0 / 9.0, -32.0 * 5.0 / 9.0)},
     "photocurrent": {"ma": (1.0, 0.0), "a": (1000.0, 0.0), "ua": (0.001, 0.0)},
+    "angle": {"deg": (1.0, 0.0), "°": (1.0, 0.0), "degrees": (1.0, 0.0), "degree": (1.0, 0.0),
+              "mrad": (0.18 / math.pi, 0.0), "rad": (180.0 / math.pi, 0.0)},
 }
 
 _QUANTITY = {"ghi": "irradiance", "dni": "irradiance", "dhi": "irradiance", "wind_speed": "wind_speed",
-             "temp_air": "temp_air", "photocurrent": "photocurrent"}
+             "temp_air": "temp_air", "photocurrent": "photocurrent", "pointing": "angle", "pointing_2": "angle"}
 
 
 def normalise_unit(text: str) -> str:

@@ -1,0 +1,174 @@
+"""Where results go: never through a symbolic link, never over a file unasked, JSON strictly.
+
+Every function that writes a result file first passes the paths it is about to write to
+`claim`, all at once, before anything is written:
+
+* a path that is a symbolic link, or lies in a folder that is one, is refused: a link planted
+  in an output folder would send the result somewhere else;
+* a path that exists already is replaced only under the current `replacing` policy. The
+  command line refuses unless ``--force`` is given, and names the files it would replace (or,
+  with ``--force``, the files it replaced); from Python the files are replaced as `open` would,
+  unless the call runs inside ``with replacing(False):``.
+
+`strict_json` writes JSON that any parser reads: a missing or non-finite number is ``null``,
+never ``NaN`` or ``Infinity``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import json
+import math
+import os
+import sys
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+
+import numpy as np
+
+from .errors import HybridtrackError
+
+__all__ = ["claim", "replacing", "write", "strict_json", "plain_numbers", "reader_may_leave"]
+
+_FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
+_REPLACED: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_replaced", default=None)
+
+
+@contextlib.contextmanager
+def replacing(force: bool) -> Iterator[list[Path]]:
+    """Within the block, existing files are replaced only if `force`; yields the files replaced.
+
+    Parameters
+    ----------
+    force : bool
+        False refuses to write over any existing file (`claim` raises `HybridtrackError`).
+
+    Yields
+    ------
+    list of Path
+        Filled with each existing file `claim` let through, in order.
+    """
+    replaced: list[Path] = []
+    force_token, replaced_token = _FORCE.set(bool(force)), _REPLACED.set(replaced)
+    try:
+        yield replaced
+    finally:
+        _FORCE.reset(force_token)
+        _REPLACED.reset(replaced_token)
+
+
+def claim(paths: Iterable) -> list[Path]:
+    """Check the files about to be written, all before any is, and make their folders.
+
+    Returns
+    -------
+    list of Path
+
+    Raises
+    ------
+    HybridtrackError
+        If a path or its folder is a symbolic link, a path is a folder, or files exist and
+        the policy (`replacing`) does not allow replacing them; the message names them all.
+    """
+    paths = [Path(p) for p in paths]
+    for path in paths:
+        for candidate in (path.parent, path):
+            if candidate.is_symlink():
+                raise HybridtrackError(f"{candidate} is a symbolic link; results are never written through one "
+                                       "(remove it or write elsewhere)")
+        if path.is_dir():
+            raise HybridtrackError(f"{path} is a folder; a result file would go there")
+    existing = [path for path in paths if path.exists()]
+    if existing and not _FORCE.get():
+        raise HybridtrackError(f"would replace {len(existing)} existing file{'s' if len(existing) > 1 else ''}: "
+                               f"{', '.join(map(str, existing))}; give --force to replace them, or write elsewhere")
+    replaced = _REPLACED.get()
+    if replaced is not None:
+        replaced.extend(p for p in existing if p not in replaced)
+    for folder in dict.fromkeys(path.parent for path in paths):
+        _make_folder(folder)
+    return paths
+
+
+def _make_folder(folder: Path) -> None:
+    if folder.exists() and not folder.is_dir():
+        raise HybridtrackError(f"{folder} is a file, not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise HybridtrackError(f"{folder}: cannot make the folder ({exc.strerror or exc})") from None
+
+
+def write(path, writer: Callable[[Path], object]) -> Path:
+    """Call ``writer(path)``; a failure to write (a full disk, no permission) becomes a
+    `HybridtrackError` that names `path`."""
+    path = Path(path)
+    try:
+        writer(path)
+    except OSError as exc:
+        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    return path
+
+
+def plain_numbers(value):
+    """`value` with numpy scalars as Python numbers and every NaN or infinity as None."""
+    if isinstance(value, dict):
+        return {key: plain_numbers(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain_numbers(item) for item in value]
+    if isinstance(value, np.ndarray):
+        return plain_numbers(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def strict_json(value, **options) -> str:
+    """JSON text with ``null`` for a missing or non-finite number; `options` go to `json.dumps`."""
+    return json.dumps(plain_numbers(value), allow_nan=False, **options)
+
+
+class _PipeSafe:
+    """A text stream that, once its reader has gone, discards what is written instead of raising."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _discard(self) -> None:
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._discard()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._discard()
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def reader_may_leave() -> Iterator[None]:
+    """Within the block, a closed standard output (``| head``) ends the printing, not the work:
+    the command goes on and writes its files."""
+    original = sys.stdout
+    sys.stdout = _PipeSafe(original)
+    try:
+        yield
+    finally:
+        with contextlib.suppress(BrokenPipeError):
+            sys.stdout.flush()
+        sys.stdout = original

@@ -1,0 +1,84 @@
+"""Numbers checked at the door: finite, within a physical range, whole where they count;
+durations positive.
+
+Each helper returns the value in its plain Python type, or raises `HybridtrackError` naming
+the parameter, its range and the value given; config classes, CLI flags and API arguments
+share them so that the same mistake reads the same everywhere.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+import pandas as pd
+
+from .errors import HybridtrackError
+
+__all__ = ["number", "whole", "seed", "duration", "angle_pair"]
+
+#: The largest seed: numpy's generators take any non-negative integer; this keeps it in 64 bits.
+MAX_SEED = 2**63 - 1
+
+
+def _range(low: float, high: float, above: bool) -> str:
+    opening = "(" if above else "["
+    return f"{opening}{low:g}, {high:g}]"
+
+
+def number(value, name: str, low: float = -math.inf, high: float = math.inf, *, above: bool = False) -> float:
+    """`value` as a float, refused unless a finite real number within [`low`, `high`].
+
+    Parameters
+    ----------
+    value : object
+    name : str
+        Where the value came from, e.g. ``"drive: speed"``.
+    low, high : float
+        The physical range, inclusive.
+    above : bool
+        Exclude `low` itself: the value must be greater than it.
+
+    Returns
+    -------
+    float
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise HybridtrackError(f"{name} must be a finite number within {_range(low, high, above)}, got {value!r}")
+    if value < low or value > high or (above and value == low):
+        raise HybridtrackError(f"{name} = {value!r} is outside {_range(low, high, above)}")
+    return float(value)
+
+
+def whole(value, name: str, least: int = 0, most: int = 10_000) -> int:
+    """`value` as an int, refused unless a whole number (not a float) within [`least`, `most`]."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not least <= value <= most:
+        raise HybridtrackError(f"{name} must be a whole number within [{least:,}, {most:,}], got {value!r}")
+    return int(value)
+
+
+def seed(value, name: str = "seed") -> int:
+    """A random seed: a whole number from 0 to 2**63 - 1."""
+    return whole(value, name, 0, MAX_SEED)
+
+
+def duration(text, name: str) -> pd.Timedelta:
+    """A positive, finite duration such as ``"20min"``."""
+    try:
+        value = pd.Timedelta(text)
+    except (TypeError, ValueError):
+        value = None
+    if value is None or value is pd.NaT or value <= pd.Timedelta(0):
+        raise HybridtrackError(f"{name} {text!r} is not a positive duration such as '20min'")
+    return value
+
+
+def angle_pair(values, name: str, low: float, high: float) -> tuple[float, float]:
+    """Two finite angles in increasing order within [`low`, `high`] degrees, e.g. an axis's limits."""
+    pair = tuple(values)
+    if len(pair) != 2:
+        raise HybridtrackError(f"{name} must be [low, high], got {list(pair)!r}")
+    first, second = (number(v, name, low, high) for v in pair)
+    if not first < second:
+        raise HybridtrackError(f"{name} must be [low, high] with low < high, got {list(pair)!r}")
+    return first, second

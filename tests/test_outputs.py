@@ -1,0 +1,238 @@
+"""Outputs kept (issue 11, item 5) and runs sized before they start (item 4).
+
+Results are written in full even when the reader of the printout has gone, never through a
+symbolic link, never over an existing file without ``--force``, and their JSON is strict.
+"""
+
+import datetime as dt
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import HybridtrackError, budget, sites
+from hybridtrack.cli import main
+from hybridtrack.collectors import Collector
+from hybridtrack.outputs import claim, replacing, strict_json
+from hybridtrack.simulation import Result, SimulationConfig
+
+REPO = Path(__file__).resolve().parents[1]
+RECORD = str(REPO / "data" / "nanjing-2013-cloudy.csv")
+SHORT = ["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min"]
+RUN_FILES = ("log.parquet", "events.csv", "summary.json", "report.png")
+
+
+def strict(text: str):
+    """Parse JSON, refusing NaN and Infinity as any strict parser would."""
+    def refuse(constant):
+        raise ValueError(f"not JSON: {constant}")
+    return json.loads(text, parse_constant=refuse)
+
+
+# -- strict JSON ----------------------------------------------------------------------------------
+
+def test_strict_json_writes_null_for_every_missing_or_non_finite_number():
+    value = {"a": math.nan, "b": [math.inf, -math.inf, np.float64(2.5), np.int64(3)], "c": None, "d": np.bool_(True)}
+    assert strict_json(value) == '{"a": null, "b": [null, null, 2.5, 3], "c": null, "d": true}'
+
+
+def test_a_summary_with_nan_is_saved_as_strict_json(tmp_path):
+    log = pd.DataFrame({"error": [0.1, 0.2]}, index=pd.date_range("2021-06-21", periods=2, freq="min", tz="UTC"))
+    result = Result(log, {"rms": math.nan, "max": math.inf, "steps": 2}, pd.DataFrame({"event": []}),
+                    sites.get("lanzhou"), Collector(), SimulationConfig())
+    written = result.save(tmp_path / "run", plot=False, log_format="csv")
+    assert strict(written["summary"].read_text()) == {"rms": None, "max": None, "steps": 2}
+
+
+def test_classify_json_is_strict_for_an_infinite_reading(capsys):
+    assert main(["classify", "--intensity", "inf", "--variation", "1", "--json"]) == 0
+    printed = strict(capsys.readouterr().out)
+    assert printed["intensity"] is None and printed["variation"] == 1.0
+
+
+# -- a closed pipe does not lose the results ------------------------------------------------------
+
+class ClosedPipe:
+    """Standard output whose reader has gone: every write and flush raises BrokenPipeError."""
+
+    def write(self, text):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    def flush(self):
+        raise BrokenPipeError(32, "Broken pipe")
+
+
+@pytest.mark.parametrize("args, files", [
+    (SHORT, RUN_FILES),
+    (["replay", RECORD, "--site", "nanjing"], RUN_FILES),
+    (["demo"], RUN_FILES),
+    (["field", "trough", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min", "--count", "2"],
+     ("collectors.csv", "events.csv", "summary.json", "field_map.png", "log.nc")),
+    (["compare", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min"],
+     ("comparison.json", "comparison.png", "hybrid/summary.json", "sensor/log.parquet")),
+], ids=["simulate", "replay", "demo", "field", "compare"])
+def test_results_are_written_when_the_reader_has_gone(tmp_path, monkeypatch, args, files):
+    out = tmp_path / "out"
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    assert main(args + ["--out", str(out)]) == 0
+    for name in files:
+        assert (out / name).stat().st_size > 0, name
+
+
+def test_replay_into_head_writes_out_through_a_real_pipe(tmp_path):
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    child = subprocess.Popen([sys.executable, "-m", "hybridtrack", "replay", RECORD, "--site", "nanjing",
+                              "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    first = child.stdout.readline()  # `| head -1`: one line, then the reader goes
+    child.stdout.close()
+    error = child.stderr.read().decode()
+    assert child.wait() == 0 and first.startswith(RECORD.encode())
+    assert "Traceback" not in error and "Exception ignored" not in error
+    assert strict((out / "summary.json").read_text())["steps"] == 3604
+
+
+# -- existing files: refused without --force, named either way -------------------------------------
+
+def test_existing_results_are_refused_without_force_and_named(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text("the user's own\n")
+    assert main(SHORT + ["--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"hybridtrack: error: would replace 1 existing file: {out / 'summary.json'}; give --force to "
+                   "replace them, or write elsewhere\n")
+    assert (out / "summary.json").read_text() == "the user's own\n" and not (out / "log.parquet").exists()
+
+
+def test_force_replaces_and_says_which(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(SHORT + ["--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(SHORT + ["--out", str(out), "--force"]) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last == "replaced (--force): " + ", ".join(str(out / name) for name in RUN_FILES)
+
+
+def test_demo_run_twice_replaces_its_own_folder_but_not_another(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["demo"]) == 0
+    capsys.readouterr()
+    assert main(["demo"]) == 0
+    assert capsys.readouterr().out.rstrip().endswith("(replacing those of an earlier run)")
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "events.csv").write_text("the user's own\n")
+    assert main(["demo", "--out", str(mine)]) == 2
+    assert "would replace 1 existing file" in capsys.readouterr().err
+    assert (mine / "events.csv").read_text() == "the user's own\n"
+
+
+def test_the_api_replaces_unless_asked_not_to(tmp_path):
+    path = tmp_path / "run.toml"
+    path.write_text("seed = 1\n")
+    SimulationConfig().to_toml(path)  # as open() would
+    assert "seed = 0" in path.read_text()
+    with replacing(False), pytest.raises(HybridtrackError, match="would replace 1 existing file"):
+        SimulationConfig(seed=2).to_toml(path)
+    with replacing(True) as replaced:
+        claim([path, tmp_path / "new.toml"])
+    assert replaced == [path]
+
+
+# -- symbolic links --------------------------------------------------------------------------------
+
+def test_a_link_planted_in_out_is_refused_and_nothing_is_written(tmp_path, capsys):
+    out, victim = tmp_path / "out", tmp_path / "elsewhere.json"
+    out.mkdir()
+    (out / "summary.json").symlink_to(victim)
+    assert main(SHORT + ["--out", str(out), "--force"]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {out / 'summary.json'} is a symbolic link; results are "
+                                       "never written through one (remove it or write elsewhere)\n")
+    assert not victim.exists() and not (out / "log.parquet").exists()
+
+
+def test_an_out_folder_that_is_a_link_is_refused(tmp_path, capsys):
+    target, out = tmp_path / "target", tmp_path / "out"
+    target.mkdir()
+    out.symlink_to(target, target_is_directory=True)
+    assert main(["sky", "--site", "lanzhou", "--date", "2021-06-21", "--out", str(out / "sky.csv")]) == 2
+    assert f"{out} is a symbolic link" in capsys.readouterr().err and not list(target.iterdir())
+
+
+# -- the size of a run, before anything is made ----------------------------------------------------
+
+def test_the_budget_is_half_the_available_memory_up_to_16_gib(monkeypatch):
+    monkeypatch.setattr(budget, "available_memory", lambda: 2_000_000_000)
+    assert budget.memory_budget() == 1_000_000_000
+    monkeypatch.setattr(budget, "available_memory", lambda: 2**40)
+    assert budget.memory_budget() == 16 * 2**30
+
+
+def test_a_refusal_names_a_coarser_step_and_a_shorter_span(monkeypatch):
+    # budget 1e9 bytes = 500,000 steps of 2,000 bytes; ten days at 1 s are 864,000 steps (1.728e9 bytes).
+    # At 2 s they are 432,001 steps (0.864e9 bytes): they fit. At 1 s, 499,999 s = 5.787 days fit.
+    monkeypatch.setattr(budget, "available_memory", lambda: 2_000_000_000)
+    first = pd.Timestamp("2021-06-21", tz="UTC")
+    last = first + pd.Timedelta(days=10) - pd.Timedelta(seconds=1)
+    with pytest.raises(HybridtrackError) as error:
+        budget.check_steps(first, last, "1s", what="ten days")
+    assert str(error.value) == ("ten days: 864,000 steps of 1s would need about 1.7 GB of memory, over the 1.0 GB a run "
+                                "may use; use a step of 2s or a span of at most 5.8 days at this step")
+    assert budget.check_steps(first, last, "2s") == 432_000
+
+
+def test_simulate_refuses_a_year_at_one_second_before_allocating(capsys):
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-01-01", "--days", "365", "--freq", "1s"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("hybridtrack: error: 2021-01-01 to 2021-12-31: 31,536,000 steps of 1s would need about "
+                          "63.1 GB of memory") and err.count("\n") == 1
+
+
+def test_a_frame_too_long_for_memory_is_refused_by_simulate(monkeypatch):
+    from hybridtrack.simulation import simulate
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-21", freq="10min")  # 144 steps x 2,000 bytes = 288,000 bytes
+    monkeypatch.setattr(budget, "available_memory", lambda: 500_000)  # a budget of 250,000 bytes
+    with pytest.raises(HybridtrackError, match="the weather frame: 144 steps of 10min would need about 288 kB of memory, over the 250 kB"):
+        simulate(frame, "lanzhou")
+
+
+@pytest.mark.slow
+def test_bytes_per_step_covers_the_measured_peak_of_a_run():
+    """The slope of simulate's peak traced memory between a 2-day and an 8-day run at 30 s."""
+    import tracemalloc
+
+    from hybridtrack.simulation import simulate
+    from hybridtrack.sky import synthetic
+
+    def peak(days, collector):
+        first = dt.date(2021, 6, 21)
+        tracemalloc.start()
+        frame = synthetic("lanzhou", first, first + dt.timedelta(days=days - 1), freq="30s", seed=1)
+        simulate(frame, "lanzhou", collector=collector)
+        size = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        return len(frame), size
+
+    peak(1, "trough-ns")  # imports and caches out of the way
+    for collector in ("trough-ns", "heliostat"):
+        (n1, p1), (n2, p2) = peak(2, collector), peak(8, collector)
+        assert 0 < (p2 - p1) / (n2 - n1) <= budget.BYTES_PER_STEP
+
+
+def test_an_out_that_is_a_file_or_under_one_is_one_line(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("the user's own\n")
+    assert main(SHORT + ["--out", str(afile)]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {afile} is a file, not a folder\n"
+    assert main(SHORT + ["--out", str(afile / "sub")]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {afile / 'sub'}: cannot make the folder (Not a directory)\n"
+    assert afile.read_text() == "the user's own\n"
