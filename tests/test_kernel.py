@@ -248,6 +248,26 @@ def test_a_recorded_photocurrent_and_a_frame_without_wind_or_diffuse_run_the_sam
         assert_same_run(*both(recorded, "lanzhou", config=config, strategy=strategy))
 
 
+@pytest.mark.parametrize("policy,distrust", [("sensor", "60min"), ("model", "25min")])
+def test_either_disagreement_policy_runs_the_same_compiled(policy, distrust):
+    scenario = SCENARIOS["encoder-step"]
+    frame, faults, _, _ = scenario.build(scenario.site)
+    config = replaced(controller={"on_disagreement": policy, "distrust": distrust})
+    runs = both(frame, scenario.site, collector=scenario.collector, config=config, faults=faults)
+    assert runs[1].events["reason"].str.contains("sensor trusted" if policy == "sensor" else "25 min").any()
+    assert_same_run(*runs)
+
+
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_a_recorded_pointing_signal_runs_the_same_compiled(mixed_day, collector):
+    rng = np.random.default_rng(2)
+    n = len(mixed_day)
+    recorded = mixed_day.assign(pointing=np.where(rng.random(n) < 0.2, np.nan, rng.normal(0.0, 0.3, n)))
+    if collector == "heliostat":
+        recorded = recorded.assign(pointing_2=rng.normal(0.0, 0.3, n))
+    assert_same_run(*both(recorded, "lanzhou", collector=collector))
+
+
 def test_the_clock_watch_alarms_the_same_compiled():
     """Both of the clock watch's alarms, worded by the kernel as the reference words them, and the
     summary's clock fit (a trough drifting a minute a day, a heliostat five minutes wrong)."""

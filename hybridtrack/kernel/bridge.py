@@ -45,6 +45,7 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
         return np.full(n, default, dtype) if values is None else np.asarray(values, dtype)
 
     recorded = world._recorded_current
+    pointing = world._recorded_pointing
     arrays = WorldArrays(
         np.asarray(world._truth, float), beam, aureole, patch, patch_offset, diffuse,
         np.asarray(world._noise, float), np.asarray(world._current_noise, float),
@@ -59,7 +60,8 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
         float(sensor.responsivity), float(sensor.diffuse_share), float(sensor.current_noise),
         float(world.imperfections.encoder_offset), np.array([d.resolution for d in world.drives]),
         np.array([d.limits[0] for d in world.drives]), np.array([d.limits[1] for d in world.drives]),
-        np.array(world.circular, bool))
+        np.array(world.circular, bool),
+        np.array(pointing if pointing is not None else np.zeros((axes, 0)), float), pointing is not None)
     state = WorldState(np.array(world.actual, float), np.array(world._last_encoder, float), np.full((axes, n), np.nan))
     return arrays, state
 
@@ -74,7 +76,8 @@ def _settings(controller: Controller) -> kc.ControllerSettings:
         config.uses_sensor, config.uses_model, config.calibrates, config.sensor_only, config.strategy in CLASSIFYING,
         config.strategy in ("hybrid-always", "sensor"), config.strategy == "hybrid-oracle", bool(config.lead),
         controller.dwell, controller.loss, controller.coast_for, float(config.dusk_current),
-        float(config.sensor_plausibility), float(config.disagreement),
+        float(config.sensor_plausibility), float(config.disagreement), config.on_disagreement == "sensor",
+        float(config.minutes("distrust")),
         float(controller.wind.stow_above), float(controller.wind.release_at), float(controller.wind.hold),
         controller.wind.stow_when_missing, int(config.encoder_confirm),
         float(gate.filter.q), np.array([g.filter.r for g in controller.gates], float), int(gate.angles.maxlen),

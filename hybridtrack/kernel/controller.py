@@ -34,7 +34,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..control.clockwatch import ALARM_SIGMAS, CLOCK_TOLERANCE, DRIFT_DAYS, DRIFT_TOLERANCE, SPELL, SPELL_GAP
-from ..control.controller import DISTRUST_MINUTES, DUSK_MINUTES, FIT_EVERY, SETTLE_UPDATES
+from ..control.controller import DUSK_MINUTES, FIT_EVERY, SETTLE_UPDATES
 from ..control.disagreement import ALLOWANCE, MIN_RUN, THRESHOLD
 from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGHT, NOT_READ, OK, OUT_OF_VIEW,
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
@@ -49,7 +49,7 @@ __all__ = ["ControllerSettings", "ControllerPlanArrays", "ControllerState", "Con
 #: What the controller is told (its config, its drives' datasheets, its classifier as a table).
 ControllerSettings = namedtuple("ControllerSettings", [
     "uses_sensor", "uses_model", "calibrates", "sensor_only", "classifying", "trusts_always", "oracle", "lead",
-    "dwell", "loss", "coast_for", "dusk_current", "plausibility", "disagreement",
+    "dwell", "loss", "coast_for", "dusk_current", "plausibility", "disagreement", "follow_sensor", "distrust",
     "wind_stow", "wind_release", "wind_hold", "stow_when_missing", "encoder_confirm",
     "q", "r", "stuck_scans", "stuck_spread", "gate2", "reacquire", "tau", "max_rate",
     "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "clock_r", "clock_prior",
@@ -600,10 +600,14 @@ def _disagrees(cfg, state, log, i, miss, spread):
         return False
     count = state.k[CUSUM_RUN]
     mean = state.s[CUSUM_SUM] / count if count else 0.0
+    _disagreement_reset(state)
+    if cfg.follow_sensor:  # on_disagreement = "sensor": the mount moved, the fit follows the sensor
+        _checkpoint(state)
+        _alarm(i, ev.DISAGREEMENT_FOLLOWED, mean, float(count), state, log)
+        return False
     if state.k[HAS_CHECKPOINT]:
         _recall(cfg, state)
-    _disagreement_reset(state)
-    state.s[DISTRUSTED_UNTIL] = state.s[PREVIOUS_T] + DISTRUST_MINUTES
+    state.s[DISTRUSTED_UNTIL] = state.s[PREVIOUS_T] + cfg.distrust
     _alarm(i, ev.DISAGREEMENT, mean, float(count), state, log)
     return True
 

@@ -7,7 +7,6 @@ mode, code, value, value, value); `wording` words it exactly as the reference co
 
 from __future__ import annotations
 
-from ..control.controller import DISTRUST_MINUTES
 from ..control.modes import SENSOR_STATUS, SKY_CODES
 from ..control.wind import STUCK_HOURS
 
@@ -16,7 +15,7 @@ __all__ = ["wording"]
 (PLAN_ALARM, CLOCK_STEPPED, ENCODER_FROZEN, ENCODER_BELIEVED, ENCODER_GLITCH, ANEMOMETER_MOVING, ANEMOMETER_STUCK,
  WIND_MISSING, WIND_HIGH, WIND_RELEASED, WIND_RELEASED_FROZEN, NEW_DAY_PROBE, NIGHT, WAKE, SENSOR_LOST, SKY_NOT_SUNNY,
  TRUE_SKY_NOT_SUNNY, SENSOR_TRUSTED, SKY_SUNNY, SUN_BACK, OUT_OF_FINE_VIEW, DISAGREEMENT, CLOCK_OFF,
- CLOCK_DRIFTING) = range(1, 25)
+ CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED) = range(1, 26)
 #: A flag added to the wind codes when the stow is a timed move from the last trusted reading.
 BLIND = 100
 
@@ -24,6 +23,7 @@ BLIND = 100
 def wording(config, plan_alarms: dict):
     """`reason(code, value, other, scan, third)`: the reference controller's text for an event, for a
     run of controller `config` whose plan raised `plan_alarms` (by scan)."""
+    distrust = config.minutes("distrust")
     released = f"wind at or below {config.wind_release} m/s for {config.wind_hold}"
     texts = {
         PLAN_ALARM: lambda value, other, scan, third: plan_alarms[scan],
@@ -55,7 +55,10 @@ def wording(config, plan_alarms: dict):
         OUT_OF_FINE_VIEW: lambda value, other, scan, third: "the acquisition cells see the sun outside the fine view",
         DISAGREEMENT: lambda value, other, scan, third: (
             f"sensor and calibrated model disagree: mean residual {value:+.3f}° over {int(other)} readings; "
-            f"calibration rolled back, sensor not trusted for {DISTRUST_MINUTES:.0f} min"),
+            f"calibration rolled back, sensor not trusted for {distrust:.0f} min"),
+        DISAGREEMENT_FOLLOWED: lambda value, other, scan, third: (
+            f"sensor and calibrated model disagree: mean residual {value:+.3f}° over {int(other)} readings; "
+            "sensor trusted, calibration follows it (on_disagreement = 'sensor')"),
         CLOCK_OFF: lambda value, other, scan, third: (
             f"controller clock off by {value:+.0f} s (±{other:.0f} s) against the sun the sensor shows, "
             f"over {int(third)} readings"),

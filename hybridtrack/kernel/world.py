@@ -26,7 +26,7 @@ WorldArrays = namedtuple("WorldArrays", [
     "sensor_fault", "sensor_drift", "sensor_dropout", "encoder_fault", "encoder_frozen",
     "bias", "field_of_view", "direct_threshold", "sensor_noise", "coarse_field_of_view", "coarse_accuracy",
     "dark_current", "responsivity", "diffuse_share", "current_noise_ma",
-    "encoder_offset", "resolution", "low", "high", "circular"])
+    "encoder_offset", "resolution", "low", "high", "circular", "pointing", "has_pointing"])
 #: Where each axis stands, the encoder's last reading, and the angle of every scan (axes, N).
 WorldState = namedtuple("WorldState", ["actual", "last_encoder", "angles"])
 
@@ -109,7 +109,15 @@ def world_observe(w, state, i, obs, obs_axes, offsets, reported):
     axes = state.actual.shape[0]
     for a in range(axes):
         offsets[a] = _offset(w, state, a, i)
-    obs[2] = 1.0 if read_pointing(w, i, offsets, reported) else 0.0
+    if w.has_pointing:  # as recorded: what the logger's sensor said
+        valid = True
+        for a in range(axes):
+            reported[a] = w.pointing[a, i]
+            if math.isnan(reported[a]):
+                valid = False
+        obs[2] = 1.0 if valid else 0.0
+    else:
+        obs[2] = 1.0 if read_pointing(w, i, offsets, reported) else 0.0
     _sensor_faults(w, i, reported, obs, obs_axes)
     obs[0], obs[1] = w.minutes[i], w.wind[i]
     worst = 0.0
