@@ -27,6 +27,7 @@ from .budget import check_steps
 from .errors import HybridtrackError
 from .outputs import claim, strict_json, write
 from .fuzzy import FuzzyWeatherClassifier
+from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
 from .mounting import incidence_cosine
 from .mountreport import FIT_PREFIX
@@ -76,6 +77,12 @@ class SimulationConfig:
     truth : {"spa-fast", "spa"}
         How the world computes the true sun: SPA with its slow series interpolated from hourly
         knots (within 1e-5° of SPA, a tenth of its cost; ``hybridtrack.sun``) or SPA itself.
+    engine : {"auto", "compiled", "reference"}
+        How the scans are stepped: ``reference`` the readable Python controller and world,
+        ``compiled`` the numba kernel that restates them (`hybridtrack.kernel`, held equal by
+        tests), ``auto`` the kernel where it supports the run, numba is installed and the kernel
+        is compiled already (its disk cache) or the run is long enough to pay for compiling it
+        (`hybridtrack.kernel.COMPILE_PAYS_AT` scans), else the reference: the same results.
     """
 
     controller: ControllerConfig = field(default_factory=ControllerConfig)
@@ -86,11 +93,14 @@ class SimulationConfig:
     sky: SkyInputConfig = field(default_factory=SkyInputConfig)
     seed: int = 0
     truth: str = "spa-fast"
+    engine: str = "auto"
 
     def __post_init__(self) -> None:
         if self.truth not in ("spa-fast", "spa"):
             raise HybridtrackError(f"truth {self.truth!r}: choose 'spa-fast' or 'spa'")
         params.seed(self.seed, "seed")
+        if self.engine not in ENGINES:
+            raise HybridtrackError(f"engine {self.engine!r}: choose {', '.join(map(repr, ENGINES))}")
 
     def to_dict(self) -> dict:
         """A plain dict in the TOML layout."""
@@ -330,8 +340,11 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         plan.apparent_altitude = clear["apparent_elevation"].to_numpy()
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory)
-    _run(world, controller, progress, bulk_nights and not faults)
-    out = controller.outputs()
+    if uses_kernel(config, world.n):
+        out = run_compiled(world, controller, progress, bulk_nights and not faults)
+    else:
+        _run(world, controller, progress, bulk_nights and not faults)
+        out = controller.outputs()
     index = frame.index
     log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
                                                        world.controller_site()))

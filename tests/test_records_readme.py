@@ -106,7 +106,7 @@ def test_the_alias_table_in_the_docs_is_the_codes():
     text = (ROOT / "docs" / "records.md").read_text()
     section = text[text.index("### Column names"):text.index("## Time stamps")]
     for line in section.splitlines():
-        match = re.match(r"\| (time|date|clock|ghi|dni|dhi|wind_speed|temp_air|photocurrent)\b[^|]*\| (.*) \|$", line)
+        match = re.match(r"\| (time|date|clock|ghi|dni|dhi|wind_speed|temp_air|photocurrent|pointing_2|pointing)\b[^|]*\| (.*) \|$", line)
         if match:
             rows[match.group(1)] = set(re.findall(r"`([^`]*)`", match.group(2)))
     assert set(rows) == set(ALIASES)

@@ -185,7 +185,7 @@ def test_the_controllers_own_sky_watch_matches_the_reference_inputs(inputs):
 
     Controller.outputs = keep
     try:
-        result = simulate(frame, "nanjing", config=SimulationConfig(sky=sky), warm_start=False)
+        result = simulate(frame, "nanjing", config=SimulationConfig(sky=sky, engine="reference"), warm_start=False)
     finally:
         Controller.outputs = original
     online = captured["out"].sky_score

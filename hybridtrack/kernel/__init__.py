@@ -1,0 +1,84 @@
+"""The compiled controller kernel (numba): the same controller and world step as the readable
+reference (`hybridtrack.control`, `hybridtrack.world`), run over the scans in compiled code.
+
+`SimulationConfig.engine` chooses: ``auto`` (the default) runs the kernel where it supports the
+run, numba imports and the kernel is quicker than the reference loop: compiled in this process
+already, or the run long enough to pay for loading it from the disk cache (`LOAD_PAYS_AT` scans)
+or for compiling it (`COMPILE_PAYS_AT`); ``compiled`` insists on it, ``reference`` runs the
+Python loop. The two give the same results, so ``auto`` only chooses
+the faster way.
+See ``docs/kernel.md`` for what it covers, how parity with the reference is tested, and its speed.
+"""
+
+from __future__ import annotations
+
+from ..errors import HybridtrackError
+from .jit import available
+
+__all__ = ["ENGINES", "COMPILE_PAYS_AT", "LOAD_PAYS_AT", "available", "cached", "compiled", "unsupported", "uses_kernel", "run_compiled"]
+
+#: The choices of `SimulationConfig.engine`.
+ENGINES = ("auto", "compiled", "reference")
+#: Scans from which ``auto`` compiles the kernel when it is not compiled yet: compiling into an
+#: empty cache took 76 s on a 2-core machine (115 s with the other core busy) and the compiled
+#: loop saves about 20 µs a scan against the reference loop, so it pays from about 4 million
+#: scans (docs/kernel.md, measured).
+COMPILE_PAYS_AT = 4_000_000
+#: Scans from which ``auto`` loads the kernel from its disk cache: loading took 0.9-1.5 s, so it
+#: pays from 45,000-75,000 scans by the loop's saving alone (fewer end to end): 50,000, 35 days
+#: at 1 minute.
+LOAD_PAYS_AT = 50_000
+
+
+def unsupported(config) -> str | None:
+    """Why the kernel cannot run `config` (a `SimulationConfig`), or None when it can."""
+    if config.controller.kalman != "fast":
+        return f"the kernel runs the 'fast' Kalman filter, not {config.controller.kalman!r}"
+    return None
+
+
+def compiled() -> bool:
+    """Whether the kernel's scan loop is compiled in this process already."""
+    if not available():
+        return False
+    from .loop import run_scans
+
+    return bool(run_scans.signatures)
+
+
+def cached() -> bool:
+    """Whether numba's disk cache holds the kernel's scan loop for these sources (its first call
+    in a process then loads it in about a second instead of compiling)."""
+    if not available():
+        return False
+    from .loop import run_scans  # importing empties a cache stamped for other sources (`jit`)
+
+    try:
+        return bool(run_scans._cache._cache_file._load_index())  # {} when absent or stale
+    except Exception:  # pragma: no cover - numba's cache internals moved: compile only when it pays
+        return False
+
+
+def uses_kernel(config, scans: int = 0) -> bool:
+    """Whether a run of `config` over `scans` scans goes through the kernel; ``compiled`` refuses
+    what it cannot run; ``auto`` takes it where it is compiled already or the run pays for
+    loading it (`LOAD_PAYS_AT`, from the disk cache) or compiling it (`COMPILE_PAYS_AT`)."""
+    if config.engine == "reference":
+        return False
+    why = unsupported(config)
+    if config.engine == "compiled":
+        if why:
+            raise HybridtrackError(f"engine 'compiled': {why}; use engine 'auto' or 'reference'")
+        if not available():
+            raise HybridtrackError("engine 'compiled' needs numba, which is not installed (pip install numba)")
+        return True
+    if why is not None or not available():
+        return False
+    return compiled() or scans >= COMPILE_PAYS_AT or (scans >= LOAD_PAYS_AT and cached())
+
+
+def run_compiled(world, controller, progress, bulk_nights):
+    """Run the scans through the kernel (`hybridtrack.kernel.bridge.run_compiled`)."""
+    from .bridge import run_compiled as run
+
+    return run(world, controller, progress, bulk_nights)

@@ -1,0 +1,432 @@
+"""The compiled kernel (hybridtrack.kernel) against the readable reference controller and world:
+identical modes, sensor statuses, sky and events, angles and every other number to 1e-9."""
+
+import ast
+import dataclasses
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import hybridtrack.kernel as kernel
+from hybridtrack import simulate
+from hybridtrack.control import STRATEGIES
+from hybridtrack.errors import HybridtrackError
+from hybridtrack.faults import SCENARIOS
+from hybridtrack.simulation import FAULTS, SimulationConfig
+from hybridtrack.sky import synthetic
+from hybridtrack.skyinputs import SkyInputConfig
+from hybridtrack.world import Imperfections
+
+COLLECTORS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
+TOLERANCE = 1e-9
+
+
+def both(frame, site, *, config=None, **options):
+    """The same run on the reference loop and on the kernel."""
+    config = config or SimulationConfig()
+    return [simulate(frame, site, config=dataclasses.replace(config, engine=engine), **options)
+            for engine in ("reference", "compiled")]
+
+
+def assert_same_numbers(reference, compiled, where):
+    reference, compiled = np.asarray(reference, float), np.asarray(compiled, float)
+    assert reference.shape == compiled.shape, where
+    assert np.array_equal(np.isnan(reference), np.isnan(compiled)), where
+    assert np.allclose(reference, compiled, rtol=0.0, atol=TOLERANCE, equal_nan=True), \
+        f"{where}: {np.nanmax(np.abs(reference - compiled))}"
+
+
+def assert_same_run(reference, compiled):
+    """Every log column, every event, the summary and the memory the run carries over."""
+    assert list(reference.log.columns) == list(compiled.log.columns)
+    for column in reference.log.columns:
+        ours, theirs = reference.log[column], compiled.log[column]
+        if ours.dtype.kind in "fc":
+            assert_same_numbers(ours, theirs, column)
+        else:
+            assert ours.astype(object).equals(theirs.astype(object)), column
+    pd.testing.assert_frame_equal(reference.events, compiled.events)
+    assert_same_summary(reference.summary, compiled.summary, "summary")
+    assert_same_summary(reference.memory, compiled.memory, "memory")
+
+
+def assert_same_summary(reference, compiled, where):
+    if isinstance(reference, dict):
+        assert set(reference) == set(compiled), where
+        for key in reference:
+            assert_same_summary(reference[key], compiled[key], f"{where}.{key}")
+    elif isinstance(reference, (list, tuple, np.ndarray)) and np.asarray(reference).dtype.kind in "fiub":
+        assert_same_numbers(reference, compiled, where)
+    elif isinstance(reference, float):
+        assert_same_numbers([reference], [compiled], where)
+    else:
+        assert reference == compiled, where
+
+
+@pytest.fixture(scope="module")
+def mixed_day():
+    return synthetic("lanzhou", "2021-06-21", weather="mixed", seed=3, gusts_per_day=2.0)
+
+
+def _strategies_on_collectors():
+    """Every strategy on every collector; the default run keeps every strategy on the heliostat
+    (two axes, the most of the controller) and the hybrid on each collector, the rest are slow."""
+    for collector in COLLECTORS:
+        for strategy in STRATEGIES:
+            quick = collector == "heliostat" or strategy == "hybrid"
+            yield pytest.param(strategy, collector, marks=() if quick else pytest.mark.slow,
+                               id=f"{strategy}-{collector}")
+
+
+@pytest.mark.parametrize("strategy,collector", _strategies_on_collectors())
+def test_every_strategy_on_every_collector_runs_the_same_compiled(mixed_day, strategy, collector):
+    assert_same_run(*both(mixed_day, "lanzhou", strategy=strategy, collector=collector))
+
+
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+@pytest.mark.parametrize("fault", FAULTS)
+def test_every_injected_fault_runs_the_same_compiled(mixed_day, fault, collector):
+    n = len(mixed_day)
+    window = (np.arange(n) >= 660) & (np.arange(n) < 780)
+    axes = 2 if collector == "heliostat" else 1
+    values = {
+        "sensor": np.where(window, 0.1, np.nan), "sensor_dropout": window, "sensor_drift": np.where(window, 0.5, 0.0),
+        "encoder": np.where(np.arange(n) == 700, 5.625, 0.0), "encoder_frozen": window,
+        "clock": np.where(np.arange(n) >= 720, 600.0, 0.0)}[fault]
+    if fault == "sensor" and axes == 2:
+        values = np.column_stack([values, values])
+    assert_same_run(*both(mixed_day, "lanzhou", collector=collector, faults={fault: values}))
+
+
+def scenario_runs(name):
+    scenario = SCENARIOS[name]
+    frame, faults, changes, _ = scenario.build(scenario.site)
+    config = SimulationConfig()
+    for part, values in changes.items():
+        config = dataclasses.replace(config, **{part: dataclasses.replace(getattr(config, part), **values)})
+    return both(frame, scenario.site, collector=scenario.collector, config=config, faults=faults or None)
+
+
+@pytest.mark.parametrize("name", ["sensor-drift", "encoder-frozen-gust", "clock-creep", "wind-stuck",
+                                  "heliostat-wrap"])
+def test_fault_scenarios_run_the_same_compiled(name):
+    assert_same_run(*scenario_runs(name))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(SCENARIOS))
+def test_every_fault_scenario_runs_the_same_compiled(name):
+    assert_same_run(*scenario_runs(name))
+
+
+def test_a_warm_start_and_a_cold_one_both_run_the_same_compiled(mixed_day):
+    for warm in (True, False):
+        assert_same_run(*both(mixed_day, "lanzhou", warm_start=warm))
+
+
+def test_nights_in_bulk_or_scan_by_scan_run_the_same_compiled(mixed_day):
+    bulk = simulate(mixed_day, "lanzhou", config=SimulationConfig(engine="compiled"))
+    scans = simulate(mixed_day, "lanzhou", config=SimulationConfig(engine="compiled"), bulk_nights=False)
+    assert_same_run(bulk, scans)
+
+
+def test_the_kernel_reports_progress_over_every_scan(mixed_day):
+    done = []
+    simulate(mixed_day, "lanzhou", config=SimulationConfig(engine="compiled"), progress=done.append)
+    assert sum(done) == len(mixed_day)
+
+
+def test_the_engine_round_trips_through_toml_and_unknown_ones_are_refused(tmp_path):
+    config = SimulationConfig(engine="reference")
+    assert SimulationConfig.from_toml(config.to_toml(tmp_path / "run.toml")) == config
+    with pytest.raises(HybridtrackError, match="engine"):
+        SimulationConfig(engine="fortran")
+
+
+def test_auto_takes_the_reference_path_for_what_the_kernel_does_not_run(mixed_day):
+    filterpy = SimulationConfig(controller=dataclasses.replace(SimulationConfig().controller, kalman="filterpy"))
+    assert kernel.unsupported(filterpy) and not kernel.uses_kernel(filterpy, kernel.COMPILE_PAYS_AT)
+    assert kernel.uses_kernel(SimulationConfig(), kernel.COMPILE_PAYS_AT)
+    with pytest.raises(HybridtrackError, match="fast"):
+        kernel.uses_kernel(dataclasses.replace(filterpy, engine="compiled"))
+
+
+def test_auto_takes_the_kernel_only_where_it_is_quicker(monkeypatch, mixed_day):
+    """Compiled in this process: always; loaded from the disk cache: from LOAD_PAYS_AT scans;
+    compiled afresh: from COMPILE_PAYS_AT scans; otherwise the reference (the same results)."""
+    config, day = SimulationConfig(), len(mixed_day)
+    simulate(mixed_day, "lanzhou", config=dataclasses.replace(config, engine="compiled"))
+    assert kernel.compiled() and kernel.cached()  # a compiled run leaves the loop in numba's disk cache
+    assert kernel.uses_kernel(config, day)
+    monkeypatch.setattr(kernel, "compiled", lambda: False)
+    monkeypatch.setattr(kernel, "cached", lambda: True)
+    assert not kernel.uses_kernel(config, day) and kernel.uses_kernel(config, kernel.LOAD_PAYS_AT)
+    monkeypatch.setattr(kernel, "cached", lambda: False)
+    assert not kernel.uses_kernel(config, kernel.COMPILE_PAYS_AT - 1)
+    assert kernel.uses_kernel(config, kernel.COMPILE_PAYS_AT)
+    assert kernel.uses_kernel(dataclasses.replace(config, engine="compiled"), day)
+    assert not kernel.uses_kernel(dataclasses.replace(config, engine="reference"), kernel.COMPILE_PAYS_AT)
+
+
+def test_a_fresh_install_runs_a_day_on_auto_without_compiling(tmp_path):
+    script = (
+        "import hybridtrack.kernel as kernel\n"
+        "from hybridtrack import simulate\n"
+        "from hybridtrack.kernel.loop import run_scans\n"
+        "from hybridtrack.sky import synthetic\n"
+        "assert not kernel.cached()\n"
+        "simulate(synthetic('lanzhou', '2021-06-21', weather='mixed', seed=1), 'lanzhou')\n"
+        "print(len(run_scans.signatures))\n")
+    env = dict(os.environ, PYTHONPATH=str(Path(kernel.__file__).parents[2]), NUMBA_CACHE_DIR=str(tmp_path))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "0"
+
+
+def test_the_compiled_controller_imports_nothing_of_the_world():
+    source = Path(kernel.__file__).parent / "controller.py"
+    for node in ast.walk(ast.parse(source.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            named = module.split(".")[-1]
+            assert not module.startswith("..") and named not in ("world", "sensor", "sky", "simulation"), module
+            assert node.level < 2 or module.split(".")[0] == "control", module
+
+
+def test_without_numba_the_package_runs_the_reference_with_one_warning():
+    script = (
+        "import sys, warnings\n"
+        "sys.modules['numba'] = None\n"
+        "warnings.simplefilter('always')\n"
+        "with warnings.catch_warnings(record=True) as caught:\n"
+        "    from hybridtrack import simulate\n"
+        "    from hybridtrack.sky import synthetic\n"
+        "    frame = synthetic('lanzhou', '2021-06-21 10:00', '2021-06-21 12:00', weather='sunny', seed=1)\n"
+        "    simulate(frame, 'lanzhou', bulk_nights=False)\n"
+        "    simulate(frame, 'lanzhou')\n"
+        "ours = [str(w.message) for w in caught if 'controller loop' in str(w.message)]\n"
+        "print(len(ours))\n")
+    env = dict(os.environ, PYTHONPATH=str(Path(kernel.__file__).parents[2]))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "1"
+
+
+def replaced(**parts):
+    """A config with some of its parts' fields changed: ``controller={"lead": False}``."""
+    config = SimulationConfig()
+    for part, values in parts.items():
+        current = getattr(config, part)
+        config = dataclasses.replace(config, **{part: dataclasses.replace(current, **values) if isinstance(values, dict)
+                                                else values})
+    return config
+
+
+@pytest.mark.parametrize("config", [
+    replaced(sky=SkyInputConfig.published()),
+    replaced(sky={"low_sun": "unknown", "smoothing": None}),
+    replaced(controller={"lead": False, "sun_model": "spa", "working_hours": ("07:00", "18:30")}),
+    replaced(controller={"wind_missing": "track"}, imperfections=Imperfections.none()),
+    replaced(drive={"deadband": 0.1, "encoder_bits": 16}, seed=7),
+], ids=["published-sky", "no-smoothing-no-low-sun-label", "no-lead-spa-hours", "track-missing-wind", "fine-drive"])
+@pytest.mark.parametrize("strategy", ["hybrid", "sensor"])
+def test_other_configs_run_the_same_compiled(mixed_day, config, strategy):
+    assert_same_run(*both(mixed_day, "lanzhou", config=config, strategy=strategy))
+
+
+def test_a_recorded_photocurrent_and_a_frame_without_wind_or_diffuse_run_the_same_compiled(mixed_day):
+    rng = np.random.default_rng(0)
+    current = 30.0 + rng.uniform(0, 300, len(mixed_day))
+    recorded = mixed_day.drop(columns=["wind_speed", "dhi"]).assign(photocurrent=current)
+    config = replaced(controller={"wind_missing": "track"})
+    for strategy in ("hybrid", "sensor"):
+        assert_same_run(*both(recorded, "lanzhou", config=config, strategy=strategy))
+
+
+@pytest.mark.parametrize("policy,distrust", [("sensor", "60min"), ("model", "25min")])
+def test_either_disagreement_policy_runs_the_same_compiled(policy, distrust):
+    scenario = SCENARIOS["encoder-step"]
+    frame, faults, _, _ = scenario.build(scenario.site)
+    config = replaced(controller={"on_disagreement": policy, "distrust": distrust})
+    runs = both(frame, scenario.site, collector=scenario.collector, config=config, faults=faults)
+    assert runs[1].events["reason"].str.contains("sensor trusted" if policy == "sensor" else "25 min").any()
+    assert_same_run(*runs)
+
+
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_a_recorded_pointing_signal_runs_the_same_compiled(mixed_day, collector):
+    rng = np.random.default_rng(2)
+    n = len(mixed_day)
+    recorded = mixed_day.assign(pointing=np.where(rng.random(n) < 0.2, np.nan, rng.normal(0.0, 0.3, n)))
+    if collector == "heliostat":
+        recorded = recorded.assign(pointing_2=rng.normal(0.0, 0.3, n))
+    assert_same_run(*both(recorded, "lanzhou", collector=collector))
+
+
+def test_the_clock_watch_alarms_the_same_compiled():
+    """Both of the clock watch's alarms, worded by the kernel as the reference words them, and the
+    summary's clock fit (a trough drifting a minute a day, a heliostat five minutes wrong)."""
+    drifting = replaced(imperfections={"clock_drift": 60.0, "clock_error": 0.0, "commissioned_days_ago": 0.0}, seed=1)
+    runs = both(synthetic("lanzhou", "2021-06-21", "2021-06-23", weather="sunny", seed=1), "lanzhou",
+                config=drifting, collector="trough-ns")
+    assert any("clock drifting" in reason for reason in runs[1].events["reason"])
+    assert "drift_s_per_day" in runs[1].summary["clock"]
+    assert_same_run(*runs)
+    wrong = replaced(imperfections={"clock_error": 300.0, "clock_drift": 0.0}, seed=1)
+    runs = both(synthetic("delingha", "2018-06-21", "2018-06-21", weather="sunny", seed=1), "delingha",
+                config=wrong, collector="heliostat")
+    assert any("clock off by" in reason for reason in runs[1].events["reason"])
+    assert_same_run(*runs)
+
+
+def test_a_rolled_heliostat_pedestal_runs_the_same_compiled(mixed_day):
+    rolled = replaced(imperfections={"axis_roll_error": 0.4})
+    runs = both(mixed_day, "lanzhou", config=rolled, collector="heliostat")
+    plain = simulate(mixed_day, "lanzhou", collector="heliostat", config=replaced(engine="compiled"))
+    assert not np.array_equal(runs[1].log["target_true"], plain.log["target_true"])  # the roll reaches the world
+    assert any(column.startswith("fit_") for column in runs[1].log.columns)
+    assert_same_run(*runs)
+
+
+def test_irregular_scans_run_the_same_compiled(mixed_day):
+    keep = np.random.default_rng(1).random(len(mixed_day)) > 0.3
+    assert_same_run(*both(mixed_day[keep], "lanzhou"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_a_site_year_runs_the_same_compiled(collector):
+    year = synthetic("nanjing", "2013-01-01", "2013-12-31", weather="climate", seed=1, gusts_per_day=0.5)
+    assert_same_run(*both(year, "nanjing", collector=collector))
+
+
+def test_a_changed_source_empties_the_kernels_cache(tmp_path):
+    from hybridtrack.kernel import jit
+
+    (tmp_path / "controller.run_scans-1.py311.nbi").write_text("stale")
+    jit._empty_stale_cache(tmp_path)
+    assert not list(tmp_path.glob("*.nbi")) and (tmp_path / "kernel-sources.sha256").read_text() == jit._sources_hash()
+    (tmp_path / "controller.run_scans-1.py311.nbi").write_text("fresh")
+    jit._empty_stale_cache(tmp_path)
+    assert list(tmp_path.glob("*.nbi"))
+
+
+# -- piece by piece: each compiled piece against the reference class it restates --------------------
+
+@pytest.fixture(scope="module")
+def packed():
+    """A reference controller of a hybrid heliostat, and its settings and state as the kernel has them."""
+    from hybridtrack import sites
+    from hybridtrack.collectors import Collector
+    from hybridtrack.control import Controller, make_plan
+    from hybridtrack.control.plan import east_park
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+    from hybridtrack.kernel import bridge
+    from hybridtrack.simulation import _drives
+    from hybridtrack.world import World
+
+    frame = synthetic("lanzhou", "2021-06-21 10:00", "2021-06-21 12:00", weather="sunny", seed=1)
+    site, collector, config = sites.get("lanzhou"), Collector("heliostat"), SimulationConfig()
+    drives = _drives(collector, config)
+    world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
+    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
+    controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
+                            east_park(collector))
+    return controller, bridge._settings(controller), bridge._state(controller, world.minutes)
+
+
+def test_the_sky_table_compiled_scores_as_the_reference(packed):
+    from hybridtrack.kernel.controller import table_code, table_score
+
+    controller, cfg, _ = packed
+    table = controller.sky.table
+    rng = np.random.default_rng(0)
+    for intensity, variation in zip(rng.uniform(-50, 400, 2000), rng.uniform(-10, 250, 2000)):
+        score = table_score(cfg, intensity, variation)
+        assert score == table.score(intensity, variation)
+        assert table_code(cfg, score) == table.code(score)
+    assert np.isnan(table_score(cfg, np.nan, 1.0)) and table_code(cfg, np.nan) == table.code(np.nan)
+
+
+def test_the_trailing_windows_compiled_keep_the_reference_range_and_mean(packed):
+    from hybridtrack.control.skywatch import TrailingMean, TrailingRange
+    from hybridtrack.kernel.controller import ABSOLUTE_HIGHS, ABSOLUTE_LOWS, trailing_mean, trailing_range
+
+    _, _, state = packed
+    state.window_ends[:] = 0
+    rng = np.random.default_rng(1)
+    times = np.cumsum(rng.choice([0.5, 1.0, 1.0, 7.0], 5000))
+    values = np.where(rng.random(5000) < 0.1, np.nan, rng.normal(100.0, 30.0, 5000))
+    spread, mean = TrailingRange(20.0), TrailingMean(3.0)
+    for t, value in zip(times, values):
+        expected = spread.add(t, value)
+        ranged = trailing_range(state, ABSOLUTE_HIGHS, ABSOLUTE_LOWS, 20.0, t, value)
+        assert ranged == pytest.approx(expected, nan_ok=True)
+        assert trailing_mean(state, 3.0, t, value) == pytest.approx(mean.add(t, value), rel=0, abs=0, nan_ok=True)
+
+
+def test_the_gate_and_kalman_filter_compiled_take_readings_as_the_reference(packed):
+    from hybridtrack.control.sensing import SensorGate
+    from hybridtrack.kernel.controller import P00, P01, P11, READY, X0, X1, gate_take
+
+    controller, cfg, state = packed
+    config = controller.config
+    gate = SensorGate("fast", config.process_noise, controller.gates[0].filter.r, config.stuck_scans, config.gate,
+                      config.reacquire, config.sensor_noise)
+    state.gate[:] = 0
+    rng = np.random.default_rng(2)
+    for k in range(3000):
+        z = 0.25 * k + rng.normal(0, 0.05) + (3.0 if rng.random() < 0.05 else 0.0)
+        miss = rng.normal(0, 1.2) if rng.random() < 0.5 else np.nan
+        dt = float(rng.choice([1.0, 1.0, 2.0]))
+        assert gate_take(cfg, state, 0, z, dt, miss, 2.0, 0.25) == gate.take(z, dt, miss, 2.0, 0.25)
+        if k % 500 == 0:
+            gate.forget()
+            state.gate[0, READY] = 0
+    f = gate.filter
+    assert state.kf[0, [X0, X1, P00, P01, P11]].tolist() == [f.x0, f.x1, f.p00, f.p01, f.p11]
+
+
+def test_the_cusum_compiled_flags_as_the_reference():
+    from hybridtrack.control.disagreement import DisagreementMonitor
+    from hybridtrack.kernel.controller import (CUSUM_RUN, CUSUM_SUM, FLOAT_SLOTS, INT_SLOTS, ControllerState,
+                                               disagreement_add)
+
+    monitor, rng = DisagreementMonitor(), np.random.default_rng(3)
+    unused = [np.zeros(1)] * (len(ControllerState._fields) - 2)
+    compiled = ControllerState(np.zeros(FLOAT_SLOTS), np.zeros(INT_SLOTS, np.int64), *unused)
+    alarms = 0
+    for k in range(5000):
+        residual = rng.normal(0.3 if (k // 400) % 2 else 0.0, 0.1)
+        flagged = monitor.add(residual / 0.1, residual, 0.25)
+        assert disagreement_add(compiled, residual / 0.1, residual, 0.25) == flagged
+        alarms += flagged
+        if flagged:
+            monitor.reset()
+            compiled.s[:], compiled.k[:] = 0.0, 0
+        assert (compiled.k[CUSUM_RUN], compiled.s[CUSUM_SUM]) == (monitor.run, monitor.run_sum)
+    assert alarms > 0
+
+
+def test_the_mount_fit_compiled_updates_as_the_reference():
+    from hybridtrack.control.mountfit import MountEstimator
+    from hybridtrack.kernel.controller import fit_condition, fit_forget, fit_update
+
+    fit, rng = MountEstimator(2, 0.05), np.random.default_rng(4)
+    theta, p, information = fit.theta.copy(), fit.p.copy(), fit.information.copy()
+    for k in range(400):
+        derivatives, weight, residual = rng.normal(size=4), rng.uniform(0.2, 1.0), rng.normal(0, 0.3)
+        fit.forget(5.0)
+        fit_forget(p, information, fit.memory, fit.prior, 5.0)
+        frozen = fit.axis_frozen
+        fit.update(derivatives * weight, residual * weight)
+        fit_update(theta, p, information, fit.r, fit.clip, frozen, derivatives, weight, residual * weight)
+        assert np.array_equal(theta, fit.theta) and np.array_equal(p, fit.p)
+        assert np.array_equal(information, fit.information)
+        if fit.updates % fit.check_every == 0:
+            assert fit_condition(information) == pytest.approx(fit.condition, rel=1e-12)
