@@ -67,14 +67,19 @@ def _ablate(args: argparse.Namespace) -> int:
     print(result.table.to_string(float_format=lambda v: f"{v:.4f}"))
     print(result.gap_note())
     if args.out:
-        from ..report import save_figure
-
-        runs, table, picture = claim(files)
-        write(runs, lambda file: result.runs.to_csv(file, index=False, float_format="%.6g"))
-        write(table, lambda file: result.table.to_csv(file, float_format="%.6g"))
-        save_figure(result.plot(), picture)
-        print(f"wrote {runs}, {table} and {picture}")
+        _write(files, result)
     return 0
+
+
+def _write(files: list, result) -> None:
+    """The runs, the table and the plot of an ablation or a trade-off, to the files claimed for them."""
+    from ..report import save_figure
+
+    runs, table, picture = claim(files)
+    write(runs, lambda file: result.runs.to_csv(file, index=False, float_format="%.6g"))
+    write(table, lambda file: result.table.to_csv(file, float_format="%.6g"))
+    save_figure(result.plot(), picture)
+    print(f"wrote {runs}, {table} and {picture}")
 
 
 def _deadbands(text: str) -> tuple[float, ...]:
@@ -108,11 +113,5 @@ def _tradeoff(args: argparse.Namespace) -> int:
           f"{len(plan.days()) // len(plan.periods)} day(s); held: the error between scans")
     print(result.table.to_string(float_format=lambda v: f"{v:.4g}"))
     if args.out:
-        from ..report import save_figure
-
-        runs, table, picture = claim(files)
-        write(runs, lambda file: result.runs.to_csv(file, index=False, float_format="%.6g"))
-        write(table, lambda file: result.table.to_csv(file, float_format="%.6g"))
-        save_figure(result.plot(), picture)
-        print(f"wrote {runs}, {table} and {picture}")
+        _write(files, result)
     return 0
