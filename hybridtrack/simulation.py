@@ -33,7 +33,6 @@ from .mounting import incidence_cosine
 from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
-from .sun import solar_position
 from .world import Imperfections, World
 
 __all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
@@ -334,10 +333,9 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
                      config.controller, mount)
     clf = classifier or FuzzyWeatherClassifier(fuzzy_config(config.sky))
-    clear = _expected_clear_sky(world, config)
+    clear = _expected_clear_sky(world, config, plan)
     if clear is not None:
         plan.clear_light = (clear_sky_photocurrent(clear, config.sensor) - config.sensor.dark_current).to_numpy()
-        plan.apparent_altitude = clear["apparent_elevation"].to_numpy()
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory)
     if uses_kernel(config, world.n):
@@ -477,13 +475,13 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
     return np.where(np.isnan(values), default, values) if not np.isnan(default) else values
 
 
-def _expected_clear_sky(world: World, config: SimulationConfig) -> pd.DataFrame | None:
+def _expected_clear_sky(world: World, config: SimulationConfig, plan) -> pd.DataFrame | None:
     """The clear sky the controller expects at each scan, from what a PLC has: its clock, its site
-    and its own sun model; on the scans' index."""
+    and the sun its plan computed; on the scans' index."""
     if config.sky.mode != "relative" or config.controller.sensor_only:
         return None
-    clock, site = world.controller_clock(), world.controller_site()
-    return clear_sky(clock, site, solar_position(clock, site, config.controller.sun_model)).set_axis(world.index)
+    position = pd.DataFrame({"apparent_altitude": plan.apparent_altitude})
+    return clear_sky(world.controller_clock(), world.controller_site(), position).set_axis(world.index)
 
 
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,

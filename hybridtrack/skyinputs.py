@@ -189,8 +189,8 @@ def clear_sky(index: pd.DatetimeIndex, site: Site | str, position: pd.DataFrame 
     index : pandas.DatetimeIndex
     site : Site or str
     position : pandas.DataFrame, optional
-        The sun's position at each stamp (``hybridtrack.sun.solar_position``: ``apparent_zenith``
-        and ``apparent_altitude``), e.g. a controller's own sun model; pvlib's SPA by default.
+        The sun's ``apparent_altitude`` (degrees) at each stamp, e.g. from a controller's own sun
+        model (``hybridtrack.sun.solar_position``); pvlib's SPA by default.
 
     Returns
     -------
@@ -212,9 +212,8 @@ def clear_sky(index: pd.DatetimeIndex, site: Site | str, position: pd.DataFrame 
     if position is None:
         position = location.get_solarposition(index)
     else:
-        position = pd.DataFrame({"apparent_zenith": np.asarray(position["apparent_zenith"], float),
-                                 "apparent_elevation": np.asarray(position["apparent_altitude"], float)},
-                                index=index)
+        elevation = np.asarray(position["apparent_altitude"], float)
+        position = pd.DataFrame({"apparent_zenith": 90.0 - elevation, "apparent_elevation": elevation}, index=index)
     clear = location.get_clearsky(index, model="ineichen", solar_position=position)
     clear["apparent_elevation"] = position["apparent_elevation"]
     return clear[["apparent_elevation", "ghi", "dni", "dhi"]]

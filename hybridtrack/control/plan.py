@@ -85,8 +85,8 @@ class ControllerPlan:
     """Per scan: timer (minutes), computed targets (N, axes), awake, clock steps (seconds, 0 if
     none), and for a controller that fits its mount the targets' derivatives by the mount's
     parameters (N, axes, parameters) with each axis's weight in pointing terms (N, axes), and for
-    the sky watch the photocurrent above dark the controller expects under a clear sky (mA) and
-    its computed sun's apparent altitude (degrees)."""
+    the sky watch its computed sun's apparent altitude (degrees) and the photocurrent above dark
+    it expects under a clear sky (mA; set from that altitude by the run)."""
 
     minutes: np.ndarray
     model: np.ndarray
@@ -160,7 +160,8 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
         rising = (soon > config.min_altitude) & ~up & (soon > altitude)
         setting = (before > config.min_altitude) & ~up & (before > altitude)
         awake = working & (up | rising | setting)
-    plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps, alarms=alarms)
+    plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps, alarms=alarms,
+                          apparent_altitude=sun["apparent_altitude"].to_numpy())
     if config.calibrates:
         plan.jacobian = _lit_jacobian(altitude, sun["azimuth"].to_numpy(), model, collector)
         plan.weight = np.ones(model.shape)
