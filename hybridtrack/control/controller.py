@@ -157,7 +157,6 @@ class Controller:
         self.dark_since = math.nan
         self.was_awake = False
         self.blind_stow: list[float] | None = None  # what is left of a timed stow move, per axis
-        self.was_awake = False
         self.found_today = False
         self.events: list = []
         self.out = {name: [0] * n for name in ("mode", "status", "sky")}
