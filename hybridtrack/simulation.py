@@ -504,7 +504,7 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
     from .collectors import sun_vector
 
     truth = world.truth
-    angle = np.array(world.angles, float).T.reshape(-1, world.axes)
+    angle = world.angles.T
     main = 0 if collector.single_axis else 1  # a heliostat's main columns are its elevation axis
     if collector.single_axis:
         error = angle[:, 0] - truth[:, 0]
@@ -514,10 +514,10 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
         error = np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
     log = pd.DataFrame({
         "target_true": truth[:, main], "target": out.target[:, main], "angle": angle[:, main], "error": error,
-        "mode": pd.Categorical(np.asarray(MODES)[out.mode], categories=list(MODES)),
+        "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)),
         "sky": pd.Categorical(sky["sky"].to_numpy(object), categories=list(SKY_CODES)),
         "sky_score": sky["sky_score"].to_numpy(), "sensor_valid": out.sensor_status == 0,
-        "sensor_status": pd.Categorical(np.asarray(SENSOR_STATUS)[out.sensor_status], categories=list(SENSOR_STATUS)),
+        "sensor_status": pd.Categorical.from_codes(out.sensor_status, categories=list(SENSOR_STATUS)),
         "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(), "wind_speed": world.wind,
         "dni": world.frame_dni, "calibration": out.calibration[:, main], "sensor_sun": out.sun[:, main],
     }, index=index)

@@ -163,28 +163,39 @@ class World:
         clear_dni, clear_dhi = self._clear_sky(frame, position)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
         scene = sensor_scene(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi, rng=rng)
-        self._scene = (scene.beam.tolist(), scene.aureole.tolist(), scene.patch.tolist(),
-                       [scene.patch_offset[:, k].tolist() for k in range(2)], scene.diffuse.tolist())
-        self._truth = [np.nan_to_num(self.truth[:, a]).tolist() for a in range(self.axes)]
-        self._noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
-        self._current_noise = rng.standard_normal(self.n).tolist()
-        self._coarse_noise = [rng.standard_normal(self.n).tolist() for _ in range(self.axes)]
-        recorded = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
-        self._recorded_current = recorded.tolist() if recorded is not None else None
-        self._recorded_pointing = self._recorded_pointing_columns(frame)
+        self.scene = (scene.beam, scene.aureole, scene.patch, np.ascontiguousarray(scene.patch_offset.T), scene.diffuse)
+        self.truth_axes = np.ascontiguousarray(np.nan_to_num(self.truth[:, :self.axes].T))
+        self.noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
+        self.current_noise = rng.standard_normal(self.n)
+        self.coarse_noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
+        self.recorded_current = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
+        self.recorded_pointing = self._recorded_pointing_columns(frame)
         self.frame_dni = frame["dni"].to_numpy(float)
         self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
-        self._wind = self.wind.tolist()
-        self._sky = self._true_sky(frame)
+        self.true_sky = self._true_sky(frame)
         self.minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
-        self._minutes = self.minutes.tolist()
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.actual = [d.stow - imperfections.encoder_offset for d in drives]  # parked where stow reads
-        self.angles = [[math.nan] * self.n for _ in drives]
-        self._last_encoder = [math.nan] * self.axes
-        self._faults = {name: (np.asarray(v).tolist() if np.ndim(v) == 1 else [np.asarray(v)[:, a].tolist()
-                                                                                for a in range(self.axes)])
-                        for name, v in faults.items() if name != "clock"}
+        self.angles = np.full((self.axes, self.n), np.nan)
+        self.last_encoder = [math.nan] * self.axes
+        self._scans = None
+
+    def _listed(self) -> dict:
+        """The frame-wide arrays as Python lists, which the reference loop reads one value at a
+        time (a list gives a Python float about three times faster than an array does); made
+        on the first scan, so the compiled kernel, which reads the arrays, never pays for them."""
+        if self._scans is None:
+            def listed(values):
+                return None if values is None else np.asarray(values).tolist()
+
+            self._scans = {"scene": [listed(v) for v in self.scene], "truth": listed(self.truth_axes),
+                           "noise": listed(self.noise), "current_noise": listed(self.current_noise),
+                           "coarse_noise": listed(self.coarse_noise), "recorded": listed(self.recorded_current),
+                           "pointing": listed(self.recorded_pointing), "wind": listed(self.wind),
+                           "minutes": listed(self.minutes), "sky": listed(self.true_sky),
+                           "faults": {name: listed(np.asarray(v).T) for name, v in self.faults.items()
+                                      if name != "clock"}}
+        return self._scans
 
     # -- set up ----------------------------------------------------------------------------------
 
@@ -197,7 +208,7 @@ class World:
         if len(present) < len(names):
             raise HybridtrackError(f"a recorded pointing signal needs a column per axis: {', '.join(names)}; "
                                    f"the frame has {', '.join(present)}")
-        return [frame[name].to_numpy(float).tolist() for name in names]
+        return np.array([frame[name].to_numpy(float) for name in names])
 
     def _true_sun(self, model: str) -> pd.DataFrame:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
@@ -219,16 +230,17 @@ class World:
         return dni, dhi
 
     @staticmethod
-    def _true_sky(frame: pd.DataFrame) -> list | None:
+    def _true_sky(frame: pd.DataFrame) -> np.ndarray | None:
+        """The frame's true sky as `SKY_CODES` codes (anything else: unknown), or None."""
         if "sky" not in frame.columns:
             return None
-        labels = frame["sky"].astype(object).to_numpy()
-        return [SKY_CODES.index(v) if v in SKY_CODES else SKY_CODES.index("unknown") for v in labels]
+        labels = pd.Categorical(frame["sky"].astype(object), categories=list(SKY_CODES))
+        return np.where(labels.codes < 0, SKY_CODES.index("unknown"), labels.codes).astype(np.int64)
 
     @property
     def has_true_sky(self) -> bool:
         """Whether the frame carries the true sky label (needed by the oracle policy)."""
-        return self._sky is not None
+        return self.true_sky is not None
 
     def controller_clock(self) -> pd.DatetimeIndex:
         """What the controller's clock shows at each scan: true time plus its error, its drift since
@@ -246,49 +258,48 @@ class World:
 
     # -- each scan -------------------------------------------------------------------------------
 
-    def _offset(self, a: int, i: int) -> float:
+    def _offset(self, truth: list, a: int, i: int) -> float:
         """Degrees from the sensor's axis to the true sun on axis `a` (the mounting bias included)."""
-        difference = self._truth[a][i] - self.actual[a]
+        difference = truth[a][i] - self.actual[a]
         if self.circular[a]:
             difference = (difference + 180.0) % 360.0 - 180.0
         return difference + self.sensor.bias
 
-    def _encoder(self, a: int, i: int) -> float:
-        faults = self._faults
-        if "encoder_frozen" in faults and faults["encoder_frozen"][i] and not math.isnan(self._last_encoder[a]):
-            return self._last_encoder[a]
+    def _encoder(self, faults: dict, a: int, i: int) -> float:
+        if "encoder_frozen" in faults and faults["encoder_frozen"][i] and not math.isnan(self.last_encoder[a]):
+            return self.last_encoder[a]
         value = encoder_reading(self.actual[a] + self.imperfections.encoder_offset, self.drives[a].resolution)
         if "encoder" in faults:
             value += faults["encoder"][a][i]
-        self._last_encoder[a] = value
+        self.last_encoder[a] = value
         return value
 
     def observe(self, i: int, obs: Observation) -> None:
         """Fill `obs` with what the controller's instruments read at scan `i`."""
-        beam, aureole, patch, patch_offset, diffuse = self._scene
-        offsets = [self._offset(a, i) for a in range(self.axes)]
-        noise = [self._noise[a][i] for a in range(self.axes)]
-        if self._recorded_pointing is not None:  # as recorded: what the logger's sensor said
-            reported = [self._recorded_pointing[a][i] for a in range(self.axes)]
+        scans = self._listed()
+        beam, aureole, patch, patch_offset, diffuse = scans["scene"]
+        offsets = [self._offset(scans["truth"], a, i) for a in range(self.axes)]
+        noise = [scans["noise"][a][i] for a in range(self.axes)]
+        if scans["pointing"] is not None:  # as recorded: what the logger's sensor said
+            reported = [scans["pointing"][a][i] for a in range(self.axes)]
             valid = not any(math.isnan(value) for value in reported)
         else:
             reported, valid = read_pointing(offsets, beam[i], aureole[i], patch[i],
                                             [patch_offset[a][i] for a in range(self.axes)], noise, self.sensor)
         obs.valid = valid
-        self._sensor_faults(i, reported, obs)
-        obs.i, obs.t, obs.wind = i, self._minutes[i], self._wind[i]
+        self._sensor_faults(scans["faults"], i, reported, obs)
+        obs.i, obs.t, obs.wind = i, scans["minutes"][i], scans["wind"][i]
         for a in range(self.axes):
-            obs.encoder[a] = self._encoder(a, i)
-            obs.coarse[a] = coarse_offset(offsets[a], beam[i], self._coarse_noise[a][i], self.sensor)
+            obs.encoder[a] = self._encoder(scans["faults"], a, i)
+            obs.coarse[a] = coarse_offset(offsets[a], beam[i], scans["coarse_noise"][a][i], self.sensor)
         worst = max(abs(o) for o in offsets)
-        obs.intensity = self._recorded_current[i] if self._recorded_current is not None else \
-            read_photocurrent(worst, beam[i], diffuse[i], self._current_noise[i], self.sensor)
-        obs.true_sky = self._sky[i] if self._sky is not None else -1
+        obs.intensity = scans["recorded"][i] if scans["recorded"] is not None else \
+            read_photocurrent(worst, beam[i], diffuse[i], scans["current_noise"][i], self.sensor)
+        obs.true_sky = scans["sky"][i] if scans["sky"] is not None else -1
 
-    def _sensor_faults(self, i: int, reported: list, obs: Observation) -> None:
+    def _sensor_faults(self, faults: dict, i: int, reported: list, obs: Observation) -> None:
         """The sensor's reading after any injected fault: a wrong value (the sensor still says it
         sees the sun), a drift, or a dropout (no number at all)."""
-        faults = self._faults
         for a in range(self.axes):
             value = reported[a]
             if "sensor" in faults and not math.isnan(faults["sensor"][a][i]):
@@ -305,9 +316,9 @@ class World:
         for a, drive in enumerate(self.drives):
             low, high = drive.limits
             self.actual[a] = min(max(self.actual[a] + moves[a], low - HARD_STOP_MARGIN), high + HARD_STOP_MARGIN)
-            self.angles[a][i] = self.actual[a]
+            self.angles[a, i] = self.actual[a]
 
     def rest(self, i: int, j: int) -> None:
         """Scans `i` to `j` - 1 with nothing moving."""
         for a in range(self.axes):
-            self.angles[a][i:j] = [self.actual[a]] * (j - i)
+            self.angles[a, i:j] = self.actual[a]

@@ -32,7 +32,7 @@ CHUNK = 65536
 def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
     """The world's frame-wide arrays and its moving state."""
     n, axes = world.n, world.axes
-    beam, aureole, patch, patch_offset, diffuse = (np.asarray(v, float) for v in world._scene)
+    beam, aureole, patch, patch_offset, diffuse = world.scene
     faults = world.faults
     sensor = world.sensor
 
@@ -44,15 +44,12 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
         values = faults.get(name)
         return np.full(n, default, dtype) if values is None else np.asarray(values, dtype)
 
-    recorded = world._recorded_current
-    pointing = world._recorded_pointing
+    recorded = world.recorded_current
+    pointing = world.recorded_pointing
     arrays = WorldArrays(
-        np.asarray(world._truth, float), beam, aureole, patch, patch_offset, diffuse,
-        np.asarray(world._noise, float), np.asarray(world._current_noise, float),
-        np.asarray(world._coarse_noise, float),
-        np.asarray(recorded if recorded is not None else np.zeros(n), float), recorded is not None,
-        np.asarray(world.wind, float), np.asarray(world.minutes, float),
-        np.asarray(world._sky if world._sky is not None else np.full(n, -1), float),
+        world.truth_axes, beam, aureole, patch, patch_offset, diffuse, world.noise, world.current_noise,
+        world.coarse_noise, recorded if recorded is not None else np.zeros(n), recorded is not None,
+        world.wind, world.minutes, np.asarray(world.true_sky if world.true_sky is not None else np.full(n, -1), float),
         per_axis("sensor", math.nan), per_scan("sensor_drift", 0.0), per_scan("sensor_dropout", False, bool),
         per_axis("encoder", 0.0), per_scan("encoder_frozen", False, bool),
         float(sensor.bias), float(sensor.field_of_view), float(sensor.direct_threshold), float(sensor.noise),
@@ -60,9 +57,11 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
         float(sensor.responsivity), float(sensor.diffuse_share), float(sensor.current_noise),
         float(world.imperfections.encoder_offset), np.array([d.resolution for d in world.drives]),
         np.array([d.limits[0] for d in world.drives]), np.array([d.limits[1] for d in world.drives]),
-        np.array(world.circular, bool),
-        np.array(pointing if pointing is not None else np.zeros((axes, 0)), float), pointing is not None)
-    state = WorldState(np.array(world.actual, float), np.array(world._last_encoder, float), np.full((axes, n), np.nan))
+        np.array(world.circular, bool), pointing if pointing is not None else np.zeros((axes, 0)), pointing is not None)
+    # C order throughout: the kernel is compiled (and cached) for C-contiguous arrays only, and a
+    # frame's column can be a strided view
+    arrays = WorldArrays(*(np.ascontiguousarray(v) if isinstance(v, np.ndarray) else v for v in arrays))
+    state = WorldState(np.array(world.actual, float), np.array(world.last_encoder, float), world.angles)
     return arrays, state
 
 
@@ -243,7 +242,6 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
         if done < stop:
             events = _grown(events)
         i = done
-    world.angles = world_state.angles
     controller.events = _worded(controller, events, int(state.k[kc.EVENTS]))
     controller.moves, controller.travel = state.moves.tolist(), state.travel.tolist()
     _write_back(controller, state)
