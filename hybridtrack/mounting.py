@@ -10,7 +10,7 @@ import numpy as np
 
 from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
 
-__all__ = ["mounting_rotation", "mount_targets", "incidence_cosine"]
+__all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine"]
 
 
 def _about(direction: np.ndarray, angle: float) -> np.ndarray:
@@ -47,20 +47,33 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     then the geometry is followed below the horizon too (to pre-position before sunrise).
     """
     alt = np.asarray(altitude, float)
-    s = sun_vector(alt, np.asarray(azimuth, float))
-    rot = np.eye(3) if rotation is None else rotation
-    if collector.kind == "heliostat":
-        normals = heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim) @ rot.T
-        az, el = normal_angles(normals)
-        out = np.stack([az, el], axis=-1)
-    else:
-        sun = across_angle(s @ rot.T, collector.axis)
-        if collector.kind == "fresnel":
-            sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
-        out = sun[:, None]
+    out = angles_on_mount(pointing_vectors(alt, azimuth, collector, night=night), collector, rotation)
     if not night:
         out[alt < 0] = np.nan
     return out
+
+
+def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = False) -> np.ndarray:
+    """What a collector's angles follow, as unit vectors in the site frame (N, 3): the sun for a
+    single-axis collector, a heliostat's wanted mirror normal (with `night`, the normal for the
+    sun mirrored above the horizon). Computed once, they serve any number of mounts
+    (`angles_on_mount`)."""
+    alt = np.asarray(altitude, float)
+    if collector.kind == "heliostat":
+        return heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim)
+    return sun_vector(alt, np.asarray(azimuth, float))
+
+
+def angles_on_mount(vectors: np.ndarray, collector: Collector, rotation: np.ndarray | None = None) -> np.ndarray:
+    """The collector's angles (N, axes), degrees, that follow `vectors` (`pointing_vectors`) on
+    a mount turned by `rotation` (`mounting_rotation`; None: the nominal mount)."""
+    rotated = vectors if rotation is None else vectors @ rotation.T
+    if collector.kind == "heliostat":
+        return np.stack(normal_angles(rotated), axis=-1)
+    sun = across_angle(rotated, collector.axis)
+    if collector.kind == "fresnel":
+        sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
+    return sun[:, None]
 
 
 def incidence_cosine(altitude, azimuth, collector: Collector) -> np.ndarray:

@@ -227,3 +227,23 @@ def test_the_clear_sky_the_controller_expects_comes_from_its_own_sun_model():
     np.testing.assert_allclose(spa.loc[up, "dni"], reference.loc[up, "dni"], atol=0.5)
     assert (plc.loc[up, "dni"] - reference.loc[up, "dni"]).abs().max() < 3.0
     assert (plc.loc[up, "apparent_elevation"] - reference.loc[up, "apparent_elevation"]).abs().max() < 0.3
+
+
+@pytest.mark.parametrize("site, model", [("lanzhou", "plc"), ("nanjing", "spa")])
+def test_the_plan_wakes_where_the_sun_ahead_or_behind_says_at_every_scan(site, model):
+    """The plan looks ahead (pre-position) and back (after sunset) only near the horizon; the
+    reference computes the sun 30 minutes ahead and 15 back at every scan of a month."""
+    from hybridtrack.control.config import ControllerConfig
+    from hybridtrack.control.plan import AFTER_SUNSET, PRE_POSITION, _sun_day
+
+    where = sites.get(site)
+    clock = pd.date_range("2021-03-01", "2021-04-01", freq="1min", tz=where.tz, inclusive="left")
+    config = ControllerConfig(sun_model=model)
+    altitude = solar_position(clock, where, model)["altitude"].to_numpy()
+    soon = solar_position(clock + PRE_POSITION, where, model)["altitude"].to_numpy()
+    before = solar_position(clock - AFTER_SUNSET, where, model)["altitude"].to_numpy()
+    up = altitude > config.min_altitude
+    reference = up | (~up & (soon > config.min_altitude) & (soon > altitude)) \
+        | (~up & (before > config.min_altitude) & (before > altitude))
+    assert reference.sum() > up.sum() + 31 * 40  # about 45 minutes a day beyond the sun up
+    np.testing.assert_array_equal(_sun_day(clock, altitude, where, config), reference)

@@ -46,6 +46,8 @@ import math
 
 import numpy as np
 
+from ..mounting import angles_on_mount, pointing_vectors
+
 __all__ = ["MountEstimator", "jacobian", "parameter_names", "MAX_CONDITION", "DERIVATIVE_STEP"]
 
 #: Above this condition number of the information matrix, axis azimuth and tilt are frozen.
@@ -65,16 +67,22 @@ def jacobian(altitude, azimuth, collector) -> np.ndarray:
     """d(target)/d(parameter) per scan, (N, axes, parameters): the pedestal terms by central
     differences of the mount geometry about the nominal mount, each encoder zero exactly 1 on
     its own axis."""
+    return vector_jacobian(pointing_vectors(altitude, azimuth, collector, night=True), collector)
+
+
+def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
+    """`jacobian` from the collector's pointing vectors (`hybridtrack.mounting.pointing_vectors`,
+    with ``night=True``), when the caller has them already."""
     from .plan import MountEstimate
 
     names = parameter_names(collector)
     axes = len(names) - 2
     circular = [axes == 2 and a == 0 for a in range(axes)]
     h = DERIVATIVE_STEP
-    out = np.zeros((len(np.atleast_1d(altitude)), axes, len(names)))
+    out = np.zeros((len(vectors), axes, len(names)))
     for k, name in enumerate(names[:2]):
-        up, down = (MountEstimate.from_parameters(names, [sign * h if n == name else 0.0 for n in names])
-                    .targets(altitude, azimuth, collector) for sign in (1.0, -1.0))
+        up, down = (angles_on_mount(vectors, collector, MountEstimate.from_parameters(
+            names, [sign * h if n == name else 0.0 for n in names]).rotation(collector)) for sign in (1.0, -1.0))
         difference = up - down
         difference[:, circular] = (difference[:, circular] + 180.0) % 360.0 - 180.0
         out[:, :, k] = difference / (2.0 * h)

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from ..collectors import Collector
-from ..mounting import mount_targets, mounting_rotation
+from ..mounting import angles_on_mount, mounting_rotation, pointing_vectors
 from ..sites import Site
 from ..sun import solar_position
 from ..times import clock_hours, parse_clock
@@ -72,11 +72,17 @@ class MountEstimate:
         return cls(given.get("axis_azimuth_error", 0.0), given.get("axis_tilt_error", 0.0),
                    given.get("axis_roll_error", 0.0), encoders)
 
+    def rotation(self, collector: Collector) -> np.ndarray:
+        """The mount's rotation (`hybridtrack.mounting.mounting_rotation`)."""
+        return mounting_rotation(self.axis_azimuth_error, self.axis_tilt_error, collector.axis, self.axis_roll_error)
+
     def targets(self, altitude, azimuth, collector: Collector) -> np.ndarray:
         """Computed targets in encoder coordinates, (N, axes); the geometry is followed below the horizon."""
-        rotation = mounting_rotation(self.axis_azimuth_error, self.axis_tilt_error, collector.axis,
-                                     self.axis_roll_error)
-        targets = mount_targets(altitude, azimuth, collector, rotation, night=True)
+        return self.vector_targets(pointing_vectors(altitude, azimuth, collector, night=True), collector)
+
+    def vector_targets(self, vectors: np.ndarray, collector: Collector) -> np.ndarray:
+        """`targets` from the pointing vectors (`hybridtrack.mounting.pointing_vectors`, ``night=True``)."""
+        targets = angles_on_mount(vectors, collector, self.rotation(collector))
         return targets + np.resize(np.asarray(self.encoder_offset, float), targets.shape[1])
 
 
@@ -149,35 +155,51 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     clock, steps, alarms = _rebased(clock, minutes)
     working = _working(clock.tz_convert(site.tz), config.working_hours)
     sun = solar_position(clock, site, config.sun_model)
-    altitude = sun["altitude"].to_numpy()
-    model = (mount or MountEstimate()).targets(altitude, sun["azimuth"].to_numpy(), collector)
-    if config.sensor_only:
-        awake = np.ones(len(clock), bool)
-    else:
-        soon = solar_position(clock + PRE_POSITION, site, config.sun_model)["altitude"].to_numpy()
-        before = solar_position(clock - AFTER_SUNSET, site, config.sun_model)["altitude"].to_numpy()
-        up = altitude > config.min_altitude
-        rising = (soon > config.min_altitude) & ~up & (soon > altitude)
-        setting = (before > config.min_altitude) & ~up & (before > altitude)
-        awake = working & (up | rising | setting)
+    altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    vectors = pointing_vectors(altitude, azimuth, collector, night=True)
+    model = (mount or MountEstimate()).vector_targets(vectors, collector)
+    awake = np.ones(len(clock), bool) if config.sensor_only else \
+        working & _sun_day(clock, altitude, site, config)
     plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps, alarms=alarms,
                           apparent_altitude=sun["apparent_altitude"].to_numpy())
     if config.calibrates:
-        plan.jacobian = _lit_jacobian(altitude, sun["azimuth"].to_numpy(), model, collector)
+        plan.jacobian = _lit_jacobian(vectors, model, collector)
         plan.weight = np.ones(model.shape)
         if not collector.single_axis:  # an azimuth error counts cos(elevation) in pointing terms
             plan.weight[:, 0] = np.cos(np.radians(np.clip(model[:, 1], 0.0, 90.0)))
     return plan
 
 
-def _lit_jacobian(altitude: np.ndarray, azimuth: np.ndarray, model: np.ndarray, collector: Collector) -> np.ndarray:
+#: Degrees a minute the sun's altitude can change at most (the earth turns 0.25° a minute), with
+#: room for refraction's change near the horizon: bounds where `_sun_day` must look ahead or back.
+ALTITUDE_RATE = 0.3
+
+
+def _sun_day(clock: pd.DatetimeIndex, altitude: np.ndarray, site: Site, config: ControllerConfig) -> np.ndarray:
+    """Scans with the computed sun up, rising within `PRE_POSITION` or set within `AFTER_SUNSET`.
+
+    The sun `PRE_POSITION` ahead and `AFTER_SUNSET` back is computed only where it could be
+    above `min_altitude` while the sun now is not (within `ALTITUDE_RATE` a minute of it): the
+    same answer as computing it at every scan, for a fraction of the sun passes."""
+    up = altitude > config.min_altitude
+    awake = up.copy()
+    for shift, direction in ((PRE_POSITION, 1), (AFTER_SUNSET, -1)):
+        reach = ALTITUDE_RATE * shift / pd.Timedelta(minutes=1)
+        near = np.flatnonzero(~up & (altitude > config.min_altitude - reach))
+        if len(near):
+            other = solar_position(clock[near] + direction * shift, site, config.sun_model)["altitude"].to_numpy()
+            awake[near] |= (other > config.min_altitude) & (other > altitude[near])
+    return awake
+
+
+def _lit_jacobian(vectors: np.ndarray, model: np.ndarray, collector: Collector) -> np.ndarray:
     """`mountfit.jacobian` where the computed target exists; zero elsewhere, as it comes out there
     anyway (no target, no derivative): a year's nights are half its scans, not worth four mounts."""
-    from .mountfit import jacobian
+    from .mountfit import vector_jacobian
 
     lit = np.isfinite(model).all(axis=1)
-    derivatives = jacobian(altitude[lit], azimuth[lit], collector)
-    out = np.zeros((len(altitude), *derivatives.shape[1:]))
+    derivatives = vector_jacobian(vectors[lit], collector)
+    out = np.zeros((len(model), *derivatives.shape[1:]))
     out[lit] = derivatives
     return out
 
