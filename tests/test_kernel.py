@@ -430,3 +430,28 @@ def test_the_mount_fit_compiled_updates_as_the_reference():
         assert np.array_equal(information, fit.information)
         if fit.updates % fit.check_every == 0:
             assert fit_condition(information) == pytest.approx(fit.condition, rel=1e-12)
+
+
+@pytest.mark.parametrize("days", [1.0, 40.0])  # within DRIFT_DAYS the drift is held; beyond it is fitted
+def test_the_kernels_clock_fit_sums_its_normal_equations_to_the_references_answer(days):
+    """The kernel sums the clock fit's normal equations reading by reading (linear in the
+    readings, where forming the design matrix every evening made a year quadratic); the
+    reference forms the matrix. Two axes, readings in five-minute spells with gaps."""
+    pytest.importorskip("numba")
+    from hybridtrack.control.clockwatch import ClockWatch
+    from hybridtrack.kernel import controller as kc
+
+    rng = np.random.default_rng(5)
+    times = np.arange(0.0, days * 1440.0, 5.0)
+    count = min(400, len(times) // 2)
+    t = np.sort(rng.choice(times, count, replace=False)).repeat(2)
+    axis = np.tile([0, 1], count)
+    rows = rng.standard_normal((2 * count, 5))  # four mount columns and the clock's
+    values = 0.02 * np.cumsum(rng.standard_normal(2 * count)) + rows @ [0.1, -0.2, 0.05, 0.3, 0.01]
+    watch = ClockWatch(4, 0.05)
+    watch.rows = [(ti, ai, x, y) for ti, ai, x, y in zip(t, axis, rows, values)]
+    expected, expected_std = watch.solve()
+    estimate, std = kc.clock_solve(t, axis, rows, values, len(t), np.diag(watch.prior_information), watch.r)
+    np.testing.assert_allclose(estimate, expected, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(std, expected_std, rtol=1e-9)
+    assert np.isinf(std[-1]) == (days < 1.5)

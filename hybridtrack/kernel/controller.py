@@ -667,29 +667,44 @@ def clock_add(state, t, a, row, rate, residual, weight):
         k[CLOCK_PENDING] = 0
 
 
+@kernel
+def _clock_row(times, rows, row, n, k, j):
+    """Column `j` of reading `row` in the clock fit: the mount's and the clock's columns as
+    added, then the drift's (the clock's column times the days since the first reading)."""
+    if j < n - 1:
+        return rows[row, j]
+    return rows[row, n - 2] * (times[row] - times[0]) / 1440.0
+
+
 @kernel(allocates=True)
 def clock_solve(times, axis, rows, values, count, prior, r):
     """ClockWatch.solve over the first `count` rows: (estimate, 1σ), each of the mount's
-    parameters, the clock's error and its drift (held at zero, 1σ infinite, under DRIFT_DAYS)."""
+    parameters, the clock's error and its drift (held at zero, 1σ infinite, under DRIFT_DAYS).
+    The normal equations are summed reading by reading, without forming the design matrix."""
     n = prior.shape[0]
-    t = times[:count]
-    span = (t[count - 1] - t[0]) / 1440.0
+    span = (times[count - 1] - times[0]) / 1440.0
     k = n if span >= DRIFT_DAYS else n - 1
-    x = np.empty((count, k))
+    information, projected = np.zeros((k, k)), np.zeros(k)
     for row in range(count):
-        for j in range(n - 1):
-            x[row, j] = rows[row, j]
-        if k == n:
-            x[row, n - 1] = rows[row, n - 2] * (t[row] - t[0]) / 1440.0
-    y = values[:count].copy()
-    information = x.T @ x / r
+        for j in range(k):
+            xj = _clock_row(times, rows, row, n, k, j)
+            projected[j] += xj * values[row] / r
+            for m in range(k):
+                information[j, m] += xj * _clock_row(times, rows, row, n, k, m) / r
     for j in range(k):
         information[j, j] += prior[j]
     covariance = np.linalg.inv(information)
-    estimate = covariance @ (x.T @ y) / r
-    error = y - x @ estimate
-    unit_variance = max(1.0, np.dot(error, error) / r / max(count - k, 1))
-    factor = _correlation_factor(t, axis[:count], error)
+    estimate = covariance @ projected
+    error = np.empty(count)
+    squares = 0.0
+    for row in range(count):
+        fitted = 0.0
+        for j in range(k):
+            fitted += _clock_row(times, rows, row, n, k, j) * estimate[j]
+        error[row] = values[row] - fitted
+        squares += error[row] * error[row]
+    unit_variance = max(1.0, squares / r / max(count - k, 1))
+    factor = _correlation_factor(times[:count], axis[:count], error)
     estimates, std = np.zeros(n), np.full(n, np.inf)
     for j in range(k):
         estimates[j] = estimate[j]
@@ -697,28 +712,29 @@ def clock_solve(times, axis, rows, values, count, prior, r):
     return estimates, std
 
 
-@kernel(allocates=True)
+@kernel
 def _correlation_factor(t, axis, error):
-    """clockwatch._correlation_factor: readings sorted by axis, then time."""
-    count = t.shape[0]
-    order = np.empty(count, np.int64)
-    m = 0
-    for a in range(axis.max() + 1):
-        for row in range(count):
-            if axis[row] == a:
-                order[m] = row
-                m += 1
-    first, second = np.empty(count), np.empty(count)
-    linked = 0
-    for j in range(count - 1):
-        p, q = order[j], order[j + 1]
-        if t[q] - t[p] <= SPELL_GAP and axis[q] == axis[p]:
-            first[linked], second[linked] = error[p], error[q]
-            linked += 1
+    """clockwatch._correlation_factor: successive readings on one axis within one spell, taken
+    axis by axis in one pass each (the rows are in time order), their products summed as they
+    come."""
+    linked = axes = 0
+    ab = aa = bb = 0.0
+    for row in range(t.shape[0]):
+        axes = max(axes, axis[row] + 1)
+    for a in range(axes):
+        previous = -1
+        for row in range(t.shape[0]):
+            if axis[row] != a:
+                continue
+            if previous >= 0 and t[row] - t[previous] <= SPELL_GAP:
+                ab += error[previous] * error[row]
+                aa += error[previous] * error[previous]
+                bb += error[row] * error[row]
+                linked += 1
+            previous = row
     if linked < 2:
         return 1.0
-    a, b = first[:linked], second[:linked]
-    rho = min(max(np.dot(a, b) / max(math.sqrt(np.dot(a, a) * np.dot(b, b)), 1e-300), 0.0), 0.95)
+    rho = min(max(ab / max(math.sqrt(aa * bb), 1e-300), 0.0), 0.95)
     return (1.0 + rho) / (1.0 - rho)
 
 
