@@ -24,6 +24,7 @@ import pandas as pd
 
 from . import params, sites
 from .budget import BYTES_PER_STEP, check_steps
+from .cluster import check_workers
 from .collectors import (
     AXIS_AZIMUTH,
     MAX_DISTANCE,
@@ -507,7 +508,8 @@ def _end_loss_columns(field: FresnelField, dni, altitude, azimuth) -> dict[str, 
 
 
 def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None, seed: int = 0,
-                   keep_log: bool = True, progress: bool | None = None) -> FieldResult:
+                   keep_log: bool = True, progress: bool | None = None, workers: int | None = None,
+                   scheduler: str | None = None) -> FieldResult:
     """Run the tracker for every collector of a field on the same weather.
 
     Parameters
@@ -528,15 +530,19 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         and step, 80 for a heliostat); False keeps only the metrics.
     progress : bool, optional
         A progress bar over collectors (on stderr); by default when there are more than four.
+    workers : int, optional
+        Run the collectors on a local Dask cluster of this many worker processes
+        (`hybridtrack.cluster`); by default they run one after another in this process. The
+        result is the same either way: each collector's run depends only on its own draws.
+    scheduler : str, optional
+        Run them on the Dask scheduler at this address instead.
 
     Returns
     -------
     FieldResult
     """
-    from tqdm import tqdm
-
-    from .simulation import SimulationConfig, _check_frame, simulate
-    from .sun import reuse_positions, solar_position
+    from .simulation import SimulationConfig, _check_frame
+    from .sun import solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
@@ -545,35 +551,84 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     site = sites.get(site)
     frame = _check_frame(frame)
     config = config or SimulationConfig()
+    if workers is not None:
+        check_workers(workers)
     collectors = field.collectors()
     if keep_log:
         first, last = frame.index[0], frame.index[-1]
         check_steps(first, last, (last - first) / (len(frame) - 1), what=f"a field of {len(collectors)} collectors",
                     bytes_per_step=BYTES_PER_STEP + LOG_BYTES * len(collectors))
-    imperfections = field.spread.draw(config.imperfections, len(collectors), int(seed))
-    rows, events, store = [], [], None
-    with reuse_positions():
-        truth = solar_position(frame.index, site, config.truth)  # what every collector's run asks for, once
-        bar = tqdm(total=len(collectors), unit="collector", file=sys.stderr, leave=False,
-                   disable=not (progress if progress is not None else len(collectors) > 4))
-        with bar:
-            for i, (name, collector, imperfect) in enumerate(zip(field.names, collectors, imperfections)):
-                run_config = dataclasses.replace(config, imperfections=imperfect,
-                                                 seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
-                result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
-                altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
-                rows.append({**dataclasses.asdict(imperfect), **_metrics(result.summary),
-                             "offered": _offered(result.log["dni"].to_numpy(float), altitude, azimuth, collector)})
-                events.append(result.events.assign(collector=name))
+    runs = [(i, name, collector, imperfect) for i, (name, collector, imperfect)
+            in enumerate(zip(field.names, collectors, field.spread.draw(config.imperfections, len(collectors), seed)))]
+    bar = _bar(len(runs), progress)
+    rows, events, store = [None] * len(runs), [None] * len(runs), None
+    job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
+    with bar:
+        for block in _blocks(frame, runs, job, workers, scheduler):
+            for i, row, run_events, log in block:
+                rows[i], events[i] = row, run_events
                 if keep_log:
-                    store = store or _LogStore(field.names, result.log)
-                    store.add(i, result.log)
+                    store = store or _LogStore(field.names, frame.index, log)
+                    store.add(i, log)
                 bar.update()
+    truth = solar_position(frame.index, site, config.truth)
     table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
     dataset = store.dataset(table, field, site) if keep_log else None
     return FieldResult(table, summary, all_events, dataset, field, site)
+
+
+def _bar(total: int, progress: bool | None):
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="collector", file=sys.stderr, leave=False,
+                disable=not (progress if progress is not None else total > 4))
+
+
+def _blocks(frame: pd.DataFrame, runs: list, job: dict, workers: int | None, scheduler: str | None):
+    """Each block of collectors' results as it is done: one after another here, or on Dask in
+    blocks of a few collectors per task (each worker shares a block's sun positions)."""
+    if workers is None and scheduler is None:
+        for run in runs:
+            yield run_collectors(frame, [run], **job)
+        return
+    from dask.distributed import as_completed
+
+    from .cluster import close, dask_client
+
+    client, cluster = dask_client(scheduler, workers, what="parallel fields")
+    try:
+        shared = client.scatter(frame, broadcast=True)
+        size = max(1, min(8, len(runs) // (4 * max(len(client.scheduler_info()["workers"]), 1))))
+        futures = [client.submit(run_collectors, shared, runs[k:k + size], pure=False, **job)
+                   for k in range(0, len(runs), size)]
+        for future in as_completed(futures):
+            yield future.result()
+    finally:
+        close(client, cluster)
+
+
+def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, seed: int, keep_log: bool) -> list:
+    """Run a block of a field's collectors, each ``(i, name, collector, imperfections)``, and
+    return for each ``(i, row, events, log)``: its row of the collector table, its events and
+    its log's kept columns (`LOG_VARIABLES`, as arrays; None unless `keep_log`). The sun every
+    run of the block asks for is computed once (`hybridtrack.sun.reuse_positions`)."""
+    from .simulation import simulate
+    from .sun import reuse_positions, solar_position
+
+    done = []
+    with reuse_positions():
+        truth = solar_position(frame.index, site, config.truth)
+        altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
+        for i, name, collector, imperfect in runs:
+            run_config = dataclasses.replace(config, imperfections=imperfect,
+                                             seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
+            result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
+            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary),
+                   "offered": _offered(result.log["dni"].to_numpy(float), altitude, azimuth, collector)}
+            done.append((i, row, result.events.assign(collector=name), _kept(result.log) if keep_log else None))
+    return done
 
 
 def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:
@@ -607,29 +662,37 @@ def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, 
     return summary
 
 
+def _kept(log: pd.DataFrame) -> dict:
+    """The log columns a field keeps (`LOG_VARIABLES`, a heliostat's ``*_azimuth`` too, and the
+    shared weather), as arrays: categories as their codes."""
+    kept = [c for c in log.columns if c in LOG_VARIABLES or c.endswith("_azimuth") or c in SHARED_VARIABLES]
+    return {c: (_values(log[c]), list(log[c].cat.categories) if isinstance(log[c].dtype, pd.CategoricalDtype)
+                else None) for c in kept}
+
+
 class _LogStore:
-    """Every collector's log, kept as it comes in (collector × time arrays), each run's frame dropped.
+    """Every collector's kept log columns (collector × time arrays), filled as the runs come in.
 
     Holding the runs' frames until the end would cost a whole log per collector; the arrays cost
     about 50 bytes per collector and step (80 for a heliostat).
     """
 
-    def __init__(self, names: list[str], first: pd.DataFrame) -> None:
+    def __init__(self, names: list[str], index: pd.DatetimeIndex, first: dict) -> None:
         self.names = names
-        self.time = first.index.tz_convert("UTC").tz_localize(None)
-        self.shared = {c: first[c].to_numpy(float) for c in SHARED_VARIABLES if c in first}
+        self.time = index.tz_convert("UTC").tz_localize(None)
+        self.shared = {c: values for c, (values, _) in first.items() if c in SHARED_VARIABLES}
         self.attrs, self.arrays = {}, {}
-        for column in (c for c in first.columns if c in LOG_VARIABLES or c.endswith("_azimuth")):
-            codes = _values(first[column])
-            self.arrays[column] = np.empty((len(names), len(first)), codes.dtype)
-            if isinstance(first[column].dtype, pd.CategoricalDtype):
-                categories = list(first[column].cat.categories)
+        for column, (values, categories) in first.items():
+            if column in SHARED_VARIABLES:
+                continue
+            self.arrays[column] = np.empty((len(names), len(values)), values.dtype)
+            if categories is not None:
                 self.attrs[column] = {"flag_values": np.arange(len(categories), dtype=np.int8),
                                       "flag_meanings": " ".join(categories)}
 
-    def add(self, i: int, log: pd.DataFrame) -> None:
+    def add(self, i: int, log: dict) -> None:
         for column, array in self.arrays.items():
-            array[i] = _values(log[column])
+            array[i] = log[column][0]
 
     def dataset(self, table: pd.DataFrame, field, site: sites.Site):
         """The logs as an xarray Dataset; categories as codes with CF flag attributes, time in UTC."""

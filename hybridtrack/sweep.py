@@ -34,7 +34,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
-import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .cluster import close, dask_client
 from .errors import HybridtrackError
 from .outputs import claim, write
 
@@ -234,27 +234,6 @@ def _failed(row: dict, exc: BaseException) -> dict:
     return {**row, **{m: None for m in METRICS}, "error": f"{type(exc).__name__}: {exc}"}
 
 
-def _client(scheduler: str | None, workers: int | None):
-    """A Dask client: on `scheduler` when given, else on a local cluster of `workers` processes."""
-    try:
-        from dask.distributed import Client, LocalCluster
-    except ImportError:  # pragma: no cover - a declared dependency
-        raise HybridtrackError("sweeps need dask.distributed: pip install 'dask[distributed]'") from None
-    if scheduler:
-        if workers is not None:
-            raise HybridtrackError("give either --scheduler or --workers, not both")
-        try:
-            return Client(scheduler, timeout="10s"), None
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    count = workers if workers is not None else (os.cpu_count() or 1)
-    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 1024:
-        raise HybridtrackError(f"workers must be a whole number from 1 to 1024, got {count!r}")
-    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=40)
-    return Client(cluster), cluster
-
-
 def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None = None,
               progress: bool = True) -> pd.DataFrame:
     """Run every run of `sweep` on Dask and return the table, one row per run, sorted by run.
@@ -273,7 +252,7 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     from tqdm import tqdm
 
     runs = sweep.runs()
-    client, cluster = _client(scheduler, workers)
+    client, cluster = dask_client(scheduler, workers, what="sweeps")
     rows = []
     try:
         futures = {client.submit(run_one, sweep.base, spec, sweep.source, pure=False): spec for spec in runs}
@@ -285,9 +264,7 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
                     rows.append(_failed(_row(_spec(sweep.base, futures[future])), exc))
                 bar.update()
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        close(client, cluster)
     return _table(rows)
 
 

@@ -163,3 +163,14 @@ def test_simulate_field_refuses_what_is_not_a_field(day):
         simulate_field(day, "lanzhou", TroughLoop(count=1), seed=-1)
     with pytest.raises(HybridtrackError, match="naive"):
         simulate_field(day.tz_localize(None), "lanzhou", TroughLoop(count=1))
+
+
+def test_a_field_on_two_dask_workers_is_the_same_field(day):
+    """Each collector's run depends only on its own draws, so where it runs changes nothing."""
+    field = TroughLoop(count=5)
+    here = simulate_field(day, "lanzhou", field, seed=4)
+    there = simulate_field(day, "lanzhou", field, seed=4, workers=2)
+    pd.testing.assert_frame_equal(here.collectors, there.collectors)
+    assert here.summary == there.summary
+    pd.testing.assert_frame_equal(here.events, there.events)
+    assert here.dataset.equals(there.dataset)

@@ -207,3 +207,11 @@ def synthetic_frame(args: argparse.Namespace, site):
     weather = args.weather.split(",") if "," in args.weather else args.weather
     return synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather, freq=args.freq,
                      seed=args.seed, gusts_per_day=args.gusts_per_day)
+
+
+def add_dask_arguments(parser, *, default: str) -> None:
+    """``--scheduler`` and ``--workers``: where a command's independent runs go (`hybridtrack.cluster`)."""
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help=f"a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: {default})")
+    parser.add_argument("--workers", type=int, help="worker processes of a local Dask cluster (default: one per core "
+                                                    "when a cluster is used)")

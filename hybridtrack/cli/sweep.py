@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import HybridtrackError
-from .base import add_force_argument, command
+from .base import add_dask_arguments, add_force_argument, command
 
 
 def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
@@ -14,9 +14,7 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True,
                         help="folder for runs.parquet (one row per run), tradeoff.png and sweep.toml")
     add_force_argument(parser)
-    parser.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
-                                                               "(default: a local cluster on this machine's cores)")
-    parser.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+    add_dask_arguments(parser, default="a local cluster on this machine's cores")
 
 
 @command("sweep", "run a grid of runs (config fields, sites, dates, weather, seeds, strategies, collectors) on Dask",

@@ -1,0 +1,57 @@
+"""Where independent runs go in parallel: a Dask client on a local cluster of worker processes,
+or on a running scheduler. Sweeps (`hybridtrack.sweep`) and fields (`hybridtrack.fields`) use it.
+
+Worker processes, one thread each: a run holds the GIL in the reference loop and in pandas, so
+threads would take turns; processes use every core.
+"""
+
+from __future__ import annotations
+
+import os
+
+from .errors import HybridtrackError
+
+__all__ = ["dask_client", "check_workers", "close"]
+
+
+def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
+    """A Dask client and the local cluster it runs on (None on a given `scheduler`).
+
+    Parameters
+    ----------
+    scheduler : str or None
+        Address of a running Dask scheduler (``tcp://host:8786``); None for a local cluster.
+    workers : int or None
+        Worker processes of the local cluster (one thread each); the machine's cores when None.
+    what : str
+        What needs Dask, for the message when it is missing.
+    """
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover - a declared dependency
+        raise HybridtrackError(f"{what} need dask.distributed: pip install 'dask[distributed]'") from None
+    if scheduler:
+        if workers is not None:
+            raise HybridtrackError("give either --scheduler or --workers, not both")
+        try:
+            return Client(scheduler, timeout="10s"), None
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    count = check_workers(workers) if workers is not None else (os.cpu_count() or 1)
+    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=40)
+    return Client(cluster), cluster
+
+
+def check_workers(workers) -> int:
+    """`workers` when it is a whole number from 1 to 1024; else a `HybridtrackError`."""
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
+        raise HybridtrackError(f"workers must be a whole number from 1 to 1024, got {workers!r}")
+    return workers
+
+
+def close(client, cluster) -> None:
+    """Close a client from `dask_client` and its local cluster."""
+    client.close()
+    if cluster is not None:
+        cluster.close()
