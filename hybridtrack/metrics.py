@@ -108,10 +108,12 @@ def shares(log: pd.DataFrame, sun_up: np.ndarray) -> tuple[dict, dict]:
     from .control import MODES, SKY_CODES
 
     n = max(len(log), 1)
-    modes = log["mode"].astype(str).value_counts()
-    sky = log["sky"].astype(str).where(np.asarray(sun_up, bool), "night").value_counts()
+    up = np.asarray(sun_up, bool)
+    modes = log["mode"].value_counts()  # by category, without making a string per step
+    sky = log["sky"][up].value_counts()
+    night = float(sky.get("night", 0)) + float((~up).sum())
     return ({m: round(float(modes.get(m, 0)) / n, 5) for m in MODES},
-            {k: round(float(sky.get(k, 0)) / n, 5) for k in (*SKY_CODES, "night")})
+            {k: round((night if k == "night" else float(sky.get(k, 0))) / n, 5) for k in (*SKY_CODES, "night")})
 
 
 def event_counts(events: pd.DataFrame) -> dict:

@@ -364,14 +364,29 @@ def _remembered(key: tuple, index: pd.DatetimeIndex) -> pd.DataFrame | None:
         if entry[1].index.equals(index):
             rows = entry[1]
         else:
-            where = entry[1].index.get_indexer(index)
-            if (where < 0).any():
+            where = _positions(entry[1].index, index)
+            if where is None:
                 continue
             rows = entry[1].iloc[where]
         memory.remove(entry)
         memory.append(entry)  # most recently used last
         return rows.set_axis(index).copy()
     return None
+
+
+def _positions(known: pd.DatetimeIndex, index: pd.DatetimeIndex) -> np.ndarray | None:
+    """Where each of `index`'s times is in `known`, or None if any is not there. Both increasing
+    (a frame's index and the subsets runs ask for): a binary search, without building a hash
+    table of a year's stamps."""
+    if not (known.is_monotonic_increasing and index.is_monotonic_increasing):
+        where = known.get_indexer(index)
+        return None if (where < 0).any() else where
+    stamps, wanted = known.as_unit("ns").asi8, index.as_unit("ns").asi8
+    where = np.searchsorted(stamps, wanted)
+    if len(where) and (where[-1] >= len(stamps) or not np.array_equal(stamps[np.minimum(where, len(stamps) - 1)],
+                                                                       wanted)):
+        return None
+    return where
 
 
 def _remember(key: tuple, frame: pd.DataFrame) -> None:

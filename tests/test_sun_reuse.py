@@ -1,5 +1,6 @@
 """Reusing sun positions inside a block gives the very numbers the model gives, computed once."""
 
+import numpy as np
 import pandas as pd
 import pvlib
 import pytest
@@ -46,3 +47,14 @@ def test_memory_keeps_only_the_newest_answers(monkeypatch):
         for temperature in (10.0, 20.0, 30.0, 10.0):
             solar_position(times, "nanjing", temperature=temperature)
     assert len(calls) == 4  # the first answer was forgotten by the time it was asked again
+
+
+def test_a_remembered_answer_serves_an_increasing_subset_and_refuses_a_stranger():
+    from hybridtrack.sun import _positions
+
+    known = pd.date_range("2021-06-21", periods=10, freq="1min", tz="Asia/Shanghai")
+    np.testing.assert_array_equal(_positions(known, known[[1, 4, 9]]), [1, 4, 9])
+    np.testing.assert_array_equal(_positions(known, known[[1, 4]].tz_convert("UTC").as_unit("us")), [1, 4])
+    assert _positions(known, known[[2]] + pd.Timedelta(seconds=1)) is None
+    assert _positions(known, pd.DatetimeIndex([known[-1] + pd.Timedelta(minutes=1)])) is None
+    np.testing.assert_array_equal(_positions(known, known[[4, 1]]), [4, 1])  # not increasing: by hash
