@@ -1,25 +1,33 @@
-"""Whole fields on today's per-collector loop: wall time and peak memory, each case in its own process.
+"""Whole fields: wall time and peak memory, each case in its own process.
 
-Run: ``python benchmarks/fields.py [--repeats N]``. Every case runs in a fresh Python process
+Run: ``python benchmarks/fields.py [--repeats N] [--heliostats N]``. Every case runs in a fresh Python process
 (so its peak resident memory is its own, weather frame included) on the same Lanzhou site-year
 at 1-minute steps (525,600 steps, climate weather, seed 1):
 
 * ``SPA site-year``: pvlib's SPA over the year's stamps, the reference of the ratios;
 * ``one Fresnel row``: ``simulate`` for one row;
 * ``20-row Fresnel field``: ``simulate_field`` of the default 20-row field, metrics only
-  (``keep_log=False``), running ``simulate`` per row;
+  (``keep_log=False``), running ``simulate`` per row in the process;
+* ``20-row Fresnel field, 2 workers``: the same on a local Dask cluster of two worker processes
+  (``workers=2``; starting the cluster is timed too);
+* ``N heliostats, 2 workers``: a field of ``--heliostats`` mirrors (``HeliostatField.rings``,
+  100 by default) on two workers, metrics only; the table also gives its time per mirror and
+  what 1,000 mirrors would take at that rate (an extrapolation, marked as one);
 * ``1,000 heliostats, geometry, per mirror``: every mirror's normal, azimuth and elevation for
   the year, one mirror per call, as the per-collector loop does it;
 * ``1,000 heliostats, geometry, vectorised``: the same numbers for all mirrors in one call a day
   (``HeliostatField.targets``, 1,440 x 1,000 x 3 at a time).
 
-Medians of `--repeats` runs of each (1 by default: the field-year takes minutes).
+Medians of `--repeats` runs of each (1 by default: the field-year takes minutes). Peak memory
+is the largest resident set of the case's process and, for the cases on workers, the parent's
+plus each worker's at most (``RUSAGE_CHILDREN`` gives the largest child's).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import resource
 import statistics
 import subprocess
@@ -29,6 +37,8 @@ import time
 from _timing import print_table
 
 YEAR = ("2021-01-01", "2021-12-31")
+#: Mirrors of the heliostat field-year case (``--heliostats``).
+HELIOSTATS = int(os.environ.get("HYBRIDTRACK_BENCH_HELIOSTATS", "100"))
 
 
 def _year():
@@ -60,6 +70,20 @@ def _fresnel_field(frame):
     simulate_field(frame, "lanzhou", FresnelField(), keep_log=False, progress=False)
 
 
+def _fresnel_field_on_workers(frame):
+    from hybridtrack import simulate_field
+    from hybridtrack.fields import FresnelField
+
+    simulate_field(frame, "lanzhou", FresnelField(), keep_log=False, progress=False, workers=2)
+
+
+def _heliostats_on_workers(frame):
+    from hybridtrack import simulate_field
+    from hybridtrack.fields import HeliostatField
+
+    simulate_field(frame, "lanzhou", HeliostatField.rings(HELIOSTATS), keep_log=False, progress=False, workers=2)
+
+
 def _sun(frame):
     from hybridtrack.sun import solar_position
 
@@ -87,6 +111,8 @@ def _geometry_vectorised(sun):
 
 CASES = {"SPA site-year": (_year, _spa), "one Fresnel row": (_year, _one_row),
          "20-row Fresnel field": (_year, _fresnel_field),
+         "20-row Fresnel field, 2 workers": (_year, _fresnel_field_on_workers),
+         "N heliostats, 2 workers": (_year, _heliostats_on_workers),
          "1,000 heliostats, geometry, per mirror": (lambda: _sun(_year()), _geometry_per_mirror),
          "1,000 heliostats, geometry, vectorised": (lambda: _sun(_year()), _geometry_vectorised)}
 
@@ -98,6 +124,8 @@ def _child(case: str) -> None:
     run(data)
     seconds = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
+    if "workers" in case:
+        peak += 2 * resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     print(json.dumps({"seconds": seconds, "peak_mib": peak}))
 
 
@@ -112,18 +140,24 @@ def _measure(case: str, repeats: int) -> tuple[float, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--heliostats", type=int, default=HELIOSTATS, help="mirrors in the heliostat field-year case")
     parser.add_argument("--case", choices=list(CASES), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    os.environ["HYBRIDTRACK_BENCH_HELIOSTATS"] = str(args.heliostats)
     if args.case:
         _child(args.case)
         return
     measured = {case: _measure(case, args.repeats) for case in CASES}
     spa = measured["SPA site-year"][0]
     per_mirror = measured["1,000 heliostats, geometry, per mirror"][0]
-    rows = [[case, f"{seconds:.2f}", f"{seconds / spa:.2f}x", f"{per_mirror / seconds:.1f}x" if "heliostat" in case
+    rows = [[case, f"{seconds:.2f}", f"{seconds / spa:.2f}x", f"{per_mirror / seconds:.1f}x" if "geometry" in case
              else "", f"{peak:,.0f}"] for case, (seconds, peak) in measured.items()]
+    rows = [[case.replace("N heliostats", f"{args.heliostats:,} heliostats"), *rest] for case, *rest in rows]
+    mirrors = measured["N heliostats, 2 workers"][0]
     print(f"Lanzhou site-year at 1 min (525,600 steps), median of {args.repeats} run(s) each, one process per case")
     print_table(["case", "wall s", "/ SPA", "per-mirror / this", "peak RSS MiB"], rows)
+    print(f"heliostat field-year on 2 workers: {mirrors / args.heliostats:.2f} s a mirror; 1,000 mirrors at that rate "
+          f"(extrapolated, not run): {1000 * mirrors / args.heliostats:.0f} s")
 
 
 if __name__ == "__main__":
