@@ -363,11 +363,12 @@ def _day_cycle(events: pd.DataFrame, site: sites.Site) -> list[dict]:
     """When the collector woke and stowed for the night each day (local time), and why."""
     woke = events[(events["from"] == "stow_night") & (events["to"] != "stow_night")]
     slept = events[(events["to"] == "stow_night") & (events["from"] != "stow_night")]
-    days = []
-    for _, row in pd.concat([woke.assign(kind="woke"), slept.assign(kind="stowed")]).sort_values("time").iterrows():
-        local = row["time"].tz_convert(site.tz)
-        days.append({"time": local.isoformat(), "event": row["kind"], "reason": row["reason"]})
-    return days
+    both = pd.concat([woke.assign(kind="woke"), slept.assign(kind="stowed")]).sort_values("time")
+    if both.empty:
+        return []
+    local = pd.DatetimeIndex(both["time"]).tz_convert(site.tz)
+    return [{"time": time.isoformat(), "event": kind, "reason": reason}
+            for time, kind, reason in zip(local, both["kind"], both["reason"])]
 
 
 def _wind_data(frame: pd.DataFrame) -> str:
