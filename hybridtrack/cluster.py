@@ -39,7 +39,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
     count = check_workers(workers) if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=40)
+                           silence_logs=50)  # a failed task is reported by its result, not logged
     return Client(cluster), cluster
 
 
