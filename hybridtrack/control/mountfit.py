@@ -90,7 +90,7 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
     for k, name in enumerate(names[:2]):
         up, down = (MountEstimate.from_parameters(names, [sign * h if n == name else 0.0 for n in names])
                     .rotation(collector) for sign in (1.0, -1.0))
-        turned = vectors @ ((up - down) / (2.0 * h)).T  # d(vectors as the mount sees them)/d(parameter)
+        turned = vectors @ np.ascontiguousarray(((up - down) / (2.0 * h)).T)  # d(vectors as the mount sees)/d(parameter)
         out[:, :, k] = np.einsum("nac,nc->na", gradient, turned)
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
