@@ -144,6 +144,20 @@ class World:
         Injected faults, one array per step (see ``hybridtrack.simulation.FAULTS``).
     truth : {"spa-fast", "spa"}
         The true sun's model (``hybridtrack.sun.solar_position``).
+
+    Attributes
+    ----------
+    truth : numpy.ndarray
+        (N, axes) the true targets on the true mount, degrees (NaN with the sun down);
+        ``truth_axes`` the same per axis, (axes, N), with 0 for NaN, as the scans read it.
+    scene : tuple of numpy.ndarray
+        The sensor's scene (`hybridtrack.sensor.SensorScene`): beam, aureole, patch, the patch's
+        offset per axis (2, N) and the diffuse light.
+    noise, current_noise, coarse_noise : numpy.ndarray
+        Standard normal draws: the fine cells' (axes, N), the photocurrent's (N,), the coarse
+        cells' (axes, N).
+    angles : numpy.ndarray
+        (axes, N) the angle each axis stood at after each scan, filled as the run goes.
     """
 
     def __init__(self, frame: pd.DataFrame, site: sites.Site, collector: Collector, imperfections: Imperfections,
