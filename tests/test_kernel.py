@@ -414,18 +414,28 @@ def test_the_cusum_compiled_flags_as_the_reference():
 
 
 def test_the_mount_fit_compiled_updates_as_the_reference():
-    from hybridtrack.control.mountfit import MountEstimator
-    from hybridtrack.kernel.controller import fit_condition, fit_forget, fit_update
+    from hybridtrack.control.mountfit import MountEstimator, pull_spread
+    from hybridtrack.kernel.controller import (FLOAT_SLOTS, INT_SLOTS, LIGHT_LEVEL, ControllerState, fit_condition,
+                                               fit_excess_light, fit_forget, fit_update)
+    from hybridtrack.kernel.controller import pull_spread as compiled_spread
 
     fit, rng = MountEstimator(2, 0.05), np.random.default_rng(4)
     theta, p, information = fit.theta.copy(), fit.p.copy(), fit.information.copy()
+    unused = [np.zeros(1)] * (len(ControllerState._fields) - 2)
+    compiled = ControllerState(np.full(FLOAT_SLOTS, np.nan), np.zeros(INT_SLOTS, np.int64), *unused)
     for k in range(400):
         derivatives, weight, residual = rng.normal(size=4), rng.uniform(0.2, 1.0), rng.normal(0, 0.3)
+        ratio = np.nan if k % 50 == 7 else rng.choice([1.03, 1.1]) + rng.normal(0, 0.01)
+        altitude = np.nan if k % 70 == 3 else rng.uniform(-2.0, 90.0)
+        pull = weight * pull_spread(1.4, fit.excess_light(ratio), altitude)
+        compiled_pull = weight * compiled_spread(1.4, fit_excess_light(compiled, ratio), altitude)
+        assert compiled_pull == pull and compiled.s[LIGHT_LEVEL] == fit.level
         fit.forget(5.0)
         fit_forget(p, information, fit.memory, fit.prior, 5.0)
         frozen = fit.axis_frozen
-        fit.update(derivatives * weight, residual * weight)
-        fit_update(theta, p, information, fit.r, fit.clip, frozen, derivatives, weight, residual * weight)
+        fit.update(derivatives * weight, residual * weight, fit.r + pull * pull)
+        fit_update(theta, p, information, fit.r + pull * pull, fit.clip, frozen, derivatives, weight,
+                   residual * weight)
         assert np.array_equal(theta, fit.theta) and np.array_equal(p, fit.p)
         assert np.array_equal(information, fit.information)
         if fit.updates % fit.check_every == 0:

@@ -22,7 +22,7 @@ STRATEGIES = ("hybrid", "hybrid-nocal", "astronomical", "astronomical-commission
 _RANGES = (("wind_stow", 0, 60, True), ("wind_release", 0, 60, True), ("min_altitude", -10, 30, False),
            ("process_noise", 0, 10, True), ("gate", 0, 100, True), ("calibration_max_rate", 0, 100, True),
            ("sensor_plausibility", 0, 45, True), ("sensor_noise", 0, 5, True), ("dusk_current", 0, 1000, True),
-           ("disagreement", 0, 45, True))
+           ("disagreement", 0, 45, True), ("pull_gain", 0, 100, False))
 
 
 def _check_working_hours(hours) -> None:
@@ -118,6 +118,13 @@ class ControllerConfig:
     distrust : str
         How long a sensor judged against the model is not trusted (``on_disagreement = "model"``):
         an hour, long enough for the sun to move about 15° and show a bias again from another angle.
+    pull_gain : float
+        Degrees: how far a reading in a clear gap may be pulled toward the cloud light near the
+        sun, per unit of light above the clear sky's level, at the zenith (1/sin of the sun's
+        altitude lower down). The mount fit weighs each reading by it
+        (`hybridtrack.control.mountfit.pull_spread`, which derives the default from the
+        circumsolar share of cloud light and a cloud edge's distance); 0 weighs every reading by
+        the sensor's noise alone.
     kalman : {"fast", "filterpy"}
         ``filterpy`` runs filterpy's KalmanFilter, the reference; ``fast`` the same
         equations in plain floats (a test keeps them equal).
@@ -149,6 +156,7 @@ class ControllerConfig:
     on_disagreement: str = "model"
     distrust: str = "60min"
     kalman: str = "fast"
+    pull_gain: float = 1.4
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "working_hours", tuple(self.working_hours))

@@ -21,7 +21,7 @@ from .clockwatch import ClockWatch
 from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import EncoderMonitor
-from .mountfit import MountEstimator
+from .mountfit import MountEstimator, pull_spread
 from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR,
                     SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
@@ -147,6 +147,8 @@ class Controller:
         self.distrusted_until = -math.inf  # the sensor disagreed with the calibrated model: not trusted till then
         if memory:
             self._recall(memory)
+            if self.fit is not None:  # the clear sky's level is the sky's, not the fit's: no checkpoint restores it
+                self.fit.level = memory.get("light_level", self.fit.level)
         self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
         self.coast_for = config.minutes("coast")
         self.mode, self.mode_since = STOW_NIGHT, -math.inf
@@ -421,7 +423,9 @@ class Controller:
             self.fit_since = t
             w = self.weight[i, a]
             miss, spread = self._against_checkpoint(i, a, z, m0, w)
-            self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w)
+            pull = w * pull_spread(self.config.pull_gain, self.fit.excess_light(self._light_ratio(i)),
+                                   self.altitude[i])
+            self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w, self.fit.r + pull * pull)
             self.theta = self.fit.theta
             if self._disagrees(i, miss, spread):
                 return
@@ -431,6 +435,12 @@ class Controller:
         mount = self._correction(i, a) - self.calibrators[a].offset
         residual = self._turn(a, self.gates[a].filter.angle - m0 - mount)
         self.calibrators[a].learn(dt, residual, self._turn(a, m0 - m1), bound)
+
+    def _light_ratio(self, i: int) -> float:
+        """The photocurrent above dark over the clear-sky photocurrent expected at scan `i` (NaN
+        where none is expected)."""
+        expected = self.clear_light[i]
+        return (self.out["intensity"][i] - self.sky.dark) / expected if expected > 0 else math.nan
 
     def _against_checkpoint(self, i: int, a: int, z: float, m0: float, w: float) -> tuple[float, float]:
         """The sensor's sun angle less the mount as fitted at the last checkpoint, and the spread that
@@ -469,12 +479,13 @@ class Controller:
         return True
 
     def memory(self) -> dict:
-        """What this controller would carry into a next run: its mount fit and offsets."""
+        """What this controller would carry into a next run: its mount fit (with the clear sky's
+        light level its readings are judged against) and offsets."""
         fit = self.fit
         state = {"offsets": [c.offset for c in self.calibrators]}
         if fit is not None:
             state.update(theta=fit.theta.tolist(), p=fit.p.copy(), information=fit.information.copy(),
-                         frozen=fit.axis_frozen, updates=fit.updates)
+                         frozen=fit.axis_frozen, updates=fit.updates, light_level=fit.level)
         return state
 
     def _recall(self, memory: dict) -> None:

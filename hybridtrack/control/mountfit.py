@@ -20,6 +20,24 @@ errors; measured in the tests). The update is RLS with an exponential forgetting
 (time constant `memory`), its covariance bounded by the prior so it cannot wind up while the
 sun is hidden; each step is bounded by clipping the innovation at `clip` standard deviations.
 
+A reading taken in a clear gap between clouds is pulled toward the bright cloud edge near the
+sun, and the controller can see how much such light there is. Each reading's variance is the
+sensor's noise plus the pull it may carry, σ_pull = `pull_gain` · x / max(sin h, cos 85°)
+(`pull_spread`), from the light above the clear sky's level, x, and the computed sun's altitude
+h. The derivation follows the world's sensor (`hybridtrack.sensor.read_pointing`): cloud light
+in view, P, off the sun by d, moves the centroid by P / (B + P) · d, B the beam. In a clear gap
+the beam is the clear sky's, and the photocurrent's excess over what a clear sky gives is the
+cloud light on the sensor's diffuse share s_d of the diffuse light, x ≈ s_d · ΔD / B. The
+circumsolar part of ΔD that a sun-facing sensor sees is F1 · ΔD / max(cos z, cos 85°) (Perez
+et al. 1990), of which the view holds a share v, so P / B ≈ (F1 · v / s_d) · x / sin h. With
+F1 ≈ 0.3 (Perez's circumsolar brightening under broken cloud), v = 0.8, s_d = 0.5 and d the 2–6°
+of a cloud edge (rms per axis about 2.8°), the gain is F1 · v / s_d · 2.8° ≈ 1.4°. The level is
+a running mean of the ratio over the last hour of fit readings (`MountEstimator.excess_light`),
+since the controller's clear-sky model misses a given day's clear sky by a few percent. A bound
+on the step in the fit's own metric, Δθᵀ P⁻¹ Δθ ≤ c², is already implied by the innovation
+clip: an RLS step has Δθᵀ P⁻¹ Δθ = ν² · hᵀPh / s ≤ ν² with ν the normalised innovation, so a
+bound with c at `clip` never binds; a larger variance shrinks the step in every direction.
+
 A parameter the sun's path does not excite is not fitted to noise. Every `check_every`
 updates the information matrix (forgotten like the covariance) is inspected: while its
 condition number exceeds `MAX_CONDITION`, the pedestal (axis) terms are frozen and only the
@@ -38,6 +56,10 @@ Khalsa, S. S. S., Ho, C. K. & Andraka, C. E. (2011). An automated method to corr
 tracking errors. SolarPACES 2011, Granada. SAND2011-6233C.
 
 Ljung, L. & Söderström, T. (1983). *Theory and Practice of Recursive Identification*. MIT Press.
+
+Perez, R., Ineichen, P., Seals, R., Michalsky, J. & Stewart, R. (1990). Modeling daylight
+availability and irradiance components from direct and global irradiance. *Solar Energy* 44(5),
+271-289. doi:10.1016/0038-092X(90)90055-H
 """
 
 from __future__ import annotations
@@ -48,13 +70,20 @@ import numpy as np
 
 from ..mounting import angles_on_mount, pointing_vectors
 
-__all__ = ["MountEstimator", "jacobian", "parameter_names", "MAX_CONDITION", "ROTATION_STEP"]
+__all__ = ["MountEstimator", "jacobian", "pull_spread", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
+           "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
 
 #: Above this condition number of the information matrix, axis azimuth and tilt are frozen.
 MAX_CONDITION = 1e3
 #: Degrees: the central-difference step of the mount rotation's derivative (a 3 × 3 matrix,
 #: smooth in its angles: the difference errs by about 1e-12 at this step).
 ROTATION_STEP = 1e-4
+#: Fit readings over which the clear-sky light level is averaged (an hour at one every five minutes).
+LEVEL_READINGS = 12
+#: How far a clear sky's light ratio wanders about its level within an hour, not counted as excess.
+LIGHT_TOLERANCE = 0.01
+#: cos 85°: Perez's bound on the zenith's cosine (circumsolar light stops growing below 5° of sun).
+HORIZON = math.cos(math.radians(85.0))
 
 
 def parameter_names(collector) -> list[str]:
@@ -119,6 +148,19 @@ def _angle_gradient(vectors: np.ndarray, collector) -> np.ndarray:
         return share * degrees * np.stack([d_across * np.cos(b), -d_across * np.sin(b), d_z], axis=-1)[:, None, :]
 
 
+def pull_spread(gain: float, excess: float, altitude: float) -> float:
+    """Degrees, 1σ: how far cloud light near the sun may pull a sensor reading, from the light
+    above the clear sky's level (`excess`, a share of the expected clear-sky light) and the
+    computed sun's `altitude` (degrees; NaN counts as the horizon).
+
+    gain · excess / max(sin(altitude), cos 85°): the circumsolar light on a sun-facing plane
+    per unit of diffuse light grows as 1/sin(altitude), bounded at 85° from the zenith, as in
+    Perez et al. (1990). The module's notes derive it.
+    """
+    rise = math.sin(math.radians(altitude)) if altitude == altitude else 0.0
+    return gain * excess / max(rise, HORIZON)
+
+
 class MountEstimator:
     """Online estimate of the mount's errors (degrees) with its covariance.
 
@@ -152,6 +194,25 @@ class MountEstimator:
         self.updates = 0
         self.axis_frozen = True
         self.condition = math.inf
+        self.level = math.nan
+
+    def excess_light(self, ratio: float) -> float:
+        """The light above the clear sky's level at a fit reading, then the level updated.
+
+        `ratio` is the photocurrent above dark over the clear-sky photocurrent the controller
+        expects (NaN where it expects none). The level is the ratio's running mean over the last
+        `LEVEL_READINGS` fit readings: what a clear sky gives against the controller's clear-sky
+        model, which misses the day's turbidity by a few percent. Returns
+        max(0, ratio − level − `LIGHT_TOLERANCE`), the level taken before the update (0 for a NaN ratio, which leaves the level as it was). The first
+        reading a fit ever takes sets the level (and has no excess).
+        """
+        if not math.isfinite(ratio):
+            return 0.0
+        if math.isnan(self.level):
+            self.level = ratio
+        excess = max(0.0, ratio - self.level - LIGHT_TOLERANCE)
+        self.level += (ratio - self.level) / LEVEL_READINGS
+        return excess
 
     def predict(self, row) -> float:
         """The correction the fitted mount makes to a computed target: row · theta."""
@@ -165,17 +226,19 @@ class MountEstimator:
         self.p = p * np.outer(scale, scale)
         self.information *= factor
 
-    def update(self, row, residual: float) -> None:
-        """Take one measurement: `residual` = measured angle − computed target, with derivatives `row`.
+    def update(self, row, residual: float, variance: float | None = None) -> None:
+        """Take one measurement: `residual` = measured angle − computed target, with derivatives `row`
+        and the reading's `variance` (deg², the datasheet noise's when not given).
 
         While the pedestal terms are frozen they are "consider" parameters (the Schmidt-Kalman
         filter): their uncertainty is carried in the gain and covariance of the others, but
         they are not moved.
         """
         row = np.asarray(row, float)
-        self.information += np.outer(row, row) / self.r  # what it tells of every parameter, frozen or not
+        r = self.r if variance is None else variance
+        self.information += np.outer(row, row) / r  # what it tells of every parameter, frozen or not
         pr = self.p @ row
-        s = self.r + float(row @ pr)
+        s = r + float(row @ pr)
         gain = pr / s
         if self.axis_frozen:
             gain[:2] = 0.0
@@ -184,7 +247,7 @@ class MountEstimator:
         error = max(-bound, min(bound, innovation))
         self.theta = self.theta + gain * error
         a = np.eye(self.n) - np.outer(gain, row)  # Joseph form, right for any gain
-        self.p = a @ self.p @ a.T + self.r * np.outer(gain, gain)
+        self.p = a @ self.p @ a.T + r * np.outer(gain, gain)
         self.updates += 1
         if self.updates % self.check_every == 0:
             self._check()

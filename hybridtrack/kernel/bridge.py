@@ -84,6 +84,7 @@ def _settings(controller: Controller) -> kc.ControllerSettings:
         float(calibrator.max_rate),
         fit is not None, float(fit.r) if fit else 1.0, float(fit.prior) if fit else 1.0,
         float(fit.memory) if fit else 1.0, float(fit.clip) if fit else 1.0, int(fit.check_every) if fit else 1,
+        float(config.pull_gain),
         float(clock.r) if clock else 1.0,
         np.array(np.diag(clock.prior_information) if clock else [], float),
         inputs.mode == "relative", float(sky.mean.window) if sky.mean is not None else 0.0, float(sky.window_minutes),
@@ -226,6 +227,7 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
     arrays, world_state = pack_world(world)
     cfg, plan = _settings(controller), _plan(controller)
     state = _state(controller, arrays.minutes)
+    state.s[kc.LIGHT_LEVEL] = controller.fit.level if controller.fit is not None else math.nan
     out = _record(n, axes, len(state.theta))
     events = _events(1024 + EVENTS_PER_SCAN)
     guard = controller.wind
@@ -245,6 +247,8 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
     controller.events = _worded(controller, events, int(state.k[kc.EVENTS]))
     controller.moves, controller.travel = state.moves.tolist(), state.travel.tolist()
     _write_back(controller, state)
+    if controller.fit is not None:
+        controller.fit.level = float(state.s[kc.LIGHT_LEVEL])
     return ControllerOutputs(out.mode, out.status, out.sky, out.score, out.intensity, out.variation, out.target,
                              out.reading, out.calibration, out.sun, out.fit_value, out.fit_std,
                              np.array(controller.moves), np.array(controller.travel), controller.events)

@@ -14,7 +14,8 @@ SkyWatch                `trailing_mean`, `trailing_range`, `sky_update`
 ClassifierTable         `table_score`, `table_code`
 SensorGate + Kalman     `gate_judge`, `gate_take`, `kalman_*`
 Calibrator.learn        `calibrator_learn`
-MountEstimator          `fit_forget`, `fit_update`, `fit_check`
+MountEstimator          `fit_forget`, `fit_update`, `fit_check`, `fit_excess_light`
+pull_spread             `pull_spread`
 DisagreementMonitor     `disagreement_add`
 ClockWatch              `clock_add`, `clock_solve`, `clock_verdict`
 Controller.step         `controller_step` and its `_`-named helpers
@@ -38,7 +39,7 @@ from ..control.controller import DUSK_MINUTES, FIT_EVERY, SETTLE_UPDATES
 from ..control.disagreement import ALLOWANCE, MIN_RUN, THRESHOLD
 from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGHT, NOT_READ, OK, OUT_OF_VIEW,
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
-from ..control.mountfit import MAX_CONDITION
+from ..control.mountfit import HORIZON, LEVEL_READINGS, LIGHT_TOLERANCE, MAX_CONDITION
 from ..control.wind import STUCK_HOURS, STUCK_SPREAD
 from . import events as ev
 from .jit import kernel
@@ -52,7 +53,7 @@ ControllerSettings = namedtuple("ControllerSettings", [
     "dwell", "loss", "coast_for", "dusk_current", "plausibility", "disagreement", "follow_sensor", "distrust",
     "wind_stow", "wind_release", "wind_hold", "stow_when_missing", "encoder_confirm",
     "q", "r", "stuck_scans", "stuck_spread", "gate2", "reacquire", "tau", "max_rate",
-    "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "clock_r", "clock_prior",
+    "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "pull_gain", "clock_r", "clock_prior",
     "sky_relative", "smoothing", "window", "min_altitude", "low_sun_absolute", "relative_floor", "full_variation",
     "dark", "table", "table_step", "table_last", "ranges", "edges", "codes",
     "deadband", "speed", "stow_speed", "low", "high", "stow", "resolution", "circular"])
@@ -74,8 +75,8 @@ EventLog = namedtuple("EventLog", ["scan", "before", "after", "code", "value"])
 
 # slots of ControllerState.s
 (MODE_SINCE, INVALID_SINCE, PREVIOUS_T, DARK_SINCE, DISTRUSTED_UNTIL, FIT_SINCE, CALM_SINCE, FLAT_VALUE, FLAT_SINCE,
- MEAN_TOTAL, CONDITION, CUSUM_HIGH, CUSUM_LOW, CUSUM_SUM, SPELL_START, SPELL_LAST) = range(16)
-FLOAT_SLOTS = 16
+ MEAN_TOTAL, CONDITION, CUSUM_HIGH, CUSUM_LOW, CUSUM_SUM, SPELL_START, SPELL_LAST, LIGHT_LEVEL) = range(17)
+FLOAT_SLOTS = 17
 # slots of ControllerState.k
 (MODE, RESTING, WAS_AWAKE, FOUND_TODAY, BLIND_STOW, WIND_STUCK, EVENTS, HAS_CHECKPOINT, UPDATES, FROZEN,
  CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN, MOUNT_AT_SCAN, MOUNT_AT_UPDATES, CLOCK_ROWS, CLOCK_PENDING,
@@ -535,6 +536,27 @@ def fit_update(theta, p, information, r, clip, frozen, derivatives, weight, resi
 
 
 @kernel
+def fit_excess_light(state, ratio):
+    """MountEstimator.excess_light: the light ratio above the clear sky's level (less the
+    tolerance), then the level (`s[LIGHT_LEVEL]`) updated."""
+    if not math.isfinite(ratio):
+        return 0.0
+    s = state.s
+    if math.isnan(s[LIGHT_LEVEL]):
+        s[LIGHT_LEVEL] = ratio
+    excess = max(0.0, ratio - s[LIGHT_LEVEL] - LIGHT_TOLERANCE)
+    s[LIGHT_LEVEL] += (ratio - s[LIGHT_LEVEL]) / LEVEL_READINGS
+    return excess
+
+
+@kernel
+def pull_spread(gain, excess, altitude):
+    """mountfit.pull_spread: 1σ of a reading's cloud pull, degrees."""
+    rise = math.sin(math.radians(altitude)) if altitude == altitude else 0.0
+    return gain * excess / max(rise, HORIZON)
+
+
+@kernel
 def disagreement_add(state, normalised, residual, limit):
     """DisagreementMonitor.add."""
     s, k = state.s, state.k
@@ -613,7 +635,7 @@ def _disagrees(cfg, state, log, i, miss, spread):
 
 
 @kernel
-def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound):
+def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound, intensity):
     t = state.s[PREVIOUS_T]
     if cfg.has_fit and t - state.fitted_at[a] >= FIT_EVERY:
         state.fitted_at[a] = t
@@ -624,7 +646,10 @@ def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound):
         fitted, spread = _against_checkpoint(plan.jacobian[i, a], state.checkpoint_theta if has else state.theta,
                                              state.checkpoint_p if has else state.p, cfg.fit_r, w)
         miss = _turn(cfg, a, z - m0 - fitted) * w
-        fit_update(state.theta, state.p, state.information, cfg.fit_r, cfg.clip, state.k[FROZEN],
+        expected = plan.clear_light[i]
+        ratio = (intensity - cfg.dark) / expected if expected > 0 else math.nan
+        pull = w * pull_spread(cfg.pull_gain, fit_excess_light(state, ratio), plan.altitude[i])
+        fit_update(state.theta, state.p, state.information, cfg.fit_r + pull * pull, cfg.clip, state.k[FROZEN],
                    plan.jacobian[i, a], w, _turn(cfg, a, z - m0) * w)
         state.k[UPDATES] += 1
         if state.k[UPDATES] % cfg.check_every == 0:
@@ -769,7 +794,7 @@ def _plausibility_bound(cfg, plan, i, a, axes):
 
 
 @kernel
-def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes):
+def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes, intensity):
     m0 = plan.model[i, a]
     m1 = plan.model[i - 1, a] if i else math.nan
     bound = _plausibility_bound(cfg, plan, i, a, axes)
@@ -781,7 +806,7 @@ def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes):
         rate = state.kf[a, X1] if state.gate[a, READY] else 0.0
     verdict = gate_take(cfg, state, a, z, dt, miss, bound, rate)
     if verdict == OK and trusted and has_model:
-        _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound)
+        _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound, intensity)
     return verdict
 
 
@@ -817,7 +842,7 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
         if verdict == OK and obs[0] < state.s[DISTRUSTED_UNTIL]:
             verdict = IMPLAUSIBLE
         if verdict == OK:
-            verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted, axes)
+            verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted, axes, obs[3])
         valid[a] = verdict == OK
         if valid[a]:
             out.sun[i, a] = state.kf[a, X0]
