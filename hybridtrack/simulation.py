@@ -191,8 +191,9 @@ class Result:
         What the controller would carry into a next run (its mount fit and offsets, the clock
         watch's readings, a commissioned mount): `simulate`'s ``warm_start`` takes it.
     scoring : dict
-        The per-step inputs of the summary that are not in the log (``sun_up``, ``incidence``),
-        for scoring a run in parts (`hybridtrack.metrics.RunningSummary`).
+        The inputs of the summary that are not in the log (per step ``sun_up`` and ``incidence``;
+        ``moves`` and unrounded ``travel``), for scoring a run in parts
+        (`hybridtrack.metrics.RunningSummary`).
     """
 
     log: pd.DataFrame
@@ -356,10 +357,10 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                                                        world.controller_site()))
     events = pd.DataFrame([(index[i], a, b, why) for i, a, b, why in out.events],
                           columns=["time", "from", "to", "reason"])
+    scoring = {"sun_up": world.altitude > 0, "incidence": incidence_cosine(world.altitude, world.azimuth, collector),
+               "moves": int(out.moves.sum()), "travel": float(out.travel.sum())}
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
-                        moves=int(out.moves.sum()), travel=float(out.travel.sum()), events=events,
-                        sun_up=world.altitude > 0,
-                        incidence=incidence_cosine(world.altitude, world.azimuth, collector))
+                        events=events, **scoring)
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
     summary["clock"] = controller.clock.state() if controller.clock is not None else None
     summary["wind_data"] = _wind_data(frame)
@@ -367,7 +368,6 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     memory = controller.carry(index[0])
     if config.controller.strategy == "astronomical-commissioned":
         memory["commissioned"] = mount
-    scoring = {"sun_up": world.altitude > 0, "incidence": incidence_cosine(world.altitude, world.azimuth, collector)}
     return Result(log, summary, events, site, collector, config, memory, scoring)
 
 
