@@ -55,7 +55,7 @@ from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, strict_json, write
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
-           "read_log"]
+           "read_log", "stream_files"]
 
 #: Rows read from a recorded file at a time (a day at 1 s is 86,400).
 CHUNK_ROWS = 200_000
@@ -389,6 +389,12 @@ class _LogWriter:
             self.writer.close()
 
 
+def stream_files(folder) -> dict[str, Path]:
+    """The files `stream` writes into `folder`, by role."""
+    folder = Path(folder)
+    return {"log": folder / "log.parquet", "events": folder / "events.csv", "summary": folder / "summary.json"}
+
+
 def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
            config=None, classifier=None, warm_start: bool = True, progress=None,
            on_segment: Callable | None = None, resolution: float = HISTOGRAM_RESOLUTION) -> StreamResult:
@@ -429,6 +435,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     ----------
     Apache Parquet file format: row groups, https://parquet.apache.org/docs/file-format/
     """
+    from .kernel import uses_kernel
     from .simulation import SimulationConfig, simulate
 
     if not isinstance(source, DaySource):
@@ -438,10 +445,12 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     collector = Collector(collector) if isinstance(collector, str) else collector
+    if config.engine == "auto" and source.steps and uses_kernel(config, source.steps):
+        # whether the kernel pays is a question of the whole span, not of one day's segment
+        config = dataclasses.replace(config, engine="compiled")
     if not 0 < resolution <= 1:
         raise HybridtrackError(f"resolution must be above 0 and at most 1 degree, got {resolution!r}")
-    folder = Path(out)
-    files = {"log": folder / "log.parquet", "events": folder / "events.csv", "summary": folder / "summary.json"}
+    files = stream_files(out)
     claim(files.values())
     write(files["events"], lambda path: path.write_text("time,from,to,reason\n"))
     running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
