@@ -291,7 +291,8 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
              config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
-             faults: dict | None = None, progress=None, bulk_nights: bool = True, warm_start: bool | dict = True) -> Result:
+             faults: dict | None = None, progress=None, bulk_nights: bool = True,
+             warm_start: bool | dict = True) -> Result:
     """Run a tracking controller over a weather frame.
 
     Parameters

@@ -181,7 +181,8 @@ def frame_days(frame: pd.DataFrame, site) -> DaySource:
         raise HybridtrackError("the weather frame must be a DataFrame on a tz-aware DatetimeIndex")
     local = frame.index.tz_convert(site.tz)
     days = len(set(local.date))
-    if len(frame) > 1 and (frame.index[-1] - frame.index[0]) + (frame.index[1] - frame.index[0]) < pd.Timedelta(hours=23):
+    covered = (frame.index[-1] - frame.index[0]) + (frame.index[1] - frame.index[0]) if len(frame) > 1 else None
+    if covered is not None and covered < pd.Timedelta(hours=23):
         raise HybridtrackError(f"the frame spans {local[0]} to {local[-1]}: a streamed run needs at least one whole "
                                "local day (run a shorter span in memory with hybridtrack.simulate)")
     return DaySource(site, "a weather frame", len(frame), days, lambda: _by_day(iter([frame]), site, "the frame"))
@@ -300,9 +301,9 @@ class StreamResult:
         from .report import _headline, _shares
 
         s = self.summary
-        lines = [f"hybridtrack streamed run: {s['site']} · {s['collector']} · {s['strategy']} · {s['start'][:10]} to "
-                 f"{s['end'][:10]}", f"  {s['steps']:,} steps in {s['streamed']['segments']} day-long segments; "
-                 f"log in {self.files['log']}"]
+        lines = [f"hybridtrack streamed run: {s['site']} · {s['collector']} · {s['strategy']} · "
+                 f"{s['start'][:10]} to {s['end'][:10]}",
+                 f"  {s['steps']:,} steps in {s['streamed']['segments']} day-long segments; log in {self.files['log']}"]
         lines += [f"  {label}: {value}" for label, value in _headline(s)]
         lines += [f"  modes: {_shares(s['mode_share'])}", f"  sky: {_shares(s['sky_share'])} (every step)"]
         return "\n".join(lines)
