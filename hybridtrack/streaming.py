@@ -270,6 +270,11 @@ class StreamResult:
         ``log`` (Parquet, one row group a day), ``events`` (CSV), ``summary`` (JSON).
     memory : dict
         What the controller carries out of the last segment (`hybridtrack.simulation.Result`).
+    config : SimulationConfig
+        The run's config (each segment's differs only in its noise seed and the clock's age).
+
+    A run that stops part way (an error, an interrupt) leaves the log and events of the days it
+    finished, and no ``summary.json``.
     """
 
     summary: dict
@@ -410,7 +415,9 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
         Folder for ``log.parquet``, ``events.csv`` and ``summary.json``, claimed before the run
         (`hybridtrack.outputs.claim`: no symbolic links; existing files only under ``replacing``).
     collector, strategy, config, classifier
-        As `hybridtrack.simulate` takes them.
+        As `hybridtrack.simulate` takes them. The config's ``engine = "auto"`` is decided on the
+        whole span's steps (where the source knows them), not on one day's: a year at 1 s pays
+        for compiling the kernel (`hybridtrack.kernel.COMPILE_PAYS_AT`).
     warm_start : bool
         The first segment's warm start (`hybridtrack.simulate`); later segments go on from the
         one before (its `Result.memory`).
@@ -485,8 +492,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
             if on_segment is not None:
                 on_segment(result)
             memory, segments = result.memory, segments + 1
-            last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"],
-                    "config": result.config}
+            last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"]}
             del result, frame  # nothing of a segment outlives it but its memory and the running sums
     finally:
         logs.close()
@@ -503,7 +509,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     summary["streamed"] = {"segments": segments, "segment": "one local day, cut at midnight",
                            "p95_resolution_deg": resolution, "weather": source.describe}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
-    return StreamResult(summary, files, site, collector, last["config"], memory)
+    return StreamResult(summary, files, site, collector, config, memory)
 
 
 def progress_bar(source: DaySource, *, label: str = "", file=None):
