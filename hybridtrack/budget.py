@@ -9,7 +9,8 @@ step of ``simulate`` takes, measured with `tracemalloc` as the slope between a 2
 A run may use half the memory the operating system reports available, and never more than
 `MAX_BUDGET` (16 GiB), so the same request is refused the same way on every machine with at
 least 32 GiB free. A request beyond that is refused with one line naming a coarser step or a
-shorter span that fits.
+shorter span that fits, and, for a run of a day or more whose single day fits, the streamed run
+(`hybridtrack.streaming`), which holds one day at a time and is checked a day at a time.
 """
 
 from __future__ import annotations
@@ -99,6 +100,11 @@ def check_steps(first, last, step, *, bytes_per_step: int = BYTES_PER_STEP, what
         at_most = f"at most {longest / pd.Timedelta(days=1):,.1f} days"
     else:
         at_most = f"at most {duration(longest.floor('s'))}" if longest >= pd.Timedelta(seconds=1) else "under a second"
+    streamed = ""
+    day_fits = (pd.Timedelta(days=1) // step + 1) * per_step <= budget
+    if per_step == BYTES_PER_STEP and span >= pd.Timedelta(days=1) and day_fits:
+        streamed = ("; or stream it to disk a day at a time, in bounded memory (hybridtrack simulate --stream, "
+                    "hybridtrack.streaming.stream)")
     raise HybridtrackError(f"{what}: {steps:,} steps of {duration(step)} would need about "
                            f"{_gigabytes(steps * per_step)} of memory, over the {_gigabytes(budget)} a run may use; "
-                           f"use {coarser} or a span of {at_most} at this step")
+                           f"use {coarser} or a span of {at_most} at this step{streamed}")

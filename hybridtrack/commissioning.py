@@ -61,5 +61,7 @@ def commission(site, collector: Collector, config, start: pd.Timestamp, *, class
 
 
 def warm_memory(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> dict:
-    """What the run's own strategy carries out of the clear day before (`Controller.memory`)."""
-    return clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier).memory
+    """What the run's own strategy carries out of the clear day before (`Controller.memory`): its
+    mount fit and offsets. Not the clock watch's readings: the run's watch starts afresh."""
+    memory = clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier).memory
+    return {key: value for key, value in memory.items() if key != "clock"}

@@ -27,8 +27,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-__all__ = ["summarize", "daily", "shares", "event_counts", "moved_axes", "weighted_quantile", "acceptance",
-           "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES"]
+__all__ = ["summarize", "RunningSummary", "daily", "shares", "share_counts", "event_counts", "moved_axes",
+           "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
 
 TRACKING_MODES = ("sensor", "astronomical", "search")
 ACCEPTANCE_HALF_ANGLE = {"trough-ns": 1.0, "trough-ew": 1.0, "fresnel": 0.8, "heliostat": 0.25}
@@ -86,17 +86,50 @@ def moved_axes(log: pd.DataFrame) -> np.ndarray:
     return moved
 
 
-def _error_stats(steps: pd.DataFrame) -> tuple[dict, float | None]:
+def _error_sums(steps: pd.DataFrame) -> dict:
+    """The running sums the error metrics are made of, over the scored steps (weight above zero):
+    ``weight`` Σw, ``squared`` Σw·e², ``first`` Σw·e, ``within`` Σw where |e| ≤ 0.5°, ``max``
+    max |e|. Sums of two spans add (``max`` takes the larger), so a streamed run keeps only these."""
     w = steps["weight"].to_numpy()
     e = steps["error"].to_numpy()
     scored = w > 0
     w, e = w[scored], e[scored]
-    total = w.sum()
+    return {"weight": float(w.sum()), "squared": float(np.sum(w * e * e)), "first": float(np.sum(w * e)),
+            "within": float(np.sum(w[np.abs(e) <= 0.5])), "max": float(np.max(np.abs(e))) if e.size else 0.0}
+
+
+def _error_from_sums(sums: dict, p95) -> tuple[dict, float | None]:
+    """The error metrics (RMS, p95, max, mean) and the share within 0.5° from `_error_sums`."""
+    total = sums["weight"]
     if not total > 0:
         return {"rms": None, "p95": None, "max": None, "mean": None}, None
-    stats = {"rms": float(np.sqrt(np.sum(w * e * e) / total)), "p95": weighted_quantile(np.abs(e), w, 0.95),
-             "max": float(np.max(np.abs(e))), "mean": float(np.sum(w * e) / total)}
-    return stats, float(np.sum(w[np.abs(e) <= 0.5]) / total)
+    stats = {"rms": float(np.sqrt(sums["squared"] / total)), "p95": p95, "max": sums["max"],
+             "mean": float(sums["first"] / total)}
+    return stats, float(sums["within"] / total)
+
+
+def _error_stats(steps: pd.DataFrame) -> tuple[dict, float | None]:
+    scored = steps["weight"].to_numpy() > 0
+    p95 = weighted_quantile(np.abs(steps["error"].to_numpy()[scored]), steps["weight"].to_numpy()[scored], 0.95)
+    return _error_from_sums(_error_sums(steps), p95)
+
+
+def share_counts(log: pd.DataFrame, sun_up: np.ndarray) -> tuple[dict, dict]:
+    """Steps in each mode and each sky (``night`` while the true sun is down): what `shares`
+    divides by the steps; counts of two spans add."""
+    from .control import MODES, SKY_CODES
+
+    up = np.asarray(sun_up, bool)
+    modes = log["mode"].value_counts()  # by category, without making a string per step
+    sky = log["sky"][up].value_counts()
+    night = int(sky.get("night", 0)) + int((~up).sum())
+    return ({m: int(modes.get(m, 0)) for m in MODES},
+            {k: night if k == "night" else int(sky.get(k, 0)) for k in (*SKY_CODES, "night")})
+
+
+def _shares_from_counts(modes: dict, sky: dict, steps: int) -> tuple[dict, dict]:
+    n = max(steps, 1)
+    return ({m: round(float(c) / n, 5) for m, c in modes.items()}, {k: round(float(c) / n, 5) for k, c in sky.items()})
 
 
 def shares(log: pd.DataFrame, sun_up: np.ndarray) -> tuple[dict, dict]:
@@ -105,15 +138,7 @@ def shares(log: pd.DataFrame, sun_up: np.ndarray) -> tuple[dict, dict]:
     The sky share counts the steps with the true sun down as ``night``, so each set of shares
     sums to one and ``stow_night`` can be read beside ``night``.
     """
-    from .control import MODES, SKY_CODES
-
-    n = max(len(log), 1)
-    up = np.asarray(sun_up, bool)
-    modes = log["mode"].value_counts()  # by category, without making a string per step
-    sky = log["sky"][up].value_counts()
-    night = float(sky.get("night", 0)) + float((~up).sum())
-    return ({m: round(float(modes.get(m, 0)) / n, 5) for m in MODES},
-            {k: round((night if k == "night" else float(sky.get(k, 0))) / n, 5) for k in (*SKY_CODES, "night")})
+    return _shares_from_counts(*share_counts(log, sun_up), len(log))
 
 
 def event_counts(events: pd.DataFrame) -> dict:
@@ -143,19 +168,119 @@ def summarize(log: pd.DataFrame, *, site: str, collector: str, strategy: str, mo
     """The summary of a run (the keys of ``summary.json``); every count and share is defined here."""
     steps = _steps(log, collector, sun_up, incidence)
     stats, within = _error_stats(steps)
-    ideal = steps["offered"].sum()
-    mode_share, sky_share = shares(log, sun_up)
+    return _compose(site=site, collector=collector, strategy=strategy, steps=len(log), start=log.index[0],
+                    end=log.index[-1], stats=stats, within=within, captured=float(steps["captured"].sum()),
+                    offered=float(steps["offered"].sum()), moves=moves, travel=travel,
+                    shares=shares(log, sun_up), events=event_counts(events))
+
+
+def _compose(*, site, collector, strategy, steps, start, end, stats, within, captured, offered, moves, travel,
+             shares, events) -> dict:
+    """The summary's keys, in order, from its parts (`summarize` and `RunningSummary` both)."""
+    mode_share, sky_share = shares
     return {
-        "site": site, "collector": collector, "strategy": strategy, "steps": int(len(log)),
-        "start": log.index[0].isoformat(), "end": log.index[-1].isoformat(),
+        "site": site, "collector": collector, "strategy": strategy, "steps": int(steps),
+        "start": start.isoformat(), "end": end.isoformat(),
         "tracking_error_deg": {k: _rounded(v) for k, v in stats.items()},
         "within_0_5_deg": _rounded(within),
-        "energy_capture": round(float(steps["captured"].sum() / ideal), 5) if ideal > 0 else None,
+        "energy_capture": round(float(captured / offered), 5) if offered > 0 else None,
         "moves": int(moves), "travel_deg": round(float(travel), 3),
         "share_base": "every step of the run; sky 'night' while the true sun is down",
         "mode_share": mode_share, "sky_share": sky_share,
-        **event_counts(events),
+        **events,
     }
+
+
+#: Degrees: the width of `RunningSummary`'s error histogram bins (its p95 is within half of it).
+HISTOGRAM_RESOLUTION = 0.001
+#: Degrees: the histogram's range, 0 to this; a larger error counts in the last bin (max stays exact).
+HISTOGRAM_SPAN = 180.0
+
+
+class RunningSummary:
+    """`summarize` over a run that arrives in consecutive parts, in memory that does not grow with it.
+
+    Each part (`add`) contributes running sums: the error's weighted sums (`_error_sums`), the
+    energy offered and captured, mode and sky counts (`share_counts`), event counts
+    (`event_counts`), moves and travel. They add exactly (up to floating-point summation order,
+    about 1e-12 relative), so `summary` equals `summarize` over the whole run in every key but
+    the p95. The p95 comes from a fixed-bin histogram of |error| weighted as the metrics weight
+    it: bins of `resolution` degrees from 0 to `span`; the reported p95 is the centre of the bin
+    where the weighted CDF first reaches 0.95, within ``resolution / 2`` of the exact weighted
+    quantile (`weighted_quantile`). The histogram takes ``8 · span / resolution`` bytes (1.4 MB
+    at the defaults).
+
+    Parameters
+    ----------
+    site, collector, strategy : str
+        As `summarize` takes them.
+    resolution : float
+        Degrees, the histogram's bin width.
+    span : float
+        Degrees, the histogram's upper end.
+    """
+
+    def __init__(self, *, site: str, collector: str, strategy: str, resolution: float = HISTOGRAM_RESOLUTION,
+                 span: float = HISTOGRAM_SPAN):
+        if not 0 < resolution < span:
+            raise ValueError(f"resolution must be above zero and below span, got {resolution!r}")
+        self.site, self.collector, self.strategy = site, collector, strategy
+        self.resolution, self.span = float(resolution), float(span)
+        self.histogram = np.zeros(int(np.ceil(span / resolution)))
+        self.sums = {"weight": 0.0, "squared": 0.0, "first": 0.0, "within": 0.0, "max": 0.0}
+        self.captured = self.offered = self.travel = 0.0
+        self.steps = self.moves = 0
+        self.modes: dict = {}
+        self.sky: dict = {}
+        self.events: dict = {}
+        self.start = self.end = None
+
+    def add(self, log: pd.DataFrame, *, moves: int, travel: float, events: pd.DataFrame, sun_up: np.ndarray,
+            incidence: np.ndarray) -> None:
+        """Count the next part of the run (the arguments of `summarize` for that part)."""
+        if not len(log):
+            return
+        steps = _steps(log, self.collector, sun_up, incidence)
+        sums = _error_sums(steps)
+        for key in ("weight", "squared", "first", "within"):
+            self.sums[key] += sums[key]
+        self.sums["max"] = max(self.sums["max"], sums["max"])
+        w = steps["weight"].to_numpy()
+        scored = w > 0
+        bins = np.minimum((np.abs(steps["error"].to_numpy()[scored]) / self.resolution).astype(np.int64),
+                          len(self.histogram) - 1)
+        self.histogram += np.bincount(bins, weights=w[scored], minlength=len(self.histogram))
+        self.captured += float(steps["captured"].sum())
+        self.offered += float(steps["offered"].sum())
+        self.moves += int(moves)
+        self.travel += float(travel)
+        self.steps += len(log)
+        for total, counts in zip((self.modes, self.sky), share_counts(log, sun_up)):
+            for key, count in counts.items():
+                total[key] = total.get(key, 0) + count
+        for key, count in event_counts(events).items():
+            self.events[key] = self.events.get(key, 0) + count
+        self.start = log.index[0] if self.start is None else self.start
+        self.end = log.index[-1]
+
+    def p95(self) -> float | None:
+        """The weighted p95 of |error| from the histogram: its bin's centre (degrees)."""
+        total = self.histogram.sum()
+        if not total > 0:
+            return None
+        cdf = np.cumsum(self.histogram) / total
+        k = min(int(np.searchsorted(cdf, 0.95)), len(self.histogram) - 1)
+        return float((k + 0.5) * self.resolution)
+
+    def summary(self) -> dict:
+        """The summary so far, in `summarize`'s keys (its p95 from the histogram)."""
+        if self.start is None:
+            raise ValueError("no part of the run has been added")
+        stats, within = _error_from_sums(self.sums, self.p95())
+        return _compose(site=self.site, collector=self.collector, strategy=self.strategy, steps=self.steps,
+                        start=self.start, end=self.end, stats=stats, within=within, captured=self.captured,
+                        offered=self.offered, moves=self.moves, travel=self.travel,
+                        shares=_shares_from_counts(self.modes, self.sky, self.steps), events=self.events)
 
 
 def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidence: np.ndarray) -> pd.DataFrame:

@@ -20,6 +20,7 @@ from . import params, sites
 from .collectors import Collector
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
+from .control.clockwatch import ClockWatch
 from .control.mountfit import parameter_names
 from .control.plan import east_park
 from .drive import Drive
@@ -187,7 +188,12 @@ class Result:
     events : pandas.DataFrame
         Every mode change: ``time``, ``from``, ``to``, ``reason``.
     memory : dict
-        What the controller would carry into a next run (its mount fit and offsets).
+        What the controller would carry into a next run (its mount fit and offsets, the clock
+        watch's readings, a commissioned mount): `simulate`'s ``warm_start`` takes it.
+    scoring : dict
+        The inputs of the summary that are not in the log (per step ``sun_up`` and ``incidence``;
+        ``moves`` and unrounded ``travel``), for scoring a run in parts
+        (`hybridtrack.metrics.RunningSummary`).
     """
 
     log: pd.DataFrame
@@ -197,6 +203,7 @@ class Result:
     collector: Collector
     config: SimulationConfig
     memory: dict | None = None
+    scoring: dict | None = field(default=None, repr=False)
 
     @staticmethod
     def files(folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
@@ -284,7 +291,8 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
              config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
-             faults: dict | None = None, progress=None, bulk_nights: bool = True, warm_start: bool = True) -> Result:
+             faults: dict | None = None, progress=None, bulk_nights: bool = True,
+             warm_start: bool | dict = True) -> Result:
     """Run a tracking controller over a weather frame.
 
     Parameters
@@ -307,10 +315,12 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         Called with the number of steps done since its last call (e.g. a tqdm bar's update).
     bulk_nights : bool
         Record a night asleep at stow in one go (the same result, faster; a test keeps it so).
-    warm_start : bool
+    warm_start : bool or dict
         Start as a controller that has been running: ``astronomical-commissioned`` is
         commissioned, and the calibrating strategies carry their calibration, from a clear day
-        before the run (`hybridtrack.commissioning`). ``False`` starts from nothing.
+        before the run (`hybridtrack.commissioning`). ``False`` starts from nothing. A dict is
+        an earlier run's `Result.memory`: this run goes on from where that one ended (a long run
+        in day-long parts, `hybridtrack.streaming`).
 
     Returns
     -------
@@ -348,15 +358,18 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
                                                        world.controller_site()))
     events = pd.DataFrame([(index[i], a, b, why) for i, a, b, why in out.events],
                           columns=["time", "from", "to", "reason"])
+    scoring = {"sun_up": world.altitude > 0, "incidence": incidence_cosine(world.altitude, world.azimuth, collector),
+               "moves": int(out.moves.sum()), "travel": float(out.travel.sum())}
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
-                        moves=int(out.moves.sum()), travel=float(out.travel.sum()), events=events,
-                        sun_up=world.altitude > 0,
-                        incidence=incidence_cosine(world.altitude, world.azimuth, collector))
+                        events=events, **scoring)
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
     summary["clock"] = controller.clock.state() if controller.clock is not None else None
     summary["wind_data"] = _wind_data(frame)
     summary["day_cycle"] = _day_cycle(events, site)
-    return Result(log, summary, events, site, collector, config, controller.memory())
+    memory = controller.carry(index[0])
+    if config.controller.strategy == "astronomical-commissioned":
+        memory["commissioned"] = mount
+    return Result(log, summary, events, site, collector, config, memory, scoring)
 
 
 def _day_cycle(events: pd.DataFrame, site: sites.Site) -> list[dict]:
@@ -383,6 +396,14 @@ def _history(site, collector, config, start, classifier, warm_start):
     """What the controller brings from before the run: a commissioned mount, a warm calibration."""
     from .commissioning import commission, warm_memory
 
+    if isinstance(warm_start, dict):  # an earlier run carried on
+        memory = dict(warm_start)
+        mount = memory.pop("commissioned", None)
+        if config.controller.strategy == "astronomical-commissioned" and mount is None:
+            mount = commission(site, collector, config, start, classifier=classifier)
+        if "clock" in memory:
+            memory["clock"] = ClockWatch.rebase(memory["clock"], start)
+        return mount, memory if config.controller.calibrates else None
     if config.controller.strategy == "astronomical-commissioned":  # an open loop is always commissioned
         return commission(site, collector, config, start, classifier=classifier), None
     if warm_start and config.controller.calibrates:

@@ -184,7 +184,9 @@ def test_a_refusal_names_a_coarser_step_and_a_shorter_span(monkeypatch):
     with pytest.raises(HybridtrackError) as error:
         budget.check_steps(first, last, "1s", what="ten days")
     assert str(error.value) == ("ten days: 864,000 steps of 1s would need about 1.7 GB of memory, over the 1.0 GB a run "
-                                "may use; use a step of 2s or a span of at most 5.8 days at this step")
+                                "may use; use a step of 2s or a span of at most 5.8 days at this step; or stream it to "
+                                "disk a day at a time, in bounded memory (hybridtrack simulate --stream, "
+                                "hybridtrack.streaming.stream)")
     assert budget.check_steps(first, last, "2s") == 432_000
 
 

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from .. import sites
+from .. import params, sites
 from ..errors import HybridtrackError
 from ..outputs import claim, strict_json, write
 from .base import (
@@ -112,14 +112,40 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_stream_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument("--stream", action="store_true",
+                        help=f"run {what} a local day at a time in bounded memory, streaming the log to --out "
+                             "(log.parquet, events.csv, summary.json; no report.png): for spans too long to hold "
+                             "in memory, such as a year at 1 s (docs/long-runs.md)")
+
+
+def _stream(source, args, config, *, heading: str) -> int:
+    """A streamed run (`hybridtrack.streaming`): a progress bar on stderr, the summary, the files."""
+    from ..streaming import progress_bar, stream, stream_files
+
+    if not args.out:
+        raise HybridtrackError("--stream writes its log to disk: give --out FOLDER")
+    claim(stream_files(args.out).values())  # a bad --out is refused before the bar
+    with progress_bar(source, label=args.strategy) as bar:
+        result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
+                        config=config, progress=bar.update)
+    print(heading + f" (streamed in {result.summary['streamed']['segments']} day-long segments)")
+    print(summary_table({result.summary["strategy"]: result.summary}))
+    print("wrote " + ", ".join(str(p) for p in result.files.values()))
+    return 0
+
+
 def _simulate_arguments(parser: argparse.ArgumentParser) -> None:
     add_synthetic_arguments(parser)
     add_run_arguments(parser)
+    _add_stream_argument(parser, "the days")
 
 
 @command("simulate", "run a tracker over synthetic days", _simulate_arguments)
 def _simulate(args: argparse.Namespace) -> int:
     site = site_from_arguments(args)
+    if args.stream:
+        return _stream_synthetic(args, site)
     frame = synthetic_frame(args, site)
     _claim_run_folder(args)
     result = _run(frame, site, args, args.strategy, simulation_config(args, args.seed))
@@ -128,12 +154,36 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _stream_synthetic(args: argparse.Namespace, site) -> int:
+    import datetime as dt
+
+    from ..streaming import synthetic_days
+    from ..times import parse_date
+
+    if not 1 <= args.days <= 3660:
+        raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    if "," in args.weather:
+        raise HybridtrackError("--stream takes one --weather for every day (climate draws each day from the site's "
+                               "monthly climate), not a per-day list")
+    params.seed(args.seed, "--seed")
+    params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
+    first = parse_date(args.date)
+    source = synthetic_days(site, first, first + dt.timedelta(days=args.days - 1), weather=args.weather,
+                            freq=args.freq, seed=args.seed, gusts_per_day=args.gusts_per_day)
+    return _stream(source, args, simulation_config(args, args.seed),
+                   heading=f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}, "
+                           f"each day seeded from (seed, date)), {collector_from_arguments(args).kind}, "
+                           f"{args.strategy}")
+
+
 def _replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="recorded weather file (CSV or a pvlib format)")
     add_site_arguments(parser, record=True)
     add_record_arguments(parser)
     parser.add_argument("--step", default="1min", help="control step the record is resampled to (default 1min)")
     add_run_arguments(parser)
+    _add_stream_argument(parser, "a weather frame saved as .parquet or .csv (its own step; the reader's checks "
+                                 "and repairs are not run)")
 
 
 def _replay_frame(args: argparse.Namespace):
@@ -161,6 +211,16 @@ def replay_config(args: argparse.Namespace, frame):
 
 @command("replay", "run a tracker over a recorded weather file", _replay_arguments)
 def _replay(args: argparse.Namespace) -> int:
+    if args.stream:
+        from ..streaming import recorded_days
+
+        if args.map or args.units or args.format:
+            raise HybridtrackError("--stream reads a weather frame as saved (a time index, dni, ...): --map, --units "
+                                   "and --format are not taken; convert the record once with read_weather")
+        site = site_from_arguments(args)
+        return _stream(recorded_days(args.file, site, tz=args.tz), args, simulation_config(args),
+                       heading=f"replay of {args.file} at {site.name}, {collector_from_arguments(args).kind}, "
+                               f"{args.strategy}")
     site, frame = _replay_frame(args)
     _claim_run_folder(args)
     result = _run(frame, site, args, args.strategy, replay_config(args, frame))

@@ -46,6 +46,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 
 __all__ = ["ClockWatch", "ALARM_SIGMAS", "CLOCK_TOLERANCE", "DRIFT_TOLERANCE", "DRIFT_DAYS"]
 
@@ -160,6 +161,34 @@ class ClockWatch:
             alarms.append(f"controller clock drifting {drift:+.1f} s a day (±{drift_std:.1f}) against the sun the "
                           f"sensor shows, over {span:.1f} days")
         return alarms
+
+    def save(self, start) -> dict:
+        """What a next run's watch needs to go on (`restore`), as arrays: the readings (``t``,
+        ``axis``, ``x``, ``y``; the first ``counted`` counted, the rest the current spell's), the
+        spell, the alarms raised, and `start`, the instant this run's timer counts from (its first
+        scan); `rebase` moves the timers onto the next run's."""
+        rows = self.rows + self.pending
+        return {"start": start, "counted": len(self.rows), "t": np.array([r[0] for r in rows], float),
+                "axis": np.array([r[1] for r in rows], np.int64),
+                "x": np.array([r[2] for r in rows], float).reshape(len(rows), self.n - 1),
+                "y": np.array([r[3] for r in rows], float), "spell_start": self.spell_start,
+                "spell_last": self.spell_last, "raised": sorted(self.raised)}
+
+    def restore(self, saved: dict) -> None:
+        """Go on from `save` (timers already on this run's, `rebase`): the readings of earlier runs
+        count toward the clock's error and drift, and an alarm raised stays raised."""
+        rows = [(t, a, x, y) for t, a, x, y in zip(saved["t"].tolist(), saved["axis"].tolist(), saved["x"].copy(),
+                                                    saved["y"].tolist())]
+        self.rows, self.pending = rows[:saved["counted"]], rows[saved["counted"]:]
+        self.spell_start, self.spell_last = float(saved["spell_start"]), float(saved["spell_last"])
+        self.raised = set(saved["raised"])
+
+    @staticmethod
+    def rebase(saved: dict, start) -> dict:
+        """`saved` (`save`) with its timers counted from `start` instead, a later run's first scan."""
+        shift = (start - saved["start"]) / pd.Timedelta(minutes=1)
+        return {**saved, "start": start, "t": saved["t"] - shift, "spell_start": saved["spell_start"] - shift,
+                "spell_last": saved["spell_last"] - shift}
 
     def state(self) -> dict:
         """The clock's error at the first reading counted (s) and its drift (s a day, once the

@@ -149,6 +149,8 @@ class Controller:
             self._recall(memory)
             if self.fit is not None:  # the clear sky's level is the sky's, not the fit's: no checkpoint restores it
                 self.fit.level = memory.get("light_level", self.fit.level)
+            if self.clock is not None and "clock" in memory:  # a run carried on (`carry`), timers rebased
+                self.clock.restore(memory["clock"])
         self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
         self.coast_for = config.minutes("coast")
         self.mode, self.mode_since = STOW_NIGHT, -math.inf
@@ -486,6 +488,15 @@ class Controller:
         if fit is not None:
             state.update(theta=fit.theta.tolist(), p=fit.p.copy(), information=fit.information.copy(),
                          frozen=fit.axis_frozen, updates=fit.updates, light_level=fit.level)
+        return state
+
+    def carry(self, start) -> dict:
+        """`memory` and the clock watch's readings (`ClockWatch.save`; `start` is the instant the
+        scan timer counts from): what the next run of a long one starts from, so the clock's drift
+        is judged over the whole span (`hybridtrack.streaming`)."""
+        state = self.memory()
+        if self.clock is not None:
+            state["clock"] = self.clock.save(start)
         return state
 
     def _recall(self, memory: dict) -> None:

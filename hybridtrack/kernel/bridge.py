@@ -123,7 +123,8 @@ def _clock_capacity(controller: Controller, minutes: np.ndarray) -> int:
     """The most readings the clock watch can take: one per axis every `FIT_EVERY` minutes."""
     if controller.clock is None or len(minutes) == 0:
         return 0
-    return controller.axes * (int((minutes[-1] - minutes[0]) / FIT_EVERY) + 2)
+    carried = len(controller.clock.rows) + len(controller.clock.pending)  # from an earlier run (`carry`)
+    return carried + controller.axes * (int((minutes[-1] - minutes[0]) / FIT_EVERY) + 2)
 
 
 def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
@@ -148,6 +149,13 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
     capacity = _window_capacity(minutes, windows)
     readings = _clock_capacity(c, minutes)
     columns = c.clock.n - 1 if c.clock else 0
+    clock_arrays = (np.zeros(readings), np.zeros(readings, np.int64), np.zeros((readings, columns)),
+                    np.zeros(readings))
+    if c.clock is not None and (c.clock.rows or c.clock.pending or c.clock.raised):  # carried from an earlier run
+        for m, (t, a, x, y) in enumerate(c.clock.rows + c.clock.pending):
+            clock_arrays[0][m], clock_arrays[1][m], clock_arrays[2][m], clock_arrays[3][m] = t, a, x, y
+        k[[kc.CLOCK_ROWS, kc.CLOCK_PENDING]] = [len(c.clock.rows), len(c.clock.pending)]
+        k[[kc.CLOCK_RAISED, kc.DRIFT_RAISED]] = ["clock" in c.clock.raised, "drift" in c.clock.raised]
     return kc.ControllerState(
         s, k, np.array([[m.believed, m.last, m.commanded] for m in c.encoders], float),
         np.array([m.jumped for m in c.encoders], np.int64),
@@ -160,8 +168,7 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         np.array(fit.theta if fit else [], float), np.array(fit.p if fit else np.zeros((0, 0)), float),
         np.array(fit.information if fit else np.zeros((0, 0)), float),
         np.zeros(axes), np.zeros(p), np.zeros((p, p)), np.zeros((p, p)),
-        np.zeros((5, capacity)), np.zeros((5, capacity)), np.zeros((5, 2), np.int64),
-        np.zeros(readings), np.zeros(readings, np.int64), np.zeros((readings, columns)), np.zeros(readings))
+        np.zeros((5, capacity)), np.zeros((5, capacity)), np.zeros((5, 2), np.int64), *clock_arrays)
 
 
 def _record(n: int, axes: int, parameters: int) -> kc.ControllerRecord:

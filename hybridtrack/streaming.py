@@ -1,0 +1,520 @@
+"""Long runs in bounded memory: day-long segments, the log streamed to Parquet, running metrics.
+
+`simulate` holds a run's whole weather frame, world arrays and log in memory, about 2 kB a step
+(`hybridtrack.budget`): a year at 1-second steps (31.5 M steps) would need some 60 GB. `stream`
+runs the same span as consecutive segments of one local day each, cut at the site's midnight,
+when the collector is asleep at night stow. Each segment is an ordinary `simulate` call on that
+day's weather; what the controller has learnt is carried from one to the next (`Result.memory`:
+its mount fit, calibration offsets, the clock watch's readings and alarms, a commissioned
+mount). Each segment's log is appended to one Parquet file as one row group, its events to
+``events.csv``, and its metrics to a `hybridtrack.metrics.RunningSummary`; then it is dropped.
+Memory is that of one day's run (about 0.6 GB at 1 s) plus the histogram (1.4 MB), whatever the
+span.
+
+What a restart at midnight does not carry (and so where a streamed run differs from one
+`simulate` over the same weather): the controller's moment-to-moment state (mode, Kalman
+filters, sky-watch windows, wind hold, encoder monitor, the sensor/model disagreement
+checkpoint and its distrust), and the sensor-only tracker's park, which goes back to the east
+each morning. At midnight these are at rest (night stow, no readings), so the difference is
+small; ``docs/long-runs.md`` gives the measured figures. The world's sensor noise of each
+segment after the first is seeded from ``(seed, day)`` (`day_seed`), the first segment's from
+the seed itself, so the first day is exactly `simulate` on that day.
+
+Weather comes from a source that yields one local day at a time:
+
+* `synthetic_days`: `hybridtrack.sky.synthetic` one day at a time, each day seeded from
+  ``(seed, day)`` (`day_seed`). `synthetic` over a whole span draws every day from one random
+  stream, so a span made at once is not the same weather as the same span made by the day (it
+  is the same kind of weather); the streamed source is deterministic and independent of where
+  the span starts or ends: a day's weather depends only on the seed and the date.
+* `recorded_days`: a weather frame on disk, read in pieces: Parquet by record batches, CSV in
+  chunks of rows. The file must be in the weather-frame layout (a tz-aware time index or a
+  ``time`` column, a ``dni`` column, as `hybridtrack.io.read_weather` returns and
+  ``frame.to_parquet`` writes): `read_weather`'s checks and repairs (units, gaps, resampling)
+  need the whole file and are not run on the pieces. Convert a raw record once with
+  `read_weather` and ``to_parquet``.
+* `frame_days`: a frame already in memory, cut at local midnight.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as dt
+import sys
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import params, sites
+from .collectors import Collector
+from .errors import HybridtrackError
+from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
+from .outputs import claim, strict_json, write
+
+__all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
+           "read_log", "stream_files"]
+
+#: Rows read from a recorded file at a time (a day at 1 s is 86,400).
+CHUNK_ROWS = 200_000
+
+
+def day_seed(seed: int, day: dt.date) -> int:
+    """The seed of one day of a streamed run: from ``(seed, day)`` through numpy's `SeedSequence`,
+    so each day's draws are independent of every other day's and of where the span starts."""
+    state = np.random.SeedSequence([params.seed(seed), day.toordinal()]).generate_state(2, np.uint32)
+    return int(state[0]) << 31 | int(state[1]) >> 1
+
+
+@dataclass
+class DaySource:
+    """Weather one local day at a time: iterating yields ``(date, frame)`` in order.
+
+    Attributes
+    ----------
+    site : Site
+        The site whose midnight cuts the days.
+    describe : str
+        What the weather is, for headings.
+    steps : int or None
+        The steps over the whole span, when known beforehand (a progress bar's total).
+    days : int or None
+        The days, when known beforehand.
+    """
+
+    site: sites.Site
+    describe: str
+    steps: int | None
+    days: int | None
+    _days: Callable[[], Iterator[tuple[dt.date, pd.DataFrame]]] = field(repr=False)
+
+    def __iter__(self) -> Iterator[tuple[dt.date, pd.DataFrame]]:
+        return self._days()
+
+
+def _dates(start, end) -> tuple[dt.date, dt.date]:
+    from .times import parse_date
+
+    first = parse_date(start) if not isinstance(start, dt.date) else start
+    last = first if end is None else (parse_date(end) if not isinstance(end, dt.date) else end)
+    if isinstance(first, dt.datetime) or isinstance(last, dt.datetime):
+        first, last = pd.Timestamp(first).date(), pd.Timestamp(last).date()
+    if last < first:
+        raise HybridtrackError(f"the span ends ({last}) before it starts ({first})")
+    return first, last
+
+
+def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str = "1s", seed: int = 0,
+                   **options) -> DaySource:
+    """Synthetic weather from `start` to `end` (local dates, both whole days), one day at a time.
+
+    Parameters
+    ----------
+    site : Site or str
+    start, end : date or str
+        First and last local date; `end` defaults to `start`.
+    weather : str
+        One of `hybridtrack.sky.synthetic`'s weathers for every day (``"climate"``: each day
+        drawn from the site's monthly climate). A per-day list is not taken.
+    freq : str
+        Step, e.g. ``"1s"``.
+    seed : int
+        Each day is ``synthetic(site, day, ..., seed=day_seed(seed, day))``.
+    **options
+        Passed to `hybridtrack.sky.synthetic` (``gusts_per_day``, ``wind_mean``, ``climate``).
+
+    Returns
+    -------
+    DaySource
+    """
+    from .sky import WEATHERS, synthetic
+    from .times import parse_freq
+
+    site = sites.get(site)
+    first, last = _dates(start, end)
+    if not isinstance(weather, str) or weather not in WEATHERS:
+        raise HybridtrackError(f"weather {weather!r}: a streamed run takes one of {', '.join(WEATHERS)} for every day")
+    step = pd.Timedelta(parse_freq(freq))
+    params.seed(seed)
+    days = (last - first).days + 1
+
+    def each():
+        for k in range(days):
+            day = first + dt.timedelta(days=k)
+            yield day, synthetic(site, day, weather=weather, freq=freq, seed=day_seed(seed, day), **options)
+
+    return DaySource(site, f"{first} to {last}, {weather} (synthetic, each day seeded from ({seed}, date))",
+                     days * int(pd.Timedelta(days=1) // step), days, each)
+
+
+def _by_day(pieces: Iterator[pd.DataFrame], site: sites.Site, where: str) -> Iterator[tuple[dt.date, pd.DataFrame]]:
+    """Regroup consecutive pieces of a frame into local days, each yielded once it is complete."""
+    held: pd.DataFrame | None = None
+    last = None
+    for piece in pieces:
+        if not isinstance(piece.index, pd.DatetimeIndex) or piece.index.tz is None:
+            raise HybridtrackError(f"{where}: the time stamps must be tz-aware (or give tz=)")
+        if not len(piece):
+            continue
+        if last is not None and piece.index[0] <= last:
+            raise HybridtrackError(f"{where}: time goes back or repeats at {piece.index[0]}; a streamed file must be "
+                                   "sorted without repeats (write it from hybridtrack.io.read_weather)")
+        last = piece.index[-1]
+        held = piece if held is None else pd.concat([held, piece])
+        day = held.index.tz_convert(site.tz).date
+        complete = day < day[-1]
+        if complete.any():
+            done = held[complete]
+            held = held[~complete]
+            for date, frame in done.groupby(day[complete], sort=True):
+                yield date, frame
+    if held is not None and len(held):
+        yield held.index.tz_convert(site.tz)[0].date(), held
+
+
+def frame_days(frame: pd.DataFrame, site) -> DaySource:
+    """A weather frame already in memory, cut at the site's local midnight."""
+    site = sites.get(site)
+    if not isinstance(frame, pd.DataFrame) or not isinstance(frame.index, pd.DatetimeIndex) or frame.index.tz is None:
+        raise HybridtrackError("the weather frame must be a DataFrame on a tz-aware DatetimeIndex")
+    local = frame.index.tz_convert(site.tz)
+    days = len(set(local.date))
+    covered = (frame.index[-1] - frame.index[0]) + (frame.index[1] - frame.index[0]) if len(frame) > 1 else None
+    if covered is not None and covered < pd.Timedelta(hours=23):
+        raise HybridtrackError(f"the frame spans {local[0]} to {local[-1]}: a streamed run needs at least one whole "
+                               "local day (run a shorter span in memory with hybridtrack.simulate)")
+    return DaySource(site, "a weather frame", len(frame), days, lambda: _by_day(iter([frame]), site, "the frame"))
+
+
+def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySource:
+    """A weather frame on disk (Parquet or CSV), read `chunk_rows` rows at a time, by local day.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.parquet`` (record batches; a pandas-written index or a ``time`` column) or ``.csv``
+        (a first column or a ``time`` column of time stamps).
+    site : Site or str
+    tz : str, optional
+        The zone of naive time stamps; tz-aware stamps are kept.
+    chunk_rows : int
+
+    Returns
+    -------
+    DaySource
+    """
+    site = sites.get(site)
+    path = Path(path)
+    if not path.is_file():
+        raise HybridtrackError(f"{path}: no such file")
+    chunk_rows = params.whole(chunk_rows, "chunk_rows", 1, 10**9)
+    suffix = path.suffix.lower()
+    if suffix not in (".parquet", ".pq", ".csv"):
+        raise HybridtrackError(f"{path}: a streamed run reads .parquet or .csv weather frames, not {suffix or 'this'}")
+
+    def stamped(piece: pd.DataFrame) -> pd.DataFrame:
+        if not isinstance(piece.index, pd.DatetimeIndex):
+            name = "time" if "time" in piece.columns else piece.columns[0]
+            try:
+                piece = piece.set_index(pd.DatetimeIndex(pd.to_datetime(piece.pop(name), format="ISO8601")))
+            except (ValueError, TypeError) as exc:
+                raise HybridtrackError(f"{path}: column {name!r} is not time stamps ({exc})") from None
+        if piece.index.tz is None and tz is not None:
+            piece.index = piece.index.tz_localize(tz)
+        elif tz is not None:
+            piece.index = piece.index.tz_convert(tz)
+        piece.index.name = None
+        return piece
+
+    steps = None
+    if suffix == ".csv":
+        def pieces():
+            try:
+                for piece in pd.read_csv(path, chunksize=chunk_rows):
+                    yield stamped(piece)
+            except (ValueError, pd.errors.ParserError) as exc:
+                raise HybridtrackError(f"{path}: cannot read as CSV ({exc})") from None
+    else:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        try:
+            handle = pq.ParquetFile(path)
+        except (OSError, pa.ArrowException) as exc:
+            raise HybridtrackError(f"{path}: cannot read as Parquet ({exc})") from None
+        steps = handle.metadata.num_rows
+
+        def pieces():
+            schema = handle.schema_arrow
+            for batch in handle.iter_batches(batch_size=chunk_rows):
+                yield stamped(pa.Table.from_batches([batch], schema=schema).to_pandas())
+
+    return DaySource(site, f"{path}", steps, None, lambda: _by_day(pieces(), site, str(path)))
+
+
+# -- the run -------------------------------------------------------------------------------------
+
+
+@dataclass
+class StreamResult:
+    """A finished streamed run: its summary and where its log and events are on disk.
+
+    Attributes
+    ----------
+    summary : dict
+        ``summary.json``: `summarize`'s keys from running metrics (the p95 from a histogram of
+        ``streamed.p95_resolution_deg`` bins), with the streamed run's own ``streamed`` entry.
+    files : dict of Path
+        ``log`` (Parquet, one row group a day), ``events`` (CSV), ``summary`` (JSON).
+    memory : dict
+        What the controller carries out of the last segment (`hybridtrack.simulation.Result`).
+    config : SimulationConfig
+        The run's config (each segment's differs only in its noise seed and the clock's age).
+
+    A run that stops part way (an error, an interrupt) leaves the log and events of the days it
+    finished, and no ``summary.json``.
+    """
+
+    summary: dict
+    files: dict
+    site: sites.Site
+    collector: Collector
+    config: object
+    memory: dict | None = field(default=None, repr=False)
+
+    def log(self, columns=None, *, day=None) -> pd.DataFrame:
+        """The log read back (all of it, or one local `day`), `columns` only if given."""
+        return read_log(self.files["log"], columns=columns, day=day, tz=self.site.tz)
+
+    def days(self, columns=None) -> Iterator[pd.DataFrame]:
+        """The log one segment (a local day) at a time, without holding more than one."""
+        import pyarrow.parquet as pq
+
+        handle = pq.ParquetFile(self.files["log"])
+        for group in range(handle.num_row_groups):
+            yield _categorised(handle.read_row_group(group, columns=_with_index(handle, columns)).to_pandas())
+
+    def events(self) -> pd.DataFrame:
+        """Every mode change and alarm of the run (``events.csv``)."""
+        events = pd.read_csv(self.files["events"])
+        events["time"] = pd.to_datetime(events["time"], format="ISO8601")
+        return events
+
+    def __repr__(self) -> str:
+        from .report import _headline, _shares
+
+        s = self.summary
+        lines = [f"hybridtrack streamed run: {s['site']} · {s['collector']} · {s['strategy']} · "
+                 f"{s['start'][:10]} to {s['end'][:10]}",
+                 f"  {s['steps']:,} steps in {s['streamed']['segments']} day-long segments; log in {self.files['log']}"]
+        lines += [f"  {label}: {value}" for label, value in _headline(s)]
+        lines += [f"  modes: {_shares(s['mode_share'])}", f"  sky: {_shares(s['sky_share'])} (every step)"]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        from .report import _headline, _shares
+
+        s = self.summary
+        rows = [("run", f"{s['site']} · {s['collector']} · {s['strategy']} · {s['start'][:10]} to {s['end'][:10]}"),
+                ("steps", f"{s['steps']:,} in {s['streamed']['segments']} day-long segments"), *_headline(s),
+                ("mode shares", _shares(s["mode_share"])), ("sky shares (every step)", _shares(s["sky_share"])),
+                *((role, str(path)) for role, path in self.files.items())]
+        table = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td style='text-align:left'>{escape(v)}"
+                        f"</td></tr>" for k, v in rows)
+        return f"<div><strong>hybridtrack streamed run</strong><table>{table}</table></div>"
+
+
+def _with_index(handle, columns):
+    if columns is None:
+        return None
+    index = [c for c in (handle.schema_arrow.pandas_metadata or {}).get("index_columns", []) if isinstance(c, str)]
+    return [*columns, *index]
+
+
+def _categorised(log: pd.DataFrame) -> pd.DataFrame:
+    """The log's categorical columns with every category of their kind, as `simulate` makes them."""
+    from .control import MODES, SENSOR_STATUS, SKY_CODES
+
+    for column, categories in (("mode", MODES), ("sky", SKY_CODES), ("sensor_status", SENSOR_STATUS)):
+        if column in log.columns:
+            log[column] = pd.Categorical(log[column].astype(object), categories=list(categories))
+    return log
+
+
+def read_log(path, *, columns=None, day=None, tz=None) -> pd.DataFrame:
+    """A streamed run's ``log.parquet`` read back: all of it, or the local `day` (a date) only.
+
+    Parameters
+    ----------
+    path : str or Path
+    columns : list of str, optional
+    day : date or str, optional
+        One local day (the site's zone `tz`): only its row group is read.
+    tz : str, optional
+        The site's zone, to find `day`.
+    """
+    import pyarrow.parquet as pq
+
+    handle = pq.ParquetFile(path)
+    if day is None:
+        return _categorised(handle.read(columns=_with_index(handle, columns)).to_pandas())
+    wanted = pd.Timestamp(day).date()
+    for group in range(handle.num_row_groups):
+        log = _categorised(handle.read_row_group(group, columns=_with_index(handle, columns)).to_pandas())
+        if len(log) and log.index[0].tz_convert(tz or log.index.tz).date() == wanted:
+            return log
+    raise HybridtrackError(f"{path}: no segment on {wanted}")
+
+
+class _LogWriter:
+    """Appends each segment's log to one Parquet file, one row group a segment, one schema."""
+
+    def __init__(self, path: Path):
+        self.path, self.writer = path, None
+
+    def append(self, log: pd.DataFrame) -> None:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        table = pa.Table.from_pandas(log, preserve_index=True)
+        try:
+            if self.writer is None:
+                self.writer = pq.ParquetWriter(self.path, table.schema)
+            elif not table.schema.equals(self.writer.schema, check_metadata=False):
+                raise HybridtrackError(f"{self.path}: a segment's log has other columns or types than the first's")
+            self.writer.write_table(table, row_group_size=len(table))
+        except OSError as exc:
+            raise HybridtrackError(f"{self.path}: cannot write ({exc.strerror or exc})") from None
+
+    def close(self) -> None:
+        if self.writer is not None:
+            self.writer.close()
+
+
+def stream_files(folder) -> dict[str, Path]:
+    """The files `stream` writes into `folder`, by role."""
+    folder = Path(folder)
+    return {"log": folder / "log.parquet", "events": folder / "events.csv", "summary": folder / "summary.json"}
+
+
+def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
+           config=None, classifier=None, warm_start: bool = True, progress=None,
+           on_segment: Callable | None = None, resolution: float = HISTOGRAM_RESOLUTION) -> StreamResult:
+    """Run a tracking controller over a long span one local day at a time, streaming to `out`.
+
+    Parameters
+    ----------
+    source : DaySource
+        The weather, a day at a time (`synthetic_days`, `recorded_days`, `frame_days`). The span
+        must hold at least one whole local day; a part day at either end runs as a short segment.
+    out : str or Path
+        Folder for ``log.parquet``, ``events.csv`` and ``summary.json``, claimed before the run
+        (`hybridtrack.outputs.claim`: no symbolic links; existing files only under ``replacing``).
+    collector, strategy, config, classifier
+        As `hybridtrack.simulate` takes them. The config's ``engine = "auto"`` is decided on the
+        whole span's steps (where the source knows them), not on one day's: a year at 1 s pays
+        for compiling the kernel (`hybridtrack.kernel.COMPILE_PAYS_AT`).
+    warm_start : bool
+        The first segment's warm start (`hybridtrack.simulate`); later segments go on from the
+        one before (its `Result.memory`).
+    progress : callable, optional
+        Called with the steps done since its last call.
+    on_segment : callable, optional
+        Called with each segment's `Result` before it is dropped (tests, custom tallies).
+    resolution : float
+        Degrees, the bin width of the error histogram the p95 comes from.
+
+    Returns
+    -------
+    StreamResult
+
+    Notes
+    -----
+    Memory is bounded by one segment: a day at 1 s is 86,400 steps, about 0.6 GB peak with the
+    compiled kernel (``docs/long-runs.md``). Nothing is kept that grows with the span but the
+    clock watch's readings (one per axis per five clear minutes, about 2 MB a year) and the
+    summary's ``day_cycle`` (two entries a day).
+
+    References
+    ----------
+    Apache Parquet file format: row groups, https://parquet.apache.org/docs/file-format/
+    """
+    from .kernel import uses_kernel
+    from .simulation import SimulationConfig, simulate
+
+    if not isinstance(source, DaySource):
+        raise HybridtrackError("source must be a DaySource (synthetic_days, recorded_days or frame_days)")
+    site = source.site
+    config = config or SimulationConfig()
+    if strategy is not None:
+        config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
+    collector = Collector(collector) if isinstance(collector, str) else collector
+    if config.engine == "auto" and source.steps and uses_kernel(config, source.steps):
+        # whether the kernel pays is a question of the whole span, not of one day's segment
+        config = dataclasses.replace(config, engine="compiled")
+    if not 0 < resolution <= 1:
+        raise HybridtrackError(f"resolution must be above 0 and at most 1 degree, got {resolution!r}")
+    files = stream_files(out)
+    claim(files.values())
+    write(files["events"], lambda path: path.write_text("time,from,to,reason\n"))
+    running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
+                             resolution=resolution)
+    logs = _LogWriter(files["log"])
+    memory: bool | dict = warm_start
+    start = None
+    segments, whole = 0, False
+    wind, cycle, last = set(), [], None
+    try:
+        for day, frame in source:
+            begin = frame.index[0]
+            start = begin if start is None else start
+            midnight = pd.Timestamp(day).tz_localize(site.tz, nonexistent="shift_forward", ambiguous=True)
+            step = frame.index[1] - begin if len(frame) > 1 else pd.Timedelta(0)
+            next_midnight = pd.Timestamp(day + dt.timedelta(days=1)).tz_localize(site.tz, nonexistent="shift_forward",
+                                                                               ambiguous=True)
+            whole = whole or (begin <= midnight and frame.index[-1] + step >= next_midnight)
+            age = (begin - start) / pd.Timedelta(days=1)
+            setup = dataclasses.replace(config, imperfections=dataclasses.replace(
+                config.imperfections, commissioned_days_ago=config.imperfections.commissioned_days_ago + age),
+                seed=config.seed if segments == 0 else day_seed(config.seed, day))
+            result = simulate(frame, site, collector=collector, config=setup, classifier=classifier,
+                              progress=progress, warm_start=memory)
+            logs.append(result.log)
+            if len(result.events):
+                write(files["events"], lambda path: result.events.to_csv(path, mode="a", header=False, index=False))
+            running.add(result.log, events=result.events, **result.scoring)
+            wind.add(result.summary["wind_data"])
+            cycle += result.summary["day_cycle"]
+            if on_segment is not None:
+                on_segment(result)
+            memory, segments = result.memory, segments + 1
+            last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"]}
+            del result, frame  # nothing of a segment outlives it but its memory and the running sums
+    finally:
+        logs.close()
+    if segments == 0:
+        raise HybridtrackError("the weather source holds no steps")
+    if not whole:
+        raise HybridtrackError(f"a streamed run needs at least one whole local day at {site.name}; this span has "
+                               "none (run it in memory with hybridtrack.simulate)")
+    summary = running.summary()
+    summary["calibration"] = last["calibration"]
+    summary["clock"] = last["clock"]
+    summary["wind_data"] = wind.pop() if len(wind) == 1 else "partly missing"
+    summary["day_cycle"] = cycle
+    summary["streamed"] = {"segments": segments, "segment": "one local day, cut at midnight",
+                           "p95_resolution_deg": resolution, "weather": source.describe}
+    write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
+    return StreamResult(summary, files, site, collector, config, memory)
+
+
+def progress_bar(source: DaySource, *, label: str = "", file=None):
+    """A tqdm bar over the steps (or the segments, when the steps are not known) on stderr."""
+    from tqdm import tqdm
+
+    return tqdm(total=source.steps, unit="step", unit_scale=True, desc=label or "streaming",
+                file=file or sys.stderr, leave=False, mininterval=1.0)

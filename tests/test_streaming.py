@@ -1,0 +1,295 @@
+"""Long runs in day-long segments (hybridtrack.streaming): running metrics, the streamed log, what
+carries across midnight, and how far a streamed run is from one simulate over the same weather."""
+
+import dataclasses
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack.cli import main
+from hybridtrack.errors import HybridtrackError
+from hybridtrack.metrics import HISTOGRAM_RESOLUTION, RunningSummary, summarize
+from hybridtrack.simulation import SimulationConfig, simulate
+from hybridtrack.streaming import day_seed, frame_days, read_log, recorded_days, stream, synthetic_days
+from hybridtrack.world import Imperfections
+
+SITE = "lanzhou"
+
+
+@pytest.fixture(scope="module")
+def streamed(tmp_path_factory):
+    """Four climate days at 1 min, hybrid on a north-south trough, with every segment's Result."""
+    parts = []
+    source = synthetic_days(SITE, "2021-03-10", "2021-03-13", weather="climate", freq="1min", seed=3,
+                            gusts_per_day=2.0)
+    result = stream(source, tmp_path_factory.mktemp("stream"), strategy="hybrid", on_segment=parts.append)
+    return result, parts
+
+
+def _whole(parts):
+    """The segments as one run: the concatenated log and the other inputs of `summarize`."""
+    log = pd.concat([p.log for p in parts])
+    events = pd.concat([p.events for p in parts], ignore_index=True)
+    scoring = {"sun_up": np.concatenate([p.scoring["sun_up"] for p in parts]),
+               "incidence": np.concatenate([p.scoring["incidence"] for p in parts]),
+               "moves": sum(p.scoring["moves"] for p in parts), "travel": sum(p.scoring["travel"] for p in parts)}
+    return log, events, scoring
+
+
+def test_running_metrics_equal_summarize_on_the_concatenated_log(streamed):
+    result, parts = streamed
+    log, events, scoring = _whole(parts)
+    exact = summarize(log, site=SITE, collector="trough-ns", strategy="hybrid", events=events, **scoring)
+    # the running sums themselves, against one pass over the whole log
+    whole = RunningSummary(site=SITE, collector="trough-ns", strategy="hybrid")
+    whole.add(log, events=events, **scoring)
+    running = RunningSummary(site=SITE, collector="trough-ns", strategy="hybrid")
+    for part in parts:
+        running.add(part.log, events=part.events, **part.scoring)
+    for key, value in whole.sums.items():
+        assert running.sums[key] == pytest.approx(value, rel=1e-9, abs=1e-9), key
+    assert (running.captured, running.offered, running.travel) == pytest.approx(
+        (whole.captured, whole.offered, whole.travel), rel=1e-9)
+    assert (running.moves, running.steps, running.modes, running.sky, running.events) == \
+        (whole.moves, whole.steps, whole.modes, whole.sky, whole.events)
+    # the summary written: every key as summarize's, the p95 within half a bin
+    summary = result.summary
+    for key in exact:
+        if key == "tracking_error_deg":
+            for name in ("rms", "max", "mean"):
+                assert summary[key][name] == pytest.approx(exact[key][name], abs=1e-5), name
+            assert abs(summary[key]["p95"] - exact[key]["p95"]) <= HISTOGRAM_RESOLUTION / 2 + 1e-5
+        elif isinstance(exact[key], float):
+            assert summary[key] == pytest.approx(exact[key], abs=1e-5), key
+        else:
+            assert summary[key] == exact[key], key
+    assert summary["streamed"]["segments"] == 4 and summary["steps"] == 4 * 1440
+    assert summary["day_cycle"] == [entry for p in parts for entry in p.summary["day_cycle"]]
+    on_disk = json.loads(result.files["summary"].read_text())
+    assert on_disk["tracking_error_deg"] == summary["tracking_error_deg"]
+
+
+def test_the_histogram_p95_is_within_half_a_bin_of_the_exact_quantile():
+    rng = np.random.default_rng(0)
+    for resolution in (0.001, 0.01):
+        error = rng.gamma(2.0, 0.05, 5000)
+        log = pd.DataFrame({"dni": rng.uniform(100, 900, 5000), "error": error, "mode": "sensor", "sky": "sunny",
+                            "angle": np.zeros(5000)}, index=pd.date_range("2021-06-21", periods=5000, freq="1min",
+                                                                         tz="UTC"))
+        up, cosine = np.ones(5000, bool), np.ones(5000)
+        exact = summarize(log, site=SITE, collector="trough-ns", strategy="hybrid", moves=0, travel=0.0,
+                          events=pd.DataFrame(columns=["time", "from", "to", "reason"]), sun_up=up, incidence=cosine)
+        running = RunningSummary(site=SITE, collector="trough-ns", strategy="hybrid", resolution=resolution)
+        for part in np.array_split(np.arange(5000), 7):
+            running.add(log.iloc[part], moves=0, travel=0.0, events=pd.DataFrame(columns=["time", "from", "to",
+                                                                                           "reason"]),
+                        sun_up=up[part], incidence=cosine[part])
+        assert abs(running.p95() - exact["tracking_error_deg"]["p95"]) <= resolution / 2 + 1e-12
+
+
+def test_the_parquet_log_reads_back_as_the_segments_logs_concatenated(streamed):
+    result, parts = streamed
+    log = result.log()
+    expected = pd.concat([p.log for p in parts])
+    pd.testing.assert_frame_equal(log, expected, check_freq=False)
+    assert str(log.index.tz) == "Asia/Shanghai"
+    for column in ("mode", "sky", "sensor_status"):
+        assert list(log[column].cat.categories) == list(parts[0].log[column].cat.categories)
+    days = list(result.days(columns=["error", "mode"]))
+    assert len(days) == len(parts)
+    pd.testing.assert_frame_equal(days[2], parts[2].log[["error", "mode"]], check_freq=False)
+    pd.testing.assert_frame_equal(read_log(result.files["log"], day="2021-03-12", tz="Asia/Shanghai"), parts[2].log,
+                                  check_freq=False)
+    events = result.events()
+    expected_events = pd.concat([p.events for p in parts], ignore_index=True)
+    assert len(events) == len(expected_events) > 0
+    assert list(events["reason"]) == list(expected_events["reason"])
+    assert (events["time"] == expected_events["time"]).all()
+
+
+def test_a_streamed_result_displays_its_summary_and_files(streamed):
+    result, _ = streamed
+    text, html = repr(result), result._repr_html_()
+    assert "streamed run: lanzhou · trough-ns · hybrid · 2021-03-10 to 2021-03-13" in text
+    assert "4 day-long segments" in text and "<table>" in html and "log.parquet" in html
+
+
+def test_streamed_synthetic_days_are_seeded_by_seed_and_date():
+    """Each day is its own draw: the same day's weather whatever span holds it."""
+    from hybridtrack.sky import synthetic
+
+    a = dict(synthetic_days(SITE, "2021-03-10", "2021-03-12", freq="10min", seed=4))
+    b = dict(synthetic_days(SITE, "2021-03-11", "2021-03-11", freq="10min", seed=4))
+    import datetime as dt
+
+    day = dt.date(2021, 3, 11)
+    pd.testing.assert_frame_equal(a[day], b[day])
+    pd.testing.assert_frame_equal(a[day], synthetic(SITE, day, weather="climate", freq="10min",
+                                                    seed=day_seed(4, day)))
+    # synthetic over the span at once draws every day from one stream: another realisation
+    whole = synthetic(SITE, "2021-03-10", "2021-03-12", weather="climate", freq="10min", seed=4)
+    assert not np.allclose(whole.loc[a[day].index, "dni"], a[day]["dni"])
+    assert day_seed(4, day) != day_seed(4, day + dt.timedelta(days=1)) != day_seed(5, day)
+
+
+def test_the_mount_fit_and_the_clock_watch_carry_across_midnight(tmp_path):
+    """A clock gaining a minute a day over four clear days: the watch's readings carry from day to
+    day, so the drift (which needs 1.5 days of readings, more than a segment) is alarmed, once, and
+    measured as one simulate over the four days measures it (+60.7 ± 1.7 s a day); the fit's
+    updates grow from segment to segment."""
+    parts = []
+    config = SimulationConfig(imperfections=Imperfections(clock_drift=60.0, clock_error=0.0, commissioned_days_ago=0.0),
+                              seed=1)
+    source = synthetic_days(SITE, "2021-06-21", "2021-06-24", weather="sunny", freq="1min", seed=1)
+    result = stream(source, tmp_path, config=config, on_segment=parts.append)
+    updates = [p.memory["updates"] for p in parts]
+    assert updates == sorted(updates) and updates[-1] > updates[0] > 0
+    readings = [p.summary["clock"]["readings"] for p in parts]
+    # the second day's watch holds the first day's readings too (later days add few: once the clock
+    # is off by minutes the disagreement monitor distrusts the sensor, as in one simulate over the days)
+    assert readings == sorted(readings) and readings[1] > 1.5 * readings[0]
+    clock = result.summary["clock"]
+    assert clock["days"] > 1.5
+    assert clock["drift_s_per_day"] == pytest.approx(60.0, abs=max(6.0, 4 * clock["drift_std_s_per_day"]))
+    alarms = [r for r in result.events()["reason"] if "clock drifting" in r]
+    assert len(alarms) == 1  # latched: raised once across the segments
+
+
+def test_the_carried_clock_watch_runs_the_same_on_both_engines(tmp_path):
+    """The kernel packs the readings carried in (`kernel.bridge`) as the reference keeps them."""
+    config = SimulationConfig(imperfections=Imperfections(clock_drift=60.0, clock_error=0.0, commissioned_days_ago=0.0),
+                              seed=1)
+    runs = []
+    for engine in ("reference", "compiled"):
+        parts = []
+        source = synthetic_days(SITE, "2021-06-21", "2021-06-22", weather="sunny", freq="2min", seed=1)
+        stream(source, tmp_path / engine, config=dataclasses.replace(config, engine=engine), on_segment=parts.append)
+        runs.append(parts[-1])
+    reference, compiled = runs
+    assert reference.summary["clock"] == compiled.summary["clock"]
+    assert np.allclose(reference.memory["clock"]["x"], compiled.memory["clock"]["x"], atol=1e-9)
+    assert list(reference.events["reason"]) == list(compiled.events["reason"])
+    np.testing.assert_allclose(reference.log["angle"], compiled.log["angle"], atol=1e-9)
+
+
+def test_a_streamed_run_against_one_simulate_on_the_same_weather(tmp_path):
+    """What is identical: the weather, the world's truth, the first morning's warm start. What is
+    not: each segment after the first draws its own sensor noise (seed from (seed, day)), and the
+    controller restarts its moment-to-moment state (mode, filters, windows) at each midnight. So
+    the streamed run is another noise realisation of the same days: its RMS and energy capture
+    differ from the monolithic run's by about as much as the monolithic run's own differ between
+    two seeds (docs/long-runs.md gives the figures); the bound is twice that spread, at least
+    0.005° RMS and 0.001 of energy capture."""
+    source = synthetic_days(SITE, "2021-03-10", "2021-03-13", weather="climate", freq="1min", seed=3)
+    frame = pd.concat([f for _, f in source])
+    streamed_run = stream(frame_days(frame, SITE), tmp_path, strategy="hybrid")
+    mono = [simulate(frame, SITE, strategy="hybrid", config=SimulationConfig(seed=s)) for s in (0, 1)]
+    pd.testing.assert_series_equal(streamed_run.log(["target_true"])["target_true"], mono[0].log["target_true"],
+                                   check_freq=False)
+    assert streamed_run.summary["steps"] == mono[0].summary["steps"]
+
+    def rms(s):
+        return s["tracking_error_deg"]["rms"]
+
+    seed_rms = abs(rms(mono[0].summary) - rms(mono[1].summary))
+    seed_energy = abs(mono[0].summary["energy_capture"] - mono[1].summary["energy_capture"])
+    assert abs(rms(streamed_run.summary) - rms(mono[0].summary)) <= max(2 * seed_rms, 0.005)
+    assert abs(streamed_run.summary["energy_capture"] - mono[0].summary["energy_capture"]) <= \
+        max(2 * seed_energy, 0.001)
+    assert streamed_run.summary["moves"] == pytest.approx(mono[0].summary["moves"], rel=0.05)
+
+
+def test_a_recorded_parquet_or_csv_frame_streams_in_chunks(tmp_path):
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-03-10", "2021-03-11", weather="mixed", freq="5min", seed=2)
+    frame.to_parquet(tmp_path / "weather.parquet")
+    frame.to_csv(tmp_path / "weather.csv", index_label="time")
+    results = {}
+    for name in ("weather.parquet", "weather.csv"):
+        source = recorded_days(tmp_path / name, SITE, chunk_rows=100)  # days arrive over several chunks
+        days = list(source)
+        assert [len(f) for _, f in days] == [288, 288]
+        np.testing.assert_allclose(pd.concat([f for _, f in days])["dni"], frame["dni"])
+        results[name] = stream(source, tmp_path / name.replace(".", "-"))
+    memory = stream(frame_days(frame, SITE), tmp_path / "memory")
+    for result in results.values():
+        assert result.summary["tracking_error_deg"] == memory.summary["tracking_error_deg"]
+
+
+def test_bad_input_is_refused_in_one_line(tmp_path, capsys):
+    from hybridtrack.sky import synthetic
+
+    part = synthetic(SITE, "2021-03-10", weather="sunny", freq="10min").iloc[30:100]
+    with pytest.raises(HybridtrackError, match="needs at least one whole local day"):
+        frame_days(part, SITE)
+    part.to_parquet(tmp_path / "part.parquet")
+    with pytest.raises(HybridtrackError, match="needs at least one whole local day"):
+        stream(recorded_days(tmp_path / "part.parquet", SITE), tmp_path / "part")
+    (tmp_path / "a-file").write_text("")
+    with pytest.raises(HybridtrackError, match="cannot make the folder"):
+        stream(synthetic_days(SITE, "2021-03-10", freq="10min"), tmp_path / "a-file" / "out")
+    with pytest.raises(HybridtrackError, match="is not a positive duration|not a duration|step"):
+        synthetic_days(SITE, "2021-03-10", freq="soon")
+    with pytest.raises(HybridtrackError, match="ends .* before it starts"):
+        synthetic_days(SITE, "2021-03-10", "2021-03-01")
+    with pytest.raises(HybridtrackError, match="reads .parquet or .csv"):
+        recorded_days(tmp_path / "a-file", SITE)
+    base = ["simulate", "--site", SITE, "--date", "2021-03-10", "--freq", "10min", "--stream"]
+    for extra, said in ((["--out", str(tmp_path / "a-file" / "out")], "cannot make the folder"),
+                        ([], "give --out FOLDER"), (["--weather", "sunny,cloudy", "--out", str(tmp_path / "w")],
+                                                    "not a per-day list"),
+                        (["--days", "0", "--out", str(tmp_path / "d")], "--days must be between 1 and 3660")):
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err
+        assert said in err and err.count("\n") == 1 and "Traceback" not in err, err
+
+
+def test_the_in_memory_refusal_names_the_streamed_run(capsys):
+    assert main(["simulate", "--site", SITE, "--date", "2021-01-01", "--days", "365", "--freq", "1s"]) == 2
+    err = capsys.readouterr().err
+    assert "hybridtrack simulate --stream" in err and err.count("\n") == 1
+
+
+def test_the_command_streams_and_survives_a_closed_pipe(tmp_path):
+    """``--stream`` prints the summary and writes its three files; a reader that leaves (``| head``)
+    ends the printing, not the run."""
+    command = [sys.executable, "-m", "hybridtrack", "simulate", "--site", SITE, "--date", "2021-03-10", "--days", "2",
+               "--freq", "5min", "--stream", "--out", str(tmp_path / "run")]
+    reader = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    reader.stdout.close()  # nobody reads
+    _, err = reader.communicate(timeout=300)
+    assert reader.returncode == 0, err.decode()[-500:]
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["steps"] == 2 * 288 and summary["streamed"]["segments"] == 2
+    done = subprocess.run(command + ["--force"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and "streamed in 2 day-long segments" in done.stdout
+
+
+@pytest.mark.slow
+def test_days_at_one_second_stream_in_bounded_memory(tmp_path):
+    """One day and four days at 1 s, each in a fresh process: the peak RSS (getrusage) of four days
+    is that of one (memory does not grow with the span), and the summary is finite."""
+    script = (
+        "import json, resource, sys\n"
+        "from hybridtrack.streaming import stream, synthetic_days\n"
+        "days = synthetic_days('lanzhou', '2021-03-10', sys.argv[2], weather='climate', freq='1s', seed=1)\n"
+        "r = stream(days, sys.argv[1])\n"
+        "print(json.dumps({'peak': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024, 's': r.summary}))\n")
+    reports = {}
+    for last in ("2021-03-10", "2021-03-13"):
+        done = subprocess.run([sys.executable, "-c", script, str(tmp_path / last), last], capture_output=True,
+                              text=True, timeout=1200)
+        assert done.returncode == 0, done.stderr[-2000:]
+        reports[last] = json.loads(done.stdout.strip().splitlines()[-1])
+    one, four = reports.values()
+    assert four["s"]["steps"] == 4 * 86_400
+    assert four["peak"] <= 1.15 * one["peak"] + 50 * 2**20, (one["peak"], four["peak"])
+    assert four["peak"] < 1.5 * 2**30
+    error = four["s"]["tracking_error_deg"]
+    assert all(np.isfinite(error[k]) for k in ("rms", "p95", "max", "mean"))
+    assert 0.9 < four["s"]["energy_capture"] <= 1.0
