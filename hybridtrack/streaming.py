@@ -214,13 +214,19 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     if suffix not in (".parquet", ".pq", ".csv"):
         raise HybridtrackError(f"{path}: a streamed run reads .parquet or .csv weather frames, not {suffix or 'this'}")
 
-    def stamped(piece: pd.DataFrame) -> pd.DataFrame:
+    def stamped(piece: pd.DataFrame, first_row: int) -> pd.DataFrame:
         if not isinstance(piece.index, pd.DatetimeIndex):
             name = "time" if "time" in piece.columns else piece.columns[0]
-            try:
-                piece = piece.set_index(pd.DatetimeIndex(pd.to_datetime(piece.pop(name), format="ISO8601")))
-            except (ValueError, TypeError) as exc:
-                raise HybridtrackError(f"{path}: column {name!r} is not time stamps ({exc})") from None
+            stamps = piece.pop(name)
+            parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=False)
+            bad = np.flatnonzero(parsed.isna().to_numpy() & stamps.notna().to_numpy())
+            if len(bad) or stamps.isna().any():
+                row = first_row + int(bad[0] if len(bad) else np.flatnonzero(stamps.isna().to_numpy())[0])
+                raise HybridtrackError(f"{path}: row {row}, column {name!r}: {stamps.iloc[row - first_row]!r} is not an "
+                                       "ISO 8601 time stamp (a streamed file is read as written: convert a record "
+                                       "once with hybridtrack.io.read_weather(...).to_parquet(...))")
+            piece = piece.set_index(pd.DatetimeIndex(parsed))
+        _numeric(piece, path, first_row)
         if piece.index.tz is None and tz is not None:
             piece.index = piece.index.tz_localize(tz)
         elif tz is not None:
@@ -232,10 +238,12 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     if suffix == ".csv":
         def pieces():
             try:
-                for piece in pd.read_csv(path, chunksize=chunk_rows):
-                    yield stamped(piece)
+                for k, piece in enumerate(pd.read_csv(path, chunksize=chunk_rows)):
+                    yield stamped(piece, 2 + k * chunk_rows)  # the file's line: the header is line 1
+            except HybridtrackError:
+                raise
             except (ValueError, pd.errors.ParserError) as exc:
-                raise HybridtrackError(f"{path}: cannot read as CSV ({exc})") from None
+                raise HybridtrackError(f"{path}: cannot read as CSV ({' '.join(str(exc).split())})") from None
     else:
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -248,10 +256,28 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 
         def pieces():
             schema = handle.schema_arrow
-            for batch in handle.iter_batches(batch_size=chunk_rows):
-                yield stamped(pa.Table.from_batches([batch], schema=schema).to_pandas())
+            for k, batch in enumerate(handle.iter_batches(batch_size=chunk_rows)):
+                yield stamped(pa.Table.from_batches([batch], schema=schema).to_pandas(), 1 + k * chunk_rows)
 
     return DaySource(site, f"{path}", steps, None, lambda: _by_day(pieces(), site, str(path)))
+
+
+#: Columns of a weather frame that hold text (the true sky's label); every other column is a number.
+TEXT_COLUMNS = ("sky",)
+
+
+def _numeric(piece: pd.DataFrame, path: Path, first_row: int) -> None:
+    """Refuse a cell that is not a number, naming its row (`first_row` is the piece's first) and
+    column: a streamed frame is read as it was written, without the reader's repairs."""
+    for column in piece.columns:
+        if column in TEXT_COLUMNS or pd.api.types.is_numeric_dtype(piece[column].dtype):
+            continue
+        values = pd.to_numeric(piece[column], errors="coerce")
+        bad = np.flatnonzero(values.isna().to_numpy() & piece[column].notna().to_numpy())
+        if len(bad):
+            raise HybridtrackError(f"{path}: row {first_row + int(bad[0])}, column {column!r}: "
+                                   f"{piece[column].iloc[bad[0]]!r} is not a number")
+        piece[column] = values
 
 
 # -- the run -------------------------------------------------------------------------------------
@@ -494,12 +520,16 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
             memory, segments = result.memory, segments + 1
             last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"]}
             del result, frame  # nothing of a segment outlives it but its memory and the running sums
-    finally:
+    except BaseException:
         logs.close()
-    if segments == 0:
-        raise HybridtrackError("the weather source holds no steps")
-    if not whole:
-        raise HybridtrackError(f"a streamed run needs at least one whole local day at {site.name}; this span has "
+        if segments == 0:  # nothing finished: leave nothing behind that a retry would have to --force
+            _discard(files)
+        raise
+    logs.close()
+    if segments == 0 or not whole:
+        _discard(files)
+        raise HybridtrackError("the weather source holds no steps" if segments == 0 else
+                               f"a streamed run needs at least one whole local day at {site.name}; this span has "
                                "none (run it in memory with hybridtrack.simulate)")
     summary = running.summary()
     summary["calibration"] = last["calibration"]
@@ -510,6 +540,12 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
                            "p95_resolution_deg": resolution, "weather": source.describe}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
     return StreamResult(summary, files, site, collector, config, memory)
+
+
+def _discard(files: dict) -> None:
+    """Remove what a refused or failed run wrote before its first day was done."""
+    for path in files.values():
+        Path(path).unlink(missing_ok=True)
 
 
 def progress_bar(source: DaySource, *, label: str = "", file=None):

@@ -3,6 +3,7 @@ carries across midnight, and how far a streamed run is from one simulate over th
 
 import dataclasses
 import json
+import re
 import subprocess
 import sys
 
@@ -297,3 +298,20 @@ def test_days_at_one_second_stream_in_bounded_memory(tmp_path):
     error = four["s"]["tracking_error_deg"]
     assert all(np.isfinite(error[k]) for k in ("rms", "p95", "max", "mean"))
     assert 0.9 < four["s"]["energy_capture"] <= 1.0
+
+
+@pytest.mark.parametrize("cells, message", [
+    ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,abc\n", r"row 3, column 'dni': 'abc' is not a number"),
+    ("2021-06-21T00:00:00+08:00,0\n21/06/2021 00:01,5\n",
+     r"row 3, column 'time': '21/06/2021 00:01' is not an ISO 8601 time stamp"),
+])
+def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_path, capsys, cells, message):
+    """A streamed file is read as written: a cell that is not what its column holds is refused by
+    row and column, and a run refused before its first day leaves no files to --force past."""
+    path = tmp_path / "weather.csv"
+    path.write_text("time,dni\n" + cells)
+    assert main(["replay", str(path), "--site", SITE, "--stream", "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("hybridtrack: error: ") and str(path) in err
+    assert re.search(message, err), err
+    assert list((tmp_path / "run").iterdir()) == []
