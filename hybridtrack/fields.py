@@ -587,11 +587,15 @@ def _bar(total: int, progress: bool | None):
 
 
 def _blocks(frame: pd.DataFrame, runs: list, job: dict, workers: int | None, scheduler: str | None):
-    """Each block of collectors' results as it is done: one after another here, or on Dask in
-    blocks of a few collectors per task (each worker shares a block's sun positions)."""
+    """Each block of collectors' results as it is done: one after another here (sharing the sun
+    positions they ask for), or on Dask in blocks of up to 16 collectors per task, two tasks per
+    worker (each block shares its sun positions)."""
+    from .sun import reuse_positions
+
     if workers is None and scheduler is None:
-        for run in runs:
-            yield run_collectors(frame, [run], **job)
+        with reuse_positions():  # one memory for the whole field: each run's block shares it
+            for run in runs:
+                yield run_collectors(frame, [run], **job)
         return
     from dask.distributed import as_completed
 
@@ -600,7 +604,7 @@ def _blocks(frame: pd.DataFrame, runs: list, job: dict, workers: int | None, sch
     client, cluster = dask_client(scheduler, workers, what="parallel fields")
     try:
         shared = client.scatter(frame, broadcast=True)
-        size = max(1, min(8, len(runs) // (4 * max(len(client.scheduler_info()["workers"]), 1))))
+        size = max(1, min(16, len(runs) // (2 * max(len(client.scheduler_info()["workers"]), 1))))
         futures = [client.submit(run_collectors, shared, runs[k:k + size], pure=False, **job)
                    for k in range(0, len(runs), size)]
         for future in as_completed(futures):

@@ -335,6 +335,9 @@ def spa_fast(times, latitude: float, longitude: float, altitude: float = 0.0, pr
                         index=index)
 
 
+#: Stamps from which `reuse_positions` keeps an answer: a smaller one costs milliseconds to compute
+#: again, and would push out of the memory the long answers that are worth keeping.
+REMEMBERED_FROM = 10_000
 #: The answers `reuse_positions` keeps: (capacity, [(key, frame), ...] oldest first), or None outside it.
 _REUSE: ContextVar[tuple[int, list] | None] = ContextVar("hybridtrack_sun_reuse", default=None)
 
@@ -348,7 +351,11 @@ def reuse_positions(entries: int = 8) -> Iterator[None]:
     the model gives (every model here computes each stamp on its own). Runs of many collectors
     on one frame ask for the same sun again and again; this is how they share it without
     passing it around. The memory holds the last `entries` answers, for this thread or task only.
+    A block inside another shares the outer block's memory.
     """
+    if _REUSE.get() is not None:
+        yield
+        return
     token = _REUSE.set((max(int(entries), 1), []))
     try:
         yield
@@ -391,7 +398,7 @@ def _positions(known: pd.DatetimeIndex, index: pd.DatetimeIndex) -> np.ndarray |
 
 def _remember(key: tuple, frame: pd.DataFrame) -> None:
     capacity, memory = _REUSE.get() or (0, None)
-    if memory is None or not frame.index.is_unique:
+    if memory is None or not frame.index.is_unique or len(frame) < REMEMBERED_FROM:
         return
     memory.append((key, frame))
     del memory[:-capacity]  # keep the newest

@@ -5,7 +5,7 @@ import pandas as pd
 import pvlib
 import pytest
 
-from hybridtrack.sun import reuse_positions, solar_position
+from hybridtrack.sun import REMEMBERED_FROM, reuse_positions, solar_position
 
 
 @pytest.mark.parametrize("model", ["spa", "spa-fast", "plc"])
@@ -22,7 +22,7 @@ def test_each_request_is_computed_once_and_only_inside_the_block(monkeypatch):
     calls = []
     original = pvlib.solarposition.spa_python
     monkeypatch.setattr(pvlib.solarposition, "spa_python", lambda *a, **k: calls.append(1) or original(*a, **k))
-    times = pd.date_range("2021-06-21", periods=300, freq="1min", tz="Asia/Shanghai")
+    times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="Asia/Shanghai")
     with reuse_positions():
         solar_position(times, "nanjing")
         solar_position(times[10:50], "nanjing")
@@ -31,18 +31,19 @@ def test_each_request_is_computed_once_and_only_inside_the_block(monkeypatch):
         solar_position(times, "lanzhou")  # another site is another request
         solar_position(times, "nanjing", temperature=30.0)  # and other options
         assert len(calls) == 3
-        later = pd.date_range("2021-06-22", periods=5, freq="1min", tz="Asia/Shanghai")
+        later = pd.date_range("2021-07-22", periods=5, freq="1min", tz="Asia/Shanghai")
         solar_position(later, "nanjing")  # times it has not seen
-        assert len(calls) == 4
+        solar_position(later, "nanjing")  # too few to keep: computed again
+        assert len(calls) == 5
     solar_position(times, "nanjing")
-    assert len(calls) == 5
+    assert len(calls) == 6
 
 
 def test_memory_keeps_only_the_newest_answers(monkeypatch):
     calls = []
     original = pvlib.solarposition.spa_python
     monkeypatch.setattr(pvlib.solarposition, "spa_python", lambda *a, **k: calls.append(1) or original(*a, **k))
-    times = pd.date_range("2021-06-21", periods=50, freq="1min", tz="UTC")
+    times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="UTC")
     with reuse_positions(entries=2):
         for temperature in (10.0, 20.0, 30.0, 10.0):
             solar_position(times, "nanjing", temperature=temperature)
@@ -58,3 +59,15 @@ def test_a_remembered_answer_serves_an_increasing_subset_and_refuses_a_stranger(
     assert _positions(known, known[[2]] + pd.Timedelta(seconds=1)) is None
     assert _positions(known, pd.DatetimeIndex([known[-1] + pd.Timedelta(minutes=1)])) is None
     np.testing.assert_array_equal(_positions(known, known[[4, 1]]), [4, 1])  # not increasing: by hash
+
+
+def test_a_block_inside_another_shares_its_memory():
+    times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="Asia/Shanghai")
+    with reuse_positions():
+        first = solar_position(times, "lanzhou", "spa")
+        with reuse_positions():
+            again = solar_position(times[10:20], "lanzhou", "spa")
+            with pytest.MonkeyPatch.context() as patch:  # answered from memory: pvlib is not asked
+                patch.setattr(pvlib.solarposition, "spa_python", None)
+                pd.testing.assert_frame_equal(solar_position(times, "lanzhou", "spa"), first)
+    pd.testing.assert_frame_equal(again, first.iloc[10:20])
