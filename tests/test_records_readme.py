@@ -69,6 +69,7 @@ def _fuzzy_files(folder: Path) -> None:
 @pytest.fixture
 def readme_folder(tmp_path, monkeypatch):
     shutil.copytree(ROOT / "data", tmp_path / "data")
+    shutil.copytree(ROOT / "examples" / "tuning", tmp_path / "examples" / "tuning")  # the tuning walk-through's labels
     _logger_csv(tmp_path / "logger.csv")
     shutil.copy(RECORDS / "utc-declared-local.csv", tmp_path / "utc-logger.csv")
     shutil.copy(RECORDS / "lanzhou.epw", tmp_path / "station.epw")
