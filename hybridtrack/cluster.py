@@ -9,9 +9,13 @@ from __future__ import annotations
 
 import os
 
+from . import params
 from .errors import HybridtrackError
 
-__all__ = ["dask_client", "check_workers", "close"]
+__all__ = ["dask_client", "close", "MAX_WORKERS"]
+
+#: The most worker processes a local cluster is asked for.
+MAX_WORKERS = 1024
 
 
 def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
@@ -37,17 +41,10 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
             return Client(scheduler, timeout="10s"), None
         except (OSError, TimeoutError, ValueError) as exc:
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    count = check_workers(workers) if workers is not None else (os.cpu_count() or 1)
+    count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
                            silence_logs=50)  # a failed task is reported by its result, not logged
     return Client(cluster), cluster
-
-
-def check_workers(workers) -> int:
-    """`workers` when it is a whole number from 1 to 1024; else a `HybridtrackError`."""
-    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
-        raise HybridtrackError(f"workers must be a whole number from 1 to 1024, got {workers!r}")
-    return workers
 
 
 def close(client, cluster) -> None:

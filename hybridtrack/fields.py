@@ -24,7 +24,7 @@ import pandas as pd
 
 from . import params, sites
 from .budget import BYTES_PER_STEP, check_steps
-from .cluster import check_workers
+from .cluster import MAX_WORKERS
 from .collectors import (
     AXIS_AZIMUTH,
     MAX_DISTANCE,
@@ -552,7 +552,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     frame = _check_frame(frame)
     config = config or SimulationConfig()
     if workers is not None:
-        check_workers(workers)
+        params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()
     if keep_log:
         first, last = frame.index[0], frame.index[-1]
