@@ -542,7 +542,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     FieldResult
     """
     from .simulation import SimulationConfig, _check_frame
-    from .sun import solar_position
+    from .sun import reuse_positions, solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
@@ -563,7 +563,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     bar = _bar(len(runs), progress)
     rows, events, store = [None] * len(runs), [None] * len(runs), None
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
-    with bar:
+    with bar, reuse_positions():  # in this process, every run shares the sun with the others and the table
         for block in _blocks(frame, runs, job, workers, scheduler):
             for i, row, run_events, log in block:
                 rows[i], events[i] = row, run_events
@@ -571,7 +571,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                     store = store or _LogStore(field.names, frame.index, log)
                     store.add(i, log)
                 bar.update()
-    truth = solar_position(frame.index, site, config.truth)
+        truth = solar_position(frame.index, site, config.truth)
     table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
@@ -587,15 +587,12 @@ def _bar(total: int, progress: bool | None):
 
 
 def _blocks(frame: pd.DataFrame, runs: list, job: dict, workers: int | None, scheduler: str | None):
-    """Each block of collectors' results as it is done: one after another here (sharing the sun
-    positions they ask for), or on Dask in blocks of up to 16 collectors per task, two tasks per
-    worker (each block shares its sun positions)."""
-    from .sun import reuse_positions
-
+    """Each block of collectors' results as it is done: one after another here, or on Dask in
+    blocks of up to 16 collectors per task, two tasks per worker (each block shares its sun
+    positions)."""
     if workers is None and scheduler is None:
-        with reuse_positions():  # one memory for the whole field: each run's block shares it
-            for run in runs:
-                yield run_collectors(frame, [run], **job)
+        for run in runs:
+            yield run_collectors(frame, [run], **job)
         return
     from dask.distributed import as_completed
 
