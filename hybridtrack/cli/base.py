@@ -193,10 +193,11 @@ def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: b
     parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
 
 
-def synthetic_frame(args: argparse.Namespace, site):
+def synthetic_span(args: argparse.Namespace):
+    """The first and last day of the synthetic run the arguments ask for, with its ``--days``,
+    ``--seed`` and ``--gusts-per-day`` checked."""
     import datetime as dt
 
-    from ..sky import synthetic
     from ..times import parse_date
 
     if not 1 <= args.days <= 3660:
@@ -204,9 +205,16 @@ def synthetic_frame(args: argparse.Namespace, site):
     params.seed(args.seed, "--seed")
     params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
     first = parse_date(args.date)
+    return first, first + dt.timedelta(days=args.days - 1)
+
+
+def synthetic_frame(args: argparse.Namespace, site):
+    from ..sky import synthetic
+
+    first, last = synthetic_span(args)
     weather = args.weather.split(",") if "," in args.weather else args.weather
-    return synthetic(site, first, first + dt.timedelta(days=args.days - 1), weather=weather, freq=args.freq,
-                     seed=args.seed, gusts_per_day=args.gusts_per_day)
+    return synthetic(site, first, last, weather=weather, freq=args.freq, seed=args.seed,
+                     gusts_per_day=args.gusts_per_day)
 
 
 def add_dask_arguments(parser, *, default: str) -> None:

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from .. import params, sites
+from .. import sites
 from ..errors import HybridtrackError
 from ..outputs import claim, strict_json, write
 from .base import (
@@ -23,6 +23,7 @@ from .base import (
     simulation_config,
     site_from_arguments,
     synthetic_frame,
+    synthetic_span,
 )
 
 
@@ -65,7 +66,6 @@ def _fmt(value, spec: str) -> str:
 
 def _claim_run_folder(args: argparse.Namespace) -> None:
     """Refuse a bad ``--out`` before the run rather than after it."""
-    from ..outputs import claim
     from ..simulation import Result
 
     if args.out:
@@ -155,21 +155,14 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _stream_synthetic(args: argparse.Namespace, site) -> int:
-    import datetime as dt
-
     from ..streaming import synthetic_days
-    from ..times import parse_date
 
-    if not 1 <= args.days <= 3660:
-        raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    first, last = synthetic_span(args)
     if "," in args.weather:
         raise HybridtrackError("--stream takes one --weather for every day (climate draws each day from the site's "
                                "monthly climate), not a per-day list")
-    params.seed(args.seed, "--seed")
-    params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
-    first = parse_date(args.date)
-    source = synthetic_days(site, first, first + dt.timedelta(days=args.days - 1), weather=args.weather,
-                            freq=args.freq, seed=args.seed, gusts_per_day=args.gusts_per_day)
+    source = synthetic_days(site, first, last, weather=args.weather, freq=args.freq, seed=args.seed,
+                            gusts_per_day=args.gusts_per_day)
     return _stream(source, args, simulation_config(args, args.seed),
                    heading=f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}, "
                            f"each day seeded from (seed, date)), {collector_from_arguments(args).kind}, "
