@@ -407,14 +407,11 @@ class _LogWriter:
         import pyarrow.parquet as pq
 
         table = pa.Table.from_pandas(log, preserve_index=True)
-        try:
-            if self.writer is None:
-                self.writer = pq.ParquetWriter(self.path, table.schema)
-            elif not table.schema.equals(self.writer.schema, check_metadata=False):
-                raise HybridtrackError(f"{self.path}: a segment's log has other columns or types than the first's")
-            self.writer.write_table(table, row_group_size=len(table))
-        except OSError as exc:
-            raise HybridtrackError(f"{self.path}: cannot write ({exc.strerror or exc})") from None
+        if self.writer is None:
+            write(self.path, lambda path: setattr(self, "writer", pq.ParquetWriter(path, table.schema)))
+        elif not table.schema.equals(self.writer.schema, check_metadata=False):
+            raise HybridtrackError(f"{self.path}: a segment's log has other columns or types than the first's")
+        write(self.path, lambda _: self.writer.write_table(table, row_group_size=len(table)))
 
     def close(self) -> None:
         if self.writer is not None:
