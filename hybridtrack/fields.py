@@ -568,7 +568,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
             for i, row, run_events, log in block:
                 rows[i], events[i] = row, run_events
                 if keep_log:
-                    store = store or _LogStore(field.names, frame.index, log)
+                    store = store or _LogStore(field.names, frame, log)
                     store.add(i, log)
                 bar.update()
         truth = solar_position(frame.index, site, config.truth)
@@ -664,9 +664,9 @@ def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, 
 
 
 def _kept(log: pd.DataFrame) -> dict:
-    """The log columns a field keeps (`LOG_VARIABLES`, a heliostat's ``*_azimuth`` too, and the
-    shared weather), as arrays: categories as their codes."""
-    kept = [c for c in log.columns if c in LOG_VARIABLES or c.endswith("_azimuth") or c in SHARED_VARIABLES]
+    """The log columns a field keeps per collector (`LOG_VARIABLES`, a heliostat's ``*_azimuth``
+    too), as arrays: categories as their codes."""
+    kept = [c for c in log.columns if c in LOG_VARIABLES or c.endswith("_azimuth")]
     return {c: (_values(log[c]), list(log[c].cat.categories) if isinstance(log[c].dtype, pd.CategoricalDtype)
                 else None) for c in kept}
 
@@ -678,14 +678,13 @@ class _LogStore:
     about 50 bytes per collector and step (80 for a heliostat).
     """
 
-    def __init__(self, names: list[str], index: pd.DatetimeIndex, first: dict) -> None:
+    def __init__(self, names: list[str], frame: pd.DataFrame, first: dict) -> None:
         self.names = names
-        self.time = index.tz_convert("UTC").tz_localize(None)
-        self.shared = {c: values for c, (values, _) in first.items() if c in SHARED_VARIABLES}
+        self.time = frame.index.tz_convert("UTC").tz_localize(None)
+        self.shared = {c: frame[c].to_numpy(float) if c in frame.columns else np.full(len(frame), np.nan)
+                       for c in SHARED_VARIABLES}  # the weather every collector's log repeats
         self.attrs, self.arrays = {}, {}
         for column, (values, categories) in first.items():
-            if column in SHARED_VARIABLES:
-                continue
             self.arrays[column] = np.empty((len(names), len(values)), values.dtype)
             if categories is not None:
                 self.attrs[column] = {"flag_values": np.arange(len(categories), dtype=np.int8),
