@@ -27,6 +27,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from . import params
+
 __all__ = ["summarize", "RunningSummary", "daily", "shares", "share_counts", "event_counts", "moved_axes",
            "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
 
@@ -222,8 +224,8 @@ class RunningSummary:
 
     def __init__(self, *, site: str, collector: str, strategy: str, resolution: float = HISTOGRAM_RESOLUTION,
                  span: float = HISTOGRAM_SPAN):
-        if not 0 < resolution < span:
-            raise ValueError(f"resolution must be above zero and below span, got {resolution!r}")
+        span = params.number(span, "span", 0.0, 180.0, above=True)
+        resolution = params.number(resolution, "resolution", 0.0, min(1.0, span), above=True)  # degrees
         self.site, self.collector, self.strategy = site, collector, strategy
         self.resolution, self.span = float(resolution), float(span)
         self.histogram = np.zeros(int(np.ceil(span / resolution)))

@@ -487,13 +487,11 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     if config.engine == "auto" and source.steps and uses_kernel(config, source.steps):
         # whether the kernel pays is a question of the whole span, not of one day's segment
         config = dataclasses.replace(config, engine="compiled")
-    if not 0 < resolution <= 1:
-        raise HybridtrackError(f"resolution must be above 0 and at most 1 degree, got {resolution!r}")
+    running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
+                             resolution=resolution)  # checks `resolution` before anything is written
     files = stream_files(out)
     claim(files.values())
     write(files["events"], lambda path: path.write_text("time,from,to,reason\n"))
-    running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
-                             resolution=resolution)
     logs = _LogWriter(files["log"])
     memory: bool | dict = warm_start
     start = None
