@@ -134,6 +134,7 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         [c.mode_since, c.invalid_since, c.previous_t, c.dark_since, c.distrusted_until, c.fit_since]
     s[[kc.CALM_SINCE, kc.FLAT_VALUE, kc.FLAT_SINCE]] = [c.wind.calm_since, c.wind.flat_value, c.wind.flat_since]
     s[kc.CONDITION] = c.fit.condition if c.fit else math.inf
+    s[kc.LIGHT_LEVEL] = c.fit.level if c.fit else math.nan
     clock = c.clock
     s[[kc.SPELL_START, kc.SPELL_LAST]] = [clock.spell_start, clock.spell_last] if clock else [math.nan, math.nan]
     k = np.zeros(kc.INT_SLOTS, np.int64)
@@ -213,6 +214,7 @@ def _write_back(controller: Controller, state: kc.ControllerState) -> None:
         fit.theta, fit.p, fit.information = state.theta.copy(), state.p.copy(), state.information.copy()
         fit.updates, fit.axis_frozen = int(state.k[kc.UPDATES]), bool(state.k[kc.FROZEN])
         fit.condition = float(state.s[kc.CONDITION])
+        fit.level = float(state.s[kc.LIGHT_LEVEL])
         controller.theta = fit.theta.copy()
     clock = controller.clock
     if clock is not None:
@@ -234,7 +236,6 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
     arrays, world_state = pack_world(world)
     cfg, plan = _settings(controller), _plan(controller)
     state = _state(controller, arrays.minutes)
-    state.s[kc.LIGHT_LEVEL] = controller.fit.level if controller.fit is not None else math.nan
     out = _record(n, axes, len(state.theta))
     events = _events(1024 + EVENTS_PER_SCAN)
     guard = controller.wind
@@ -254,8 +255,6 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
     controller.events = _worded(controller, events, int(state.k[kc.EVENTS]))
     controller.moves, controller.travel = state.moves.tolist(), state.travel.tolist()
     _write_back(controller, state)
-    if controller.fit is not None:
-        controller.fit.level = float(state.s[kc.LIGHT_LEVEL])
     return ControllerOutputs(out.mode, out.status, out.sky, out.score, out.intensity, out.variation, out.target,
                              out.reading, out.calibration, out.sun, out.fit_value, out.fit_std,
                              np.array(controller.moves), np.array(controller.travel), controller.events)
