@@ -478,12 +478,6 @@ def _metrics(summary: dict) -> dict:
     return {name: error[name] if name in error else summary[name] for name in COLLECTOR_METRICS}
 
 
-def _offered(dni: np.ndarray, altitude: np.ndarray, azimuth: np.ndarray, collector: Collector) -> float:
-    """Direct light a perfect tracker would take in, the weight of a collector in the field's figures."""
-    beam = np.nan_to_num(dni) * incidence_cosine(altitude, azimuth, collector)
-    return float(np.sum(beam[(altitude > 0) & (np.nan_to_num(dni) > 0)]))
-
-
 def _weighted(values: pd.Series, weights: pd.Series, *, squared: bool = False) -> float | None:
     ok = values.notna() & (weights > 0)
     if not ok.any():
@@ -615,19 +609,18 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
     return for each ``(i, row, events, log)``: its row of the collector table, its events and
     its log's kept columns (`LOG_VARIABLES`, as arrays; None unless `keep_log`). The sun every
     run of the block asks for is computed once (`hybridtrack.sun.reuse_positions`)."""
+    from .metrics import offered_light
     from .simulation import simulate
-    from .sun import reuse_positions, solar_position
+    from .sun import reuse_positions
 
     done = []
     with reuse_positions():
-        truth = solar_position(frame.index, site, config.truth)
-        altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
             result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
-            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary),
-                   "offered": _offered(result.log["dni"].to_numpy(float), altitude, azimuth, collector)}
+            offered = offered_light(result.log["dni"], result.scoring["sun_up"], result.scoring["incidence"])
+            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary), "offered": float(offered.sum())}
             done.append((i, row, result.events.assign(collector=name), _kept(result.log) if keep_log else None))
     return done
 

@@ -29,7 +29,7 @@ import pandas as pd
 
 from . import params
 
-__all__ = ["summarize", "RunningSummary", "daily", "shares", "share_counts", "event_counts", "moved_axes",
+__all__ = ["summarize", "RunningSummary", "offered_light", "daily", "shares", "share_counts", "event_counts", "moved_axes",
            "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
 
 TRACKING_MODES = ("sensor", "astronomical", "search")
@@ -53,6 +53,13 @@ def weighted_quantile(values, weights, q: float) -> float:
     return float(v[order][min(np.searchsorted(cdf, q), len(v) - 1)])
 
 
+def offered_light(dni, sun_up, incidence) -> np.ndarray:
+    """Direct light a perfect tracker would catch at each step (W/m², 0 with the sun down or no
+    DNI): the weight of energy capture, and of a collector in a field's figures."""
+    dni = np.nan_to_num(np.asarray(dni, float))
+    return np.where(np.asarray(sun_up, bool) & (dni > 0), dni * np.asarray(incidence, float), 0.0)
+
+
 def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.ndarray) -> pd.DataFrame:
     """Per-step terms every metric is built from, so the run summary and the daily table agree.
 
@@ -64,7 +71,7 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
     error = log["error"].to_numpy(float)
     beam = dni * np.asarray(incidence, float)  # direct light on the aperture
     tracking = log["mode"].isin(TRACKING_MODES).to_numpy() & (beam > 0) & np.isfinite(error)
-    offered = np.where(np.asarray(sun_up, bool) & (dni > 0), beam, 0.0)
+    offered = offered_light(dni, sun_up, incidence)
     gained = acceptance(np.where(tracking, error, np.inf), ACCEPTANCE_HALF_ANGLE[collector])
     return pd.DataFrame({"weight": np.where(tracking, beam, 0.0), "error": np.where(tracking, error, np.nan),
                          "offered": offered, "captured": np.where(tracking, offered * gained, 0.0),
