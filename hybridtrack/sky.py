@@ -39,7 +39,7 @@ from . import params
 from .budget import check_steps
 from .errors import HybridtrackError
 from .sites import Site, get
-from .times import clock_hours, local_range, parse_freq
+from .times import clock_hours, local_midnight, local_range, parse_freq
 
 __all__ = ["synthetic", "clear_sky", "smooth_noise", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters",
            "REGIMES",
@@ -303,7 +303,7 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     # regimes and cloud passages in continuous time
     edges, tau, boost, regimes, clouded = [], [], [], [], []
     for day, day_type in zip(days, day_types):
-        day_start = pd.Timestamp(day).tz_localize(site.tz, nonexistent="shift_forward", ambiguous=True)
+        day_start = local_midnight(day, site.tz)
         for s0, s1, regime in _regime_spells(day_start, day_type, rng):
             for c0, c1, t, e, cloud in _cloud_passages(s0, s1, regime, rng):
                 edges.append(c1)

@@ -53,6 +53,7 @@ from .collectors import Collector
 from .errors import HybridtrackError
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, strict_json, write
+from .times import local_midnight, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
            "read_log", "stream_files"]
@@ -95,8 +96,6 @@ class DaySource:
 
 
 def _dates(start, end) -> tuple[dt.date, dt.date]:
-    from .times import parse_date
-
     first = parse_date(start)
     last = first if end is None else parse_date(end)
     if last < first:
@@ -128,7 +127,6 @@ def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str
     DaySource
     """
     from .sky import WEATHERS, synthetic
-    from .times import parse_freq
 
     site = sites.get(site)
     first, last = _dates(start, end)
@@ -501,10 +499,8 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
         for day, frame in source:
             begin = frame.index[0]
             start = begin if start is None else start
-            midnight = pd.Timestamp(day).tz_localize(site.tz, nonexistent="shift_forward", ambiguous=True)
+            midnight, next_midnight = (local_midnight(d, site.tz) for d in (day, day + dt.timedelta(days=1)))
             step = frame.index[1] - begin if len(frame) > 1 else pd.Timedelta(0)
-            next_midnight = pd.Timestamp(day + dt.timedelta(days=1)).tz_localize(site.tz, nonexistent="shift_forward",
-                                                                               ambiguous=True)
             whole = whole or (begin <= midnight and frame.index[-1] + step >= next_midnight)
             age = (begin - start) / pd.Timedelta(days=1)
             setup = dataclasses.replace(config, imperfections=dataclasses.replace(

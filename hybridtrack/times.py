@@ -9,7 +9,7 @@ import pandas as pd
 from .budget import check_steps
 from .errors import HybridtrackError
 
-__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "check_tz", "clock_hours"]
+__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "local_midnight", "check_tz", "clock_hours"]
 
 
 def clock_hours(local: pd.DatetimeIndex):
@@ -75,6 +75,12 @@ def _localise(day: dt.date, clock: dt.time, tz: str) -> pd.Timestamp:
     stamp = pd.Timestamp(dt.datetime.combine(day, clock))
     # a clock time skipped or repeated by a DST change maps to the first valid instant
     return stamp.tz_localize(tz, nonexistent="shift_forward", ambiguous=True)
+
+
+def local_midnight(day: dt.date, tz: str) -> pd.Timestamp:
+    """The instant `day` begins on the local clock of `tz` (a midnight a DST change skips: the
+    first instant after it)."""
+    return _localise(day, dt.time(0), tz)
 
 
 def local_range(start_date, tz: str, *, end_date=None, start: str = "00:00", end: str | None = None,
