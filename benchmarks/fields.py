@@ -34,7 +34,7 @@ import subprocess
 import sys
 import time
 
-from _timing import print_table
+from _timing import peak_rss_bytes, print_table
 
 YEAR = ("2021-01-01", "2021-12-31")
 #: Mirrors of the heliostat field-year case (``--heliostats``).
@@ -123,8 +123,8 @@ def _child(case: str) -> None:
     start = time.perf_counter()
     run(data)
     seconds = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
-    if "workers" in case:
+    peak = peak_rss_bytes() / 2**20
+    if "workers" in case:  # an upper bound: a worker's ru_maxrss starts at its parent's
         peak += 2 * resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     print(json.dumps({"seconds": seconds, "peak_mib": peak}))
 

@@ -5,7 +5,7 @@ trough at Lanzhou, hybrid strategy, synthetic climate weather made a day at a ti
 (`hybridtrack.streaming.synthetic_days`), 1-second steps: a year (365 days, 31.5 M steps) and a
 month (30 days) are each run by `hybridtrack.streaming.stream` in a fresh subprocess, which
 reports its wall time (weather made, run, log written) and its peak resident memory
-(`resource.getrusage(RUSAGE_SELF).ru_maxrss`, the whole process: Python, numpy, the kernel).
+(`_timing.peak_rss_bytes`, the whole process: Python, numpy, the kernel).
 If memory does not grow with the span, the year's peak is the month's.
 
 The same-run reference is pvlib's ``spa_python`` over one day's 1-second stamps (the median of
@@ -29,13 +29,14 @@ from _timing import median_seconds, print_table
 from hybridtrack import sites
 
 CHILD = """
-import json, resource, sys, time
+import json, sys, time
+from _timing import peak_rss_bytes
 start = time.perf_counter()
 from hybridtrack.streaming import stream, synthetic_days
 days = synthetic_days("lanzhou", "2021-01-01", sys.argv[2], weather="climate", freq="1s", seed=1)
 result = stream(days, sys.argv[1], collector="trough-ns", strategy="hybrid")
 wall = time.perf_counter() - start
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux reports KiB
+peak = peak_rss_bytes()
 s = result.summary
 print(json.dumps({"wall": wall, "peak": peak, "steps": s["steps"], "rms": s["tracking_error_deg"]["rms"],
                   "p95": s["tracking_error_deg"]["p95"], "energy": s["energy_capture"], "clock": s["clock"],
@@ -47,7 +48,8 @@ def streamed(days: int) -> dict:
     """Run `days` days from 2021-01-01 in a fresh process; its wall time, peak RSS and summary."""
     end = (pd.Timestamp("2021-01-01") + pd.Timedelta(days=days - 1)).date().isoformat()
     with tempfile.TemporaryDirectory() as folder:
-        env = {**os.environ, "PYTHONPATH": os.pathsep.join([os.getcwd(), os.environ.get("PYTHONPATH", "")])}
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join([os.getcwd(), os.path.dirname(os.path.abspath(__file__)),
+                                                     os.environ.get("PYTHONPATH", "")])}
         done = subprocess.run([sys.executable, "-c", CHILD, folder, end], capture_output=True, text=True, env=env,
                               check=False)
     if done.returncode != 0:

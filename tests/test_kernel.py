@@ -444,9 +444,10 @@ def test_the_mount_fit_compiled_updates_as_the_reference():
 
 @pytest.mark.parametrize("days", [1.0, 40.0])  # within DRIFT_DAYS the drift is held; beyond it is fitted
 def test_the_kernels_clock_fit_sums_its_normal_equations_to_the_references_answer(days):
-    """The kernel sums the clock fit's normal equations reading by reading (linear in the
-    readings, where forming the design matrix every evening made a year quadratic); the
-    reference forms the matrix. Two axes, readings in five-minute spells with gaps."""
+    """The kernel keeps running sums of the clock fit's normal equations, its residuals' squares
+    and their lag products, each reading summed once as it is counted (forming the design matrix
+    every evening made a year quadratic); the reference forms the matrix. Two axes, readings in
+    five-minute spells with gaps."""
     pytest.importorskip("numba")
     from hybridtrack.control.clockwatch import ClockWatch
     from hybridtrack.kernel import controller as kc
@@ -461,7 +462,10 @@ def test_the_kernels_clock_fit_sums_its_normal_equations_to_the_references_answe
     watch = ClockWatch(4, 0.05)
     watch.rows = [(ti, ai, x, y) for ti, ai, x, y in zip(t, axis, rows, values)]
     expected, expected_std = watch.solve()
-    estimate, std = kc.clock_solve(t, axis, rows, values, len(t), np.diag(watch.prior_information), watch.r)
+    n = watch.n
+    moments, sums, last = np.zeros((4, n, n)), np.zeros((5, n + 1)), np.full(2, -1, np.int64)
+    kc.clock_recount(t, axis, rows, values, moments, sums, last, len(t))
+    estimate, std = kc.clock_solve(moments, sums, len(t), watch.span, np.diag(watch.prior_information), watch.r)
     np.testing.assert_allclose(estimate, expected, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(std, expected_std, rtol=1e-9)
     assert np.isinf(std[-1]) == (days < 1.5)

@@ -6,6 +6,7 @@ import json
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -272,15 +273,18 @@ def test_the_command_streams_and_survives_a_closed_pipe(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="the peak is read from Linux's /proc")
 def test_days_at_one_second_stream_in_bounded_memory(tmp_path):
-    """One day and four days at 1 s, each in a fresh process: the peak RSS (getrusage) of four days
-    is that of one (memory does not grow with the span), and the summary is finite."""
+    """One day and four days at 1 s, each in a fresh process: the peak RSS of four days is that of
+    one (memory does not grow with the span), and the summary is finite. The peak is the child's
+    VmHWM: its ru_maxrss starts at this (pytest's) process's peak, inherited through the exec."""
     script = (
-        "import json, resource, sys\n"
+        "import json, sys\n"
         "from hybridtrack.streaming import stream, synthetic_days\n"
         "days = synthetic_days('lanzhou', '2021-03-10', sys.argv[2], weather='climate', freq='1s', seed=1)\n"
         "r = stream(days, sys.argv[1])\n"
-        "print(json.dumps({'peak': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024, 's': r.summary}))\n")
+        "peak = next(int(l.split()[1]) * 1024 for l in open('/proc/self/status') if l.startswith('VmHWM:'))\n"
+        "print(json.dumps({'peak': peak, 's': r.summary}))\n")
     warm = ("from hybridtrack import simulate\nfrom hybridtrack.simulation import SimulationConfig\n"
             "from hybridtrack.sky import synthetic\n"
             "simulate(synthetic('lanzhou', '2021-03-10'), 'lanzhou', config=SimulationConfig(engine='compiled'))\n")
@@ -294,7 +298,7 @@ def test_days_at_one_second_stream_in_bounded_memory(tmp_path):
     one, four = reports.values()
     assert four["s"]["steps"] == 4 * 86_400
     assert four["peak"] <= 1.15 * one["peak"] + 50 * 2**20, (one["peak"], four["peak"])
-    assert four["peak"] < 1.5 * 2**30
+    assert four["peak"] < 1.5 * 2**30, (one["peak"], four["peak"])
     error = four["s"]["tracking_error_deg"]
     assert all(np.isfinite(error[k]) for k in ("rms", "p95", "max", "mean"))
     assert 0.9 < four["s"]["energy_capture"] <= 1.0

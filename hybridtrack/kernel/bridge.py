@@ -150,8 +150,10 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
     capacity = _window_capacity(minutes, windows)
     readings = _clock_capacity(c, minutes)
     columns = c.clock.n - 1 if c.clock else 0
+    parameters = columns + 1 if c.clock else 0  # with the drift's column
     clock_arrays = (np.zeros(readings), np.zeros(readings, np.int64), np.zeros((readings, columns)),
-                    np.zeros(readings))
+                    np.zeros(readings), np.zeros((4, parameters, parameters)), np.zeros((5, parameters + 1)),
+                    np.full(axes, -1, np.int64))
     if c.clock is not None and (c.clock.rows or c.clock.pending or c.clock.raised):  # carried from an earlier run
         for m, (t, a, x, y) in enumerate(c.clock.rows + c.clock.pending):
             clock_arrays[0][m], clock_arrays[1][m], clock_arrays[2][m], clock_arrays[3][m] = t, a, x, y

@@ -17,7 +17,7 @@ Calibrator.learn        `calibrator_learn`
 MountEstimator          `fit_forget`, `fit_update`, `fit_check`, `fit_excess_light`
 pull_spread             `pull_spread`
 DisagreementMonitor     `disagreement_add`
-ClockWatch              `clock_add`, `clock_solve`, `clock_verdict`
+ClockWatch              `clock_add`, `clock_count`, `clock_solve`, `clock_verdict`
 Controller.step         `controller_step` and its `_`-named helpers
 Controller.rest         `controller_rest`
 =====================  ===================================================
@@ -65,7 +65,8 @@ ControllerState = namedtuple("ControllerState", [
     "s", "k", "encoder", "jumped", "kf", "gate", "stuck_angles", "stuck_expected", "stuck_fill",
     "calibration", "fitted_at", "blind_stow", "park", "moves", "travel", "mount",
     "theta", "p", "information", "checkpoint_offsets", "checkpoint_theta", "checkpoint_p",
-    "checkpoint_information", "window_t", "window_v", "window_ends", "clock_t", "clock_axis", "clock_x", "clock_y"])
+    "checkpoint_information", "window_t", "window_v", "window_ends", "clock_t", "clock_axis", "clock_x", "clock_y",
+    "clock_moments", "clock_sums", "clock_last"])
 #: What the controller records per scan (`hybridtrack.control.controller.ControllerOutputs`).
 ControllerRecord = namedtuple("ControllerRecord", [
     "mode", "status", "sky", "score", "intensity", "variation", "target", "reading", "calibration", "sun",
@@ -82,6 +83,13 @@ FLOAT_SLOTS = 17
  CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN, MOUNT_AT_SCAN, MOUNT_AT_UPDATES, CLOCK_ROWS, CLOCK_PENDING,
  CLOCK_RAISED, DRIFT_RAISED) = range(19)
 INT_SLOTS = 19
+# the clock watch's running sums over its counted readings: rows of clock_moments (n x n each), of
+# clock_sums (n each) and, after the n columns, its scalars; x a reading's row with its drift
+# column, y its residual; a reading linked to the one before it on its axis (`_correlation_factor`)
+# is c, that one p
+XX, PP, CC, PC = range(4)
+XY, PY_P, CY_C, PY_C, CY_P = range(5)
+YY, YP_YP, YC_YC, YP_YC, LINKED = range(5)
 # columns of ControllerState.encoder, .kf, .gate, .calibration
 BELIEVED, LAST, COMMANDED = range(3)
 X0, X1, P00, P01, P11 = range(5)
@@ -669,7 +677,8 @@ def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound, intensity):
 
 @kernel
 def clock_add(state, t, a, row, rate, residual, weight):
-    """ClockWatch.add: rows [0, k[CLOCK_ROWS]) are counted, the current spell's follow them."""
+    """ClockWatch.add: rows [0, k[CLOCK_ROWS]) are counted (and summed, `clock_count`), the
+    current spell's follow them."""
     s, k = state.s, state.k
     if not t - s[SPELL_LAST] <= SPELL_GAP:  # a new spell
         k[CLOCK_PENDING] = 0
@@ -688,48 +697,108 @@ def clock_add(state, t, a, row, rate, residual, weight):
     state.clock_y[n] = residual * weight
     k[CLOCK_PENDING] += 1
     if t - s[SPELL_START] >= SPELL:
+        for counted in range(k[CLOCK_ROWS], k[CLOCK_ROWS] + k[CLOCK_PENDING]):
+            clock_count(state.clock_t, state.clock_axis, state.clock_x, state.clock_y, state.clock_moments,
+                        state.clock_sums, state.clock_last, counted)
         k[CLOCK_ROWS] += k[CLOCK_PENDING]
         k[CLOCK_PENDING] = 0
 
 
 @kernel
-def _clock_row(times, rows, row, n, k, j):
+def _clock_column(times, rows, row, j):
     """Column `j` of reading `row` in the clock fit: the mount's and the clock's columns as
     added, then the drift's (the clock's column times the days since the first reading)."""
-    if j < n - 1:
+    columns = rows.shape[1]
+    if j < columns:
         return rows[row, j]
-    return rows[row, n - 2] * (times[row] - times[0]) / 1440.0
+    return rows[row, columns - 1] * (times[row] - times[0]) / 1440.0
+
+
+@kernel
+def clock_count(times, axis, rows, values, moments, sums, last, row):
+    """Add counted reading `row` to the running sums the clock fit is solved from
+    (`clock_solve`): its own moments and, with the reading before it on its axis (`last`) when
+    that is within `SPELL_GAP`, the pair's (the residuals' serial correlation). Each reading is
+    summed once, so a year's evenings cost what its readings do, not their square."""
+    n = moments.shape[1]
+    y = values[row]
+    previous = last[axis[row]]
+    last[axis[row]] = row
+    linked = previous >= 0 and times[row] - times[previous] <= SPELL_GAP
+    yp = values[previous] if linked else 0.0
+    for j in range(n):
+        xj = _clock_column(times, rows, row, j)
+        sums[XY, j] += xj * y
+        for m in range(n):
+            moments[XX, j, m] += xj * _clock_column(times, rows, row, m)
+        if linked:
+            pj = _clock_column(times, rows, previous, j)
+            sums[PY_P, j] += pj * yp
+            sums[CY_C, j] += xj * y
+            sums[PY_C, j] += pj * y
+            sums[CY_P, j] += xj * yp
+            for m in range(n):
+                moments[PP, j, m] += pj * _clock_column(times, rows, previous, m)
+                moments[CC, j, m] += xj * _clock_column(times, rows, row, m)
+                moments[PC, j, m] += pj * _clock_column(times, rows, row, m)
+    sums[YY, n] += y * y
+    if linked:
+        sums[YP_YP, n] += yp * yp
+        sums[YC_YC, n] += y * y
+        sums[YP_YC, n] += yp * y
+        sums[LINKED, n] += 1.0
+
+
+@kernel
+def clock_recount(times, axis, rows, values, moments, sums, last, count):
+    """The running sums of the first `count` readings, summed afresh (a run carried on from an
+    earlier one's readings, `hybridtrack.streaming`)."""
+    moments[:, :, :] = 0.0
+    sums[:, :] = 0.0
+    last[:] = -1
+    for row in range(count):
+        clock_count(times, axis, rows, values, moments, sums, last, row)
+
+
+@kernel
+def _quadratic(moments, which, beta, k):
+    """βᵀ M β over the first `k` parameters of moment matrix `which`."""
+    total = 0.0
+    for j in range(k):
+        for m in range(k):
+            total += beta[j] * moments[which, j, m] * beta[m]
+    return total
+
+
+@kernel
+def _linear(sums, which, beta, k):
+    """β · v over the first `k` parameters of sum vector `which`."""
+    total = 0.0
+    for j in range(k):
+        total += beta[j] * sums[which, j]
+    return total
 
 
 @kernel(allocates=True)
-def clock_solve(times, axis, rows, values, count, prior, r):
-    """ClockWatch.solve over the first `count` rows: (estimate, 1σ), each of the mount's
-    parameters, the clock's error and its drift (held at zero, 1σ infinite, under DRIFT_DAYS).
-    The normal equations are summed reading by reading, without forming the design matrix."""
+def clock_solve(moments, sums, count, span, prior, r):
+    """ClockWatch.solve from the running sums of its `count` readings (`clock_count`) spanning
+    `span` days: (estimate, 1σ), each of the mount's parameters, the clock's error and its drift
+    (held at zero, 1σ infinite, under DRIFT_DAYS). The residuals' squares are the sums expanded
+    about the estimate, Σ(y − xβ)² = Σy² − 2β·Σxy + βᵀ(Σxxᵀ)β, so no evening goes over the
+    readings."""
     n = prior.shape[0]
-    span = (times[count - 1] - times[0]) / 1440.0
     k = n if span >= DRIFT_DAYS else n - 1
     information, projected = np.zeros((k, k)), np.zeros(k)
-    for row in range(count):
-        for j in range(k):
-            xj = _clock_row(times, rows, row, n, k, j)
-            projected[j] += xj * values[row] / r
-            for m in range(k):
-                information[j, m] += xj * _clock_row(times, rows, row, n, k, m) / r
     for j in range(k):
+        projected[j] = sums[XY, j] / r
+        for m in range(k):
+            information[j, m] = moments[XX, j, m] / r
         information[j, j] += prior[j]
     covariance = np.linalg.inv(information)
     estimate = covariance @ projected
-    error = np.empty(count)
-    squares = 0.0
-    for row in range(count):
-        fitted = 0.0
-        for j in range(k):
-            fitted += _clock_row(times, rows, row, n, k, j) * estimate[j]
-        error[row] = values[row] - fitted
-        squares += error[row] * error[row]
+    squares = max(sums[YY, n] - 2.0 * _linear(sums, XY, estimate, k) + _quadratic(moments, XX, estimate, k), 0.0)
     unit_variance = max(1.0, squares / r / max(count - k, 1))
-    factor = _correlation_factor(times[:count], axis[:count], error)
+    factor = _correlation_factor(moments, sums, estimate, k)
     estimates, std = np.zeros(n), np.full(n, np.inf)
     for j in range(k):
         estimates[j] = estimate[j]
@@ -738,28 +807,17 @@ def clock_solve(times, axis, rows, values, count, prior, r):
 
 
 @kernel
-def _correlation_factor(t, axis, error):
-    """clockwatch._correlation_factor: successive readings on one axis within one spell, taken
-    axis by axis in one pass each (the rows are in time order), their products summed as they
-    come."""
-    linked = axes = 0
-    ab = aa = bb = 0.0
-    for row in range(t.shape[0]):
-        axes = max(axes, axis[row] + 1)
-    for a in range(axes):
-        previous = -1
-        for row in range(t.shape[0]):
-            if axis[row] != a:
-                continue
-            if previous >= 0 and t[row] - t[previous] <= SPELL_GAP:
-                ab += error[previous] * error[row]
-                aa += error[previous] * error[previous]
-                bb += error[row] * error[row]
-                linked += 1
-            previous = row
-    if linked < 2:
+def _correlation_factor(moments, sums, beta, k):
+    """clockwatch._correlation_factor from the linked pairs' sums: the lag-one products of the
+    residuals, e = y − xβ, expanded about the estimate."""
+    n = moments.shape[1]
+    if sums[LINKED, n] < 2.0:
         return 1.0
-    rho = min(max(ab / max(math.sqrt(aa * bb), 1e-300), 0.0), 0.95)
+    aa = sums[YP_YP, n] - 2.0 * _linear(sums, PY_P, beta, k) + _quadratic(moments, PP, beta, k)
+    bb = sums[YC_YC, n] - 2.0 * _linear(sums, CY_C, beta, k) + _quadratic(moments, CC, beta, k)
+    ab = sums[YP_YC, n] - _linear(sums, PY_C, beta, k) - _linear(sums, CY_P, beta, k) \
+        + _quadratic(moments, PC, beta, k)
+    rho = min(max(ab / max(math.sqrt(max(aa, 0.0) * max(bb, 0.0)), 1e-300), 0.0), 0.95)
     return (1.0 + rho) / (1.0 - rho)
 
 
@@ -771,11 +829,10 @@ def clock_verdict(cfg, state, log, i):
     n = cfg.clock_prior.shape[0]
     if count < n:
         return
-    estimate, std = clock_solve(state.clock_t, state.clock_axis, state.clock_x, state.clock_y, count,
-                                cfg.clock_prior, cfg.clock_r)
+    span = (state.clock_t[count - 1] - state.clock_t[0]) / 1440.0
+    estimate, std = clock_solve(state.clock_moments, state.clock_sums, count, span, cfg.clock_prior, cfg.clock_r)
     clock, drift = estimate[n - 2], estimate[n - 1]
     clock_std, drift_std = std[n - 2], std[n - 1]
-    span = (state.clock_t[count - 1] - state.clock_t[0]) / 1440.0
     if not k[CLOCK_RAISED] and abs(clock) >= max(ALARM_SIGMAS * clock_std, CLOCK_TOLERANCE):
         k[CLOCK_RAISED] = 1
         _alarm3(i, ev.CLOCK_OFF, clock, clock_std, float(count), state, log)

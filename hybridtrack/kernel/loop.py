@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .controller import EVENTS, RESTING, controller_rest, controller_step, sleeps_until
+from .controller import CLOCK_ROWS, EVENTS, RESTING, clock_recount, controller_rest, controller_step, sleeps_until
 from .jit import kernel
 from .world import world_move, world_observe, world_rest
 
@@ -23,7 +23,11 @@ EVENTS_PER_SCAN = 32
 def run_scans(start, stop, bulk_nights, wind_ok, world, world_state, cfg, plan, state, out, log, obs, obs_axes,
               moves):
     """Step world and controller from scan `start` until `stop` (or a nearly full event log);
-    return the next scan."""
+    return the next scan. A run's first call first sums the clock watch's readings carried from
+    an earlier run (`clock_recount`)."""
+    if start == 0:
+        clock_recount(state.clock_t, state.clock_axis, state.clock_x, state.clock_y, state.clock_moments,
+                      state.clock_sums, state.clock_last, state.k[CLOCK_ROWS])
     capacity = log.scan.shape[0]
     axes = moves.shape[0]
     offsets, reported = np.empty(axes), np.empty(axes)  # the world's scratch
