@@ -51,11 +51,14 @@ import pandas as pd
 from . import params, sites
 from .collectors import Collector
 from .errors import HybridtrackError
+from .io.checks import LIMITS, check_magnitude
+from .io.columns import IRRADIANCE
+from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, strict_json, write
 from .times import local_midnight, parse_date, parse_freq
 
-__all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
+__all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "recorded_wind", "frame_days", "day_seed",
            "read_log", "stream_files"]
 
 #: Rows read from a recorded file at a time (a day at 1 s is 86,400).
@@ -233,6 +236,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
                                        "once with hybridtrack.io.read_weather(...).to_parquet(...))")
             piece = piece.set_index(pd.DatetimeIndex(parsed))
         _numeric(piece, path, first_row)
+        _physical(piece, path, first_row)
         if piece.index.tz is None and tz is not None:
             piece.index = piece.index.tz_localize(tz)
         elif tz is not None:
@@ -272,6 +276,30 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 TEXT_COLUMNS = ("sky",)
 
 
+def recorded_wind(path) -> bool:
+    """Whether a weather frame on disk (as `recorded_days` reads it) holds any finite wind speed,
+    read column alone, a chunk at a time (a file without one is replayed tracking through, as
+    `hybridtrack replay` does with a file in memory)."""
+    try:
+        return _any_wind(Path(path))
+    except (OSError, ValueError):  # pandas' and pyarrow's read errors; the run's own read names the row
+        return True
+
+
+def _any_wind(path: Path) -> bool:
+    if path.suffix.lower() == ".csv":
+        chunks = pd.read_csv(path, usecols=lambda name: name == "wind_speed", chunksize=CHUNK_ROWS)
+        columns = (chunk["wind_speed"] for chunk in chunks if "wind_speed" in chunk)
+    else:
+        import pyarrow.parquet as pq
+
+        handle = pq.ParquetFile(path)
+        if "wind_speed" not in handle.schema_arrow.names:
+            return False
+        columns = (batch.column(0).to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=["wind_speed"]))
+    return any(np.isfinite(pd.to_numeric(column, errors="coerce").to_numpy(float)).any() for column in columns)
+
+
 def _numeric(piece: pd.DataFrame, path: Path, first_row: int) -> None:
     """Refuse a cell that is not a number, naming its row (`first_row` is the piece's first) and
     column: a streamed frame is read as it was written, without the reader's repairs."""
@@ -284,6 +312,26 @@ def _numeric(piece: pd.DataFrame, path: Path, first_row: int) -> None:
             raise HybridtrackError(f"{path}: row {first_row + int(bad[0])}, column {column!r}: "
                                    f"{piece[column].iloc[bad[0]]!r} is not a number")
         piece[column] = values
+
+
+def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
+    """Refuse what the reader's checks would repair (`hybridtrack.io.checks`): a value outside
+    its column's physical range, a negative irradiance or wind (a night offset the reader clips)
+    and irradiance in kW/m²; each by its row (`first_row` is the piece's first) and column."""
+    for column, (low, high) in LIMITS.items():
+        if column not in piece:
+            continue
+        values = piece[column].to_numpy(float)
+        floor = 0.0 if column in (*IRRADIANCE, "wind_speed") else low
+        bad = np.flatnonzero(~np.isnan(values) & ~((values >= floor) & (values <= high)))
+        if len(bad):
+            raise HybridtrackError(
+                f"{path}: row {first_row + int(bad[0])}, column {column!r}: {values[bad[0]]:g} is outside "
+                f"{floor:g}..{high:g} {FRAME_UNITS[column]} (a streamed file is read as written, without the "
+                f"reader's repairs: convert it once with hybridtrack.io.read_weather(...).to_parquet(...))")
+    lines = piece.assign(_line=np.arange(first_row, first_row + len(piece), dtype=float))
+    check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack.io.read_weather(..., "
+                                                  "units={{'{name}': 'kW/m2'}}).to_parquet(...)")
 
 
 # -- the run -------------------------------------------------------------------------------------
@@ -489,6 +537,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
                              resolution=resolution)  # checks `resolution` before anything is written
     files = stream_files(out)
     claim(files.values())
+    files["summary"].unlink(missing_ok=True)  # a replaced run's summary must not outlive it (written last)
     write(files["events"], lambda path: path.write_text("time,from,to,reason\n"))
     logs = _LogWriter(files["log"])
     memory: bool | dict = warm_start

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from . import params
 from .cluster import close, dask_client
 from .errors import HybridtrackError
 from .outputs import claim, write
@@ -202,13 +203,14 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
     row = _row(spec)
     try:
         site = sites.get(spec["site"])
+        seed = params.seed(spec["seed"])  # 1.5 or true is refused, not truncated to another run's seed
         dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
-        config = dataclasses.replace(_config_from(base.get("config", {}), dotted, source), seed=int(spec["seed"]))
+        config = dataclasses.replace(_config_from(base.get("config", {}), dotted, source), seed=seed)
         geometry = {k.partition(".")[2]: (tuple(v) if isinstance(v, list) else v)
                     for k, v in spec.items() if k.startswith("collector.")}
         collector = Collector(spec["collector"], **geometry)
         frame = _frame(site, _plain(spec["start"]), spec["days"], _plain(spec["weather"]), spec["freq"],
-                       int(spec["seed"]), float(spec["gusts_per_day"]))
+                       seed, float(spec["gusts_per_day"]))
         summary = simulate(frame, site, collector=collector, strategy=spec["strategy"], config=config).summary
         error = summary["tracking_error_deg"]
         row.update({m: error[m] if m in error else summary[m] for m in METRICS})
@@ -273,6 +275,10 @@ def _table(rows: list[dict]) -> pd.DataFrame:
     for metric in METRICS:
         table[metric] = pd.to_numeric(table[metric], errors="coerce").astype("Int64" if metric in COUNTS else float)
     table["error"] = table["error"].astype("string")
+    for column in table.columns.difference([*METRICS, "error"]):
+        values = table[column]
+        if values.dtype == object and len({type(v) for v in values.dropna()}) > 1:  # [0.1, "wide"]: Parquet holds one type
+            table[column] = values.map(lambda v: v if v is None else str(v)).astype("string")
     return table
 
 

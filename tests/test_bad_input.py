@@ -241,11 +241,25 @@ def test_bad_input_is_one_clear_line_from_api_and_cli(tmp_path, capsys, make, ap
 
 
 @pytest.mark.parametrize("argv", [["ablate", "--policies", "bogus"], ["simulate", "--date", "2021-06-21", "--freq"],
-                                  ["sun", "--variation"], [], ["classify", "--intensity", "--variation", "1"]])
+                                  ["sun", "--variation"], [], ["classify", "--intensity", "--variation", "1"],
+                                  ["simulate", "--date", "2021-06-21", "--bogus"]])
 def test_a_command_line_argparse_refuses_is_one_line_too(capsys, argv):
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and err.startswith("hybridtrack: error: hybridtrack")
+    assert err.count("\n") == 1 and err.startswith("hybridtrack: error: ") and "--help)" in err
+    assert not err.startswith("hybridtrack: error: hybridtrack: ")  # the prefix once, a command named after it
+
+
+def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys):
+    import hybridtrack.cli.runs as runs
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runs, "synthetic_frame", interrupted)
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21"]) == 130
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("hybridtrack: interrupted") and "Traceback" not in err
 
 
 def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):

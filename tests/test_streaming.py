@@ -308,6 +308,12 @@ def test_days_at_one_second_stream_in_bounded_memory(tmp_path):
     ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,abc\n", r"row 3, column 'dni': 'abc' is not a number"),
     ("2021-06-21T00:00:00+08:00,0\n21/06/2021 00:01,5\n",
      r"row 3, column 'time': '21/06/2021 00:01' is not an ISO 8601 time stamp"),
+    # what the reader would repair (clip, flag) is refused instead, as nothing may change unsaid
+    ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,-3\n", r"row 3, column 'dni': -3 is outside 0\.\.1400 W/m²"),
+    ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,inf\n", r"row 3, column 'dni': inf is outside"),
+    ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,1e6\n", r"row 3, column 'dni': 1e\+06 is outside"),
+    ("".join(f"2021-06-21T{h:02d}:00:00+08:00,{0.9 * (6 <= h <= 18)}\n" for h in range(24)),
+     r"column 'dni': dni is at most 0\.9 over 23 hours; the values look like kW/m² read as W/m²: convert"),
 ])
 def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_path, capsys, cells, message):
     """A streamed file is read as written: a cell that is not what its column holds is refused by
@@ -319,3 +325,30 @@ def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_p
     assert err.startswith("hybridtrack: error: ") and str(path) in err
     assert re.search(message, err), err
     assert list((tmp_path / "run").iterdir()) == []
+
+
+def test_a_streamed_file_without_wind_is_tracked_through_as_in_memory(tmp_path, capsys):
+    """A wind column with no reading is missing wind, as `replay` reads a file in memory: tracked
+    through and said, not a day in wind stow."""
+    frame = synthetic_days(SITE, "2021-06-21", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    day = next(iter(frame))[1].assign(wind_speed=np.nan)
+    path = tmp_path / "weather.csv"
+    day.rename_axis("time").to_csv(path)
+    assert main(["replay", str(path), "--site", SITE, "--stream", "--out", str(tmp_path / "run")]) == 0
+    assert "wind: MISSING in this file; replayed as tracking through" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["energy_capture"] > 0.9 and summary["mode_share"].get("stow_wind", 0.0) == 0.0
+
+
+def test_a_failed_forced_rerun_leaves_no_earlier_summary_beside_its_log(tmp_path, capsys):
+    """--force replaces a finished run; if the new run stops, the folder must not pair its partial
+    log with the old run's summary.json (a finished run writes it last)."""
+    out = tmp_path / "run"
+    good, bad = tmp_path / "good.csv", tmp_path / "bad.csv"
+    day = next(iter(synthetic_days(SITE, "2021-06-21", "2021-06-21", weather="sunny", freq="10min", seed=1)))[1]
+    day.rename_axis("time").to_csv(good)
+    bad.write_text(good.read_text() + "2021-06-22T00:00:00+08:00" + ",x" * len(day.columns) + "\n")
+    assert main(["replay", str(good), "--site", SITE, "--stream", "--out", str(out)]) == 0
+    assert (out / "summary.json").exists()
+    assert main(["replay", str(bad), "--site", SITE, "--stream", "--out", str(out), "--force"]) == 2
+    assert not (out / "summary.json").exists()

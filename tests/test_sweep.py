@@ -12,7 +12,7 @@ from hybridtrack.cli import main
 from hybridtrack.collectors import Collector
 from hybridtrack.simulation import SimulationConfig
 from hybridtrack.sky import synthetic
-from hybridtrack.sweep import METRICS, Sweep, pareto_front, plot_tradeoff, run_one, run_sweep
+from hybridtrack.sweep import METRICS, Sweep, pareto_front, plot_tradeoff, _table, run_one, run_sweep
 
 TINY = {"base": {"site": "lanzhou", "collector": "fresnel", "start": "2021-06-21", "days": 1, "freq": "15min"},
         "grid": {"drive.deadband": [0.1, 0.4, -1.0], "seed": [0, 1]}}
@@ -66,6 +66,17 @@ def test_a_runs_row_is_that_run_and_a_failure_is_a_row():
     assert all(failed[m] is None for m in METRICS)
     geometry = run_one({**sweep.base, "collector.row_distance": -4.0}, {"run": 0, "seed": 0})
     assert geometry["error"] is None and geometry["collector.row_distance"] == -4.0
+    for seed in (1.5, True):  # not truncated to seed 1's run
+        assert "seed must be a whole number" in run_one(sweep.base, {"run": 0, "seed": seed})["error"]
+
+
+def test_a_grid_of_mixed_types_makes_a_table_parquet_can_hold(tmp_path):
+    """[0.1, "wide"] is two runs, one failing; the table keeps both values, as text."""
+    rows = [run_one(Sweep.from_dict(TINY).base, {"run": k, "drive.deadband": v}) for k, v in enumerate([0.1, "wide"])]
+    table = _table(rows)
+    table.to_parquet(tmp_path / "runs.parquet", index=False)
+    assert list(pd.read_parquet(tmp_path / "runs.parquet")["drive.deadband"]) == ["0.1", "wide"]
+    assert table["error"].isna().tolist() == [True, False]
 
 
 def test_pareto_front_hand_case():

@@ -21,7 +21,7 @@ from .. import __version__
 from ..errors import HybridtrackError
 from ..outputs import reader_may_leave, replacing
 from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
-from .base import _COMMANDS, _HELP, EXIT_USAGE
+from .base import _COMMANDS, _HELP, EXIT_INTERRUPTED, EXIT_USAGE
 
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
 
@@ -31,7 +31,8 @@ class OneLineParser(argparse.ArgumentParser):
     like every other refusal, instead of the usage block and the error."""
 
     def error(self, message: str):
-        raise HybridtrackError(f"{self.prog}: {message} (see {self.prog} --help)")
+        command = f"{self.prog}: " if " " in self.prog else ""  # the top parser's name is the error's prefix already
+        raise HybridtrackError(f"{command}{message} (see {self.prog} --help)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -66,6 +67,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except HybridtrackError as exc:
         print(f"hybridtrack: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except KeyboardInterrupt:  # Ctrl-C: one line, no traceback; the shell's status for SIGINT
+        print("\nhybridtrack: interrupted; files already written are left as they are (an unfinished streamed "
+              "run has no summary.json)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except OSError as exc:
         name = f" {exc.filename}" if exc.filename else ""
         print(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}", file=sys.stderr)

@@ -10,6 +10,8 @@ from .. import params, sites
 from ..errors import HybridtrackError
 
 EXIT_USAGE = 2
+#: The shell's status for a run stopped by SIGINT (128 + 2).
+EXIT_INTERRUPTED = 130
 
 _COMMANDS: dict[str, tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = {}
 _HELP: dict[str, str] = {}

@@ -175,8 +175,9 @@ def _replay_arguments(parser: argparse.ArgumentParser) -> None:
     add_record_arguments(parser)
     parser.add_argument("--step", default="1min", help="control step the record is resampled to (default 1min)")
     add_run_arguments(parser)
-    _add_stream_argument(parser, "a weather frame saved as .parquet or .csv (its own step; the reader's checks "
-                                 "and repairs are not run)")
+    _add_stream_argument(parser, "a weather frame saved as .parquet or .csv (its own step, read as written: a "
+                                 "value the reader would repair, such as a negative or impossible irradiance, is "
+                                 "refused by row and column)")
 
 
 def _replay_frame(args: argparse.Namespace):
@@ -188,13 +189,13 @@ def _replay_frame(args: argparse.Namespace):
     return site, frame
 
 
-def replay_config(args: argparse.Namespace, frame):
-    """The run's config for a recorded file: a file with no wind at all is tracked through, not
-    stowed all day (``wind_missing = "track"``), unless the config chose otherwise; said aloud."""
+def replay_config(args: argparse.Namespace, has_wind: bool):
+    """The run's config for a recorded file: a file with no wind at all (`has_wind` false) is
+    tracked through, not stowed all day (``wind_missing = "track"``), unless the config chose
+    otherwise; said aloud."""
     import dataclasses
 
     config = simulation_config(args)
-    has_wind = "wind_speed" in frame.columns and np.isfinite(frame["wind_speed"].to_numpy(float)).any()
     if not has_wind and not args.config:
         print("wind: MISSING in this file; replayed as tracking through (controller.wind_missing = 'track'), "
               "not as calm")
@@ -202,21 +203,26 @@ def replay_config(args: argparse.Namespace, frame):
     return config
 
 
+def _has_wind(frame) -> bool:
+    return "wind_speed" in frame.columns and bool(np.isfinite(frame["wind_speed"].to_numpy(float)).any())
+
+
 @command("replay", "run a tracker over a recorded weather file", _replay_arguments)
 def _replay(args: argparse.Namespace) -> int:
     if args.stream:
-        from ..streaming import recorded_days
+        from ..streaming import recorded_days, recorded_wind
 
         if args.map or args.units or args.format:
             raise HybridtrackError("--stream reads a weather frame as saved (a time index, dni, ...): --map, --units "
                                    "and --format are not taken; convert the record once with read_weather")
         site = site_from_arguments(args)
-        return _stream(recorded_days(args.file, site, tz=args.tz), args, simulation_config(args),
+        source = recorded_days(args.file, site, tz=args.tz)
+        return _stream(source, args, replay_config(args, recorded_wind(args.file)),
                        heading=f"replay of {args.file} at {site.name}, {collector_from_arguments(args).kind}, "
                                f"{args.strategy}")
     site, frame = _replay_frame(args)
     _claim_run_folder(args)
-    result = _run(frame, site, args, args.strategy, replay_config(args, frame))
+    result = _run(frame, site, args, args.strategy, replay_config(args, _has_wind(frame)))
     _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, {args.strategy}")
     return 0
 
@@ -247,7 +253,7 @@ def _compare(args: argparse.Namespace) -> int:
         raise HybridtrackError("give a recorded FILE, or --date for synthetic days")
     if args.file is not None:
         site, frame = _replay_frame(args)
-        config = replay_config(args, frame)
+        config = replay_config(args, _has_wind(frame))
     else:
         if args.site is not None and args.tz is not None:
             raise HybridtrackError("--tz is a recorded file's time zone; synthetic days at --site keep its clock")

@@ -148,14 +148,16 @@ def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
     return frame
 
 
-def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None) -> None:
+def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
+                    remedy: str = "give the unit (--units {name}=kW/m2)") -> None:
     """Refuse irradiance a thousand times too small: kW/m² read as W/m².
 
     In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
     tens of W/m² while the sun is well up. So GHI (or DHI) whose largest value is above 0 and at
     most 1.5 is refused when the site's clear sky (`clear_ghi`, W/m², on the frame's stamps)
     reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
-    judged so only in a file without GHI and DHI, since an overcast day has none.
+    judged so only in a file without GHI and DHI, since an overcast day has none. `remedy` ends
+    the message (``{name}`` is the column).
     """
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
     judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
@@ -176,7 +178,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
             where = f"line {line[0]}, " if line else ""
             raise HybridtrackError(f"{path}: {where}column {header!r}: {name} is {why}; the values look like kW/m² "
-                                   f"read as W/m²: give the unit (--units {name}=kW/m2)")
+                                   f"read as W/m²: {remedy.format(name=name)}")
 
 
 def refuse_repairs(path: Path, report: dict) -> None:
