@@ -153,10 +153,10 @@ def _by_day(pieces: Iterator[pd.DataFrame], site: sites.Site, where: str) -> Ite
     held: pd.DataFrame | None = None
     last = None
     for piece in pieces:
+        if not len(piece):  # a file of a header alone
+            continue
         if not isinstance(piece.index, pd.DatetimeIndex) or piece.index.tz is None:
             raise HybridtrackError(f"{where}: the time stamps must be tz-aware (or give tz=)")
-        if not len(piece):
-            continue
         if last is not None and piece.index[0] <= last:
             raise HybridtrackError(f"{where}: time goes back or repeats at {piece.index[0]}; a streamed file must be "
                                    "sorted without repeats (write it from hybridtrack.io.read_weather)")
@@ -216,6 +216,8 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     """
     site = sites.get(site)
     path = Path(path)
+    if path.is_dir():
+        raise HybridtrackError(f"{path}: is a folder, not a weather file")
     if not path.is_file():
         raise HybridtrackError(f"{path}: no such file")
     chunk_rows = params.whole(chunk_rows, "chunk_rows", 1, 10**9)
@@ -242,6 +244,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
         elif tz is not None:
             piece.index = piece.index.tz_convert(tz)
         piece.index.name = None
+        _in_order(piece, path, first_row)
         return piece
 
     steps = None
@@ -314,6 +317,17 @@ def _numeric(piece: pd.DataFrame, path: Path, first_row: int) -> None:
         piece[column] = values
 
 
+def _in_order(piece: pd.DataFrame, path: Path, first_row: int) -> None:
+    """Refuse a stamp that repeats or goes back from the row before it (the reader would sort and
+    drop it), naming its row."""
+    back = np.flatnonzero(np.diff(piece.index.as_unit("ns").asi8) <= 0)
+    if len(back):
+        row = first_row + int(back[0]) + 1
+        raise HybridtrackError(f"{path}: row {row}: time {piece.index[back[0] + 1]} repeats or goes back from the row "
+                               "before; a streamed file must be sorted without repeats (write it from "
+                               "hybridtrack.io.read_weather)")
+
+
 def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
     """Refuse what the reader's checks would repair (`hybridtrack.io.checks`): a value outside
     its column's physical range, a negative irradiance or wind (a night offset the reader clips)
@@ -329,6 +343,8 @@ def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
                 f"{path}: row {first_row + int(bad[0])}, column {column!r}: {values[bad[0]]:g} is outside "
                 f"{floor:g}..{high:g} {FRAME_UNITS[column]} (a streamed file is read as written, without the "
                 f"reader's repairs: convert it once with hybridtrack.io.read_weather(...).to_parquet(...))")
+    if len(piece) < 2:  # no span to judge a magnitude over
+        return
     lines = piece.assign(_line=np.arange(first_row, first_row + len(piece), dtype=float))
     check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack.io.read_weather(..., "
                                                   "units={{'{name}': 'kW/m2'}}).to_parquet(...)")
@@ -576,7 +592,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     logs.close()
     if segments == 0 or not whole:
         _discard(files)
-        raise HybridtrackError("the weather source holds no steps" if segments == 0 else
+        raise HybridtrackError(f"{source.describe}: holds no time steps" if segments == 0 else
                                f"a streamed run needs at least one whole local day at {site.name}; this span has "
                                "none (run it in memory with hybridtrack.simulate)")
     summary = running.summary()

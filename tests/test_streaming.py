@@ -308,7 +308,9 @@ def test_days_at_one_second_stream_in_bounded_memory(tmp_path):
     ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,abc\n", r"row 3, column 'dni': 'abc' is not a number"),
     ("2021-06-21T00:00:00+08:00,0\n21/06/2021 00:01,5\n",
      r"row 3, column 'time': '21/06/2021 00:01' is not an ISO 8601 time stamp"),
-    # what the reader would repair (clip, flag) is refused instead, as nothing may change unsaid
+    # what the reader would repair (sort, drop, clip, flag) is refused instead, as nothing may change unsaid
+    ("2021-06-21T00:01:00+08:00,0\n2021-06-21T00:00:00+08:00,0\n", r"row 3: time 2021-06-21 00:00:00\+08:00 repeats or goes back"),
+    ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:00:00+08:00,0\n", r"row 3: time .* repeats or goes back"),
     ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,-3\n", r"row 3, column 'dni': -3 is outside 0\.\.1400 W/m²"),
     ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,inf\n", r"row 3, column 'dni': inf is outside"),
     ("2021-06-21T00:00:00+08:00,0\n2021-06-21T00:01:00+08:00,1e6\n", r"row 3, column 'dni': 1e\+06 is outside"),
@@ -325,6 +327,18 @@ def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_p
     assert err.startswith("hybridtrack: error: ") and str(path) in err
     assert re.search(message, err), err
     assert list((tmp_path / "run").iterdir()) == []
+
+
+@pytest.mark.parametrize("name, text, message", [
+    ("header.csv", "time,dni\n", "header.csv: holds no time steps"),
+    ("folder.csv", None, "is a folder, not a weather file"),
+])
+def test_an_empty_or_folder_streamed_file_is_one_line(tmp_path, capsys, name, text, message):
+    path = tmp_path / name
+    path.write_text(text) if text is not None else path.mkdir()
+    assert main(["replay", str(path), "--site", SITE, "--stream", "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("hybridtrack: error: ") and message in err, err
 
 
 def test_a_streamed_file_without_wind_is_tracked_through_as_in_memory(tmp_path, capsys):
