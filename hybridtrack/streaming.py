@@ -51,8 +51,7 @@ import pandas as pd
 from . import params, sites
 from .collectors import Collector
 from .errors import HybridtrackError
-from .io.checks import LIMITS, check_magnitude
-from .io.columns import IRRADIANCE
+from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, strict_json, write
@@ -336,7 +335,7 @@ def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
         if column not in piece:
             continue
         values = piece[column].to_numpy(float)
-        floor = 0.0 if column in (*IRRADIANCE, "wind_speed") else low
+        floor = 0.0 if column in CLIPPED_AT_ZERO else low
         bad = np.flatnonzero(~np.isnan(values) & ~((values >= floor) & (values <= high)))
         if len(bad):
             raise HybridtrackError(

@@ -28,12 +28,15 @@ from ..errors import HybridtrackError
 from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
-__all__ = ["LIMITS", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude", "refuse_repairs"]
+__all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
 LIMITS = {"ghi": (-50.0, 1500.0), "dni": (-50.0, 1400.0), "dhi": (-50.0, 1000.0), "wind_speed": (-0.5, 75.0),
           "temp_air": (-90.0, 65.0), "photocurrent": (0.0, 10_000.0), "pointing": (-90.0, 90.0),
           "pointing_2": (-90.0, 90.0)}
+
+#: Columns whose small negative readings are an instrument's zero offset, clipped to 0 by the reader.
+CLIPPED_AT_ZERO = (*IRRADIANCE, "wind_speed")
 
 #: m/s: negative wind down to this is an anemometer's zero offset in calm air, read as 0.
 CALM_OFFSET = -0.5
@@ -117,7 +120,7 @@ def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
                                 "first": float(first) if np.isfinite(first) else str(first), "action": "set to NaN"}
             values = np.where(bad, np.nan, values)
         negative = ~np.isnan(values) & (values < 0)
-        if negative.any() and name in (*IRRADIANCE, "wind_speed"):
+        if negative.any() and name in CLIPPED_AT_ZERO:
             entry = {"count": int(negative.sum()), "lines": first_lines(frame, negative),
                      "lowest": float(values[negative].min())}
             (calm if name == "wind_speed" else clipped)[name] = entry
