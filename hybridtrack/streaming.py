@@ -225,21 +225,14 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
         raise HybridtrackError(f"{path}: a streamed run reads .parquet or .csv weather frames, not {suffix or 'this'}")
 
     def stamped(piece: pd.DataFrame, first_row: int) -> pd.DataFrame:
+        name = "time"
         if not isinstance(piece.index, pd.DatetimeIndex):
             name = "time" if "time" in piece.columns else piece.columns[0]
-            stamps = piece.pop(name)
-            parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=False)
-            bad = np.flatnonzero(parsed.isna().to_numpy() & stamps.notna().to_numpy())
-            if len(bad) or stamps.isna().any():
-                row = first_row + int(bad[0] if len(bad) else np.flatnonzero(stamps.isna().to_numpy())[0])
-                raise HybridtrackError(f"{path}: row {row}, column {name!r}: {stamps.iloc[row - first_row]!r} is not an "
-                                       "ISO 8601 time stamp (a streamed file is read as written: convert a record "
-                                       "once with hybridtrack.io.read_weather(...).to_parquet(...))")
-            piece = piece.set_index(pd.DatetimeIndex(parsed))
+            piece = piece.set_index(_parsed_stamps(piece.pop(name), path, first_row))
         _numeric(piece, path, first_row)
         _physical(piece, path, first_row)
         if piece.index.tz is None and tz is not None:
-            piece.index = piece.index.tz_localize(tz)
+            piece.index = _localised(piece.index, tz, path, first_row, name)
         elif tz is not None:
             piece.index = piece.index.tz_convert(tz)
         piece.index.name = None
@@ -248,9 +241,11 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 
     steps = None
     if suffix == ".csv":
+        separator = csv_separator(path)
+
         def pieces():
             try:
-                for k, piece in enumerate(pd.read_csv(path, chunksize=chunk_rows)):
+                for k, piece in enumerate(pd.read_csv(path, sep=separator, chunksize=chunk_rows)):
                     yield stamped(piece, 2 + k * chunk_rows)  # the file's line: the header is line 1
             except HybridtrackError:
                 raise
@@ -274,6 +269,50 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     return DaySource(site, f"{path}", steps, None, lambda: _by_day(pieces(), site, str(path)))
 
 
+#: The separators a streamed CSV may use: the one its header line holds most of is used.
+SEPARATORS = (",", ";", "\t")
+#: What a streamed file's stamp trouble is refused with: the way to a file that streams.
+CONVERT_ONCE = ("a streamed file is read as written: convert a record once with "
+                "hybridtrack.io.read_weather(...).to_parquet(...)")
+
+
+def csv_separator(path: Path) -> str:
+    """The separator of a CSV file, judged from its header line: a logger on a European locale
+    writes ``;`` (with a decimal comma, refused by row as not a number) and some write tabs."""
+    with open(path, encoding="utf-8-sig", errors="replace") as handle:
+        header = handle.readline()
+    return max(SEPARATORS, key=header.count)
+
+
+def _parsed_stamps(stamps: pd.Series, path: Path, first_row: int) -> pd.DatetimeIndex:
+    """A CSV's time column parsed as ISO 8601, or refused by its first bad row. Stamps whose UTC
+    offset changes (a logger on local time with daylight saving) are instants: kept as UTC, as
+    `hybridtrack.io.read_weather` keeps them."""
+    try:
+        parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=False)
+    except ValueError:  # offsets that differ from row to row
+        parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=True)
+    bad = np.flatnonzero(parsed.isna().to_numpy())
+    if len(bad):
+        row = first_row + int(bad[0])
+        raise HybridtrackError(f"{path}: row {row}, column {stamps.name!r}: {stamps.iloc[bad[0]]!r} is not an "
+                               f"ISO 8601 time stamp ({CONVERT_ONCE})")
+    return pd.DatetimeIndex(parsed)
+
+
+def _localised(index: pd.DatetimeIndex, tz: str, path: Path, first_row: int, name: str) -> pd.DatetimeIndex:
+    """Naive stamps put in `tz`, or refused by the first row that the zone's daylight-saving change
+    skips or repeats (the reader drops or resolves those; a stream does not repair)."""
+    try:
+        return index.tz_localize(tz)
+    except ValueError:  # pandas' NonExistentTimeError and AmbiguousTimeError
+        unresolved = np.flatnonzero(index.tz_localize(tz, nonexistent="NaT", ambiguous="NaT").isna())
+        row = first_row + int(unresolved[0])
+        raise HybridtrackError(f"{path}: row {row}, column {name!r}: {index[unresolved[0]]} does not exist or is "
+                               f"ambiguous in {tz} (a daylight-saving change); give the stamps a UTC offset or "
+                               f"tz=UTC ({CONVERT_ONCE})") from None
+
+
 #: Columns of a weather frame that hold text (the true sky's label); every other column is a number.
 TEXT_COLUMNS = ("sky",)
 
@@ -290,7 +329,8 @@ def recorded_wind(path) -> bool:
 
 def _any_wind(path: Path) -> bool:
     if path.suffix.lower() == ".csv":
-        chunks = pd.read_csv(path, usecols=lambda name: name == "wind_speed", chunksize=CHUNK_ROWS)
+        chunks = pd.read_csv(path, sep=csv_separator(path), usecols=lambda name: name == "wind_speed",
+                             chunksize=CHUNK_ROWS)
         columns = (chunk["wind_speed"] for chunk in chunks if "wind_speed" in chunk)
     else:
         import pyarrow.parquet as pq

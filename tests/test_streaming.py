@@ -329,6 +329,37 @@ def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_p
     assert list((tmp_path / "run").iterdir()) == []
 
 
+def test_a_naive_stamp_the_clock_change_skips_is_refused_by_its_row(tmp_path, capsys):
+    """New York's 2021-03-14 02:00-02:59 does not exist: the reader drops it and counts it; a stream
+    does not repair, so it names the row instead of passing on pandas' advice."""
+    path = tmp_path / "weather.csv"
+    stamps = pd.date_range("2021-03-14 01:58", periods=4, freq="1min")  # 01:58, 01:59, 02:00, 02:01
+    path.write_text("time,dni\n" + "".join(f"{t:%Y-%m-%d %H:%M:%S},0\n" for t in stamps))
+    assert main(["replay", str(path), "--site", SITE, "--tz", "America/New_York", "--stream",
+                 "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "row 4, column 'time': 2021-03-14 02:00:00 does not exist or is ambiguous in America/New_York" in err, err
+
+
+def test_stamps_whose_offset_changes_are_instants_and_a_semicolon_file_streams(tmp_path):
+    """A logger on local time writes its offset as daylight saving changes it: the stamps are
+    instants, read as the reader reads them (kept in order, not refused). A semicolon-separated
+    file (a European locale's CSV) streams as the comma-separated one does."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-03-10", "2021-03-11", weather="mixed", freq="10min", seed=2)
+    frame.to_csv(tmp_path / "comma.csv", index_label="time")
+    frame.to_csv(tmp_path / "semicolon.csv", index_label="time", sep=";")
+    shifted = [(t.tz_convert("Europe/Berlin") if k % 2 else t.tz_convert("UTC")).isoformat()
+               for k, t in enumerate(frame.index)]  # +01:00 and +00:00 by turns
+    frame.set_axis(shifted).to_csv(tmp_path / "offsets.csv", index_label="time")
+    expected = pd.concat([day for _, day in recorded_days(tmp_path / "comma.csv", SITE)])
+    for name in ("semicolon.csv", "offsets.csv"):
+        days = pd.concat([day for _, day in recorded_days(tmp_path / name, SITE, chunk_rows=50)])
+        assert (days.index == expected.index).all(), name  # the same instants
+        np.testing.assert_array_equal(days["dni"].to_numpy(), expected["dni"].to_numpy())
+
+
 @pytest.mark.parametrize("name, text, message", [
     ("header.csv", "time,dni\n", "header.csv: holds no time steps"),
     ("folder.csv", None, "is a folder, not a weather file"),
