@@ -273,6 +273,8 @@ def test_an_anemometer_stuck_in_daylight_raises_an_alarm_and_counts_as_missing()
     assert len(alarm) == 1 and alarm["time"].iloc[0].tz_convert("Asia/Shanghai").hour == 12  # 3 h of daylight
     after = result.log.loc[alarm["time"].iloc[0]:]
     assert (after.loc[after["target_true"].notna(), "mode"] == "stow_wind").all()  # missing wind: stow
+    stowed = result.events.loc[result.events["to"] == "stow_wind", "reason"]
+    assert list(stowed) == ["wind reading missing"]  # not "wind 0.0 m/s > 17.2": the stuck reading is no speed
     track = SimulationConfig(controller=ControllerConfig(wind_missing="track"))
     tracked_on = simulate(frame.assign(wind_speed=wind), "lanzhou", config=track)
     assert tracked_on.events["reason"].str.contains("anemometer stuck").any()

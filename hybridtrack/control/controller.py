@@ -249,13 +249,14 @@ class Controller:
         stuck = self.wind.watch(t, obs.wind, awake)
         if stuck:
             self._alarm(i, stuck)
-        gusty = self.wind.update(t, obs.wind)
+        wind = self.wind.heard(obs.wind)
+        gusty = self.wind.update(t, wind)
         if self.resting and not awake and not gusty:
             self.was_awake = False
             self.out["sky"][i] = UNKNOWN
             self._record(i, NOT_READ, [self._night_target(a) for a in range(self.axes)], reading)
             return [0.0] * self.axes
-        self._day_and_wind(i, t, awake, gusty, obs.wind)
+        self._day_and_wind(i, t, awake, gusty, wind)
         if self.was_awake and not awake and self.clock is not None:  # the day's end: judge the clock
             for alarm in self.clock.verdict():
                 self._alarm(i, alarm)

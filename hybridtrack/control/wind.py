@@ -58,10 +58,14 @@ class WindGuard:
                     "its readings count as missing")
         return None
 
-    def update(self, t: float, wind: float) -> bool:
-        """Take a reading at scan time `t` (minutes); return whether it is a gust."""
+    def heard(self, wind: float) -> float:
+        """The reading as the guard counts it: NaN (missing) while the anemometer is stuck at it."""
         if self.stuck and not math.isnan(wind) and abs(wind - self.flat_value) <= STUCK_SPREAD:
-            wind = math.nan
+            return math.nan
+        return wind
+
+    def update(self, t: float, wind: float) -> bool:
+        """Take a reading at scan time `t` (minutes), as `heard`; return whether it is a gust."""
         if self.gusty(wind):
             self.calm_since = math.inf
             return True

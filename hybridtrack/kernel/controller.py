@@ -9,7 +9,7 @@ constants below name the slots of the shared scalar arrays) and is its own funct
 reference               here
 =====================  ===================================================
 EncoderMonitor.read     `encoder_read`
-WindGuard               `wind_watch`, `wind_update`, `wind_released`
+WindGuard               `wind_watch`, `wind_heard`, `wind_update`, `wind_released`
 SkyWatch                `trailing_mean`, `trailing_range`, `sky_update`
 ClassifierTable         `table_score`, `table_code`
 SensorGate + Kalman     `gate_judge`, `gate_take`, `kalman_*`
@@ -255,11 +255,17 @@ def wind_watch(state, t, wind, daylight):
 
 
 @kernel
+def wind_heard(state, wind):
+    """WindGuard.heard: the reading, NaN while the anemometer is stuck at it."""
+    if state.k[WIND_STUCK] and not math.isnan(wind) and abs(wind - state.s[FLAT_VALUE]) <= STUCK_SPREAD:
+        return math.nan
+    return wind
+
+
+@kernel
 def wind_update(cfg, state, t, wind):
-    """WindGuard.update: whether the reading is a gust."""
+    """WindGuard.update: whether the (heard) reading is a gust."""
     s = state.s
-    if state.k[WIND_STUCK] and not math.isnan(wind) and abs(wind - s[FLAT_VALUE]) <= STUCK_SPREAD:
-        wind = math.nan
     if _gusty(cfg, wind):
         s[CALM_SINCE] = math.inf
         return True
@@ -1093,7 +1099,8 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading
     code, value = wind_watch(state, t, obs[1], awake)
     if code:
         _alarm(i, code, value, 0.0, state, log)
-    gusty = wind_update(cfg, state, t, obs[1])
+    wind = wind_heard(state, obs[1])
+    gusty = wind_update(cfg, state, t, wind)
     if k[RESTING] and not awake and not gusty:
         k[WAS_AWAKE] = 0
         out.sky[i] = UNKNOWN
@@ -1102,7 +1109,7 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading
         _record(cfg, plan, state, out, i, NOT_READ, targets, reading)
         moves[:] = 0.0
         return
-    _day_and_wind(cfg, state, log, i, t, awake, gusty, obs[1])
+    _day_and_wind(cfg, state, log, i, t, awake, gusty, wind)
     if k[WAS_AWAKE] and not awake and cfg.has_fit:  # the day's end: judge the clock
         clock_verdict(cfg, state, log, i)
     k[WAS_AWAKE] = awake
