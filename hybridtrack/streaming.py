@@ -57,7 +57,7 @@ from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, strict_json, write
 from .times import local_midnight, parse_date, parse_freq
 
-__all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "recorded_wind", "frame_days", "day_seed",
+__all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
            "read_log", "stream_files"]
 
 #: Rows read from a recorded file at a time (a day at 1 s is 86,400).
@@ -92,6 +92,9 @@ class DaySource:
     steps: int | None
     days: int | None
     _days: Callable[[], Iterator[tuple[dt.date, pd.DataFrame]]] = field(repr=False)
+    #: Whether the weather holds any wind reading (a recorded file without one is replayed tracking
+    #: through, as `hybridtrack replay` does with a file in memory); None where not judged.
+    wind_measured: bool | None = None
 
     def __iter__(self) -> Iterator[tuple[dt.date, pd.DataFrame]]:
         return self._days()
@@ -239,9 +242,13 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
         _in_order(piece, path, first_row)
         return piece
 
+    separator = csv_separator(path) if suffix == ".csv" else None
+    measured = _measured(path, separator, ("dni", "wind_speed"))
+    if "dni" not in measured:
+        raise HybridtrackError(f"{path}: column 'dni' is missing or holds no number; {CONVERT_ONCE}, which derives "
+                               "it from GHI and DHI")
     steps = None
     if suffix == ".csv":
-        separator = csv_separator(path)
 
         def pieces():
             try:
@@ -266,7 +273,8 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
             for k, batch in enumerate(handle.iter_batches(batch_size=chunk_rows)):
                 yield stamped(pa.Table.from_batches([batch], schema=schema).to_pandas(), 1 + k * chunk_rows)
 
-    return DaySource(site, f"{path}", steps, None, lambda: _by_day(pieces(), site, str(path)))
+    return DaySource(site, f"{path}", steps, None, lambda: _by_day(pieces(), site, str(path)),
+                     wind_measured="wind_speed" in measured)
 
 
 #: The separators a streamed CSV may use: the one its header line holds most of is used.
@@ -317,29 +325,28 @@ def _localised(index: pd.DatetimeIndex, tz: str, path: Path, first_row: int, nam
 TEXT_COLUMNS = ("sky",)
 
 
-def recorded_wind(path) -> bool:
-    """Whether a weather frame on disk (as `recorded_days` reads it) holds any finite wind speed,
-    read column alone, a chunk at a time (a file without one is replayed tracking through, as
-    `hybridtrack replay` does with a file in memory)."""
+def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> set[str]:
+    """Which of the columns `names` hold at least one finite number, read alone a chunk at a time.
+    A file without rows, or one pandas or pyarrow cannot read, counts as holding them all: the
+    run's own read then says what is wrong, by row."""
     try:
-        return _any_wind(Path(path))
-    except (OSError, ValueError):  # pandas' and pyarrow's read errors; the run's own read names the row
-        return True
+        if separator is not None:
+            chunks = pd.read_csv(path, sep=separator, usecols=lambda name: name in names, chunksize=CHUNK_ROWS)
+        else:
+            import pyarrow.parquet as pq
 
-
-def _any_wind(path: Path) -> bool:
-    if path.suffix.lower() == ".csv":
-        chunks = pd.read_csv(path, sep=csv_separator(path), usecols=lambda name: name == "wind_speed",
-                             chunksize=CHUNK_ROWS)
-        columns = (chunk["wind_speed"] for chunk in chunks if "wind_speed" in chunk)
-    else:
-        import pyarrow.parquet as pq
-
-        handle = pq.ParquetFile(path)
-        if "wind_speed" not in handle.schema_arrow.names:
-            return False
-        columns = (batch.column(0).to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=["wind_speed"]))
-    return any(np.isfinite(pd.to_numeric(column, errors="coerce").to_numpy(float)).any() for column in columns)
+            handle = pq.ParquetFile(path)
+            kept = [name for name in names if name in handle.schema_arrow.names]
+            chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=kept)) if kept else ()
+        found: set[str] = set()
+        rows = 0
+        for chunk in chunks:
+            rows += len(chunk)
+            found |= {name for name in chunk.columns
+                      if np.isfinite(pd.to_numeric(chunk[name], errors="coerce").to_numpy(float)).any()}
+        return found if rows else set(names)
+    except (OSError, ValueError):  # pandas' and pyarrow's read errors
+        return set(names)
 
 
 def _numeric(piece: pd.DataFrame, path: Path, first_row: int) -> None:

@@ -69,6 +69,9 @@ REFUSALS = [
      {"tz": "UTC"}, ["--tz", "UTC"], ["line 3: 2 of 3 stamps repeat an earlier one", "clock column"]),
     ("negative wind beyond an offset (strict)", PLAIN.replace(",2.0\n", ",-0.2\n", 1), {"tz": "UTC", "strict": True},
      ["--tz", "UTC", "--strict"], ["line 2, column 'wind_speed': a negative wind reading (strict)"]),
+    ("a DNI column without a number (strict)", PLAIN.replace(",300,", ",,").replace(",800,", ",,").replace(
+        ",900,", ",,").replace(",820,", ",,").replace(",500,", ",,"), {"site": "lanzhou", "strict": True},
+     ["--site", "lanzhou", "--strict"], ["column 'dni': an irradiance column without a readable value (strict)"]),
 ]
 
 
@@ -121,6 +124,27 @@ def test_a_file_without_wind_is_never_calm_and_check_and_replay_say_so(tmp_path,
     assert "wind: MISSING: no wind column in the file" in capsys.readouterr().out
     assert main(["replay", str(path), "--site", "lanzhou", "--tz", "Asia/Shanghai", "--step", "10min"]) == 0
     assert "wind: MISSING" in capsys.readouterr().out
+
+
+def test_a_dead_pyrheliometer_column_is_derived_from_ghi_and_dhi_and_counted(tmp_path, capsys):
+    """A DNI column without one number is not a day without beam: it is dropped and derived by
+    closure, DNI = (GHI - DHI) / cos(zenith), and both changes are in the report."""
+    import numpy as np
+    import pvlib
+
+    path = tmp_path / "dead-dni.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed\n" + "".join(
+        f"2021-06-05 {h:02d}:00,{g},,{d},2.0\n" for h, g, d in ((9, 600, 90), (12, 950, 100), (15, 700, 95))))
+    frame = read_weather(path, site="lanzhou", tz="Asia/Shanghai")
+    report = frame.attrs["validation"]
+    assert report["empty_dropped"] == {"dni": {"rows": 3}} and "nan" not in report
+    assert frame.attrs["dni_source"] != "measured"
+    zenith = pvlib.solarposition.get_solarposition(frame.index, 36.1055556, 103.726389, 1520.0)["zenith"].to_numpy()
+    expected = (frame["ghi"] - frame["dhi"]).to_numpy() / np.cos(np.radians(zenith))
+    np.testing.assert_allclose(frame["dni"].to_numpy(), expected, rtol=0.01)  # pvlib's closure, to its sun
+    assert main(["check", str(path), "--site", "lanzhou", "--tz", "Asia/Shanghai"]) == 0
+    out = capsys.readouterr().out
+    assert "dropped (irradiance column without a readable value): dni rows 3" in out and "NaN kept" not in out
 
 
 def test_site_flags_keep_their_meaning_for_commands_without_a_file(capsys):

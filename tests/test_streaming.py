@@ -362,6 +362,9 @@ def test_stamps_whose_offset_changes_are_instants_and_a_semicolon_file_streams(t
 
 @pytest.mark.parametrize("name, text, message", [
     ("header.csv", "time,dni\n", "header.csv: holds no time steps"),
+    ("no-dni.csv", "time,ghi\n2021-06-21T00:00:00+08:00,0\n", "column 'dni' is missing or holds no number"),
+    ("dead-dni.csv", "time,dni,ghi\n2021-06-21T00:00:00+08:00,,0\n2021-06-21T00:01:00+08:00,,0\n",
+     "column 'dni' is missing or holds no number"),
     ("folder.csv", None, "is a folder, not a weather file"),
 ])
 def test_an_empty_or_folder_streamed_file_is_one_line(tmp_path, capsys, name, text, message):

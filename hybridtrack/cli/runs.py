@@ -210,14 +210,14 @@ def _has_wind(frame) -> bool:
 @command("replay", "run a tracker over a recorded weather file", _replay_arguments)
 def _replay(args: argparse.Namespace) -> int:
     if args.stream:
-        from ..streaming import recorded_days, recorded_wind
+        from ..streaming import recorded_days
 
         if args.map or args.units or args.format:
             raise HybridtrackError("--stream reads a weather frame as saved (a time index, dni, ...): --map, --units "
                                    "and --format are not taken; convert the record once with read_weather")
         site = site_from_arguments(args)
         source = recorded_days(args.file, site, tz=args.tz)
-        return _stream(source, args, replay_config(args, recorded_wind(args.file)),
+        return _stream(source, args, replay_config(args, source.wind_measured),
                        heading=f"replay of {args.file} at {site.name}, {collector_from_arguments(args).kind}, "
                                f"{args.strategy}")
     site, frame = _replay_frame(args)

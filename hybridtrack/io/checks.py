@@ -49,7 +49,7 @@ REPAIRS = {
     "unreadable": "text in a numeric column", "dst_dropped": "a time stamp that does not exist in the time zone",
     "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",
     "impossible": "a physically impossible value", "negative_clipped": "a negative irradiance",
-    "calm_clipped": "a negative wind reading",
+    "calm_clipped": "a negative wind reading", "empty_dropped": "an irradiance column without a readable value",
 }
 
 
@@ -148,6 +148,20 @@ def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
     if light and all(frame[name].isna().all() for name in light):
         header = report.get("columns", {}).get(light[0], light[0])
         raise HybridtrackError(f"{path}: column {header!r}: no readable value in any irradiance column")
+    return _drop_empty(frame, report)
+
+
+def _drop_empty(frame: pd.DataFrame, report: dict) -> pd.DataFrame:
+    """Drop an irradiance column without one readable value (a logger's dead pyrheliometer) beside
+    one that has values, so that it is derived from the others as a missing column is
+    (`hybridtrack.io.gapfill`), not replayed as a day without light; counted in `report`."""
+    empty = [name for name in IRRADIANCE if name in frame and frame[name].isna().all()]
+    if empty:
+        report["empty_dropped"] = {name: {"rows": int(len(frame))} for name in empty}
+        nan = {name: count for name, count in report.get("nan", {}).items() if name not in empty}
+        report.pop("nan", None)
+        report.update({"nan": nan} if nan else {})
+        frame = frame.drop(columns=empty)
     return frame
 
 
@@ -194,4 +208,5 @@ def refuse_repairs(path: Path, report: dict) -> None:
             raise HybridtrackError(f"{path}: line {entry['lines'][0]}: {what} (strict)")
         column, detail = next(iter(entry.items()))
         header = report.get("columns", {}).get(column, column)
-        raise HybridtrackError(f"{path}: line {detail['lines'][0]}, column {header!r}: {what} (strict)")
+        where = f"line {detail['lines'][0]}, " if "lines" in detail else ""
+        raise HybridtrackError(f"{path}: {where}column {header!r}: {what} (strict)")

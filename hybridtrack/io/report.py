@@ -15,7 +15,7 @@ __all__ = ["validation_report", "ISSUES"]
 
 #: Report keys that make the verdict "usable, with issues" rather than "clean".
 ISSUES = ("unreadable", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
-          "impossible", "light_at_night", "wind_missing")
+          "impossible", "light_at_night", "wind_missing", "empty_dropped")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
              "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING"}
@@ -25,7 +25,7 @@ _CHANGES = {
     "dst_dropped": "dropped (DST: stamps that do not exist)", "unsorted": "sorted (stamps out of order)",
     "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
     "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",
-    "filled": "filled",
+    "empty_dropped": "dropped (irradiance column without a readable value)", "filled": "filled",
 }
 
 
