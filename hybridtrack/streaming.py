@@ -151,6 +151,25 @@ def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str
 
 
 def _by_day(pieces: Iterator[pd.DataFrame], site: sites.Site, where: str) -> Iterator[tuple[dt.date, pd.DataFrame]]:
+    """Local days (`_cut_days`), a day of one stamp joined to a neighbour: a run needs two steps,
+    and a logger's export that ends on the next midnight's stamp (00:00-24:00) is common. A lone
+    stamp joins the day before it (the day after it, at the start of the span); no step is lost."""
+    held = None  # the day before, kept until the next shows whether a lone stamp joins it
+    for day, frame in _cut_days(pieces, site, where):
+        if held is None:
+            held = day, frame
+        elif len(frame) == 1:
+            held = held[0], pd.concat([held[1], frame])
+        elif len(held[1]) == 1:
+            held = day, pd.concat([held[1], frame])
+        else:
+            yield held
+            held = day, frame
+    if held is not None:
+        yield held
+
+
+def _cut_days(pieces: Iterator[pd.DataFrame], site: sites.Site, where: str) -> Iterator[tuple[dt.date, pd.DataFrame]]:
     """Regroup consecutive pieces of a frame into local days, each yielded once it is complete."""
     held: pd.DataFrame | None = None
     last = None
@@ -331,20 +350,24 @@ def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> set[
     run's own read then says what is wrong, by row."""
     try:
         if separator is not None:
-            chunks = pd.read_csv(path, sep=separator, usecols=lambda name: name in names, chunksize=CHUNK_ROWS)
+            header = pd.read_csv(path, sep=separator, nrows=0).columns
+            chunks = pd.read_csv(path, sep=separator, usecols=[header[0], *(n for n in names if n in header)],
+                                 chunksize=CHUNK_ROWS)
         else:
             import pyarrow.parquet as pq
 
             handle = pq.ParquetFile(path)
             kept = [name for name in names if name in handle.schema_arrow.names]
             chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=kept)) if kept else ()
+            if handle.metadata.num_rows == 0:
+                return set(names)
         found: set[str] = set()
         rows = 0
         for chunk in chunks:
             rows += len(chunk)
-            found |= {name for name in chunk.columns
-                      if np.isfinite(pd.to_numeric(chunk[name], errors="coerce").to_numpy(float)).any()}
-        return found if rows else set(names)
+            found |= {name for name in names if name in chunk.columns
+                      and np.isfinite(pd.to_numeric(chunk[name], errors="coerce").to_numpy(float)).any()}
+        return found if rows or separator is None else set(names)
     except (OSError, ValueError):  # pandas' and pyarrow's read errors
         return set(names)
 

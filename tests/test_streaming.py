@@ -329,6 +329,22 @@ def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_p
     assert list((tmp_path / "run").iterdir()) == []
 
 
+def test_a_lone_stamp_on_a_day_joins_its_neighbour_and_every_step_runs(tmp_path):
+    """A logger's day export runs 00:00 to the next 00:00 inclusive: the last stamp is alone on its
+    local day (a run needs two steps). It joins the day before; a lone first stamp joins the day
+    after. Nothing is dropped: the streamed log has every stamp of the file."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-20", "2021-06-22", weather="sunny", freq="10min", seed=1)
+    span = frame.iloc[143:289]  # 2021-06-20 23:50 (alone) to 2021-06-22 00:00 (alone)
+    span.to_csv(tmp_path / "weather.csv", index_label="time")
+    days = list(recorded_days(tmp_path / "weather.csv", SITE))
+    assert [(str(day), len(part)) for day, part in days] == [("2021-06-21", 146)]
+    result = stream(recorded_days(tmp_path / "weather.csv", SITE), tmp_path / "run")
+    assert (read_log(tmp_path / "run" / "log.parquet").index == span.index).all()
+    assert result.summary["steps"] == len(span)
+
+
 def test_a_naive_stamp_the_clock_change_skips_is_refused_by_its_row(tmp_path, capsys):
     """New York's 2021-03-14 02:00-02:59 does not exist: the reader drops it and counts it; a stream
     does not repair, so it names the row instead of passing on pandas' advice."""
