@@ -140,6 +140,20 @@ def _finite_vector(values, name: str, *, positive: bool = False, bound: float = 
     return array
 
 
+def _distinct(points: np.ndarray, what: str, unit: str) -> None:
+    """Refuse two collectors at one place (a typo in a layout: two mirrors cannot share it),
+    naming both by their 1-based numbers."""
+    rows = points.reshape(len(points), -1)
+    _, first, group = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    earlier = first[group.ravel()]  # each collector's first at its place
+    repeats = np.flatnonzero(earlier != np.arange(len(rows)))
+    if len(repeats):
+        again, before = int(repeats[0]), int(earlier[repeats[0]])
+        place = ", ".join(f"{v:g}" for v in rows[again])
+        raise HybridtrackError(f"{what} {before + 1} and {again + 1} are both at {place} {unit}: two collectors "
+                               "cannot share a place")
+
+
 def _finite_number(value, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> float:
     return float(_finite_vector([value], name, positive=positive, bound=bound)[0])
 
@@ -172,7 +186,9 @@ class FresnelField:
     kind = "fresnel"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "row_distances", tuple(_finite_vector(self.row_distances, "row distances").tolist()))
+        distances = _finite_vector(self.row_distances, "row distances")
+        _distinct(distances, "rows", "m from the receiver line")
+        object.__setattr__(self, "row_distances", tuple(distances.tolist()))
         for name in ("receiver_height", "row_length"):
             object.__setattr__(self, name, _finite_number(getattr(self, name), name.replace("_", " "), positive=True))
         object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
@@ -283,6 +299,7 @@ class HeliostatField:
         if not np.all(np.isfinite(xyz)):
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(~np.isfinite(xyz).all(1))[0]) + 1}: "
                                    "position is not finite")
+        _distinct(xyz, "heliostats", "m (east, north, up)")
         object.__setattr__(self, "positions", xyz)
         aims = np.broadcast_to(np.asarray(self.aim, float), xyz.shape) if self.aims is None else self.aims
         aims = np.asarray(aims, float) if _is_numeric(aims) else None

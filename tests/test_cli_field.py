@@ -45,6 +45,7 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
 
 @pytest.mark.parametrize("flags, message", [
     (["fresnel", "--rows", "1,x"], "--rows takes numbers"),
+    (["fresnel", "--rows="], "--rows takes numbers separated by commas, got ''"),  # not the default 20 rows
     (["fresnel", "--receiver-height", "0"], "receiver height must be finite and positive"),
     (["trough", "--count", "0"], "count must be a whole number"),
     (["heliostat", "--positions", "/no/such/file.csv"], "no such file"),

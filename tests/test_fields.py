@@ -70,6 +70,8 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: HeliostatField(positions=[[1, 2]], aims=[[0, 0, 1], [0, 0, 2]]), "one \\(x, y, z\\) per heliostat"),
     (lambda: FresnelField(row_distances=[1.0, float("inf")]), "row distances must be finite"),
     (lambda: FresnelField(row_distances=[]), "non-empty"),
+    (lambda: FresnelField(row_distances=[-1, 0, 1, 0.0]), "rows 2 and 4 are both at 0 m from the receiver line"),
+    (lambda: HeliostatField(positions=[[10, 20], [30, 40], [10, 20]]), "heliostats 1 and 3 are both at 10, 20, 0 m"),
     (lambda: FresnelField(receiver_height=-2), "receiver height must be finite and positive"),
     (lambda: TroughLoop(count=0), "count must be a whole number"),
     (lambda: TroughLoop(count=2.5), "count must be a whole number"),

@@ -76,9 +76,12 @@ def _spread(args: argparse.Namespace):
 
 def _numbers(text: str, flag: str) -> list[float]:
     try:
-        return [float(part) for part in text.split(",") if part.strip()]
+        numbers = [float(part) for part in text.split(",") if part.strip()]
     except ValueError:
-        raise HybridtrackError(f"{flag} takes numbers separated by commas, got {text!r}") from None
+        numbers = []
+    if not numbers:
+        raise HybridtrackError(f"{flag} takes numbers separated by commas, got {text!r}")
+    return numbers
 
 
 def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
@@ -117,7 +120,7 @@ def field_from_arguments(args: argparse.Namespace):
 
     spread = _spread(args)
     if args.kind == "fresnel":
-        rows = _numbers(args.rows, "--rows") if args.rows else FresnelField().row_distances
+        rows = _numbers(args.rows, "--rows") if args.rows is not None else FresnelField().row_distances
         return FresnelField(row_distances=rows, receiver_height=args.receiver_height, row_length=args.row_length,
                             axis_azimuth=args.axis_azimuth, spread=spread)
     if args.kind == "trough":
