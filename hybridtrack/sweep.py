@@ -23,7 +23,8 @@ Run keys are ``site``, ``collector``, ``strategy``, ``start``, ``days``, ``weath
 field of the run config in its TOML layout (``drive.deadband``, ``controller.sun_model``,
 ``imperfections.encoder_offset``), or of the collector (``collector.row_distance``). A base
 ``[base.config]`` table is a whole run config. Keys and their places are checked before the sweep
-starts; values are checked by each run, so a bad value fails that run only.
+starts, and so are the base values the grid leaves alone (every run would fail on them); a bad
+grid value is checked by its run, so it fails that run only.
 
 Every run is independent and seeded, and the table is sorted by run number, so it is the same
 whatever the number of workers. A run that fails is kept, with its error, and the sweep goes on.
@@ -91,9 +92,9 @@ class Sweep:
         for name, table in (("base", base), ("grid", grid), ("plot", plot), ("base.config", config)):
             if not isinstance(table, dict):
                 raise HybridtrackError(f"{source}: [{name}] must be a table")
-        _config_from(config, {}, source)  # the base config must stand on its own
         for key in base:
             _check_key(key, source, "base")
+        _check_base(base, config, data.get("grid", {}), source)
         if not grid:
             raise HybridtrackError(f"{source}: [grid] is empty; give at least one key with a list of values")
         for key, values in grid.items():
@@ -152,6 +153,52 @@ def _check_key(key: str, source: str, table: str) -> None:
         raise HybridtrackError(f"{source}: {table}.{key}: is a whole table; name one of its fields")
 
 
+def _check_base(base: dict, config: dict, grid, source: str) -> None:
+    """Refuse a base value every run would fail on before a cluster starts: the run keys and the
+    config's dotted keys that the grid does not set (a grid value fails its own run only)."""
+    grid = grid if isinstance(grid, dict) else {}
+    for key in RUN_KEYS.keys() & base.keys() - grid.keys():
+        try:
+            _checks()[key](base[key])
+        except HybridtrackError as exc:
+            raise HybridtrackError(f"{source}: base.{key}: {exc}") from None
+    dotted = {k: v for k, v in base.items() if "." in k and not k.startswith("collector.") and k not in grid}
+    _config_from(config, dotted, f"{source}: base")  # the base config must stand on its own
+
+
+def _whole_days(days) -> int:
+    if isinstance(days, bool) or not isinstance(days, int) or not 1 <= days <= 3660:
+        raise HybridtrackError(f"days must be a whole number from 1 to 3660, got {days!r}")
+    return days
+
+
+def _strategy(name) -> str:
+    from .control import STRATEGIES
+
+    if name not in STRATEGIES:
+        raise HybridtrackError(f"unknown strategy {name!r}; choose from {', '.join(STRATEGIES)}")
+    return name
+
+
+def _weather(value):
+    from .sky import WEATHERS
+
+    for name in (value if isinstance(value, list) else str(value).split(",")):
+        if name not in WEATHERS:
+            raise HybridtrackError(f"unknown weather {name!r}; choose from {', '.join(WEATHERS)} or a per-day list")
+    return value
+
+
+def _checks() -> dict:
+    from . import sites
+    from .collectors import Collector
+    from .times import parse_date, parse_freq
+
+    return {"site": sites.get, "collector": Collector, "strategy": _strategy, "start": parse_date,
+            "days": _whole_days, "weather": _weather, "freq": parse_freq, "seed": params.seed,
+            "gusts_per_day": lambda value: params.number(value, "gusts_per_day", 0, 200)}
+
+
 def _config_from(base: dict, dotted: dict, source: str):
     """The run config: the base table with the dotted values set in it."""
     import copy
@@ -176,8 +223,7 @@ def _frame(site, start: str, days: int, weather: str, freq: str, seed: int, gust
     from .sky import synthetic
     from .times import parse_date
 
-    if isinstance(days, bool) or not isinstance(days, int) or not 1 <= days <= 3660:
-        raise HybridtrackError(f"days must be a whole number from 1 to 3660, got {days!r}")
+    _whole_days(days)
     first = parse_date(start)
     sky = weather.split(",") if "," in weather else weather
     return synthetic(site, first, first + dt.timedelta(days=days - 1), weather=sky, freq=freq, seed=seed,

@@ -45,10 +45,27 @@ def test_the_grid_is_every_combination_in_order():
     ({"grid": {"seed": [0]}, "plot": {"y": "happiness"}}, "plot.y: 'happiness' is not a metric"),
     ({"grid": {"seed": [0]}, "plot": {"z": "rms"}}, "plot.z: unknown key"),
     ({"grid": {"seed": list(range(1000)), "days": list(range(1, 1001))}}, "makes 1,000,000 runs; at most 100,000"),
+    # a base value every run would fail on is refused before a cluster starts, naming its key
+    ({"base": {"site": "atlantis"}, "grid": {"seed": [0]}}, "s.toml: base.site: unknown site 'atlantis'"),
+    ({"base": {"seed": [[1, 2]]}, "grid": {"days": [1]}}, r"base.seed: seed must be a whole number .* got \[\[1, 2\]\]"),
+    ({"base": {"weather": "sunny,rainy"}, "grid": {"seed": [0]}}, "base.weather: unknown weather 'rainy'"),
+    ({"base": {"days": 0}, "grid": {"seed": [0]}}, "base.days: days must be a whole number from 1 to 3660, got 0"),
+    ({"base": {"strategy": "psychic"}, "grid": {"seed": [0]}}, "base.strategy: unknown strategy 'psychic'"),
+    ({"base": {"collector": "dish"}, "grid": {"seed": [0]}}, "base.collector: unknown collector 'dish'"),
+    ({"base": {"start": "2021-02-30"}, "grid": {"seed": [0]}}, "base.start: "),
+    ({"base": {"freq": "soon"}, "grid": {"seed": [0]}}, "base.freq: "),
+    ({"base": {"gusts_per_day": -1.0}, "grid": {"seed": [0]}}, "base.gusts_per_day: "),
+    ({"base": {"drive.deadband": -1}, "grid": {"seed": [0]}}, "s.toml: base: drive: deadband .* = -1 is outside"),
 ])
 def test_bad_sweeps_are_refused_before_any_run(data, message):
     with pytest.raises(HybridtrackError, match=message):
         Sweep.from_dict(data, source="s.toml")
+
+
+def test_a_bad_base_value_the_grid_overrides_fails_no_run():
+    """days = 0 in [base] is never run when the grid sets days: only a value a run uses is judged."""
+    sweep = Sweep.from_dict({"base": {"days": 0, "site": "atlantis"}, "grid": {"days": [1], "site": ["lanzhou"]}})
+    assert [run["days"] for run in sweep.runs()] == [1]
 
 
 def test_a_runs_row_is_that_run_and_a_failure_is_a_row():
