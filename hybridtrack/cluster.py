@@ -42,8 +42,13 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         except (OSError, TimeoutError, ValueError) as exc:
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
     count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else (os.cpu_count() or 1)
-    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=50)  # a failed task is reported by its result, not logged
+    try:
+        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=50)  # a failed task is reported by its result, not logged
+    except RuntimeError as exc:  # distributed's "Nanny failed to start", multiprocessing's bootstrapping error
+        raise HybridtrackError(f"cannot start {count} local Dask workers for {what} ({' '.join(str(exc).split())[:120]}); "
+                               "workers are new processes that import the running script again, so a script "
+                               "must start its run under `if __name__ == \"__main__\":`") from None
     return Client(cluster), cluster
 
 

@@ -183,3 +183,23 @@ def test_a_collector_that_fails_on_a_worker_fails_the_field_with_its_own_error_a
     with pytest.raises(HybridtrackError, match="needs the frame's true 'sky' column"):
         simulate_field(without_sky, "lanzhou", TroughLoop(count=2), strategy="hybrid-oracle", workers=1)
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_a_script_without_a_main_guard_is_told_why_its_workers_did_not_start(tmp_path):
+    """Dask's worker processes import the running script again: a script that starts a parallel
+    field at its top level cannot start them. It gets a HybridtrackError that says so, not
+    distributed's "Nanny failed to start"."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "field_script.py"
+    script.write_text("import hybridtrack as ht\n"
+                      "from hybridtrack.fields import TroughLoop\n"
+                      "from hybridtrack.sky import synthetic\n"
+                      "day = synthetic('lanzhou', '2021-06-21', weather='sunny', freq='30min')\n"
+                      "ht.simulate_field(day, 'lanzhou', TroughLoop(count=2), workers=1)\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    last = done.stderr.strip().splitlines()[-1]
+    assert done.returncode != 0
+    assert last.startswith("hybridtrack.errors.HybridtrackError: cannot start 1 local Dask workers"), last
+    assert 'if __name__ == "__main__":' in last
