@@ -247,3 +247,13 @@ def test_an_out_that_is_a_file_or_under_one_is_one_line(tmp_path, capsys):
     assert capsys.readouterr().err == f"hybridtrack: error: {afile / 'sub'}: cannot make the folder (Not a directory)\n"
     assert afile.read_text() == "the user's own\n"
 
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full, a device that is always full")
+def test_a_full_standard_output_is_one_line_that_names_it():
+    # printed 'hybridtrack: error: cannot use: No space left on device', naming nothing
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    with open("/dev/full", "w") as full:
+        child = subprocess.run([sys.executable, "-m", "hybridtrack", "faults", "list"], stdout=full,
+                               stderr=subprocess.PIPE, env=env)
+    assert child.returncode == 2
+    assert child.stderr.decode() == "hybridtrack: error: standard output: cannot write (No space left on device)\n"
