@@ -134,7 +134,8 @@ def strict_json(value, **options) -> str:
 
 
 class _PipeSafe:
-    """A text stream that, once its reader has gone, discards what is written instead of raising."""
+    """A text stream that, once its reader has gone, discards what is written instead of raising;
+    any other failure to write (a full disk) is a `HybridtrackError` naming standard output."""
 
     def __init__(self, stream):
         self._stream = stream
@@ -143,18 +144,26 @@ class _PipeSafe:
         with contextlib.suppress(OSError, ValueError, AttributeError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
 
+    def _failed(self, exc: OSError) -> HybridtrackError:
+        self._discard()  # what is left in the buffer would fail again at exit, outside the one line
+        return HybridtrackError(f"standard output: cannot write ({exc.strerror or exc})")
+
     def write(self, text: str) -> int:
         try:
             return self._stream.write(text)
         except BrokenPipeError:
             self._discard()
             return len(text)
+        except OSError as exc:
+            raise self._failed(exc) from None
 
     def flush(self) -> None:
         try:
             self._stream.flush()
         except BrokenPipeError:
             self._discard()
+        except OSError as exc:
+            raise self._failed(exc) from None
 
     def __getattr__(self, name):
         return getattr(self._stream, name)

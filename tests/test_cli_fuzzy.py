@@ -98,3 +98,47 @@ def test_a_warning_that_is_not_a_tuning_one_is_shown_once(monkeypatch):
     with tuned_config_warnings():
         warnings.warn("a plain warning", RuntimeWarning)
     assert shown == ["a plain warning"]
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_classify_refuses_a_reading_that_is_not_a_finite_number(capsys, value):
+    # classify printed 'unknown' for nan and 'sunny' for inf (clipped), status 0; rules refused both
+    assert main(["classify", f"--intensity={value}", "--variation", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err == f"hybridtrack: error: --intensity must be a finite number, got {float(value)}\n"
+    assert main(["classify", "--intensity", "100", f"--variation={value}"]) == 2
+    assert "--variation must be a finite number" in capsys.readouterr().err
+
+
+def test_classify_refuses_an_infinite_cell_by_row_and_column(tmp_path, capsys):
+    # an infinite photocurrent was clipped and classified 'sunny', status 0
+    src = tmp_path / "log.csv"
+    src.write_text("intensity,variation\n246,27\n200,inf\n")
+    assert main(["classify", str(src), "--out", str(tmp_path / "out.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err == f"hybridtrack: error: {src}: row 3, column 'variation': inf is not a finite number\n"
+    assert not (tmp_path / "out.csv").exists()
+
+
+@pytest.mark.parametrize("cells, row, column", [
+    ("246,27,sunny\n,3,overcast\n", 3, "intensity"),  # was fitted as a wrongly labelled reading
+    ("246,27,sunny\n60,inf,overcast\n", 3, "variation"),  # was 'labelled_range needs a finite ...'
+    ("246,27,sunny\n60,3,\n", 3, "weather"),  # was 'samples: unknown weather label 'nan'', no file or row
+])
+def test_tune_refuses_a_reading_without_a_number_by_row_and_column(tmp_path, capsys, cells, row, column):
+    labels = tmp_path / "labels.csv"
+    labels.write_text("intensity,variation,weather\n" + cells)
+    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
+                 "--seeds", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{labels}: row {row}, column {column!r}: " in err
+    assert not (tmp_path / "t.toml").exists()
+
+
+def test_tune_refuses_an_empty_score_cell(tmp_path, capsys):
+    # an empty score made every loss NaN and the fit was written anyway ('loss nan -> nan')
+    labels = tmp_path / "labels.csv"
+    labels.write_text("intensity,variation,score\n246,27,25\n60,3,\n150,100,15\n")
+    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
+                 "--seeds", "1"]) == 2
+    assert f"{labels}: row 3, column 'score': empty" in capsys.readouterr().err

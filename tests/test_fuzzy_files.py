@@ -244,6 +244,9 @@ def test_cli_evaluates_a_system_file(capsys):
     (["eval", "tipper.fis", "service=2"], "no value for input 'food'"),
     (["eval", "tipper.fis", "service=2", "food=x"], "input values must be numbers"),
     (["eval", "tipper.fis", "service=2", "food=1", "drink=3"], "unknown input 'drink'"),
+    # a NaN input printed 'tip = nan' and an infinite one was clipped, status 0
+    (["eval", "tipper.fis", "service=nan", "food=1"], "input 'service' must be a finite number, got nan"),
+    (["eval", "tipper.fis", "service=2", "food=inf"], "input 'food' must be a finite number, got inf"),
 ])
 def test_cli_mistakes_are_one_line(args, message, capsys, monkeypatch):
     monkeypatch.chdir(CONFORMANCE)

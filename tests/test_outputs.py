@@ -50,10 +50,18 @@ def test_a_summary_with_nan_is_saved_as_strict_json(tmp_path):
     assert strict(written["summary"].read_text()) == {"rms": None, "max": None, "steps": 2}
 
 
-def test_classify_json_is_strict_for_an_infinite_reading(capsys):
-    assert main(["classify", "--intensity", "inf", "--variation", "1", "--json"]) == 0
-    printed = strict(capsys.readouterr().out)
-    assert printed["intensity"] is None and printed["variation"] == 1.0
+def test_classify_json_is_strict_when_no_rule_fires(tmp_path, capsys):
+    # an infinite reading is refused at the door now; a gap between triangular terms gives NaN
+    from hybridtrack.fuzzy import FuzzyConfig
+
+    data = FuzzyConfig.default().to_dict()
+    data["inputs"]["intensity"]["terms"] = {"weak": {"shape": "trimf", "params": [0.0, 0.0, 1.0]},
+                                            "medium": {"shape": "trimf", "params": [4.0, 5.0, 6.0]},
+                                            "strong": {"shape": "trimf", "params": [9.0, 10.0, 10.0]}}
+    gappy = FuzzyConfig.from_dict(data).to_toml(tmp_path / "gappy.toml")
+    assert main(["classify", "--config", str(gappy), "--intensity", "97.5", "--variation", "1", "--json"]) == 0
+    printed = strict(capsys.readouterr().out)  # 97.5 mA is 2.5 on the universe: between weak and medium
+    assert printed["score"] is None and printed["weather"] == "unknown" and printed["intensity"] == 97.5
 
 
 # -- a closed pipe does not lose the results ------------------------------------------------------
@@ -238,3 +246,14 @@ def test_an_out_that_is_a_file_or_under_one_is_one_line(tmp_path, capsys):
     assert main(SHORT + ["--out", str(afile / "sub")]) == 2
     assert capsys.readouterr().err == f"hybridtrack: error: {afile / 'sub'}: cannot make the folder (Not a directory)\n"
     assert afile.read_text() == "the user's own\n"
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full, a device that is always full")
+def test_a_full_standard_output_is_one_line_that_names_it():
+    # printed 'hybridtrack: error: cannot use: No space left on device', naming nothing
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    with open("/dev/full", "w") as full:
+        child = subprocess.run([sys.executable, "-m", "hybridtrack", "faults", "list"], stdout=full,
+                               stderr=subprocess.PIPE, env=env)
+    assert child.returncode == 2
+    assert child.stderr.decode() == "hybridtrack: error: standard output: cannot write (No space left on device)\n"

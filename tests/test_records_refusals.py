@@ -151,3 +151,22 @@ def test_site_flags_keep_their_meaning_for_commands_without_a_file(capsys):
     assert main(["sun", "--site", "lanzhou", "--tz", "UTC", "--date", "2021-06-21"]) == 2
     assert "give either --site or --lat/--lon/--tz, not both" in capsys.readouterr().err
     assert main(["sun", "--lat", "36.1", "--lon", "103.7", "--tz", "Asia/Shanghai", "--date", "2021-06-21"]) == 0
+
+
+def test_a_file_whose_header_places_it_far_from_the_site_is_refused_or_warned(capsys):
+    # a Lanzhou EPW checked at Nanjing (1,400 km east) was 'clean': at hourly steps the sun check
+    # cannot see the hour of longitude between them, but the file's header says where it was made
+    epw = "tests/records/lanzhou.epw"
+    assert main(["check", epw, "--site", "nanjing"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"hybridtrack: error: {epw}: line 1: the file's header places it at Lanzhou (36.106°, "
+                          "103.726°), 1,")
+    assert "from the site nanjing" in err and "--lenient to read it anyway" in err
+    with pytest.raises(HybridtrackError, match="header places it at Lanzhou"):
+        read_weather(epw, site="nanjing")
+    assert main(["check", epw, "--site", "nanjing", "--lenient"]) == 0
+    out = capsys.readouterr().out
+    assert "  place: WARNING: the file's header places it at Lanzhou" in out and "verdict: usable, with 1 kind" in out
+    assert main(["check", epw, "--site", "lanzhou"]) == 0  # its own site
+    assert "verdict: clean" in capsys.readouterr().out

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import sys
 import warnings
 
@@ -43,6 +44,15 @@ def load_fuzzy_config(path):
     return FuzzyConfig.from_toml(path)
 
 
+def check_reading(args: argparse.Namespace) -> None:
+    """Refuse an ``--intensity`` or ``--variation`` that is not a finite number (NaN fires no
+    rule; an infinite one would be clipped to the end of its range)."""
+    for name in ("intensity", "variation"):
+        value = getattr(args, name)
+        if value is not None and not math.isfinite(value):
+            raise HybridtrackError(f"--{name} must be a finite number, got {value}")
+
+
 def _classify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", nargs="?", help="CSV of readings to classify (instead of --intensity/--variation)")
     parser.add_argument("--intensity", type=float, help="sensor photocurrent, mA")
@@ -71,6 +81,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
     if args.file is None:
         if args.intensity is None or args.variation is None:
             raise HybridtrackError("give --intensity and --variation, or a CSV file of readings")
+        check_reading(args)
         explanation = clf.explain(args.intensity, args.variation)
         print(strict_json(explanation.to_dict(), indent=2) if args.json else explanation)
         return 0

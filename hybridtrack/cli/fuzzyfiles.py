@@ -53,6 +53,9 @@ def _evaluate(system, args: argparse.Namespace) -> int:
         x = np.array([[float(given[name]) for name in system.input_names]])
     except ValueError as exc:
         raise HybridtrackError(f"input values must be numbers: {exc}") from None
+    for name, value in zip(system.input_names, x[0]):
+        if not np.isfinite(value):
+            raise HybridtrackError(f"input {name!r} must be a finite number, got {value}")
     if args.engine == "skfuzzy":
         values = [evaluate_skfuzzy(system, x, output=o)[0] for o in range(len(system.outputs))]
     else:

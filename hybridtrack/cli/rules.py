@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..errors import HybridtrackError
 from .base import add_force_argument, command
-from .fuzzy import load_fuzzy_config, tuned_config_warnings
+from .fuzzy import check_reading, load_fuzzy_config, tuned_config_warnings
 
 
 def _rules_arguments(parser: argparse.ArgumentParser) -> None:
@@ -40,10 +39,7 @@ def rule_table(explanation, config) -> str:
 def _rules(args: argparse.Namespace) -> int:
     from ..fuzzy import FuzzyWeatherClassifier
 
-    for name in ("intensity", "variation"):
-        value = getattr(args, name)
-        if value != value or value in (float("inf"), float("-inf")):
-            raise HybridtrackError(f"--{name} must be a finite number, got {value}")
+    check_reading(args)
     clf = FuzzyWeatherClassifier(load_fuzzy_config(args.config))
     with tuned_config_warnings():
         explanation = clf.explain(args.intensity, args.variation)

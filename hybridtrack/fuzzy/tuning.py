@@ -130,7 +130,8 @@ def read_samples(source) -> pd.DataFrame:
     """Labelled readings from a CSV path or a DataFrame, checked.
 
     Columns: ``intensity``, ``variation`` (raw mA), and ``weather`` and/or ``score``;
-    optional ``tolerance`` (used by rule-table tests).
+    optional ``tolerance`` (used by rule-table tests). Every reading, label and score must be
+    given: an empty or infinite cell is refused by its row and column.
     """
     if isinstance(source, pd.DataFrame):
         frame, where = source.copy(), "samples"
@@ -146,9 +147,13 @@ def read_samples(source) -> pd.DataFrame:
         raise HybridtrackError(f"{where}: needs a 'weather' or a 'score' column to fit to")
     if frame.empty:
         raise HybridtrackError(f"{where}: no rows")
+    if "weather" in frame.columns and frame["weather"].isna().any():
+        raise HybridtrackError(f"{where}: row {int(np.flatnonzero(frame['weather'].isna())[0]) + 2}, column "
+                               "'weather': empty")
     from ..io import numeric_columns
 
-    return numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where)
+    return numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where,
+                           required=("intensity", "variation", "score"))
 
 
 def evaluate(config: FuzzyConfig, samples: pd.DataFrame, margin: float = 0.5) -> dict:

@@ -55,6 +55,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
         lines.append(f"  header notes (not units, ignored): {_describe(report['header_notes'])}")
     lines.append(f"  time: {report.get('time', '?')}" + (f"; dates {report['date_order']}" if "date_order" in report
                                                          else ""))
+    if "place" in report:
+        lines.append(f"  place: {report['place']}")
     if "sun_check" in report:
         lines.append(f"  sun check: {report['sun_check']}")
     return lines
@@ -88,7 +90,7 @@ def validation_report(frame: pd.DataFrame) -> str:
     lines.append("  changes: " + ("none" if not changes else f"{len(changes)}"))
     lines.extend(changes)
     issues = [k for k in ISSUES if k in report]
-    warning = str(report.get("sun_check", "")).startswith("WARNING")
+    warning = sum(str(report.get(key, "")).startswith("WARNING") for key in ("place", "sun_check"))
     kinds = f"{len(issues) + warning} kind{'s' if len(issues) + warning > 1 else ''}"
     lines.append("  verdict: " + ("clean" if not issues and not warning else f"usable, with {kinds} of issue noted "
                                                                               "above"))

@@ -32,13 +32,17 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .checks import first_lines, span
 
-__all__ = ["sun_check", "LIGHT", "BIN"]
+__all__ = ["sun_check", "place_check", "LIGHT", "BIN", "FAR"]
 
 #: W/m²: light a sensor cannot read with the sun below the horizon (twilight gives a few W/m²).
 LIGHT = 20.0
 #: The resolution of the offset search.
 BIN = pd.Timedelta(minutes=10)
 _SEARCH = pd.Timedelta(hours=14)
+#: km: a file whose header places it farther than this from the site is another place's weather.
+#: A typical-year file from a station a few tens of km away is the usual stand-in for a site;
+#: 300 km is a climate region and, east-west, a quarter of an hour of the sun's timing.
+FAR = 300.0
 
 
 def _sun_up(site, times: pd.DatetimeIndex) -> np.ndarray:
@@ -157,3 +161,35 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
                                     "column": header, "action": "kept"}
     report["sun_check"] = (f"light follows the sun at {site.name} (best shift {_signed(shift)}, {disagree:.1%} of "
                            "bins disagree)")
+
+
+def _distance(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Great-circle distance, km."""
+    p1, p2, dlon = np.radians(lat1), np.radians(lat2), np.radians(lon2 - lon1)
+    cosine = np.sin(p1) * np.sin(p2) + np.cos(p1) * np.cos(p2) * np.cos(dlon)
+    return float(6371.0 * np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def place_check(path: Path, meta: dict, site, report: dict, *, lenient: bool = False) -> None:
+    """Refuse (or, `lenient`, warn about in ``report["place"]``) a file whose header (EPW, TMY3,
+    ...: pvlib's `meta`) places it more than `FAR` km from `site`.
+
+    The sun check cannot see a place an hour of longitude away in hourly data; the header says
+    where the file was made.
+    """
+    try:
+        lat, lon = float(meta["latitude"]), float(meta["longitude"])
+    except (KeyError, TypeError, ValueError):
+        return
+    if not (np.isfinite(lat) and np.isfinite(lon)):
+        return
+    km = _distance(lat, lon, site.latitude, site.longitude)
+    if km <= FAR:
+        return
+    name = next((str(meta[k]).strip('" ') for k in ("city", "City", "Name", "name") if meta.get(k)), "a place")
+    message = (f"{path}: line 1: the file's header places it at {name} ({lat:.3f}°, {lon:.3f}°), {km:,.0f} km from "
+               f"the site {site.name} ({site.latitude:.3f}°, {site.longitude:.3f}°); give the right site"
+               + ("" if lenient else ", or --lenient to read it anyway"))
+    if not lenient:
+        raise HybridtrackError(message)
+    report["place"] = "WARNING: " + message.split(": line 1: ", 1)[1]

@@ -202,10 +202,12 @@ def read_table(path) -> pd.DataFrame:
     return frame
 
 
-def numeric_columns(frame: pd.DataFrame, columns, where: str) -> pd.DataFrame:
+def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) -> pd.DataFrame:
     """`frame` with `columns` (those present) as floats; text in one names its row and column.
 
-    Row numbers count the header as row 1, as a spreadsheet shows them.
+    An infinite cell (``inf``, ``1e400``) is refused: no reading is infinite. An empty cell is
+    NaN, or refused in a column of `required`. Row numbers count the header as row 1, as a
+    spreadsheet shows them.
     """
     frame = frame.copy()
     for column in columns:
@@ -217,5 +219,11 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str) -> pd.DataFrame:
             row = int(np.flatnonzero(bad)[0])
             raise HybridtrackError(f"{where}: row {row + 2}, column {column!r}: {frame[column].iloc[row]!r} "
                                    "is not a number")
-        frame[column] = values.astype(float)
+        values = values.astype(float)
+        refused = np.isinf(values.to_numpy()) | (values.isna().to_numpy() if column in required else False)
+        if refused.any():
+            row = int(np.flatnonzero(refused)[0])
+            what = "empty" if np.isnan(values.iloc[row]) else f"{values.iloc[row]} is not a finite number"
+            raise HybridtrackError(f"{where}: row {row + 2}, column {column!r}: {what}")
+        frame[column] = values
     return frame

@@ -212,6 +212,10 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         raise HybridtrackError(f"unknown format {format!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
     if site is None and {"latitude", "longitude"} <= set(meta):
         site = _site_from_meta(meta)
+    elif site is not None:
+        from .suncheck import place_check
+
+        place_check(path, meta, site, report, lenient=lenient)
     frame = check_frame(path, frame, report)
     if strict:
         refuse_repairs(path, report)
