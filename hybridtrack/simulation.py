@@ -47,6 +47,10 @@ FAULTS = {
     "clock": "(N,): seconds added to the controller's clock",
 }
 
+#: The largest size of each numeric fault: a turn of degrees, a year of seconds (a larger clock
+#: offset is no fault a tracker could meet, and beyond it pandas' time arithmetic overflows).
+FAULT_LIMITS = {"sensor": 360.0, "sensor_drift": 360.0, "encoder": 360.0, "clock": 365.0 * 86_400.0}
+
 LOG_COLUMNS = ("target_true", "target", "angle", "error", "mode", "sky", "sky_score", "sensor_valid",
                "sensor_status", "intensity_ma", "variation_ma", "wind_speed", "dni", "calibration")
 
@@ -284,9 +288,27 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
                                "(read files with hybridtrack.io.read_weather, which sorts and de-duplicates)")
     if "dni" not in frame.columns:
         raise HybridtrackError(f"the weather frame has no 'dni' column; it has {', '.join(map(str, frame.columns))}")
+    for column in ("dni", "dhi", "wind_speed"):
+        if column in frame.columns:
+            _physical_column(frame, column)
     first, last = frame.index[0], frame.index[-1]
     check_steps(first, last, (last - first) / (len(frame) - 1), what="the weather frame")
     return frame
+
+
+def _physical_column(frame: pd.DataFrame, column: str) -> None:
+    """Refuse a column that is not numbers, or holds an infinite or negative value (NaN is a
+    missing reading), naming the first such row: `hybridtrack.io.read_weather` repairs a file;
+    a frame given to `simulate` is taken as it is."""
+    values = frame[column]
+    if not pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(values.dtype):
+        raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
+    array = values.to_numpy(float)
+    bad = np.flatnonzero(np.isinf(array) | (array < 0))
+    if len(bad):
+        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} is "
+                               "not a reading (infinite or negative); read files with hybridtrack.io.read_weather, "
+                               "which flags and counts such values")
 
 
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
@@ -327,6 +349,9 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     Result
     """
     config = config or SimulationConfig()
+    if not isinstance(config, SimulationConfig):
+        raise HybridtrackError(f"config must be a SimulationConfig (SimulationConfig.from_dict for a dict), "
+                               f"got {type(config).__name__}")
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     site = sites.get(site)
@@ -468,10 +493,30 @@ def _check_faults(faults: dict, n: int, axes: int) -> dict:
     return checked
 
 
+def _fault_array(faults: dict, name: str, kind) -> np.ndarray:
+    """A fault's values as an array of `kind`, refused unless they are numbers (True/False for a
+    mask: not text, not NaN, which `bool` would read as True)."""
+    values = np.asarray(faults[name])
+    if kind is bool:
+        if values.dtype != bool and not (np.issubdtype(values.dtype, np.number) and np.isfinite(values).all()):
+            raise HybridtrackError(f"fault {name!r} needs True/False per step, got dtype {values.dtype}"
+                                   f"{' with NaN' if np.issubdtype(values.dtype, np.floating) else ''}")
+        return values.astype(bool)
+    if not (np.issubdtype(values.dtype, np.number) or values.dtype == bool):
+        raise HybridtrackError(f"fault {name!r} needs numbers, got dtype {values.dtype}")
+    values = values.astype(float)
+    beyond = np.argwhere(np.abs(values) > FAULT_LIMITS[name])  # inf too; NaN is "no fault here"
+    if len(beyond):
+        where = tuple(beyond[0])
+        raise HybridtrackError(f"fault {name!r} at step {where[0]}: {values[where]:g} is beyond "
+                               f"±{FAULT_LIMITS[name]:g}")
+    return values
+
+
 def _mask(faults: dict, name: str, n: int) -> np.ndarray | None:
     if name not in faults:
         return None
-    values = np.asarray(faults[name], bool)
+    values = _fault_array(faults, name, bool)
     if values.shape != (n,):
         raise HybridtrackError(f"fault {name!r} needs one value per step ({n}), got shape {values.shape}")
     return values
@@ -480,7 +525,7 @@ def _mask(faults: dict, name: str, n: int) -> np.ndarray | None:
 def _fault(faults: dict, name: str, n: int, default: float) -> np.ndarray:
     if name not in faults:
         return np.full(n, default)
-    values = np.asarray(faults[name], float)
+    values = _fault_array(faults, name, float)
     if values.shape != (n,):
         raise HybridtrackError(f"fault {name!r} needs one value per step ({n}), got shape {values.shape}")
     return np.nan_to_num(values, nan=default)
@@ -489,7 +534,7 @@ def _fault(faults: dict, name: str, n: int, default: float) -> np.ndarray:
 def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> np.ndarray | None:
     if name not in faults:
         return None
-    values = np.asarray(faults[name], float)
+    values = _fault_array(faults, name, float)
     if values.ndim == 1:
         values = np.repeat(values[:, None], axes, axis=1)
     if values.shape != (n, axes):

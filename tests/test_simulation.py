@@ -262,3 +262,28 @@ def test_result_saves_log_summary_events_and_report(tmp_path, mixed_runs):
 def test_bad_frames_are_refused(frame, message):
     with pytest.raises(HybridtrackError, match=message):
         simulate(frame, "lanzhou")
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda f, n: dict(faults={"clock": np.full(n, np.inf)}), r"fault 'clock' at step 0: inf is beyond ±3\.1536e\+07"),
+    (lambda f, n: dict(faults={"clock": np.full(n, 1e12)}), "fault 'clock' at step 0: 1e\\+12 is beyond"),
+    (lambda f, n: dict(faults={"sensor_drift": ["a"] * n}), "fault 'sensor_drift' needs numbers"),
+    (lambda f, n: dict(faults={"sensor_dropout": ["no"] * n}), "fault 'sensor_dropout' needs True/False per step"),
+    (lambda f, n: dict(faults={"sensor_dropout": np.full(n, np.nan)}), "needs True/False per step, got dtype float64 "
+                                                                        "with NaN"),  # bool(nan) is True: dropout on
+    (lambda f, n: dict(config={"seed": 1}), "config must be a SimulationConfig"),
+    (lambda f, n: dict(frame=f.assign(dni=f["dni"].astype(object).where(f.index != f.index[100], "abc"))),
+     "column 'dni' must hold numbers"),
+    (lambda f, n: dict(frame=f.assign(dni=f["dni"].where(f.index != f.index[100], np.inf))),
+     r"column 'dni' at 2021-06-01 16:40:00\+08:00: inf is not a reading"),
+    (lambda f, n: dict(frame=f.assign(dhi=-5.0)), r"column 'dhi' at 2021-06-01 00:00:00\+08:00: -5 is not a reading"),
+])
+def test_a_bad_frame_fault_or_config_from_the_api_is_a_hybridtrack_error(change, message):
+    """What `simulate` is given as it is (a frame not from read_weather, an injected fault) is
+    refused by name and place, not run with an infinite clock or a dropout read from NaN."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-01", freq="10min")
+    given = {"frame": frame, **change(frame, len(frame))}
+    with pytest.raises(HybridtrackError, match=message):
+        simulate(given.pop("frame"), "lanzhou", **given)
