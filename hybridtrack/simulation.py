@@ -297,18 +297,18 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def _physical_column(frame: pd.DataFrame, column: str) -> None:
-    """Refuse a column that is not numbers, or holds an infinite or negative value (NaN is a
-    missing reading), naming the first such row: `hybridtrack.io.read_weather` repairs a file;
-    a frame given to `simulate` is taken as it is."""
+    """Refuse a column that is not numbers, or light that is infinite (no world has it), naming
+    the first such row. A negative or missing reading is a sensor's fault the controller must
+    survive (`hybridtrack.faults`), so it runs; `hybridtrack.io.read_weather` repairs files."""
     values = frame[column]
     if not pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(values.dtype):
         raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
     array = values.to_numpy(float)
-    bad = np.flatnonzero(np.isinf(array) | (array < 0))
+    bad = np.flatnonzero(np.isinf(array)) if column in ("dni", "dhi") else []
     if len(bad):
-        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} is "
-                               "not a reading (infinite or negative); read files with hybridtrack.io.read_weather, "
-                               "which flags and counts such values")
+        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} W/m² "
+                               "is not light; read files with hybridtrack.io.read_weather, which flags and counts "
+                               "such values")
 
 
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
