@@ -381,8 +381,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     index = frame.index
     log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
                                                        world.controller_site()))
-    events = pd.DataFrame([(index[i], a, b, why) for i, a, b, why in out.events],
-                          columns=["time", "from", "to", "reason"])
+    events = _events_frame(index, out.events)
     scoring = {"sun_up": world.altitude > 0, "incidence": incidence_cosine(world.altitude, world.azimuth, collector),
                "moves": int(out.moves.sum()), "travel": float(out.travel.sum())}
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
@@ -395,6 +394,14 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     if config.controller.strategy == "astronomical-commissioned":
         memory["commissioned"] = mount
     return Result(log, summary, events, site, collector, config, memory, scoring)
+
+
+def _events_frame(index: pd.DatetimeIndex, events: list) -> pd.DataFrame:
+    """The controller's events, ``(scan, from, to, reason)``, as a frame stamped by the scan's time."""
+    scans = [event[0] for event in events]
+    words = {name: pd.array([event[k] for event in events], dtype="str")
+             for k, name in ((1, "from"), (2, "to"), (3, "reason"))}
+    return pd.DataFrame({"time": index[scans], **words})
 
 
 def _day_cycle(events: pd.DataFrame, site: sites.Site) -> list[dict]:
@@ -564,7 +571,13 @@ def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config
     variation[np.isnan(intensity)] = np.nan
     score = np.asarray(classifier.score(level.to_numpy(), variation), float)
     return pd.DataFrame({"intensity_ma": intensity, "variation_ma": variation, "sky_score": score,
-                         "sky": classifier.label(score)}, index=index)
+                         "sky": _sky_categorical(*classifier.label_codes(score))}, index=index)
+
+
+def _sky_categorical(codes: np.ndarray, names: tuple[str, ...]) -> pd.Categorical:
+    """Labels (codes into `names`) as a Categorical of `SKY_CODES`; a band named otherwise is NaN."""
+    recode = np.array([SKY_CODES.index(name) if name in SKY_CODES else -1 for name in names])
+    return pd.Categorical.from_codes(recode[codes], categories=list(SKY_CODES))
 
 
 def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> pd.DataFrame:
@@ -582,7 +595,7 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
     log = pd.DataFrame({
         "target_true": truth[:, main], "target": out.target[:, main], "angle": angle[:, main], "error": error,
         "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)),
-        "sky": pd.Categorical(sky["sky"].to_numpy(object), categories=list(SKY_CODES)),
+        "sky": sky["sky"].array,
         "sky_score": sky["sky_score"].to_numpy(), "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical.from_codes(out.sensor_status, categories=list(SENSOR_STATUS)),
         "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(), "wind_speed": world.wind,

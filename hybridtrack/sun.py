@@ -39,7 +39,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 from .sites import Site, get
-from .times import clock_hours
+from .times import clock_nanoseconds, calendar_days, clock_hours
 
 __all__ = [
     "solar_position",
@@ -203,9 +203,8 @@ def _plc(
     index: pd.DatetimeIndex, site: Site, declination: str, equation_of_time: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     local = index.tz_convert(site.tz)
-    utc_naive = index.tz_convert("UTC").tz_localize(None)
-    zone_hours = np.asarray((local.tz_localize(None) - utc_naive) / pd.Timedelta(hours=1), float)
-    day, year = np.asarray(local.day_of_year, float), np.asarray(local.year, float)
+    zone_hours = (clock_nanoseconds(local) - np.asarray(index.as_unit("ns").asi8)) / 3.6e12
+    day, year = calendar_days(local)
     dec = DECLINATION_MODELS[declination](day, year)
     if equation_of_time == "lamm":
         eot = lamm_equation_of_time(index)

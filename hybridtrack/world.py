@@ -248,8 +248,10 @@ class World:
         """The frame's true sky as `SKY_CODES` codes (anything else: unknown), or None."""
         if "sky" not in frame.columns:
             return None
-        labels = pd.Categorical(frame["sky"].astype(object), categories=list(SKY_CODES))
-        return np.where(labels.codes < 0, SKY_CODES.index("unknown"), labels.codes).astype(np.int64)
+        found, names = pd.factorize(frame["sky"])  # -1 for a missing label
+        known = np.array([SKY_CODES.index(name) if name in SKY_CODES else -1 for name in names] + [-1])
+        codes = known[found]
+        return np.where(codes < 0, SKY_CODES.index("unknown"), codes).astype(np.int64)
 
     @property
     def has_true_sky(self) -> bool:

@@ -105,6 +105,12 @@ def test_band_edges_are_half_open(clf):
         "overcast", "overcast", "cloudy", "cloudy", "sunny", "sunny"]
 
 
+def test_label_codes_index_the_band_names_with_unknown_for_nan(clf):
+    codes, names = clf.label_codes(np.array([np.nan, 0.0, 10.0, 20.0]))
+    assert names == ("overcast", "cloudy", "sunny", "unknown")
+    assert codes.tolist() == [3, 0, 1, 2]
+
+
 def test_explain_shows_memberships_and_firings(clf):
     explanation = clf.explain(200.1, 84.6)
     assert explanation.weather == "cloudy"

@@ -288,3 +288,18 @@ def test_a_bad_frame_fault_or_config_from_the_api_is_a_hybridtrack_error(change,
     given = {"frame": frame, **change(frame, len(frame))}
     with pytest.raises(HybridtrackError, match=message):
         simulate(given.pop("frame"), "lanzhou", **given)
+
+
+def test_the_logs_sky_is_the_classifiers_label_and_a_band_named_otherwise_is_missing():
+    """The log's sky is the label the classifier gives its score; a label outside the four sky
+    codes (a renamed band) is missing rather than a wrong code."""
+    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=2)
+    clf = FuzzyWeatherClassifier()
+    log = simulate(frame, "lanzhou", classifier=clf, warm_start=False, config=SimulationConfig(engine="reference")).log
+    assert log["sky"].astype(object).fillna("none").tolist() == list(clf.label(log["sky_score"].to_numpy()))
+    bands = tuple(("clear" if name == "sunny" else name, lo, hi) for name, lo, hi in clf.config.bands)
+    renamed = FuzzyWeatherClassifier(dataclasses.replace(clf.config, bands=bands))
+    log = simulate(frame, "lanzhou", classifier=renamed, warm_start=False,
+                   config=SimulationConfig(engine="reference")).log
+    clear = renamed.label(log["sky_score"].to_numpy()) == "clear"
+    assert clear.any() and log["sky"][clear].isna().all() and log["sky"][~clear].notna().all()

@@ -9,6 +9,7 @@ with the day cycle, the mode choice, the target and the drive command. It never 
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from dataclasses import dataclass
@@ -113,20 +114,13 @@ class Controller:
         self.config = config
         self.drives = drives
         self.axes = len(drives)
-        self.model = [plan.model[:, a].tolist() for a in range(self.axes)]
-        self.awake = plan.awake.tolist()
-        self.clock_steps = plan.clock_steps.tolist()
+        self.plan = plan
         self.plan_alarms = plan.alarms
-        n = len(self.awake)
         resolution = [d.resolution for d in drives]
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.encoders = [EncoderMonitor(r, config.encoder_confirm) for r in resolution]
         self.wind = WindGuard(config.wind_stow, config.wind_release, config.minutes("wind_hold"), config.wind_missing)
         self.sky = SkyWatch(ClassifierTable(classifier), sky_inputs, dark_current)
-        n_scans = len(plan.awake)
-        self.clear_light = plan.clear_light.tolist() if plan.clear_light is not None else [math.nan] * n_scans
-        self.altitude = plan.apparent_altitude.tolist() if plan.apparent_altitude is not None \
-            else [math.nan] * n_scans
         variance = [config.sensor_noise**2 + r * r / 12.0 for r in resolution]
         self.gates = [SensorGate(config.kalman, config.process_noise, v, config.stuck_scans, config.gate,
                                  config.reacquire, config.sensor_noise) for v in variance]
@@ -163,13 +157,49 @@ class Controller:
         self.blind_stow: list[float] | None = None  # what is left of a timed stow move, per axis
         self.found_today = False
         self.events: list = []
-        self.out = {name: [0] * n for name in ("mode", "status", "sky")}
-        self.out.update({name: [math.nan] * n for name in ("score", "variation", "intensity")})
-        self.out_axes = {name: [[math.nan] * n for _ in drives] for name in ("target", "reading", "calibration", "sun")}
-        fitted = len(self.theta) if self.fit is not None else 0
-        self.out_fit = {name: [[math.nan] * n for _ in range(fitted)] for name in ("value", "std")}
         self.moves = [0] * self.axes
         self.travel = [0.0] * self.axes
+
+    # -- the plan as lists, and the record, for the scan-by-scan step -----------------------------
+    # Built on first use: a Python list gives a float about three times faster than an array does,
+    # and the compiled kernel (`hybridtrack.kernel`), which reads the plan's arrays, never pays for them.
+
+    @functools.cached_property
+    def model(self) -> list:
+        return [self.plan.model[:, a].tolist() for a in range(self.axes)]
+
+    @functools.cached_property
+    def awake(self) -> list:
+        return self.plan.awake.tolist()
+
+    @functools.cached_property
+    def clock_steps(self) -> list:
+        return self.plan.clock_steps.tolist()
+
+    @functools.cached_property
+    def clear_light(self) -> list:
+        return _listed_or_nan(self.plan.clear_light, len(self.plan.awake))
+
+    @functools.cached_property
+    def altitude(self) -> list:
+        return _listed_or_nan(self.plan.apparent_altitude, len(self.plan.awake))
+
+    @functools.cached_property
+    def out(self) -> dict:
+        n = len(self.plan.awake)
+        out = {name: [0] * n for name in ("mode", "status", "sky")}
+        out.update({name: [math.nan] * n for name in ("score", "variation", "intensity")})
+        return out
+
+    @functools.cached_property
+    def out_axes(self) -> dict:
+        n = len(self.plan.awake)
+        return {name: [[math.nan] * n for _ in range(self.axes)] for name in ("target", "reading", "calibration", "sun")}
+
+    @functools.cached_property
+    def out_fit(self) -> dict:
+        n, fitted = len(self.plan.awake), len(self.theta) if self.fit is not None else 0
+        return {name: [[math.nan] * n for _ in range(fitted)] for name in ("value", "std")}
 
     # -- bookkeeping -----------------------------------------------------------------------------
 
@@ -626,3 +656,8 @@ class Controller:
                                  columns("target"), columns("reading"), columns("calibration"), columns("sun"),
                                  fit("value"), fit("std"),
                                  np.array(self.moves), np.array(self.travel), self.events)
+
+
+def _listed_or_nan(values: np.ndarray | None, n: int) -> list:
+    """`values` as a list, or NaN at every scan without them."""
+    return values.tolist() if values is not None else [math.nan] * n

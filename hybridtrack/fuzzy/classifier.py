@@ -139,13 +139,20 @@ class FuzzyWeatherClassifier:
         template = intensity if isinstance(intensity, pd.Series) else variation
         return self._wrap(scores, shape, template, "sky_score")
 
+    def label_codes(self, scores) -> tuple[np.ndarray, tuple[str, ...]]:
+        """Each score's label as a code into the names returned with it (the config's bands,
+        then ``unknown`` for NaN): `label` without building a string per score."""
+        values = np.asarray(scores, float)
+        names = tuple(band[0] for band in self.config.bands) + (UNKNOWN,)
+        edges = np.array([band[2] for band in self.config.bands[:-1]])
+        index = np.searchsorted(edges, values, side="right")
+        return np.where(np.isnan(values), len(names) - 1, index), names
+
     def label(self, scores):
         """Weather label of each score by the config's bands; ``unknown`` for NaN."""
         values = np.asarray(scores, float)
-        names = np.array([band[0] for band in self.config.bands] + [UNKNOWN], dtype=object)
-        edges = np.array([band[2] for band in self.config.bands[:-1]])
-        index = np.searchsorted(edges, values, side="right")
-        index = np.where(np.isnan(values), len(names) - 1, index)
+        index, names = self.label_codes(values)
+        names = np.array(names, dtype=object)
         if values.ndim == 0:
             return str(names[int(index)])
         labels = names[index]

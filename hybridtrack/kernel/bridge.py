@@ -100,16 +100,20 @@ def _settings(controller: Controller) -> kc.ControllerSettings:
 
 
 def _plan(controller: Controller) -> kc.ControllerPlanArrays:
-    n, axes = len(controller.awake), controller.axes
+    plan, axes = controller.plan, controller.axes
+    n = len(plan.awake)
     alarm = np.zeros(n, bool)
     alarm[list(controller.plan_alarms)] = True
-    jacobian = controller.jacobian if controller.jacobian is not None else np.zeros((n, axes, 0))
-    weight = controller.weight if controller.weight is not None else np.zeros((n, axes))
+    jacobian = plan.jacobian if plan.jacobian is not None else np.zeros((n, axes, 0))
+    weight = plan.weight if plan.weight is not None else np.zeros((n, axes))
+
+    def scans(values):
+        return np.full(n, np.nan) if values is None else np.ascontiguousarray(values, float)
+
     return kc.ControllerPlanArrays(
-        np.ascontiguousarray(np.array(controller.model, float).T), np.array(controller.awake, bool),
-        np.array(controller.clock_steps, float), alarm, np.array(controller.clear_light, float),
-        np.array(controller.altitude, float), np.ascontiguousarray(jacobian, float),
-        np.ascontiguousarray(weight, float))
+        np.ascontiguousarray(plan.model, float), np.ascontiguousarray(plan.awake, bool),
+        np.ascontiguousarray(plan.clock_steps, float), alarm, scans(plan.clear_light),
+        scans(plan.apparent_altitude), np.ascontiguousarray(jacobian, float), np.ascontiguousarray(weight, float))
 
 
 def _window_capacity(minutes: np.ndarray, windows: list[float]) -> int:

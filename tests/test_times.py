@@ -1,0 +1,26 @@
+"""The clock's fields by integer arithmetic against pandas' own field accessors."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack.times import calendar_days, clock_hours
+
+
+@pytest.mark.parametrize("tz", ["Asia/Shanghai", "America/New_York", "Australia/Lord_Howe", "Etc/GMT+12"])
+def test_clock_fields_match_pandas_through_daylight_saving(tz):
+    index = pd.date_range("1968-12-30", "2031-01-02", freq="47min", tz="UTC").tz_convert(tz)
+    day_of_year, year = calendar_days(index)
+    np.testing.assert_array_equal(day_of_year, index.day_of_year)
+    np.testing.assert_array_equal(year, index.year)
+    expected = index.hour + index.minute / 60.0 + (index.second + index.microsecond / 1e6) / 3600.0
+    np.testing.assert_allclose(clock_hours(index), expected, rtol=0, atol=1e-12)
+
+
+def test_clock_fields_of_a_coarser_unit_and_a_naive_index():
+    index = pd.date_range("2024-02-28 23:59:59.5", periods=500, freq="37s", tz="Europe/Paris", unit="ms")
+    np.testing.assert_array_equal(calendar_days(index)[0], index.day_of_year)  # 29 February and on
+    assert clock_hours(index)[0] == pytest.approx(23 + 59 / 60 + 59.5 / 3600, abs=1e-12)
+    naive = pd.DatetimeIndex(["2021-12-31 23:30", "2022-01-01 00:15"])
+    np.testing.assert_array_equal(calendar_days(naive)[0], [365, 1])
+    np.testing.assert_allclose(clock_hours(naive), [23.5, 0.25])
