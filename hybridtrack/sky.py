@@ -245,13 +245,19 @@ def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith) -> tuple[np.
     import pvlib
 
     apparent_zenith = np.asarray(apparent_zenith, float)
-    airmass = pvlib.atmosphere.get_relative_airmass(apparent_zenith)
-    pressure = pvlib.atmosphere.alt2pres(site.altitude)
-    linke = pvlib.clearsky.lookup_linke_turbidity(index, site.latitude, site.longitude)
-    with np.errstate(divide="ignore", invalid="ignore"):  # pvlib divides by airmass, infinite at night
-        clear = pvlib.clearsky.ineichen(apparent_zenith, pvlib.atmosphere.get_absolute_airmass(airmass, pressure),
-                                        linke.to_numpy(float), altitude=site.altitude)
-    return tuple(np.nan_to_num(np.asarray(clear[k], float)) for k in ("ghi", "dni", "dhi"))
+    up = apparent_zenith < 90.0  # below the horizon Ineichen's is zero: computed where the sun is up
+    irradiance = {name: np.zeros(len(apparent_zenith)) for name in ("ghi", "dni", "dhi")}
+    if up.any():
+        zenith = apparent_zenith[up]
+        airmass = pvlib.atmosphere.get_relative_airmass(zenith)
+        pressure = pvlib.atmosphere.alt2pres(site.altitude)
+        linke = pvlib.clearsky.lookup_linke_turbidity(index[up], site.latitude, site.longitude)
+        with np.errstate(divide="ignore", invalid="ignore"):  # pvlib divides by airmass, large at the horizon
+            clear = pvlib.clearsky.ineichen(zenith, pvlib.atmosphere.get_absolute_airmass(airmass, pressure),
+                                            linke.to_numpy(float), altitude=site.altitude)
+        for name, values in irradiance.items():
+            values[up] = np.nan_to_num(np.asarray(clear[name], float))
+    return irradiance["ghi"], irradiance["dni"], irradiance["dhi"]
 
 
 def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str] = "mixed", freq: str = "1min",

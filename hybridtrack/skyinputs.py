@@ -210,13 +210,30 @@ def clear_sky(index: pd.DatetimeIndex, site: Site | str, position: pd.DataFrame 
         raise HybridtrackError("the clear sky needs a time-zone-aware DatetimeIndex")
     location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
     if position is None:
-        position = location.get_solarposition(index)
+        elevation = location.get_solarposition(index)["apparent_elevation"].to_numpy(float)
     else:
         elevation = np.asarray(position["apparent_altitude"], float)
-        position = pd.DataFrame({"apparent_zenith": 90.0 - elevation, "apparent_elevation": elevation}, index=index)
-    clear = location.get_clearsky(index, model="ineichen", solar_position=position)
-    clear["apparent_elevation"] = position["apparent_elevation"]
-    return clear[["apparent_elevation", "ghi", "dni", "dhi"]]
+    irradiance = np.zeros((len(index), 3))  # Ineichen's is zero with the sun down: computed where it is up
+    up = elevation > 0.0
+    if up.any():
+        irradiance[up] = _ineichen(index[up], location, 90.0 - elevation[up])
+    return pd.DataFrame({"apparent_elevation": elevation, "ghi": irradiance[:, 0], "dni": irradiance[:, 1],
+                         "dhi": irradiance[:, 2]}, index=index)
+
+
+def _ineichen(times: pd.DatetimeIndex, location, apparent_zenith: np.ndarray) -> np.ndarray:
+    """GHI, DNI, DHI (N, 3) as pvlib's ``Location.get_clearsky(model="ineichen")`` gives them, from
+    its parts: the Linke turbidity looked up, the extraterrestrial beam of the day, the
+    Kasten-Young airmass (the location's default) at its pressure."""
+    import pvlib
+
+    airmass = pvlib.atmosphere.get_absolute_airmass(
+        pvlib.atmosphere.get_relative_airmass(apparent_zenith, "kastenyoung1989"),
+        pvlib.atmosphere.alt2pres(location.altitude))
+    linke = pvlib.clearsky.lookup_linke_turbidity(times, location.latitude, location.longitude)
+    clear = pvlib.clearsky.ineichen(apparent_zenith, airmass, linke.to_numpy(float), altitude=location.altitude,
+                                    dni_extra=pvlib.irradiance.get_extra_radiation(times).to_numpy(float))
+    return np.column_stack([np.asarray(clear[name], float) for name in ("ghi", "dni", "dhi")])
 
 
 def clear_sky_photocurrent(clear: pd.DataFrame, sensor: SensorModel) -> pd.Series:

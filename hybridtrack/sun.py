@@ -39,7 +39,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 from .sites import Site, get
-from .times import clock_nanoseconds, calendar_days, clock_hours
+from .times import DAY_NS, clock_nanoseconds, day_of_year
 
 __all__ = [
     "solar_position",
@@ -202,16 +202,20 @@ def _check_times(times) -> pd.DatetimeIndex:
 def _plc(
     index: pd.DatetimeIndex, site: Site, declination: str, equation_of_time: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    local = index.tz_convert(site.tz)
-    zone_hours = (clock_nanoseconds(local) - np.asarray(index.as_unit("ns").asi8)) / 3.6e12
-    day, year = calendar_days(local)
-    dec = DECLINATION_MODELS[declination](day, year)
+    wall = clock_nanoseconds(index.tz_convert(site.tz))
+    zone_hours = (wall - np.asarray(index.as_unit("ns").asi8)) / 3.6e12
+    # the series are of the calendar day: computed once a day, looked up at each scan
+    day_number = wall // DAY_NS
+    first = int(day_number.min()) if len(day_number) else 0
+    calendar = day_of_year(np.arange(first, int(day_number.max()) + 1 if len(day_number) else first))
+    on_day = day_number - first
+    dec = DECLINATION_MODELS[declination](*calendar)[on_day]
     if equation_of_time == "lamm":
         eot = lamm_equation_of_time(index)
     else:
-        eot = plc_equation_of_time(day, year)
+        eot = plc_equation_of_time(*calendar)[on_day]
     # true solar time: clock + (longitude - zone meridian)/15 + Et/60
-    solar_time = clock_hours(local) + (site.longitude - 15.0 * zone_hours) / 15.0 + eot / 60.0
+    solar_time = (wall % DAY_NS) / 3.6e12 + (site.longitude - 15.0 * zone_hours) / 15.0 + eot / 60.0
     hour_angle = (15.0 * (solar_time - 12.0) + 180.0) % 360.0 - 180.0
     return dec, hour_angle, eot
 

@@ -10,7 +10,7 @@ from .budget import check_steps
 from .errors import HybridtrackError
 
 __all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "local_midnight", "check_tz", "clock_hours",
-           "clock_nanoseconds", "calendar_days"]
+           "clock_nanoseconds", "calendar_days", "day_of_year", "DAY_NS"]
 
 
 def clock_nanoseconds(local: pd.DatetimeIndex):
@@ -28,7 +28,7 @@ def clock_hours(local: pd.DatetimeIndex):
     or repeated.
     """
     wall = clock_nanoseconds(local)
-    return (wall % _DAY_NS) / 3.6e12
+    return (wall % DAY_NS) / 3.6e12
 
 
 def calendar_days(local: pd.DatetimeIndex):
@@ -37,16 +37,21 @@ def calendar_days(local: pd.DatetimeIndex):
     Integer arithmetic on the clock's reading: the same as ``local.day_of_year`` and
     ``local.year`` at a fraction of pandas' cost for each field.
     """
+    return day_of_year(clock_nanoseconds(local) // DAY_NS)
+
+
+def day_of_year(day_number):
+    """Day of year (1 on 1 January) and year, as floats, of days counted from 1970-01-01 (day 0)."""
     import numpy as np
 
-    days = (clock_nanoseconds(local) // _DAY_NS).astype("datetime64[D]")
+    days = np.asarray(day_number, np.int64).astype("datetime64[D]")
     years = days.astype("datetime64[Y]")
-    day_of_year = (days - years.astype("datetime64[D]")).astype(np.int64) + 1
-    return day_of_year.astype(float), years.astype(np.int64).astype(float) + 1970.0
+    return ((days - years.astype("datetime64[D]")).astype(np.int64) + 1).astype(float), \
+        years.astype(np.int64).astype(float) + 1970.0
 
 
 #: Nanoseconds in a day of the clock.
-_DAY_NS = 86_400_000_000_000
+DAY_NS = 86_400_000_000_000
 
 
 def check_tz(tz: str, where: str = "") -> str:

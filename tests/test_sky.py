@@ -131,3 +131,23 @@ def test_custom_climate_and_any_site():
 def test_bad_sky_requests(kwargs, message):
     with pytest.raises(HybridtrackError, match=message):
         synthetic("lanzhou", "2021-06-21", **kwargs)
+
+
+def test_the_worlds_clear_sky_is_pvlibs_ineichen_day_and_night():
+    """Computed only where the sun is up, it equals pvlib's Ineichen over every stamp (zero below
+    the horizon, where pvlib's airmass is undefined)."""
+    import pvlib
+
+    from hybridtrack.sky import clear_sky
+
+    site = sites.get("lanzhou")
+    index = pd.date_range("2021-12-20", "2021-12-23", freq="3min", tz=site.tz)
+    zenith = pvlib.solarposition.get_solarposition(index, site.latitude, site.longitude)["zenith"].to_numpy()
+    airmass = pvlib.atmosphere.get_absolute_airmass(pvlib.atmosphere.get_relative_airmass(zenith),
+                                                    pvlib.atmosphere.alt2pres(site.altitude))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reference = pvlib.clearsky.ineichen(zenith, airmass, pvlib.clearsky.lookup_linke_turbidity(
+            index, site.latitude, site.longitude).to_numpy(float), altitude=site.altitude)
+    for mine, name in zip(clear_sky(index, site, zenith), ("ghi", "dni", "dhi")):
+        np.testing.assert_allclose(mine, np.nan_to_num(np.asarray(reference[name], float)), rtol=1e-12, atol=0)
+    assert (zenith > 90).any()

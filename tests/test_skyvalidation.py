@@ -21,7 +21,7 @@ from hybridtrack.errors import HybridtrackError
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
 from hybridtrack.io import read_weather
 from hybridtrack.sensor import SensorModel
-from hybridtrack.sites import Site
+from hybridtrack.sites import Site, get as get_site
 from hybridtrack.skyinputs import SkyInputConfig, classify_sky, clear_sky, sky_inputs
 from hybridtrack.skyvalidation import (
     BEAM_OVERCAST,
@@ -368,3 +368,19 @@ def test_validate_sky_refuses_a_file_without_dni(tmp_path, capsys):
     path.write_text("time,ghi\n2020-06-01T12:00:00+00:00,800\n2020-06-01T12:01:00+00:00,801\n")
     assert main(["validate-sky", str(path), "--lat", "40", "--lon", "0", "--tz", "UTC"]) == 2
     assert "dni is not measured" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("given", [False, True])
+def test_the_clear_sky_is_pvlibs_ineichen_at_every_stamp_day_and_night(given):
+    """Computed only where the sun is up, it equals pvlib's Location.get_clearsky everywhere."""
+    import pvlib
+
+    site = get_site("nanjing")
+    index = pd.date_range("2021-03-19", "2021-03-22", freq="7min", tz=site.tz)
+    location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
+    position = location.get_solarposition(index)
+    reference = location.get_clearsky(index, model="ineichen", solar_position=position)
+    mine = clear_sky(index, site, position.rename(columns={"apparent_elevation": "apparent_altitude"})
+                     if given else None)
+    assert (reference["ghi"] == 0).any() and (reference["ghi"] > 500).any()
+    pd.testing.assert_frame_equal(mine[["ghi", "dni", "dhi"]], reference[["ghi", "dni", "dhi"]], rtol=1e-12)
