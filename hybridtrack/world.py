@@ -228,12 +228,11 @@ class World:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
         cheap = solar_position(self.index, self.site, "plc")["altitude"].to_numpy()
         candidate = cheap > -3.0
-        position = pd.DataFrame({"altitude": -90.0, "azimuth": 0.0, "zenith": 180.0}, index=self.index)
+        altitude, azimuth = np.full(self.n, -90.0), np.zeros(self.n)
         if candidate.any():
             spa = solar_position(self.index[candidate], self.site, model)
-            position.loc[candidate, ["altitude", "azimuth", "zenith"]] = \
-                np.column_stack([spa["altitude"], spa["azimuth"], 90.0 - spa["altitude"]])
-        return position
+            altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
+        return pd.DataFrame({"altitude": altitude, "azimuth": azimuth, "zenith": 90.0 - altitude}, index=self.index)
 
     def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
         if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:
