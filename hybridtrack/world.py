@@ -123,6 +123,9 @@ def installed_site(site: sites.Site, imperfections: Imperfections) -> sites.Site
     return sites.Site(site.name, latitude, longitude, site.altitude, site.tz)
 
 
+_HOUR_NS = 3_600_000_000_000
+
+
 class World:
     """The plant one collector lives in, over one weather frame.
 
@@ -226,13 +229,25 @@ class World:
 
     def _true_sun(self, model: str) -> pd.DataFrame:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
-        cheap = solar_position(self.index, self.site, "plc")["altitude"].to_numpy()
-        candidate = cheap > -3.0
+        candidate = self._sun_may_be_up()
         altitude, azimuth = np.full(self.n, -90.0), np.zeros(self.n)
         if candidate.any():
             spa = solar_position(self.index[candidate], self.site, model)
             altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
         return pd.DataFrame({"altitude": altitude, "azimuth": azimuth, "zenith": 90.0 - altitude}, index=self.index)
+
+    def _sun_may_be_up(self) -> np.ndarray:
+        """Scans where the sun may be above -3°, as the cheap PLC model sees it at a knot every
+        hour: each scan is judged by its nearest knot, half an hour away at most, in which the
+        sun's altitude moves 7.5° at most (the earth turns 0.25° a minute), and by 0.5° more for
+        the model's declination and equation of time, held for each calendar day."""
+        stamps = np.asarray(self.index.as_unit("ns").asi8)
+        if not len(stamps):
+            return np.zeros(0, bool)
+        first = stamps.min() // _HOUR_NS
+        knots = pd.DatetimeIndex(np.arange(first, stamps.max() // _HOUR_NS + 2) * _HOUR_NS).tz_localize("UTC")
+        altitude = solar_position(knots, self.site, "plc")["altitude"].to_numpy()
+        return altitude[(stamps + _HOUR_NS // 2) // _HOUR_NS - first] > -3.0 - 7.5 - 0.5
 
     def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
         if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:

@@ -247,3 +247,23 @@ def test_the_plan_wakes_where_the_sun_ahead_or_behind_says_at_every_scan(site, m
         | (~up & (before > config.min_altitude) & (before > altitude))
     assert reference.sum() > up.sum() + 31 * 40  # about 45 minutes a day beyond the sun up
     np.testing.assert_array_equal(_sun_day(clock, altitude, where, config), reference)
+
+
+@pytest.mark.parametrize("site", [sites.get("lanzhou"), sites.Site("tromso", 69.65, 18.96, 10.0, "Europe/Oslo"),
+                                  sites.Site("quito", -0.18, -78.47, 2850.0, "America/Guayaquil")])
+def test_the_world_computes_spa_wherever_the_sun_is_near_or_above_the_horizon(site):
+    """The world runs SPA only where a cheap look at the sun, at hourly knots, says it may be up:
+    wherever pvlib's SPA puts the sun above -2°, the world's sun is SPA's (a year at 5 min)."""
+    import pvlib
+
+    index = pd.date_range("2021-01-01", "2021-12-31 23:55", freq="5min", tz=site.tz)
+    frame = pd.DataFrame({"dni": 0.0, "dhi": 0.0}, index=index)
+    config = SimulationConfig()
+    collector = Collector("trough-ns")
+    world = World(frame, site, collector, config.imperfections, config.sensor, _drives(collector, config), 0, {},
+                  truth="spa")
+    spa = pvlib.solarposition.spa_python(index, site.latitude, site.longitude, site.altitude, delta_t=67.0)
+    near = spa["elevation"].to_numpy() > -2.0
+    assert near.sum() > 0.4 * len(index)
+    np.testing.assert_allclose(world.altitude[near], spa["elevation"].to_numpy()[near], atol=1e-9)
+    assert (world.altitude[~near] < -2.0 + 1e-9).all()
