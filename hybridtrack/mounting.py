@@ -10,7 +10,8 @@ import numpy as np
 
 from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
 
-__all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine"]
+__all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine",
+           "rotate"]
 
 
 def _about(direction: np.ndarray, angle: float) -> np.ndarray:
@@ -64,10 +65,19 @@ def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = F
     return sun_vector(alt, np.asarray(azimuth, float))
 
 
+def rotate(vectors: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """Each of `vectors` (N, 3) turned by `rotation` (3 × 3): ``vectors @ rotation.T``, summed by
+    numpy's einsum rather than BLAS. A year of scans is a tall, thin product that BLAS's threads
+    do not speed up, and they spin against other work on the machine: with another process busy
+    on one of two cores a site-year's `simulate` took 2.09 s instead of 1.31 s, most of the
+    difference in these products."""
+    return np.einsum("nc,dc->nd", vectors, rotation)
+
+
 def angles_on_mount(vectors: np.ndarray, collector: Collector, rotation: np.ndarray | None = None) -> np.ndarray:
     """The collector's angles (N, axes), degrees, that follow `vectors` (`pointing_vectors`) on
     a mount turned by `rotation` (`mounting_rotation`; None: the nominal mount)."""
-    rotated = vectors if rotation is None else vectors @ rotation.T
+    rotated = vectors if rotation is None else rotate(vectors, rotation)
     if collector.kind == "heliostat":
         return np.stack(normal_angles(rotated), axis=-1)
     sun = across_angle(rotated, collector.axis)
@@ -86,7 +96,7 @@ def incidence_cosine(altitude, azimuth, collector: Collector) -> np.ndarray:
     s = sun_vector(alt, np.asarray(azimuth, float))
     if collector.kind == "heliostat":
         r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
-        cos = np.sqrt(np.clip((1.0 + s @ r) / 2.0, 0.0, 1.0))
+        cos = np.sqrt(np.clip((1.0 + np.einsum("nc,c->n", s, r)) / 2.0, 0.0, 1.0))
     else:
         b = np.radians(collector.axis)
         along = s[:, 0] * np.sin(b) + s[:, 1] * np.cos(b)

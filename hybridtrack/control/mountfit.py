@@ -68,7 +68,7 @@ import math
 
 import numpy as np
 
-from ..mounting import angles_on_mount, pointing_vectors
+from ..mounting import angles_on_mount, pointing_vectors, rotate
 
 __all__ = ["MountEstimator", "jacobian", "pull_spread", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
            "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
@@ -119,7 +119,7 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
     for k, name in enumerate(names[:2]):
         up, down = (MountEstimate.from_parameters(names, [sign * h if n == name else 0.0 for n in names])
                     .rotation(collector) for sign in (1.0, -1.0))
-        turned = vectors @ np.ascontiguousarray(((up - down) / (2.0 * h)).T)  # d(vectors as the mount sees)/d(parameter)
+        turned = rotate(vectors, (up - down) / (2.0 * h))  # d(vectors as the mount sees)/d(parameter)
         out[:, :, k] = np.einsum("nac,nc->na", gradient, turned)
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
