@@ -164,3 +164,11 @@ def test_collector_spec_gives_targets_for_each_kind():
 def test_bad_collector_geometry_is_refused(kwargs, message):
     with pytest.raises(HybridtrackError, match=message):
         Collector(**kwargs)
+
+
+def test_rotate_is_the_matrix_product_row_by_row():
+    from hybridtrack.mounting import mounting_rotation, rotate
+
+    vectors = np.random.default_rng(3).standard_normal((1000, 3))
+    rotation = mounting_rotation(0.7, -1.3, 20.0, 0.4)
+    np.testing.assert_allclose(rotate(vectors, rotation), vectors @ rotation.T, rtol=0, atol=1e-14)
