@@ -110,6 +110,14 @@ def test_classify_refuses_a_reading_that_is_not_a_finite_number(capsys, value):
     assert "--variation must be a finite number" in capsys.readouterr().err
 
 
+def test_a_bad_cell_is_named_by_the_files_own_row_past_comments_and_blank_lines(tmp_path, capsys):
+    # the row was counted among the data rows only: 'row 3' for the file's line 6
+    src = tmp_path / "log.csv"
+    src.write_text("# site notes\nintensity,variation\n\n246,27\n# a remark\n200,abc\n")
+    assert main(["classify", str(src)]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {src}: row 6, column 'variation': 'abc' is not a number\n"
+
+
 def test_classify_refuses_an_infinite_cell_by_row_and_column(tmp_path, capsys):
     # an infinite photocurrent was clipped and classified 'sunny', status 0
     src = tmp_path / "log.csv"

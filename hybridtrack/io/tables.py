@@ -199,6 +199,10 @@ def read_table(path) -> pd.DataFrame:
     if frame.empty:
         raise HybridtrackError(f"{path}: the table has no rows")
     frame.attrs["source"] = str(path)
+    if path.suffix.lower() != ".toml":
+        lines = [number for number, _ in _kept_lines(text)[0][1:]]  # the rows' own lines, comments skipped
+        if len(lines) == len(frame):
+            frame.attrs["lines"] = lines
     return frame
 
 
@@ -206,9 +210,17 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) ->
     """`frame` with `columns` (those present) as floats; text in one names its row and column.
 
     An infinite cell (``inf``, ``1e400``) is refused: no reading is infinite. An empty cell is
-    NaN, or refused in a column of `required`. Row numbers count the header as row 1, as a
-    spreadsheet shows them.
+    NaN, or refused in a column of `required`. Row numbers are the file's, as a spreadsheet
+    shows them (`read_table` keeps them past comment lines); else the header counts as row 1.
     """
+    lines = frame.attrs.get("lines")
+
+    def row_number(position: int) -> int:
+        label = frame.index[position]
+        if lines is not None and isinstance(label, (int, np.integer)) and 0 <= label < len(lines):
+            return int(lines[label])
+        return position + 2
+
     frame = frame.copy()
     for column in columns:
         if column not in frame.columns:
@@ -217,13 +229,13 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) ->
         bad = (values.isna() & frame[column].notna()).to_numpy()
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
-            raise HybridtrackError(f"{where}: row {row + 2}, column {column!r}: {frame[column].iloc[row]!r} "
+            raise HybridtrackError(f"{where}: row {row_number(row)}, column {column!r}: {frame[column].iloc[row]!r} "
                                    "is not a number")
         values = values.astype(float)
         refused = np.isinf(values.to_numpy()) | (values.isna().to_numpy() if column in required else False)
         if refused.any():
             row = int(np.flatnonzero(refused)[0])
             what = "empty" if np.isnan(values.iloc[row]) else f"{values.iloc[row]} is not a finite number"
-            raise HybridtrackError(f"{where}: row {row + 2}, column {column!r}: {what}")
+            raise HybridtrackError(f"{where}: row {row_number(row)}, column {column!r}: {what}")
         frame[column] = values
     return frame
