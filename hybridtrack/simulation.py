@@ -145,7 +145,8 @@ class SimulationConfig:
                     changes[name] = value
                 elif isinstance(current, (int, float)) and not isinstance(current, bool):
                     if not isinstance(value, (int, float)) or (isinstance(current, int) and not isinstance(value, int)):
-                        raise HybridtrackError(f"{source}: {key}: must be a number, got {value!r}")
+                        kind = "a whole number" if isinstance(current, int) else "a number"
+                        raise HybridtrackError(f"{source}: {key}: must be {kind}, got {value!r}")
                     changes[name] = value
                 elif isinstance(current, str):
                     if not isinstance(value, str):

@@ -240,6 +240,9 @@ def test_config_round_trips_and_refuses_unknown_keys(tmp_path):
     (tmp_path / "bad3.toml").write_text("[drive]\ndeadband = 'wide'\n")
     with pytest.raises(HybridtrackError, match="drive.deadband: must be a number"):
         SimulationConfig.from_toml(tmp_path / "bad3.toml")
+    (tmp_path / "bad4.toml").write_text("[controller]\nreacquire = 3.5\n")  # a count of scans
+    with pytest.raises(HybridtrackError, match="controller.reacquire: must be a whole number, got 3.5"):
+        SimulationConfig.from_toml(tmp_path / "bad4.toml")
 
 
 def test_result_saves_log_summary_events_and_report(tmp_path, mixed_runs):
