@@ -170,3 +170,44 @@ def test_a_file_whose_header_places_it_far_from_the_site_is_refused_or_warned(ca
     assert "  place: WARNING: the file's header places it at Lanzhou" in out and "verdict: usable, with 1 kind" in out
     assert main(["check", epw, "--site", "lanzhou"]) == 0  # its own site
     assert "verdict: clean" in capsys.readouterr().out
+
+
+def _clear_day_file(path, dni_scale=1.0):
+    """A 1-minute clear day at Lanzhou from pvlib's Ineichen sky, whose components add up."""
+    import pvlib
+
+    from hybridtrack import sites
+
+    site = sites.get("lanzhou")
+    index = pd.date_range("2021-06-05 05:00", "2021-06-05 21:00", freq="1min", tz=site.tz)
+    location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
+    clear = location.get_clearsky(index, model="ineichen")
+    frame = pd.DataFrame({"ghi": clear["ghi"].round(1).to_numpy(), "dni": (dni_scale * clear["dni"]).round(1).to_numpy(),
+                          "dhi": clear["dhi"].round(1).to_numpy(), "wind_speed": 2.0}, index=index.tz_localize(None))
+    frame.rename_axis("time").to_csv(path)
+    return path
+
+
+def test_the_components_of_a_clear_day_add_up_and_a_dead_pyrheliometer_is_named(tmp_path, capsys):
+    """GHI = DNI·cos z + DHI (BSRN's comparison test, ±8 %): pvlib's clear day passes; a
+    pyrheliometer that reads 0 all day (a dead one, not an empty column) passed every check
+    before and is now a warning naming the first row, and a refusal in strict reading."""
+    good = _clear_day_file(tmp_path / "clear.csv")
+    report = read_weather(good, site="lanzhou", tz="Asia/Shanghai").attrs["validation"]
+    assert report["closure"].startswith("GHI = DNI·cos z + DHI within BSRN's tolerance on 100.0% of")
+    dead = _clear_day_file(tmp_path / "dead.csv", dni_scale=0.0)
+    report = read_weather(dead, site="lanzhou", tz="Asia/Shanghai").attrs["validation"]
+    assert report["closure"].startswith("WARNING: line ") and "do not add up on 100% of" in report["closure"]
+    assert "is the DNI column dead" in report["closure"]
+    assert main(["check", str(dead), "--site", "lanzhou", "--tz", "Asia/Shanghai"]) == 0
+    out = capsys.readouterr().out
+    assert "closure: WARNING" in out and "verdict: usable, with" in out
+    assert main(["check", str(dead), "--site", "lanzhou", "--tz", "Asia/Shanghai", "--strict"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"hybridtrack: error: {dead}: line ") and err.rstrip().endswith("(strict)")
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_hourly_components_are_not_judged_for_closure():
+    report = read_weather("tests/records/lanzhou.epw", site="lanzhou").attrs["validation"]
+    assert report["closure"].startswith("not judged (steps of 1h")

@@ -59,6 +59,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
         lines.append(f"  place: {report['place']}")
     if "sun_check" in report:
         lines.append(f"  sun check: {report['sun_check']}")
+    if "closure" in report:
+        lines.append(f"  closure: {report['closure']}")
     return lines
 
 
@@ -90,7 +92,7 @@ def validation_report(frame: pd.DataFrame) -> str:
     lines.append("  changes: " + ("none" if not changes else f"{len(changes)}"))
     lines.extend(changes)
     issues = [k for k in ISSUES if k in report]
-    warning = sum(str(report.get(key, "")).startswith("WARNING") for key in ("place", "sun_check"))
+    warning = sum(str(report.get(key, "")).startswith("WARNING") for key in ("place", "sun_check", "closure"))
     kinds = f"{len(issues) + warning} kind{'s' if len(issues) + warning > 1 else ''}"
     lines.append("  verdict: " + ("clean" if not issues and not warning else f"usable, with {kinds} of issue noted "
                                                                               "above"))

@@ -16,6 +16,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from .checks import check_frame, check_magnitude, refuse_repairs
+from .closure import closure_check
 from .columns import IRRADIANCE, LABEL_COLUMN, WEATHER_COLUMNS, check_names, resolve_columns, split_header
 from .files import file_text
 from .formats import PVLIB_FORMATS, detect_format, read_pvlib
@@ -230,6 +231,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         clear = pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float)
         check_magnitude(path, frame, report, clear)
         sun_check(path, frame, site, report, lenient=lenient)
+        closure_check(path, frame, zenith.to_numpy(float), report, strict=strict)
     else:
         check_magnitude(path, frame, report, None)
     attrs: dict = {}
