@@ -366,10 +366,10 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
                                "have one)")
     mount, memory = _history(site, collector, config, frame.index[0], classifier, warm_start)
-    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
-                     config.controller, mount)
+    clock = world.controller_clock()
+    plan = make_plan(clock, world.minutes, world.controller_site(), collector, config.controller, mount)
     clf = classifier or FuzzyWeatherClassifier(fuzzy_config(config.sky))
-    clear = _expected_clear_sky(world, config, plan)
+    clear = _expected_clear_sky(world, config, plan, clock)
     if clear is not None:
         plan.clear_light = (clear_sky_photocurrent(clear, config.sensor) - config.sensor.dark_current).to_numpy()
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
@@ -550,13 +550,13 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
     return np.where(np.isnan(values), default, values) if not np.isnan(default) else values
 
 
-def _expected_clear_sky(world: World, config: SimulationConfig, plan) -> pd.DataFrame | None:
-    """The clear sky the controller expects at each scan, from what a PLC has: its clock, its site
-    and the sun its plan computed; on the scans' index."""
+def _expected_clear_sky(world: World, config: SimulationConfig, plan, clock: pd.DatetimeIndex) -> pd.DataFrame | None:
+    """The clear sky the controller expects at each scan, from what a PLC has: its `clock`, its
+    site and the sun its plan computed; on the scans' index."""
     if config.sky.mode != "relative" or config.controller.sensor_only:
         return None
     position = pd.DataFrame({"apparent_altitude": plan.apparent_altitude})
-    return clear_sky(world.controller_clock(), world.controller_site(), position).set_axis(world.index)
+    return clear_sky(clock, world.controller_site(), position).set_axis(world.index)
 
 
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,
