@@ -205,10 +205,12 @@ def _plc(
     wall = clock_nanoseconds(index.tz_convert(site.tz))
     zone_hours = (wall - np.asarray(index.as_unit("ns").asi8)) / 3.6e12
     # the series are of the calendar day: computed once a day, looked up at each scan
+    missing = np.asarray(index.isna())  # NaT: its integer is no time at all
     day_number = wall // DAY_NS
-    first = int(day_number.min()) if len(day_number) else 0
-    calendar = day_of_year(np.arange(first, int(day_number.max()) + 1 if len(day_number) else first))
-    on_day = day_number - first
+    days = day_number[~missing]
+    first, last = (int(days.min()), int(days.max())) if len(days) else (0, 0)
+    calendar = day_of_year(np.arange(first, last + 1))
+    on_day = np.where(missing, 0, day_number - first)
     dec = DECLINATION_MODELS[declination](*calendar)[on_day]
     if equation_of_time == "lamm":
         eot = lamm_equation_of_time(index)
@@ -217,6 +219,8 @@ def _plc(
     # true solar time: clock + (longitude - zone meridian)/15 + Et/60
     solar_time = (wall % DAY_NS) / 3.6e12 + (site.longitude - 15.0 * zone_hours) / 15.0 + eot / 60.0
     hour_angle = (15.0 * (solar_time - 12.0) + 180.0) % 360.0 - 180.0
+    if missing.any():
+        dec, hour_angle, eot = (np.where(missing, np.nan, values) for values in (dec, hour_angle, eot))
     return dec, hour_angle, eot
 
 

@@ -27,8 +27,10 @@ def clock_hours(local: pd.DatetimeIndex):
     Not the time since midnight: on a DST day the two differ by the hour the clock skipped
     or repeated.
     """
-    wall = clock_nanoseconds(local)
-    return (wall % DAY_NS) / 3.6e12
+    import numpy as np
+
+    hours = (clock_nanoseconds(local) % DAY_NS) / 3.6e12
+    return np.where(np.asarray(local.isna()), np.nan, hours)
 
 
 def calendar_days(local: pd.DatetimeIndex):

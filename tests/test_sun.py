@@ -135,3 +135,10 @@ def test_plc_model_reads_the_clock_on_dst_days(date):
     plc = solar_position(times, denver, "plc")
     assert np.abs(spa["hour_angle"] - plc["hour_angle"]).max() < 0.5
     assert np.abs(spa["altitude"] - plc["altitude"]).max() < 0.5
+
+
+def test_a_missing_time_has_no_sun_in_any_model():
+    index = pd.DatetimeIndex(["2021-06-21 12:00", None, "2021-06-21 13:00"]).tz_localize("Asia/Shanghai")
+    for model in ("plc", "spa"):
+        sun = solar_position(index, "lanzhou", model)
+        assert sun.iloc[1].isna().all() and sun.iloc[[0, 2]].notna().all().all()
