@@ -52,7 +52,16 @@ def assert_same_run(reference, compiled):
             assert ours.astype(object).equals(theirs.astype(object)), column
     pd.testing.assert_frame_equal(reference.events, compiled.events)
     assert_same_summary(reference.summary, compiled.summary, "summary")
-    assert_same_summary(reference.memory, compiled.memory, "memory")
+    assert_same_summary(*(without_evidence(run.memory) for run in (reference, compiled)), "memory")
+    if "evidence" in reference.memory:  # a sum of residuals over their variance (deg⁻¹, ~1e4):
+        # compared as the angles it solves for, as every angle is
+        solved = [np.linalg.solve(run.memory["information"] + np.eye(len(run.memory["evidence"])) / 4.0,
+                                  run.memory["evidence"]) for run in (reference, compiled)]
+        assert_same_numbers(*solved, "memory.evidence solved")
+
+
+def without_evidence(memory):
+    return {key: value for key, value in memory.items() if key != "evidence"}
 
 
 def assert_same_summary(reference, compiled, where):
@@ -64,6 +73,9 @@ def assert_same_summary(reference, compiled, where):
         assert_same_numbers(reference, compiled, where)
     elif isinstance(reference, float):
         assert_same_numbers([reference], [compiled], where)
+    elif dataclasses.is_dataclass(reference):  # a commissioned mount: its angles, as every angle
+        assert type(reference) is type(compiled), where
+        assert_same_summary(dataclasses.asdict(reference), dataclasses.asdict(compiled), where)
     else:
         assert reference == compiled, where
 
@@ -415,12 +427,13 @@ def test_the_cusum_compiled_flags_as_the_reference():
 
 def test_the_mount_fit_compiled_updates_as_the_reference():
     from hybridtrack.control.mountfit import MountEstimator, pull_spread
-    from hybridtrack.kernel.controller import (FLOAT_SLOTS, INT_SLOTS, LIGHT_LEVEL, ControllerState, fit_condition,
+    from hybridtrack.kernel.controller import (FLOAT_SLOTS, INT_SLOTS, LIGHT_LEVEL, ControllerState, fit_check,
                                                fit_excess_light, fit_forget, fit_update)
     from hybridtrack.kernel.controller import pull_spread as compiled_spread
 
     fit, rng = MountEstimator(2, 0.05), np.random.default_rng(4)
-    theta, p, information = fit.theta.copy(), fit.p.copy(), fit.information.copy()
+    theta, p, information, evidence = fit.theta.copy(), fit.p.copy(), fit.information.copy(), fit.evidence.copy()
+    frozen, releases = True, 0
     unused = [np.zeros(1)] * (len(ControllerState._fields) - 2)
     compiled = ControllerState(np.full(FLOAT_SLOTS, np.nan), np.zeros(INT_SLOTS, np.int64), *unused)
     for k in range(400):
@@ -431,15 +444,21 @@ def test_the_mount_fit_compiled_updates_as_the_reference():
         compiled_pull = weight * compiled_spread(1.4, fit_excess_light(compiled, ratio), altitude)
         assert compiled_pull == pull and compiled.s[LIGHT_LEVEL] == fit.level
         fit.forget(5.0)
-        fit_forget(p, information, fit.memory, fit.prior, 5.0)
-        frozen = fit.axis_frozen
+        fit_forget(p, information, evidence, fit.memory, fit.prior, 5.0)
         fit.update(derivatives * weight, residual * weight, fit.r + pull * pull)
-        fit_update(theta, p, information, fit.r + pull * pull, fit.clip, frozen, derivatives, weight,
+        fit_update(theta, p, information, evidence, fit.r + pull * pull, fit.clip, frozen, derivatives, weight,
                    residual * weight)
+        if fit.updates % fit.check_every == 0:  # a release restarts both from the information form
+            was = frozen
+            condition, frozen = fit_check(theta, p, information, evidence, fit.prior, frozen)
+            assert condition == pytest.approx(fit.condition, rel=1e-12) and frozen == fit.axis_frozen
+            releases += was and not frozen
+            np.testing.assert_allclose(theta, fit.theta, rtol=1e-12, atol=1e-14)
+            np.testing.assert_allclose(p, fit.p, rtol=1e-12, atol=1e-14)
+            theta[:], p[:, :] = fit.theta, fit.p  # LAPACK's inverse may differ in the last bit
         assert np.array_equal(theta, fit.theta) and np.array_equal(p, fit.p)
-        assert np.array_equal(information, fit.information)
-        if fit.updates % fit.check_every == 0:
-            assert fit_condition(information) == pytest.approx(fit.condition, rel=1e-12)
+        assert np.array_equal(information, fit.information) and np.array_equal(evidence, fit.evidence)
+    assert releases >= 1
 
 
 @pytest.mark.parametrize("days", [1.0, 40.0])  # within DRIFT_DAYS the drift is held; beyond it is fitted

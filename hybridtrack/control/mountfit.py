@@ -44,6 +44,15 @@ condition number exceeds `MAX_CONDITION`, the pedestal (axis) terms are frozen a
 encoder zeros learn. An east-west trough at an equinox, whose sun path moves its target as a
 tilt would, is the textbook case (a test shows it frozen).
 
+While frozen, the pedestal terms are Schmidt "consider" parameters: they are never moved, so the
+filter's covariance keeps the prior's 2° on them, although the readings taken meanwhile tell
+much more (on the clear day before Nanjing's 2013-09-23, a Fresnel row, the information form's
+1σ is 0.13° and 0.16° when the pedestal is released). A filter released from its own covariance
+would throw that away and let the next few readings set the pedestal. So the fit carries the information vector too (Σ row ·
+residual / r, forgotten like the matrix), and at a release it restarts from the batch solution
+of everything it has seen, θ = (Λ + I/σ₀²)⁻¹ b with P = (Λ + I/σ₀²)⁻¹, σ₀ the prior's 1σ: the
+information form of the same least-squares problem.
+
 References
 ----------
 Baheti, R. S. & Scott, P. F. (1980). Design of self-calibrating controllers for heliostats in a
@@ -187,6 +196,7 @@ class MountEstimator:
         self.prior = prior * prior
         self.p = np.eye(self.n) * self.prior
         self.information = np.zeros((self.n, self.n))
+        self.evidence = np.zeros(self.n)
         self.r = noise * noise
         self.memory = memory
         self.clip = clip
@@ -225,6 +235,7 @@ class MountEstimator:
         scale = np.sqrt(np.minimum(1.0, self.prior / np.diag(p)))
         self.p = p * np.outer(scale, scale)
         self.information *= factor
+        self.evidence *= factor
 
     def update(self, row, residual: float, variance: float | None = None) -> None:
         """Take one measurement: `residual` = measured angle − computed target, with derivatives `row`
@@ -237,6 +248,7 @@ class MountEstimator:
         row = np.asarray(row, float)
         r = self.r if variance is None else variance
         self.information += np.outer(row, row) / r  # what it tells of every parameter, frozen or not
+        self.evidence += row * residual / r
         pr = self.p @ row
         s = r + float(row @ pr)
         gain = pr / s
@@ -253,9 +265,20 @@ class MountEstimator:
             self._check()
 
     def _check(self) -> None:
+        """Freeze the pedestal terms while the information matrix is ill-conditioned; at a release
+        restart from the information form's solution (`solve`)."""
         singular = np.linalg.svd(self.information, compute_uv=False)
         self.condition = float(singular[0] / max(singular[-1], 1e-300))
-        self.axis_frozen = self.condition > MAX_CONDITION
+        frozen = self.condition > MAX_CONDITION
+        if self.axis_frozen and not frozen:
+            self.theta, self.p = self.solve()
+        self.axis_frozen = frozen
+
+    def solve(self) -> tuple[np.ndarray, np.ndarray]:
+        """The batch least-squares solution of every reading taken (forgotten as the fit forgets)
+        with the prior: θ = (Λ + I/σ₀²)⁻¹ b and its covariance (Λ + I/σ₀²)⁻¹."""
+        p = np.linalg.inv(self.information + np.eye(self.n) / self.prior)
+        return p @ self.evidence, p
 
     def std(self) -> list[float]:
         """1σ of each parameter, degrees."""
