@@ -453,9 +453,6 @@ def test_the_mount_fit_compiled_updates_as_the_reference():
             condition, frozen = fit_check(theta, p, information, evidence, fit.prior, frozen)
             assert condition == pytest.approx(fit.condition, rel=1e-12) and frozen == fit.axis_frozen
             releases += was and not frozen
-            np.testing.assert_allclose(theta, fit.theta, rtol=1e-12, atol=1e-14)
-            np.testing.assert_allclose(p, fit.p, rtol=1e-12, atol=1e-14)
-            theta[:], p[:, :] = fit.theta, fit.p  # LAPACK's inverse may differ in the last bit
         assert np.array_equal(theta, fit.theta) and np.array_equal(p, fit.p)
         assert np.array_equal(information, fit.information) and np.array_equal(evidence, fit.evidence)
     assert releases >= 1

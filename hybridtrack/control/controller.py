@@ -479,7 +479,8 @@ class Controller:
         if self.responsivity is None:
             return self.fit.r
         light = max((self.out["intensity"][i] - self.sky.dark) / self.responsivity, self.sun_threshold)
-        return self.fit.r * (REFERENCE_LIGHT / light) ** 2
+        ratio = REFERENCE_LIGHT / light
+        return self.fit.r * ratio * ratio  # not ** 2: libm's pow and a product may differ in the last bit
 
     def _disagrees(self, i: int, miss: float, spread: float) -> bool:
         """Watch the sensor against the checkpointed calibration (`miss`, degrees, with its expected

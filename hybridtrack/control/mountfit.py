@@ -79,7 +79,7 @@ import numpy as np
 
 from ..mounting import angles_on_mount, pointing_vectors
 
-__all__ = ["MountEstimator", "jacobian", "pull_spread", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
+__all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
            "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
 
 #: Above this condition number of the information matrix, axis azimuth and tilt are frozen.
@@ -276,10 +276,52 @@ class MountEstimator:
 
     def solve(self) -> tuple[np.ndarray, np.ndarray]:
         """The batch least-squares solution of every reading taken (forgotten as the fit forgets)
-        with the prior: θ = (Λ + I/σ₀²)⁻¹ b and its covariance (Λ + I/σ₀²)⁻¹."""
-        p = np.linalg.inv(self.information + np.eye(self.n) / self.prior)
-        return p @ self.evidence, p
+        with the prior: θ = (Λ + I/σ₀²)⁻¹ b and its covariance (Λ + I/σ₀²)⁻¹ (`spd_inverse`)."""
+        p = spd_inverse(self.information + np.eye(self.n) / self.prior)
+        theta = np.zeros(self.n)
+        for i in range(self.n):
+            total = 0.0
+            for j in range(self.n):
+                total += float(p[i, j]) * float(self.evidence[j])
+            theta[i] = total
+        return theta, p
 
     def std(self) -> list[float]:
         """1σ of each parameter, degrees."""
         return np.sqrt(np.clip(np.diag(self.p), 0.0, None)).tolist()
+
+
+def spd_inverse(a: np.ndarray) -> np.ndarray:
+    """The inverse of a symmetric positive-definite matrix through its Cholesky factor L
+    (A⁻¹ = L⁻ᵀ L⁻¹), one scalar step at a time in a fixed order: the compiled controller
+    (`hybridtrack.kernel.controller.spd_inverse`) takes the same steps and so gets the same bits,
+    which LAPACK's two builds (numpy's, numba's) do not promise; a difference in the last bit
+    grows over a year of closed-loop runs."""
+    n = len(a)
+    low = np.zeros((n, n))
+    for j in range(n):
+        total = float(a[j, j])
+        for k in range(j):
+            total -= low[j, k] * low[j, k]
+        low[j, j] = math.sqrt(total)
+        for i in range(j + 1, n):
+            total = float(a[i, j])
+            for k in range(j):
+                total -= low[i, k] * low[j, k]
+            low[i, j] = total / low[j, j]
+    inverse_low = np.zeros((n, n))
+    for i in range(n):
+        inverse_low[i, i] = 1.0 / low[i, i]
+        for j in range(i):
+            total = 0.0
+            for k in range(j, i):
+                total -= low[i, k] * inverse_low[k, j]
+            inverse_low[i, j] = total / low[i, i]
+    out = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = 0.0
+            for k in range(max(i, j), n):
+                total += inverse_low[k, i] * inverse_low[k, j]
+            out[i, j] = total
+    return out

@@ -538,11 +538,48 @@ def fit_condition(information):
 
 
 @kernel(allocates=True)
+def spd_inverse(a):
+    """mountfit.spd_inverse: the same Cholesky steps in the same order, so the same bits."""
+    n = a.shape[0]
+    low = np.zeros((n, n))
+    for j in range(n):
+        total = a[j, j]
+        for k in range(j):
+            total -= low[j, k] * low[j, k]
+        low[j, j] = math.sqrt(total)
+        for i in range(j + 1, n):
+            total = a[i, j]
+            for k in range(j):
+                total -= low[i, k] * low[j, k]
+            low[i, j] = total / low[j, j]
+    inverse_low = np.zeros((n, n))
+    for i in range(n):
+        inverse_low[i, i] = 1.0 / low[i, i]
+        for j in range(i):
+            total = 0.0
+            for k in range(j, i):
+                total -= low[i, k] * inverse_low[k, j]
+            inverse_low[i, j] = total / low[i, i]
+    out = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = 0.0
+            for k in range(max(i, j), n):
+                total += inverse_low[k, i] * inverse_low[k, j]
+            out[i, j] = total
+    return out
+
+
+@kernel(allocates=True)
 def fit_solve(theta, p, information, evidence, prior):
     """MountEstimator.solve, into `theta` and `p`: θ = (Λ + I/σ₀²)⁻¹ b, P = (Λ + I/σ₀²)⁻¹."""
     n = theta.shape[0]
-    p[:, :] = np.linalg.inv(information + np.eye(n) / prior)
-    theta[:] = p @ evidence
+    p[:, :] = spd_inverse(information + np.eye(n) / prior)
+    for i in range(n):
+        total = 0.0
+        for j in range(n):
+            total += p[i, j] * evidence[j]
+        theta[i] = total
 
 
 @kernel(allocates=True)
@@ -685,7 +722,8 @@ def _reading_variance(cfg, intensity):
     if cfg.responsivity <= 0.0:
         return cfg.fit_r
     light = max((intensity - cfg.dark) / cfg.responsivity, cfg.sun_threshold)
-    return cfg.fit_r * (REFERENCE_LIGHT / light) ** 2
+    ratio = REFERENCE_LIGHT / light
+    return cfg.fit_r * ratio * ratio
 
 
 @kernel
