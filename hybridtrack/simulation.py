@@ -373,7 +373,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     if clear is not None:
         plan.clear_light = (clear_sky_photocurrent(clear, config.sensor) - config.sensor.dark_current).to_numpy()
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
-                            east_park(collector), memory)
+                            east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
     if uses_kernel(config, world.n):
         out = run_compiled(world, controller, progress, bulk_nights and not faults)
     else:

@@ -415,12 +415,13 @@ def test_the_cusum_compiled_flags_as_the_reference():
 
 def test_the_mount_fit_compiled_updates_as_the_reference():
     from hybridtrack.control.mountfit import MountEstimator, pull_spread
-    from hybridtrack.kernel.controller import (FLOAT_SLOTS, INT_SLOTS, LIGHT_LEVEL, ControllerState, fit_condition,
+    from hybridtrack.kernel.controller import (FLOAT_SLOTS, INT_SLOTS, LIGHT_LEVEL, ControllerState, fit_check,
                                                fit_excess_light, fit_forget, fit_update)
     from hybridtrack.kernel.controller import pull_spread as compiled_spread
 
     fit, rng = MountEstimator(2, 0.05), np.random.default_rng(4)
-    theta, p, information = fit.theta.copy(), fit.p.copy(), fit.information.copy()
+    theta, p, information, evidence = fit.theta.copy(), fit.p.copy(), fit.information.copy(), fit.evidence.copy()
+    frozen, releases = True, 0
     unused = [np.zeros(1)] * (len(ControllerState._fields) - 2)
     compiled = ControllerState(np.full(FLOAT_SLOTS, np.nan), np.zeros(INT_SLOTS, np.int64), *unused)
     for k in range(400):
@@ -431,15 +432,18 @@ def test_the_mount_fit_compiled_updates_as_the_reference():
         compiled_pull = weight * compiled_spread(1.4, fit_excess_light(compiled, ratio), altitude)
         assert compiled_pull == pull and compiled.s[LIGHT_LEVEL] == fit.level
         fit.forget(5.0)
-        fit_forget(p, information, fit.memory, fit.prior, 5.0)
-        frozen = fit.axis_frozen
+        fit_forget(p, information, evidence, fit.memory, fit.prior, 5.0)
         fit.update(derivatives * weight, residual * weight, fit.r + pull * pull)
-        fit_update(theta, p, information, fit.r + pull * pull, fit.clip, frozen, derivatives, weight,
+        fit_update(theta, p, information, evidence, fit.r + pull * pull, fit.clip, frozen, derivatives, weight,
                    residual * weight)
+        if fit.updates % fit.check_every == 0:  # a release restarts both from the information form
+            was = frozen
+            condition, frozen = fit_check(theta, p, information, evidence, fit.prior, frozen)
+            assert condition == pytest.approx(fit.condition, rel=1e-12) and frozen == fit.axis_frozen
+            releases += was and not frozen
         assert np.array_equal(theta, fit.theta) and np.array_equal(p, fit.p)
-        assert np.array_equal(information, fit.information)
-        if fit.updates % fit.check_every == 0:
-            assert fit_condition(information) == pytest.approx(fit.condition, rel=1e-12)
+        assert np.array_equal(information, fit.information) and np.array_equal(evidence, fit.evidence)
+    assert releases >= 1
 
 
 @pytest.mark.parametrize("days", [1.0, 40.0])  # within DRIFT_DAYS the drift is held; beyond it is fitted

@@ -2,8 +2,14 @@
 
 Whenever the filter takes a valid reading while the model's target moves slowly, the offset
 moves toward (filtered − model): a running mean over the first `tau` of readings, then
-exponential forgetting with time constant `tau`. It is bounded by the plausibility limit and
-kept overnight.
+exponential forgetting with time constant `tau`. It is bounded by the plausibility limit.
+
+It is not carried into a new day (`start_day`). What it holds is what the fitted mount leaves at
+the hour it was learned (the controller's sun model's error for that hour, the fit's own misfit
+there), which is why the disagreement check leaves it out; the evening's offset was learned with the
+sun on the other side of the sky from the morning's, and the mount fit carries over what the
+night does not change (`docs/world.md`, issue 10's acceptance: an overcast morning, tracked on
+the computed sun, ran on the evening's +0.08°).
 """
 
 from __future__ import annotations
@@ -23,6 +29,10 @@ class Calibrator:
         self.learned = 0.0
         self.tau = tau_minutes
         self.max_rate = max_rate
+
+    def start_day(self) -> None:
+        """A new day: the offset starts again from zero (how fast it learns is left as it was)."""
+        self.offset = 0.0
 
     def carry(self, offset: float) -> None:
         """Start from an offset learned earlier, past the running-mean phase."""

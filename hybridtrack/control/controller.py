@@ -42,6 +42,8 @@ DUSK_MINUTES = 30.0
 FIT_EVERY = 5.0
 #: Fit readings (an hour at one every five minutes) before the sensor is judged against the fit.
 SETTLE_UPDATES = 12
+#: W/m² of light in view at which the sensor's datasheet noise (`ControllerConfig.sensor_noise`) is stated.
+REFERENCE_LIGHT = 1000.0
 #: The policies that decide on the fuzzy classifier's sky.
 CLASSIFYING = ("hybrid", "hybrid-nocal")
 
@@ -107,11 +109,18 @@ class Controller:
     memory : dict, optional
         What a controller that has been running carries over (`Controller.memory`): its mount
         fit and calibration offsets.
+    responsivity, sun_threshold : float, optional
+        The sensor's datasheet responsivity (mA per W/m²) and the light (W/m²) below which it
+        does not see the sun: how the light in view is read from the photocurrent, and its floor,
+        for the noise of a fit reading (`_reading_variance`). Without them a fit reading has the
+        datasheet noise as stated.
     """
 
     def __init__(self, config: ControllerConfig, drives: list[Drive], plan: ControllerPlan, classifier,
-                 sky_inputs, dark_current: float, park: list[float], memory: dict | None = None):
+                 sky_inputs, dark_current: float, park: list[float], memory: dict | None = None,
+                 responsivity: float | None = None, sun_threshold: float = 0.0):
         self.config = config
+        self.responsivity, self.sun_threshold = responsivity, sun_threshold
         self.drives = drives
         self.axes = len(drives)
         self.plan = plan
@@ -290,6 +299,9 @@ class Controller:
         if self.was_awake and not awake and self.clock is not None:  # the day's end: judge the clock
             for alarm in self.clock.verdict():
                 self._alarm(i, alarm)
+        if awake and not self.was_awake:  # a new day: the residual offsets were the evening sky's
+            for calibrator in self.calibrators:
+                calibrator.start_day()
         self.was_awake = awake
         sky = self._watch_sky(i, t, obs)
         status, valid = self._sense(i, t, dt, obs, reading, awake, sky)
@@ -458,7 +470,8 @@ class Controller:
             miss, spread = self._against_checkpoint(i, a, z, m0, w)
             pull = w * pull_spread(self.config.pull_gain, self.fit.excess_light(self._light_ratio(i)),
                                    self.altitude[i])
-            self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w, self.fit.r + pull * pull)
+            self.fit.update(self.jacobian[i, a] * w, self._turn(a, z - m0) * w,
+                            self._reading_variance(i) + pull * pull)
             self.theta = self.fit.theta
             if self._disagrees(i, miss, spread):
                 return
@@ -485,7 +498,19 @@ class Controller:
         fit = self.checkpoint if self.checkpoint is not None else {"theta": self.theta, "p": self.fit.p}
         row = self.jacobian[i, a]
         miss = self._turn(a, z - m0 - float(row @ fit["theta"])) * w
-        return miss, math.sqrt(self.fit.r + w * w * float(row @ fit["p"] @ row))
+        return miss, math.sqrt(self._reading_variance(i) + w * w * float(row @ fit["p"] @ row))
+
+    def _reading_variance(self, i: int) -> float:
+        """deg²: the variance of a sensor reading at scan `i`: the datasheet noise, stated at
+        `REFERENCE_LIGHT` in view, grown as the light falls, (σ · 1000 / L)², as the sensor's
+        amplifier noise does against a smaller signal (`hybridtrack.sensor`). L is the light the
+        cells see, from the photocurrent above dark over the `responsivity`, at least the sensor's
+        sun threshold (below it the sensor reports no sun). Without a responsivity, σ² as stated."""
+        if self.responsivity is None:
+            return self.fit.r
+        light = max((self.out["intensity"][i] - self.sky.dark) / self.responsivity, self.sun_threshold)
+        ratio = REFERENCE_LIGHT / light
+        return self.fit.r * ratio * ratio  # not ** 2: libm's pow and a product may differ in the last bit
 
     def _disagrees(self, i: int, miss: float, spread: float) -> bool:
         """Watch the sensor against the checkpointed calibration (`miss`, degrees, with its expected
@@ -518,7 +543,8 @@ class Controller:
         state = {"offsets": [c.offset for c in self.calibrators]}
         if fit is not None:
             state.update(theta=fit.theta.tolist(), p=fit.p.copy(), information=fit.information.copy(),
-                         frozen=fit.axis_frozen, updates=fit.updates, light_level=fit.level)
+                         evidence=fit.evidence.copy(), frozen=fit.axis_frozen, updates=fit.updates,
+                         light_level=fit.level)
         return state
 
     def carry(self, start) -> dict:
@@ -537,6 +563,8 @@ class Controller:
             fit = self.fit
             fit.theta, fit.p = np.array(memory["theta"], float), np.array(memory["p"], float)
             fit.information, fit.axis_frozen = memory["information"].copy(), memory["frozen"]
+            # a memory saved before the fit carried its information vector: the one its θ solves
+            fit.evidence = np.array(memory["evidence"], float) if "evidence" in memory else fit.information @ fit.theta
             fit.updates = memory["updates"]
             self.theta = np.array(fit.theta)
 

@@ -44,6 +44,15 @@ condition number exceeds `MAX_CONDITION`, the pedestal (axis) terms are frozen a
 encoder zeros learn. An east-west trough at an equinox, whose sun path moves its target as a
 tilt would, is the textbook case (a test shows it frozen).
 
+While frozen, the pedestal terms are Schmidt "consider" parameters: they are never moved, so the
+filter's covariance keeps the prior's 2° on them, although the readings taken meanwhile tell
+much more (on the clear day before Nanjing's 2013-09-23, a Fresnel row, the information form's
+1σ is 0.13° and 0.16° when the pedestal is released). A filter released from its own covariance
+would throw that away and let the next few readings set the pedestal. So the fit carries the information vector too (Σ row ·
+residual / r, forgotten like the matrix), and at a release it restarts from the batch solution
+of everything it has seen, θ = (Λ + I/σ₀²)⁻¹ b with P = (Λ + I/σ₀²)⁻¹, σ₀ the prior's 1σ: the
+information form of the same least-squares problem.
+
 References
 ----------
 Baheti, R. S. & Scott, P. F. (1980). Design of self-calibrating controllers for heliostats in a
@@ -70,7 +79,7 @@ import numpy as np
 
 from ..mounting import angles_on_mount, pointing_vectors, rotate
 
-__all__ = ["MountEstimator", "jacobian", "pull_spread", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
+__all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
            "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
 
 #: Above this condition number of the information matrix, axis azimuth and tilt are frozen.
@@ -187,6 +196,7 @@ class MountEstimator:
         self.prior = prior * prior
         self.p = np.eye(self.n) * self.prior
         self.information = np.zeros((self.n, self.n))
+        self.evidence = np.zeros(self.n)
         self.r = noise * noise
         self.memory = memory
         self.clip = clip
@@ -225,6 +235,7 @@ class MountEstimator:
         scale = np.sqrt(np.minimum(1.0, self.prior / np.diag(p)))
         self.p = p * np.outer(scale, scale)
         self.information *= factor
+        self.evidence *= factor
 
     def update(self, row, residual: float, variance: float | None = None) -> None:
         """Take one measurement: `residual` = measured angle − computed target, with derivatives `row`
@@ -237,6 +248,7 @@ class MountEstimator:
         row = np.asarray(row, float)
         r = self.r if variance is None else variance
         self.information += np.outer(row, row) / r  # what it tells of every parameter, frozen or not
+        self.evidence += row * residual / r
         pr = self.p @ row
         s = r + float(row @ pr)
         gain = pr / s
@@ -253,10 +265,63 @@ class MountEstimator:
             self._check()
 
     def _check(self) -> None:
+        """Freeze the pedestal terms while the information matrix is ill-conditioned; at a release
+        restart from the information form's solution (`solve`)."""
         singular = np.linalg.svd(self.information, compute_uv=False)
         self.condition = float(singular[0] / max(singular[-1], 1e-300))
-        self.axis_frozen = self.condition > MAX_CONDITION
+        frozen = self.condition > MAX_CONDITION
+        if self.axis_frozen and not frozen:
+            self.theta, self.p = self.solve()
+        self.axis_frozen = frozen
+
+    def solve(self) -> tuple[np.ndarray, np.ndarray]:
+        """The batch least-squares solution of every reading taken (forgotten as the fit forgets)
+        with the prior: θ = (Λ + I/σ₀²)⁻¹ b and its covariance (Λ + I/σ₀²)⁻¹ (`spd_inverse`)."""
+        p = spd_inverse(self.information + np.eye(self.n) / self.prior)
+        theta = np.zeros(self.n)
+        for i in range(self.n):
+            total = 0.0
+            for j in range(self.n):
+                total += float(p[i, j]) * float(self.evidence[j])
+            theta[i] = total
+        return theta, p
 
     def std(self) -> list[float]:
         """1σ of each parameter, degrees."""
         return np.sqrt(np.clip(np.diag(self.p), 0.0, None)).tolist()
+
+
+def spd_inverse(a: np.ndarray) -> np.ndarray:
+    """The inverse of a symmetric positive-definite matrix through its Cholesky factor L
+    (A⁻¹ = L⁻ᵀ L⁻¹), one scalar step at a time in a fixed order: the compiled controller
+    (`hybridtrack.kernel.controller.spd_inverse`) takes the same steps and so gets the same bits,
+    which LAPACK's two builds (numpy's, numba's) do not promise; a difference in the last bit
+    grows over a year of closed-loop runs."""
+    n = len(a)
+    low = np.zeros((n, n))
+    for j in range(n):
+        total = float(a[j, j])
+        for k in range(j):
+            total -= low[j, k] * low[j, k]
+        low[j, j] = math.sqrt(total)
+        for i in range(j + 1, n):
+            total = float(a[i, j])
+            for k in range(j):
+                total -= low[i, k] * low[j, k]
+            low[i, j] = total / low[j, j]
+    inverse_low = np.zeros((n, n))
+    for i in range(n):
+        inverse_low[i, i] = 1.0 / low[i, i]
+        for j in range(i):
+            total = 0.0
+            for k in range(j, i):
+                total -= low[i, k] * inverse_low[k, j]
+            inverse_low[i, j] = total / low[i, i]
+    out = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = 0.0
+            for k in range(max(i, j), n):
+                total += inverse_low[k, i] * inverse_low[k, j]
+            out[i, j] = total
+    return out

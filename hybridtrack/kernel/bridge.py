@@ -84,7 +84,7 @@ def _settings(controller: Controller) -> kc.ControllerSettings:
         float(calibrator.max_rate),
         fit is not None, float(fit.r) if fit else 1.0, float(fit.prior) if fit else 1.0,
         float(fit.memory) if fit else 1.0, float(fit.clip) if fit else 1.0, int(fit.check_every) if fit else 1,
-        float(config.pull_gain),
+        float(config.pull_gain), float(controller.responsivity or 0.0), float(controller.sun_threshold),
         float(clock.r) if clock else 1.0,
         np.array(np.diag(clock.prior_information) if clock else [], float),
         inputs.mode == "relative", float(sky.mean.window) if sky.mean is not None else 0.0, float(sky.window_minutes),
@@ -175,6 +175,7 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
         np.array(fit.theta if fit else [], float), np.array(fit.p if fit else np.zeros((0, 0)), float),
         np.array(fit.information if fit else np.zeros((0, 0)), float),
         np.zeros(axes), np.zeros(p), np.zeros((p, p)), np.zeros((p, p)),
+        np.array(fit.evidence if fit else [], float), np.zeros(p),
         np.zeros((5, capacity)), np.zeros((5, capacity)), np.zeros((5, 2), np.int64), *clock_arrays)
 
 
@@ -218,6 +219,7 @@ def _write_back(controller: Controller, state: kc.ControllerState) -> None:
     fit = controller.fit
     if fit is not None:
         fit.theta, fit.p, fit.information = state.theta.copy(), state.p.copy(), state.information.copy()
+        fit.evidence = state.evidence.copy()
         fit.updates, fit.axis_frozen = int(state.k[kc.UPDATES]), bool(state.k[kc.FROZEN])
         fit.condition = float(state.s[kc.CONDITION])
         fit.level = float(state.s[kc.LIGHT_LEVEL])

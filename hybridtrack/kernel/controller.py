@@ -13,8 +13,8 @@ WindGuard               `wind_watch`, `wind_heard`, `wind_update`, `wind_release
 SkyWatch                `trailing_mean`, `trailing_range`, `sky_update`
 ClassifierTable         `table_score`, `table_code`
 SensorGate + Kalman     `gate_judge`, `gate_take`, `kalman_*`
-Calibrator.learn        `calibrator_learn`
-MountEstimator          `fit_forget`, `fit_update`, `fit_check`, `fit_excess_light`
+Calibrator.learn        `calibrator_learn`, `_start_day`
+MountEstimator          `fit_forget`, `fit_update`, `fit_check`, `fit_solve`, `fit_excess_light`
 pull_spread             `pull_spread`
 DisagreementMonitor     `disagreement_add`
 ClockWatch              `clock_add`, `clock_count`, `clock_solve`, `clock_verdict`
@@ -35,7 +35,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..control.clockwatch import ALARM_SIGMAS, CLOCK_TOLERANCE, DRIFT_DAYS, DRIFT_TOLERANCE, SPELL, SPELL_GAP
-from ..control.controller import DUSK_MINUTES, FIT_EVERY, SETTLE_UPDATES
+from ..control.controller import DUSK_MINUTES, FIT_EVERY, REFERENCE_LIGHT, SETTLE_UPDATES
 from ..control.disagreement import ALLOWANCE, MIN_RUN, THRESHOLD
 from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGHT, NOT_READ, OK, OUT_OF_VIEW,
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
@@ -53,7 +53,8 @@ ControllerSettings = namedtuple("ControllerSettings", [
     "dwell", "loss", "coast_for", "dusk_current", "plausibility", "disagreement", "follow_sensor", "distrust",
     "wind_stow", "wind_release", "wind_hold", "stow_when_missing", "encoder_confirm",
     "q", "r", "stuck_scans", "stuck_spread", "gate2", "reacquire", "tau", "max_rate",
-    "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "pull_gain", "clock_r", "clock_prior",
+    "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "pull_gain", "responsivity", "sun_threshold",
+    "clock_r", "clock_prior",
     "sky_relative", "smoothing", "window", "min_altitude", "low_sun_absolute", "relative_floor", "full_variation",
     "dark", "table", "table_step", "table_last", "ranges", "edges", "codes",
     "deadband", "speed", "stow_speed", "low", "high", "stow", "resolution", "circular"])
@@ -65,7 +66,7 @@ ControllerState = namedtuple("ControllerState", [
     "s", "k", "encoder", "jumped", "kf", "gate", "stuck_angles", "stuck_expected", "stuck_fill",
     "calibration", "fitted_at", "blind_stow", "park", "moves", "travel", "mount",
     "theta", "p", "information", "checkpoint_offsets", "checkpoint_theta", "checkpoint_p",
-    "checkpoint_information", "window_t", "window_v", "window_ends", "clock_t", "clock_axis", "clock_x", "clock_y",
+    "checkpoint_information", "evidence", "checkpoint_evidence", "window_t", "window_v", "window_ends", "clock_t", "clock_axis", "clock_x", "clock_y",
     "clock_moments", "clock_sums", "clock_last"])
 #: What the controller records per scan (`hybridtrack.control.controller.ControllerOutputs`).
 ControllerRecord = namedtuple("ControllerRecord", [
@@ -512,14 +513,21 @@ def calibrator_learn(cfg, state, a, dt, residual, model_step, bound):
     c[a, OFFSET] = max(-bound, min(bound, c[a, OFFSET]))
 
 
+@kernel
+def _start_day(state):
+    """Calibrator.start_day on every axis."""
+    state.calibration[:, OFFSET] = 0.0
+
+
 @kernel(allocates=True)
-def fit_forget(p, information, memory, prior, dt):
-    """MountEstimator.forget (in place on `p` and `information`)."""
+def fit_forget(p, information, evidence, memory, prior, dt):
+    """MountEstimator.forget (in place on `p`, `information` and `evidence`)."""
     factor = math.exp(-dt / memory)
     grown = p / factor
     scale = np.sqrt(np.minimum(1.0, prior / np.diag(grown)))
     p[:, :] = grown * np.outer(scale, scale)
     information[:, :] = information * factor
+    evidence[:] = evidence * factor
 
 
 @kernel(allocates=True)
@@ -530,12 +538,69 @@ def fit_condition(information):
 
 
 @kernel(allocates=True)
-def fit_update(theta, p, information, r, clip, frozen, derivatives, weight, residual):
+def spd_inverse(a):
+    """mountfit.spd_inverse: the same Cholesky steps in the same order, so the same bits."""
+    n = a.shape[0]
+    low = np.zeros((n, n))
+    for j in range(n):
+        total = a[j, j]
+        for k in range(j):
+            total -= low[j, k] * low[j, k]
+        low[j, j] = math.sqrt(total)
+        for i in range(j + 1, n):
+            total = a[i, j]
+            for k in range(j):
+                total -= low[i, k] * low[j, k]
+            low[i, j] = total / low[j, j]
+    inverse_low = np.zeros((n, n))
+    for i in range(n):
+        inverse_low[i, i] = 1.0 / low[i, i]
+        for j in range(i):
+            total = 0.0
+            for k in range(j, i):
+                total -= low[i, k] * inverse_low[k, j]
+            inverse_low[i, j] = total / low[i, i]
+    out = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = 0.0
+            for k in range(max(i, j), n):
+                total += inverse_low[k, i] * inverse_low[k, j]
+            out[i, j] = total
+    return out
+
+
+@kernel(allocates=True)
+def fit_solve(theta, p, information, evidence, prior):
+    """MountEstimator.solve, into `theta` and `p`: θ = (Λ + I/σ₀²)⁻¹ b, P = (Λ + I/σ₀²)⁻¹."""
+    n = theta.shape[0]
+    p[:, :] = spd_inverse(information + np.eye(n) / prior)
+    for i in range(n):
+        total = 0.0
+        for j in range(n):
+            total += p[i, j] * evidence[j]
+        theta[i] = total
+
+
+@kernel(allocates=True)
+def fit_check(theta, p, information, evidence, prior, frozen):
+    """MountEstimator._check: the condition number and whether the pedestal stays frozen (at a
+    release `fit_solve`)."""
+    condition = fit_condition(information)
+    now = condition > MAX_CONDITION
+    if frozen and not now:
+        fit_solve(theta, p, information, evidence, prior)
+    return condition, now
+
+
+@kernel(allocates=True)
+def fit_update(theta, p, information, evidence, r, clip, frozen, derivatives, weight, residual):
     """MountEstimator.update of the row `derivatives` · `weight` (Joseph form; frozen pedestal
-    terms as consider parameters), in place on `theta`, `p` and `information`."""
+    terms as consider parameters), in place on `theta`, `p`, `information` and `evidence`."""
     row = derivatives * weight
     n = row.shape[0]
     information[:, :] = information + np.outer(row, row) / r
+    evidence[:] = evidence + row * residual / r
     pr = p @ row
     s = r + np.dot(row, pr)
     gain = pr / s
@@ -602,6 +667,7 @@ def _checkpoint(state):
     state.checkpoint_theta[:] = state.theta
     state.checkpoint_p[:, :] = state.p
     state.checkpoint_information[:, :] = state.information
+    state.checkpoint_evidence[:] = state.evidence
     state.k[CHECKPOINT_FROZEN] = state.k[FROZEN]
     state.k[CHECKPOINT_UPDATES] = state.k[UPDATES]
     state.k[HAS_CHECKPOINT] = 1
@@ -615,6 +681,7 @@ def _recall(cfg, state):
     state.theta[:] = state.checkpoint_theta
     state.p[:, :] = state.checkpoint_p
     state.information[:, :] = state.checkpoint_information
+    state.evidence[:] = state.checkpoint_evidence
     state.k[FROZEN] = state.k[CHECKPOINT_FROZEN]
     state.k[UPDATES] = state.k[CHECKPOINT_UPDATES]
 
@@ -649,26 +716,38 @@ def _disagrees(cfg, state, log, i, miss, spread):
 
 
 @kernel
+def _reading_variance(cfg, intensity):
+    """Controller._reading_variance: the datasheet noise grown as the light in view falls (as
+    stated where the responsivity is not known, 0 here)."""
+    if cfg.responsivity <= 0.0:
+        return cfg.fit_r
+    light = max((intensity - cfg.dark) / cfg.responsivity, cfg.sun_threshold)
+    ratio = REFERENCE_LIGHT / light
+    return cfg.fit_r * ratio * ratio
+
+
+@kernel
 def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound, intensity):
     t = state.s[PREVIOUS_T]
     if cfg.has_fit and t - state.fitted_at[a] >= FIT_EVERY:
         state.fitted_at[a] = t
-        fit_forget(state.p, state.information, cfg.fit_memory, cfg.prior, t - state.s[FIT_SINCE])
+        fit_forget(state.p, state.information, state.evidence, cfg.fit_memory, cfg.prior, t - state.s[FIT_SINCE])
         state.s[FIT_SINCE] = t
         has = state.k[HAS_CHECKPOINT]
         w = plan.weight[i, a]
+        r = _reading_variance(cfg, intensity)
         fitted, spread = _against_checkpoint(plan.jacobian[i, a], state.checkpoint_theta if has else state.theta,
-                                             state.checkpoint_p if has else state.p, cfg.fit_r, w)
+                                             state.checkpoint_p if has else state.p, r, w)
         miss = _turn(cfg, a, z - m0 - fitted) * w
         expected = plan.clear_light[i]
         ratio = (intensity - cfg.dark) / expected if expected > 0 else math.nan
         pull = w * pull_spread(cfg.pull_gain, fit_excess_light(state, ratio), plan.altitude[i])
-        fit_update(state.theta, state.p, state.information, cfg.fit_r + pull * pull, cfg.clip, state.k[FROZEN],
-                   plan.jacobian[i, a], w, _turn(cfg, a, z - m0) * w)
+        fit_update(state.theta, state.p, state.information, state.evidence, r + pull * pull, cfg.clip,
+                   state.k[FROZEN], plan.jacobian[i, a], w, _turn(cfg, a, z - m0) * w)
         state.k[UPDATES] += 1
         if state.k[UPDATES] % cfg.check_every == 0:
-            state.s[CONDITION] = fit_condition(state.information)
-            state.k[FROZEN] = state.s[CONDITION] > MAX_CONDITION
+            state.s[CONDITION], state.k[FROZEN] = fit_check(state.theta, state.p, state.information, state.evidence,
+                                                            cfg.prior, state.k[FROZEN])
         if _disagrees(cfg, state, log, i, miss, spread):
             return
         rate = _turn(cfg, a, m0 - m1) / dt if dt > 0 else math.nan
@@ -1112,6 +1191,8 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading
     _day_and_wind(cfg, state, log, i, t, awake, gusty, wind)
     if k[WAS_AWAKE] and not awake and cfg.has_fit:  # the day's end: judge the clock
         clock_verdict(cfg, state, log, i)
+    if awake and not k[WAS_AWAKE]:  # a new day: the residual offsets were the evening sky's
+        _start_day(state)
     k[WAS_AWAKE] = awake
     sky = _watch_sky(cfg, plan, state, out, i, t, obs[3])
     status = _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, sky, valid)
