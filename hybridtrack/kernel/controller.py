@@ -40,6 +40,7 @@ from ..control.disagreement import ALLOWANCE, MIN_RUN, THRESHOLD
 from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGHT, NOT_READ, OK, OUT_OF_VIEW,
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
 from ..control.mountfit import HORIZON, LEVEL_READINGS, LIGHT_TOLERANCE, MAX_CONDITION
+from ..control.mountfit import spd_inverse as reference_spd_inverse  # compiled below
 from ..control.wind import STUCK_HOURS, STUCK_SPREAD
 from . import events as ev
 from .jit import kernel
@@ -537,37 +538,8 @@ def fit_condition(information):
     return singular[0] / max(singular[-1], 1e-300)
 
 
-@kernel(allocates=True)
-def spd_inverse(a):
-    """mountfit.spd_inverse: the same Cholesky steps in the same order, so the same bits."""
-    n = a.shape[0]
-    low = np.zeros((n, n))
-    for j in range(n):
-        total = a[j, j]
-        for k in range(j):
-            total -= low[j, k] * low[j, k]
-        low[j, j] = math.sqrt(total)
-        for i in range(j + 1, n):
-            total = a[i, j]
-            for k in range(j):
-                total -= low[i, k] * low[j, k]
-            low[i, j] = total / low[j, j]
-    inverse_low = np.zeros((n, n))
-    for i in range(n):
-        inverse_low[i, i] = 1.0 / low[i, i]
-        for j in range(i):
-            total = 0.0
-            for k in range(j, i):
-                total -= low[i, k] * inverse_low[k, j]
-            inverse_low[i, j] = total / low[i, i]
-    out = np.zeros((n, n))
-    for i in range(n):
-        for j in range(n):
-            total = 0.0
-            for k in range(max(i, j), n):
-                total += inverse_low[k, i] * inverse_low[k, j]
-            out[i, j] = total
-    return out
+#: mountfit.spd_inverse itself, compiled: the same Cholesky steps in the same order, so the same bits.
+spd_inverse = kernel(reference_spd_inverse, allocates=True)
 
 
 @kernel(allocates=True)
