@@ -233,9 +233,15 @@ def smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: flo
     return np.interp(t, np.arange(n), grid)
 
 
-def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith, *,
+              daily_extraterrestrial: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Clear-sky GHI, DNI and DHI (W/m², 0 at night): pvlib's Ineichen model with the site's
-    altitude and the Linke turbidity looked up for the site and month.
+    altitude and the Linke turbidity looked up for the site and month, computed only where the
+    sun is up (below the horizon Ineichen's is zero).
+
+    `daily_extraterrestrial` takes the extraterrestrial beam of each day (pvlib's
+    ``get_extra_radiation``), as ``pvlib.location.Location.get_clearsky`` does; otherwise
+    Ineichen's default constant.
 
     References
     ----------
@@ -245,16 +251,17 @@ def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith) -> tuple[np.
     import pvlib
 
     apparent_zenith = np.asarray(apparent_zenith, float)
-    up = apparent_zenith < 90.0  # below the horizon Ineichen's is zero: computed where the sun is up
+    up = apparent_zenith < 90.0
     irradiance = {name: np.zeros(len(apparent_zenith)) for name in ("ghi", "dni", "dhi")}
     if up.any():
-        zenith = apparent_zenith[up]
-        airmass = pvlib.atmosphere.get_relative_airmass(zenith)
-        pressure = pvlib.atmosphere.alt2pres(site.altitude)
-        linke = pvlib.clearsky.lookup_linke_turbidity(index[up], site.latitude, site.longitude)
+        zenith, times = apparent_zenith[up], index[up]
+        airmass = pvlib.atmosphere.get_absolute_airmass(pvlib.atmosphere.get_relative_airmass(zenith),
+                                                        pvlib.atmosphere.alt2pres(site.altitude))
+        linke = pvlib.clearsky.lookup_linke_turbidity(times, site.latitude, site.longitude).to_numpy(float)
+        extra = {"dni_extra": pvlib.irradiance.get_extra_radiation(times).to_numpy(float)} \
+            if daily_extraterrestrial else {}
         with np.errstate(divide="ignore", invalid="ignore"):  # pvlib divides by airmass, large at the horizon
-            clear = pvlib.clearsky.ineichen(zenith, pvlib.atmosphere.get_absolute_airmass(airmass, pressure),
-                                            linke.to_numpy(float), altitude=site.altitude)
+            clear = pvlib.clearsky.ineichen(zenith, airmass, linke, altitude=site.altitude, **extra)
         for name, values in irradiance.items():
             values[up] = np.nan_to_num(np.asarray(clear[name], float))
     return irradiance["ghi"], irradiance["dni"], irradiance["dhi"]

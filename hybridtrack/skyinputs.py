@@ -57,6 +57,7 @@ from .errors import HybridtrackError
 from .params import duration
 from .sensor import SensorModel
 from .sites import Site, get
+from .sky import clear_sky as ineichen_clear_sky
 
 __all__ = ["SkyInputConfig", "MODES", "RULES", "LOW_SUN", "clear_sky", "clear_sky_photocurrent", "sky_inputs",
            "classify_sky", "fuzzy_config"]
@@ -208,32 +209,13 @@ def clear_sky(index: pd.DatetimeIndex, site: Site | str, position: pd.DataFrame 
     site = get(site)
     if not isinstance(index, pd.DatetimeIndex) or index.tz is None:
         raise HybridtrackError("the clear sky needs a time-zone-aware DatetimeIndex")
-    location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
     if position is None:
+        location = pvlib.location.Location(site.latitude, site.longitude, altitude=site.altitude)
         elevation = location.get_solarposition(index)["apparent_elevation"].to_numpy(float)
     else:
         elevation = np.asarray(position["apparent_altitude"], float)
-    irradiance = np.zeros((len(index), 3))  # Ineichen's is zero with the sun down: computed where it is up
-    up = elevation > 0.0
-    if up.any():
-        irradiance[up] = _ineichen(index[up], location, 90.0 - elevation[up])
-    return pd.DataFrame({"apparent_elevation": elevation, "ghi": irradiance[:, 0], "dni": irradiance[:, 1],
-                         "dhi": irradiance[:, 2]}, index=index)
-
-
-def _ineichen(times: pd.DatetimeIndex, location, apparent_zenith: np.ndarray) -> np.ndarray:
-    """GHI, DNI, DHI (N, 3) as pvlib's ``Location.get_clearsky(model="ineichen")`` gives them, from
-    its parts: the Linke turbidity looked up, the extraterrestrial beam of the day, the
-    Kasten-Young airmass (the location's default) at its pressure."""
-    import pvlib
-
-    airmass = pvlib.atmosphere.get_absolute_airmass(
-        pvlib.atmosphere.get_relative_airmass(apparent_zenith, "kastenyoung1989"),
-        pvlib.atmosphere.alt2pres(location.altitude))
-    linke = pvlib.clearsky.lookup_linke_turbidity(times, location.latitude, location.longitude)
-    clear = pvlib.clearsky.ineichen(apparent_zenith, airmass, linke.to_numpy(float), altitude=location.altitude,
-                                    dni_extra=pvlib.irradiance.get_extra_radiation(times).to_numpy(float))
-    return np.column_stack([np.asarray(clear[name], float) for name in ("ghi", "dni", "dhi")])
+    ghi, dni, dhi = ineichen_clear_sky(index, site, 90.0 - elevation, daily_extraterrestrial=True)
+    return pd.DataFrame({"apparent_elevation": elevation, "ghi": ghi, "dni": dni, "dhi": dhi}, index=index)
 
 
 def clear_sky_photocurrent(clear: pd.DataFrame, sensor: SensorModel) -> pd.Series:
