@@ -21,6 +21,7 @@ from .collectors import Collector
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
 from .control.clockwatch import ClockWatch
+from .control.modes import sky_code
 from .control.mountfit import parameter_names
 from .control.plan import east_park
 from .drive import Drive
@@ -577,7 +578,7 @@ def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config
 
 def _sky_categorical(codes: np.ndarray, names: tuple[str, ...]) -> pd.Categorical:
     """Labels (codes into `names`) as a Categorical of `SKY_CODES`; a band named otherwise is NaN."""
-    recode = np.array([SKY_CODES.index(name) if name in SKY_CODES else -1 for name in names])
+    recode = np.array([sky_code(name) for name in names])
     return pd.Categorical.from_codes(recode[codes], categories=list(SKY_CODES))
 
 

@@ -10,7 +10,7 @@ from .budget import check_steps
 from .errors import HybridtrackError
 
 __all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "local_midnight", "check_tz", "clock_hours",
-           "clock_nanoseconds", "calendar_days", "day_of_year", "DAY_NS"]
+           "clock_nanoseconds", "calendar_days", "day_of_year", "HOUR_NS", "DAY_NS"]
 
 
 def clock_nanoseconds(local: pd.DatetimeIndex):
@@ -52,8 +52,8 @@ def day_of_year(day_number):
         years.astype(np.int64).astype(float) + 1970.0
 
 
-#: Nanoseconds in a day of the clock.
-DAY_NS = 86_400_000_000_000
+#: Nanoseconds in an hour and in a day of the clock.
+HOUR_NS, DAY_NS = 3_600_000_000_000, 86_400_000_000_000
 
 
 def check_tz(tz: str, where: str = "") -> str:

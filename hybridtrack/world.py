@@ -31,13 +31,14 @@ import pandas as pd
 
 from . import sites
 from .collectors import Collector
-from .control.modes import SKY_CODES
+from .control.modes import UNKNOWN, sky_code
 from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
 from .mounting import mount_targets, mounting_rotation
 from .sensor import RECORDED_COLUMN, RECORDED_POINTING, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
 from .sun import solar_position
+from .times import HOUR_NS
 
 __all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
 
@@ -121,9 +122,6 @@ def installed_site(site: sites.Site, imperfections: Imperfections) -> sites.Site
     latitude = float(np.clip(site.latitude + imperfections.latitude_error, -90, 90))
     longitude = float((site.longitude + imperfections.longitude_error + 180) % 360 - 180)
     return sites.Site(site.name, latitude, longitude, site.altitude, site.tz)
-
-
-_HOUR_NS = 3_600_000_000_000
 
 
 class World:
@@ -244,10 +242,10 @@ class World:
         stamps = np.asarray(self.index.as_unit("ns").asi8)
         if not len(stamps):
             return np.zeros(0, bool)
-        first = stamps.min() // _HOUR_NS
-        knots = pd.DatetimeIndex(np.arange(first, stamps.max() // _HOUR_NS + 2) * _HOUR_NS).tz_localize("UTC")
+        first = stamps.min() // HOUR_NS
+        knots = pd.DatetimeIndex(np.arange(first, stamps.max() // HOUR_NS + 2) * HOUR_NS).tz_localize("UTC")
         altitude = solar_position(knots, self.site, "plc")["altitude"].to_numpy()
-        return altitude[(stamps + _HOUR_NS // 2) // _HOUR_NS - first] > -3.0 - 7.5 - 0.5
+        return altitude[(stamps + HOUR_NS // 2) // HOUR_NS - first] > -3.0 - 7.5 - 0.5
 
     def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
         if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:
@@ -262,10 +260,8 @@ class World:
         """The frame's true sky as `SKY_CODES` codes (anything else: unknown), or None."""
         if "sky" not in frame.columns:
             return None
-        found, names = pd.factorize(frame["sky"])  # -1 for a missing label
-        known = np.array([SKY_CODES.index(name) if name in SKY_CODES else -1 for name in names] + [-1])
-        codes = known[found]
-        return np.where(codes < 0, SKY_CODES.index("unknown"), codes).astype(np.int64)
+        found, names = pd.factorize(frame["sky"])  # -1 for a missing label: the table's last entry
+        return np.array([sky_code(name, UNKNOWN) for name in names] + [UNKNOWN], np.int64)[found]
 
     @property
     def has_true_sky(self) -> bool:

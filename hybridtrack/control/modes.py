@@ -1,6 +1,6 @@
 """The controller's modes, the sensor statuses it logs, and the sky classes it knows."""
 
-__all__ = ["MODES", "SENSOR_STATUS", "SKY_CODES", "TRACKING"]
+__all__ = ["MODES", "SENSOR_STATUS", "SKY_CODES", "TRACKING", "sky_code"]
 
 #: ``stow_night`` asleep at stow (or, for the sensor-only tracker, parked toward the morning sun);
 #: ``stow_wind`` stowed for wind; ``astronomical`` following the computed sun; ``sensor`` following
@@ -16,3 +16,9 @@ FAULTY = (STUCK, IMPLAUSIBLE, INVALID)
 
 SKY_CODES = ("sunny", "cloudy", "overcast", "unknown")
 SUNNY, CLOUDY, OVERCAST, UNKNOWN = range(len(SKY_CODES))
+
+
+def sky_code(name, otherwise: int = -1) -> int:
+    """The code of a sky label in `SKY_CODES`, or `otherwise` for a label outside them (a band
+    named another way, a missing label)."""
+    return SKY_CODES.index(name) if name in SKY_CODES else otherwise

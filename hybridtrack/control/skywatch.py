@@ -16,7 +16,7 @@ from collections import deque
 
 import numpy as np
 
-from .modes import SKY_CODES, UNKNOWN
+from .modes import UNKNOWN, sky_code
 
 __all__ = ["ClassifierTable", "SkyWatch", "TrailingRange", "TrailingMean"]
 
@@ -50,7 +50,7 @@ class ClassifierTable:
         self.ranges = [tuple(var.raw_range) for var in inputs]
         bands = classifier.config.bands
         self.edges = [band[2] for band in bands[:-1]]
-        self.codes = [SKY_CODES.index(b[0]) if b[0] in SKY_CODES else UNKNOWN for b in bands]
+        self.codes = [sky_code(b[0], UNKNOWN) for b in bands]
 
     def _normalised(self, value: float, which: int) -> float:
         lo, hi = self.ranges[which]
