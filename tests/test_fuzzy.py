@@ -304,3 +304,12 @@ def test_tuning_to_labels_reaches_full_accuracy_and_is_reproducible():
 def test_bad_tuning_tables_are_refused(table, message):
     with pytest.raises(HybridtrackError, match=message):
         tune(None, table, method="local")
+
+
+def test_an_unlabelled_sample_is_named_by_the_files_own_row(tmp_path):
+    from hybridtrack.fuzzy.tuning import read_samples
+
+    path = tmp_path / "labels.csv"
+    path.write_text("# labelled by hand\nintensity,variation,weather\n246,27,sunny\n\n200,80,\n")
+    with pytest.raises(HybridtrackError, match=r"labels.csv: row 5, column 'weather': empty"):
+        read_samples(path)

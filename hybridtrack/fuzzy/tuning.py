@@ -147,10 +147,11 @@ def read_samples(source) -> pd.DataFrame:
         raise HybridtrackError(f"{where}: needs a 'weather' or a 'score' column to fit to")
     if frame.empty:
         raise HybridtrackError(f"{where}: no rows")
+    from ..io import numeric_columns, table_row
+
     if "weather" in frame.columns and frame["weather"].isna().any():
-        raise HybridtrackError(f"{where}: row {int(np.flatnonzero(frame['weather'].isna())[0]) + 2}, column "
-                               "'weather': empty")
-    from ..io import numeric_columns
+        raise HybridtrackError(f"{where}: row {table_row(frame, int(np.flatnonzero(frame['weather'].isna())[0]))}, "
+                               "column 'weather': empty")
 
     return numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where,
                            required=("intensity", "variation", "score"))

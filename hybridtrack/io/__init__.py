@@ -26,8 +26,8 @@ from .columns import ALIASES, IRRADIANCE, LABEL_COLUMN, WEATHER_COLUMNS
 from .files import read_text, read_toml, write_toml
 from .formats import PVLIB_FORMATS
 from .report import validation_report
-from .tables import numeric_columns, read_table
+from .tables import numeric_columns, read_table, table_row
 from .weather import read_weather
 
-__all__ = ["read_weather", "read_table", "read_toml", "write_toml", "read_text", "numeric_columns",
+__all__ = ["read_weather", "read_table", "read_toml", "write_toml", "read_text", "numeric_columns", "table_row",
            "validation_report", "WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "PVLIB_FORMATS", "LIMITS"]

@@ -27,7 +27,7 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .files import file_text
 
-__all__ = ["Table", "locate_table", "read_table", "numeric_columns", "MISSING"]
+__all__ = ["Table", "locate_table", "read_table", "numeric_columns", "table_row", "MISSING"]
 
 #: Cell texts that mean "no value" (Campbell writes NAN, spreadsheets #N/A).
 MISSING = ("", "nan", "na", "n/a", "#n/a", "-", "null", "none", "--")
@@ -206,6 +206,16 @@ def read_table(path) -> pd.DataFrame:
     return frame
 
 
+def table_row(frame: pd.DataFrame, position: int) -> int:
+    """The file's row of a table's row at `position`, as a spreadsheet shows it: `read_table`
+    keeps each row's line past comment and blank lines; else the header counts as row 1."""
+    lines = frame.attrs.get("lines")
+    label = frame.index[position]
+    if lines is not None and isinstance(label, (int, np.integer)) and 0 <= label < len(lines):
+        return int(lines[label])
+    return position + 2
+
+
 def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) -> pd.DataFrame:
     """`frame` with `columns` (those present) as floats; text in one names its row and column.
 
@@ -213,14 +223,6 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) ->
     NaN, or refused in a column of `required`. Row numbers are the file's, as a spreadsheet
     shows them (`read_table` keeps them past comment lines); else the header counts as row 1.
     """
-    lines = frame.attrs.get("lines")
-
-    def row_number(position: int) -> int:
-        label = frame.index[position]
-        if lines is not None and isinstance(label, (int, np.integer)) and 0 <= label < len(lines):
-            return int(lines[label])
-        return position + 2
-
     frame = frame.copy()
     for column in columns:
         if column not in frame.columns:
@@ -229,13 +231,13 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) ->
         bad = (values.isna() & frame[column].notna()).to_numpy()
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
-            raise HybridtrackError(f"{where}: row {row_number(row)}, column {column!r}: {frame[column].iloc[row]!r} "
+            raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: {frame[column].iloc[row]!r} "
                                    "is not a number")
         values = values.astype(float)
         refused = np.isinf(values.to_numpy()) | (values.isna().to_numpy() if column in required else False)
         if refused.any():
             row = int(np.flatnonzero(refused)[0])
             what = "empty" if np.isnan(values.iloc[row]) else f"{values.iloc[row]} is not a finite number"
-            raise HybridtrackError(f"{where}: row {row_number(row)}, column {column!r}: {what}")
+            raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: {what}")
         frame[column] = values
     return frame
