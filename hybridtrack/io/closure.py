@@ -73,8 +73,7 @@ def closure_check(path: Path, frame: pd.DataFrame, apparent_zenith, report: dict
         return
     if bad <= SHARE * count:
         report["closure"] = (f"GHI = DNI·cos z + DHI within BSRN's tolerance on {1 - bad / count:.1%} of {count:,} "
-                             "daylight rows" + (f" (lines {', '.join(map(str, first_lines(frame, failed)))} and "
-                                                f"{max(bad - 5, 0)} more are not)" if bad else ""))
+                             f"daylight rows{_not_within(frame, failed, bad)}")
         return
     first = int(np.flatnonzero(failed)[0])
     line = first_lines(frame, np.arange(len(frame)) == first)
@@ -89,3 +88,15 @@ def closure_check(path: Path, frame: pd.DataFrame, apparent_zenith, report: dict
     if strict:
         raise HybridtrackError(message + " (strict)")
     report["closure"] = "WARNING: " + message.split(": ", 1)[1]
+
+
+def _not_within(frame: pd.DataFrame, failed: np.ndarray, bad: int) -> str:
+    """`` (lines 3, 9 and 4 more are not)``: the first file lines of the rows that fail, if any."""
+    if not bad:
+        return ""
+    lines = first_lines(frame, failed)
+    if not lines:
+        return f" ({bad:,} rows are not)"
+    more = bad - len(lines)
+    return f" (line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}" + \
+        (f" and {more:,} more" if more else "") + f" {'are' if bad > 1 else 'is'} not)"
