@@ -29,6 +29,7 @@ selectable.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -347,6 +348,7 @@ def spa_fast(times, latitude: float, longitude: float, altitude: float = 0.0, pr
 REMEMBERED_FROM = 10_000
 #: The answers `reuse_positions` keeps: (capacity, [(key, frame), ...] oldest first), or None outside it.
 _REUSE: ContextVar[tuple[int, list] | None] = ContextVar("hybridtrack_sun_reuse", default=None)
+_REUSE_LOCK = threading.Lock()
 
 
 @contextmanager
@@ -357,8 +359,9 @@ def reuse_positions(entries: int = 8) -> Iterator[None]:
     earlier one and every one of its times was among that one's; the rows are the same numbers
     the model gives (every model here computes each stamp on its own). Runs of many collectors
     on one frame ask for the same sun again and again; this is how they share it without
-    passing it around. The memory holds the last `entries` answers, for this thread or task only.
-    A block inside another shares the outer block's memory.
+    passing it around. The memory holds the last `entries` answers, for this thread or task and
+    the threads it hands a copy of its context (a field's threads). A block inside another shares
+    the outer block's memory.
     """
     if _REUSE.get() is not None:
         yield
@@ -371,8 +374,13 @@ def reuse_positions(entries: int = 8) -> Iterator[None]:
 
 
 def _remembered(key: tuple, index: pd.DatetimeIndex) -> pd.DataFrame | None:
+    with _REUSE_LOCK:  # the threads of a field share the memory
+        return _recalled(key, index)
+
+
+def _recalled(key: tuple, index: pd.DatetimeIndex) -> pd.DataFrame | None:
     capacity, memory = _REUSE.get() or (0, [])
-    for entry in memory:
+    for k, entry in enumerate(memory):
         if entry[0] != key:
             continue
         if entry[1].index.equals(index):
@@ -382,8 +390,7 @@ def _remembered(key: tuple, index: pd.DatetimeIndex) -> pd.DataFrame | None:
             if where is None:
                 continue
             rows = entry[1].iloc[where]
-        memory.remove(entry)
-        memory.append(entry)  # most recently used last
+        memory.append(memory.pop(k))  # most recently used last (by place: entries' frames do not compare)
         return rows.set_axis(index).copy()
     return None
 
@@ -407,8 +414,9 @@ def _remember(key: tuple, frame: pd.DataFrame) -> None:
     capacity, memory = _REUSE.get() or (0, None)
     if memory is None or not frame.index.is_unique or len(frame) < REMEMBERED_FROM:
         return
-    memory.append((key, frame))
-    del memory[:-capacity]  # keep the newest
+    with _REUSE_LOCK:
+        memory.append((key, frame))
+        del memory[:-capacity]  # keep the newest
 
 
 def solar_position(

@@ -5,6 +5,7 @@ import pandas as pd
 import pvlib
 import pytest
 
+from hybridtrack.sites import get
 from hybridtrack.sun import REMEMBERED_FROM, reuse_positions, solar_position
 
 
@@ -71,3 +72,18 @@ def test_a_block_inside_another_shares_its_memory():
                 patch.setattr(pvlib.solarposition, "spa_python", None)
                 pd.testing.assert_frame_equal(solar_position(times, "lanzhou", "spa"), first)
     pd.testing.assert_frame_equal(again, first.iloc[10:20])
+
+
+def test_an_answer_remembered_after_another_of_the_same_request_is_recalled():
+    """Two threads of a field may each remember an answer to one request; recalling the later
+    must not compare the two entries' frames (pandas refuses frames on other indexes)."""
+    from hybridtrack.sun import _remember
+
+    times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="UTC")
+    later = times + pd.Timedelta(days=30)
+    with reuse_positions():
+        solar_position(times, "nanjing", "plc")
+        fresh = solar_position(later, "nanjing", "plc")
+        key = ("plc", get("nanjing"), 12.0, "wang-liu", "wang-liu")
+        _remember(key, fresh)  # remembered again, as a second thread would
+        pd.testing.assert_frame_equal(solar_position(later[5:9], "nanjing", "plc"), fresh.iloc[5:9])
