@@ -52,8 +52,8 @@ import pandas as pd
 from .errors import HybridtrackError
 from .params import duration, number
 
-__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "sensor_scene", "read_pointing",
-           "read_photocurrent", "coarse_offset"]
+__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "sensor_scene",
+           "circumsolar_light", "read_pointing", "read_photocurrent", "coarse_offset"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
@@ -206,8 +206,26 @@ class SensorScene:
     diffuse: np.ndarray
 
 
-def _circumsolar(frame: pd.DataFrame, position: pd.DataFrame) -> np.ndarray:
-    """Perez's circumsolar diffuse on a plane facing the sun, W/m² (0 with the sun down)."""
+def circumsolar_light(frame: pd.DataFrame, position: pd.DataFrame) -> np.ndarray:
+    """Perez's circumsolar diffuse on a plane facing the sun, W/m² (0 with the sun down).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        ``dni`` and ``dhi``, W/m²; a missing or negative value counts as no light.
+    position : pandas.DataFrame
+        The true sun (``zenith``, ``azimuth``) on the same index.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    References
+    ----------
+    Perez, R., Ineichen, P., Seals, R., Michalsky, J. and Stewart, R. (1990). Modeling daylight
+    availability and irradiance components from direct and global irradiance. Solar Energy 44(5),
+    271-289. doi:10.1016/0038-092X(90)90055-H
+    """
     import pvlib
 
     zenith = position["zenith"].to_numpy(float)
@@ -216,8 +234,8 @@ def _circumsolar(frame: pd.DataFrame, position: pd.DataFrame) -> np.ndarray:
     if not up.any():
         return out
     index = frame.index[up]
-    dhi = np.nan_to_num(frame["dhi"].to_numpy(float)[up])
-    dni = np.nan_to_num(frame["dni"].to_numpy(float)[up])
+    dhi = np.nan_to_num(np.clip(frame["dhi"].to_numpy(float)[up], 0.0, None))
+    dni = np.nan_to_num(np.clip(frame["dni"].to_numpy(float)[up], 0.0, None))
     azimuth = position["azimuth"].to_numpy(float)[up]
     airmass = pvlib.atmosphere.get_relative_airmass(zenith[up])
     extra = pvlib.irradiance.get_extra_radiation(index).to_numpy(float)
@@ -255,7 +273,7 @@ def _smooth(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float) -
 
 
 def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel, *, clear_dni=None,
-                 clear_dhi=None, rng: np.random.Generator) -> SensorScene:
+                 clear_dhi=None, rng: np.random.Generator, circumsolar=None) -> SensorScene:
     """What a sun-facing sensor has in view at each step of a weather frame (world side).
 
     Parameters
@@ -270,6 +288,9 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
         ``dhi_clear``; pvlib's Ineichen model for a recorded one).
     rng : numpy.random.Generator
         Seeds the patch's distance from the sun and its direction.
+    circumsolar : array-like, optional
+        `circumsolar_light` for this frame and sun, if computed already (a field's collectors
+        share it); computed here otherwise.
 
     Notes
     -----
@@ -283,8 +304,9 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     dhi = np.clip(frame["dhi"].to_numpy(float), 0.0, None)
     clear_dni = np.nan_to_num(np.asarray(clear_dni, float))
     clear_dhi = np.nan_to_num(np.asarray(clear_dhi, float))
-    circumsolar = _circumsolar(frame.assign(dni=np.nan_to_num(dni), dhi=np.nan_to_num(dhi)), position) \
-        * model.view_share
+    if circumsolar is None:
+        circumsolar = circumsolar_light(frame, position)
+    circumsolar = np.asarray(circumsolar, float) * model.view_share
     cloud_share = np.divide(np.clip(np.nan_to_num(dhi) - clear_dhi, 0.0, None), dhi, out=np.zeros_like(dhi),
                             where=np.nan_to_num(dhi) > 0)
     clearness = np.clip(np.divide(np.nan_to_num(dni), np.maximum(clear_dni, 50.0)), 0.0, 1.2)

@@ -28,6 +28,7 @@ from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
 from .outputs import claim, strict_json, write
+from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
@@ -556,8 +557,12 @@ def _expected_clear_sky(world: World, config: SimulationConfig, plan, clock: pd.
     site and the sun its plan computed; on the scans' index."""
     if config.sky.mode != "relative" or config.controller.sensor_only:
         return None
-    position = pd.DataFrame({"apparent_altitude": plan.apparent_altitude})
-    return clear_sky(clock, world.controller_site(), position).set_axis(world.index)
+    site = world.controller_site()
+
+    def expected():  # the plan's sun follows from the clock, the scans, the site and the controller's config
+        return clear_sky(clock, site, pd.DataFrame({"apparent_altitude": plan.apparent_altitude})).set_axis(world.index)
+
+    return shared(("expected clear sky", Same(clock), Same(world.index), site, config.controller), expected)
 
 
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,

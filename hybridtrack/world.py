@@ -36,7 +36,9 @@ from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
 from .mounting import mount_targets, mounting_rotation
-from .sensor import RECORDED_COLUMN, RECORDED_POINTING, SensorModel, coarse_offset, read_photocurrent, read_pointing, sensor_scene
+from .reuse import Same, shared
+from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SensorModel, circumsolar_light, coarse_offset,
+                     read_photocurrent, read_pointing, sensor_scene)
 from .sun import solar_position
 from .times import HOUR_NS
 
@@ -175,9 +177,11 @@ class World:
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
                                      imperfections.axis_roll_error)
         self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation)
-        clear_dni, clear_dhi = self._clear_sky(frame, position)
+        clear_dni, clear_dhi = self._clear_sky(frame, position, truth)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
-        scene = sensor_scene(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi, rng=rng)
+        circumsolar = shared(("circumsolar", Same(frame), site, truth), lambda: circumsolar_light(weather, position))
+        scene = sensor_scene(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi, rng=rng,
+                             circumsolar=circumsolar)
         self.scene = (scene.beam, scene.aureole, scene.patch, np.ascontiguousarray(scene.patch_offset.T), scene.diffuse)
         self.truth_axes = np.ascontiguousarray(np.nan_to_num(self.truth[:, :self.axes].T))
         self.noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
@@ -226,7 +230,11 @@ class World:
         return np.array([frame[name].to_numpy(float) for name in names])
 
     def _true_sun(self, model: str) -> pd.DataFrame:
-        """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere."""
+        """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere.
+        Computed once for the runs of a field (`hybridtrack.reuse`)."""
+        return shared(("true sun", Same(self.index), self.site, model), lambda: self._sun_where_up(model))
+
+    def _sun_where_up(self, model: str) -> pd.DataFrame:
         candidate = self._sun_may_be_up()
         altitude, azimuth = np.full(self.n, -90.0), np.zeros(self.n)
         if candidate.any():
@@ -247,13 +255,16 @@ class World:
         altitude = solar_position(knots, self.site, "plc")["altitude"].to_numpy()
         return altitude[(stamps + HOUR_NS // 2) // HOUR_NS - first] > -3.0 - 7.5 - 0.5
 
-    def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame, model: str) -> tuple[np.ndarray, np.ndarray]:
+        """The frame's clear-sky DNI and DHI, or Ineichen's under the true sun (`model`'s)."""
         if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:
             return frame["dni_clear"].to_numpy(float), frame["dhi_clear"].to_numpy(float)
         from .sky import clear_sky
 
-        _, dni, dhi = clear_sky(self.index, self.site, position["zenith"].to_numpy(float))
-        return dni, dhi
+        def ineichen():
+            return clear_sky(self.index, self.site, position["zenith"].to_numpy(float))[1:]
+
+        return shared(("clear sky", Same(self.index), self.site, model), ineichen)
 
     @staticmethod
     def _true_sky(frame: pd.DataFrame) -> np.ndarray | None:
@@ -272,11 +283,15 @@ class World:
         """What the controller's clock shows at each scan: true time plus its error, its drift since
         it was set, and any clock fault."""
         imp = self.imperfections
+        if "clock" not in self.faults:  # the same clock for every collector of a field controller
+            key = ("controller clock", Same(self.index), imp.clock_error, imp.clock_drift, imp.commissioned_days_ago)
+            return shared(key, lambda: self._clock_reading(np.zeros(self.n)))
+        return self._clock_reading(np.nan_to_num(np.asarray(self.faults["clock"], float)))
+
+    def _clock_reading(self, fault_seconds: np.ndarray) -> pd.DatetimeIndex:
+        imp = self.imperfections
         age = imp.commissioned_days_ago + np.asarray((self.index - self.index[0]) / pd.Timedelta(days=1), float)
-        seconds = imp.clock_error + imp.clock_drift * age
-        if "clock" in self.faults:
-            seconds = seconds + np.nan_to_num(np.asarray(self.faults["clock"], float))
-        return self.index + pd.to_timedelta(seconds, unit="s")
+        return self.index + pd.to_timedelta(imp.clock_error + imp.clock_drift * age + fault_seconds, unit="s")
 
     def controller_site(self) -> sites.Site:
         """The site as the installer told the controller."""

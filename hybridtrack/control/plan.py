@@ -30,6 +30,7 @@ from ..collectors import Collector
 from ..mounting import angles_on_mount, mounting_rotation, pointing_vectors
 from ..sites import Site
 from ..sun import solar_position
+from ..reuse import Content, Same, shared
 from ..times import clock_hours, parse_clock
 from .config import ControllerConfig
 
@@ -152,22 +153,29 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     mount : MountEstimate, optional
         The controller's belief about its mount; nominal by default.
     """
-    clock, steps, alarms = _rebased(clock, minutes)
-    working = _working(clock.tz_convert(site.tz), config.working_hours)
-    sun = solar_position(clock, site, config.sun_model)
-    altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    clock, steps, alarms, altitude, azimuth, apparent, awake = shared(
+        ("plan's sun", Same(clock), Content(minutes), site, config), lambda: _plan_sun(clock, minutes, site, config))
     vectors = pointing_vectors(altitude, azimuth, collector, night=True)
     model = (mount or MountEstimate()).vector_targets(vectors, collector)
-    awake = np.ones(len(clock), bool) if config.sensor_only else \
-        working & _sun_day(clock, altitude, site, config)
-    plan = ControllerPlan(np.asarray(minutes, float), model, np.asarray(awake, bool), steps, alarms=alarms,
-                          apparent_altitude=sun["apparent_altitude"].to_numpy())
+    plan = ControllerPlan(np.asarray(minutes, float), model, awake, steps, alarms=alarms, apparent_altitude=apparent)
     if config.calibrates:
         plan.jacobian = _lit_jacobian(vectors, model, collector)
         plan.weight = np.ones(model.shape)
         if not collector.single_axis:  # an azimuth error counts cos(elevation) in pointing terms
             plan.weight[:, 0] = np.cos(np.radians(np.clip(model[:, 1], 0.0, 90.0)))
     return plan
+
+
+def _plan_sun(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, config: ControllerConfig) -> tuple:
+    """What the plan computes from the clock alone, the same for every collector a field controller
+    drives: the re-based clock, its steps and alarms, the computed sun (altitude, azimuth, apparent
+    altitude) and the scans awake."""
+    clock, steps, alarms = _rebased(clock, minutes)
+    working = _working(clock.tz_convert(site.tz), config.working_hours)
+    sun = solar_position(clock, site, config.sun_model)
+    altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    awake = np.ones(len(clock), bool) if config.sensor_only else working & _sun_day(clock, altitude, site, config)
+    return clock, steps, alarms, altitude, azimuth, sun["apparent_altitude"].to_numpy(), np.asarray(awake, bool)
 
 
 #: Degrees a minute the sun's altitude can change at most (the earth turns 0.25° a minute), with

@@ -1,0 +1,109 @@
+"""Work that runs on one weather frame share, done once inside a `reuse_work` block.
+
+A field's collectors stand under one sky. The true sun where it may be up, its clear sky, the
+circumsolar light of the sky, the controller's clock and the sun its plan computes from that clock
+are the same for every collector that shares the frame, the site, the field controller's clock
+and its sun model; only the mount, the sensor's own noise and what the controller does with them
+differ. Inside ``with reuse_work():`` each such piece is computed by the first run that asks for it
+and handed to every later run that asks with the same inputs.
+
+A request names its inputs in a key. Scalars are compared by value; a frame or an index by identity
+(`Same`), since the runs of a field are handed the same frame object; an array by a digest of its
+values (`Content`, a few milliseconds for a year). Every request gets its own copy of the answer's
+arrays (a millisecond for a year's array), so a run that wrote into one could not change another's.
+The memory is shared by the threads of a field (`contextvars.copy_context`) and guarded by a lock;
+it is dropped when the block ends.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import threading
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Callable, Iterator, TypeVar
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["Content", "Same", "reuse_work", "shared"]
+
+T = TypeVar("T")
+_MEMORY: ContextVar[tuple[threading.Lock, dict] | None] = ContextVar("hybridtrack_reuse_work", default=None)
+
+
+class Same:
+    """A key part that matches only the very same object (a frame, an index); it holds the object,
+    so its identity cannot pass to another while the memory lasts."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value) -> None:
+        self.value = value
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Same) and other.value is self.value
+
+    def __hash__(self) -> int:
+        return id(self.value)
+
+
+@contextmanager
+def reuse_work() -> Iterator[None]:
+    """Within this block, `shared` computes each piece once per key. A block inside another
+    shares the outer block's memory."""
+    if _MEMORY.get() is not None:
+        yield
+        return
+    token = _MEMORY.set((threading.Lock(), {}))
+    try:
+        yield
+    finally:
+        _MEMORY.reset(token)
+
+
+def shared(key: tuple, compute: Callable[[], T]) -> T:
+    """``compute()``, or its earlier answer for the same `key` inside a `reuse_work` block.
+
+    Two threads asking for a piece at once may both compute it; the first answer stored is the one
+    every later request gets (the two are equal: a piece depends only on its key).
+    """
+    memory = _MEMORY.get()
+    if memory is None:
+        return compute()
+    lock, answers = memory
+    with lock:
+        if key in answers:
+            return _handed(answers[key])
+    answer = compute()
+    with lock:
+        return _handed(answers.setdefault(key, answer))
+
+
+def _handed(answer):
+    """What a request gets: a copy of the answer's arrays and frames (in tuples and dicts too),
+    so that no run can write into another's; an index, a number or a string as it is."""
+    if isinstance(answer, (np.ndarray, pd.DataFrame, pd.Series)):
+        return answer.copy()
+    if isinstance(answer, tuple):
+        return tuple(_handed(part) for part in answer)
+    if isinstance(answer, dict):
+        return {key: _handed(value) for key, value in answer.items()}
+    return answer
+
+
+class Content:
+    """A key part that matches an array of the same shape, type and values (by a digest)."""
+
+    __slots__ = ("digest",)
+
+    def __init__(self, values) -> None:
+        values = np.ascontiguousarray(values)
+        self.digest = (values.shape, values.dtype.str, hashlib.blake2b(memoryview(values).cast("B"),
+                                                                          digest_size=16).digest())
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Content) and other.digest == self.digest
+
+    def __hash__(self) -> int:
+        return hash(self.digest)

@@ -1,0 +1,75 @@
+"""Work shared inside a reuse block: computed once per key, the same numbers, never shared between runs' arrays."""
+
+import contextvars
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pandas as pd
+
+from hybridtrack.reuse import Content, Same, reuse_work, shared
+
+
+def counted():
+    calls = []
+
+    def compute():
+        calls.append(1)
+        return np.arange(4.0)
+
+    return calls, compute
+
+
+def test_a_piece_is_computed_once_per_key_inside_the_block_and_every_time_outside():
+    calls, compute = counted()
+    frame = pd.DataFrame({"dni": [1.0, 2.0]})
+    with reuse_work():
+        for _ in range(3):
+            np.testing.assert_array_equal(shared(("piece", Same(frame), 1.5), compute), np.arange(4.0))
+        assert len(calls) == 1
+        shared(("piece", Same(frame), 2.5), compute)  # another scalar: another piece
+        shared(("piece", Same(frame.copy()), 1.5), compute)  # an equal frame that is not the same object
+        assert len(calls) == 3
+        with reuse_work():  # a block inside shares the outer memory
+            shared(("piece", Same(frame), 1.5), compute)
+        assert len(calls) == 3
+    shared(("piece", Same(frame), 1.5), compute)
+    shared(("piece", Same(frame), 1.5), compute)
+    assert len(calls) == 5
+
+
+def test_arrays_are_matched_by_their_values_and_handed_out_as_copies():
+    calls, compute = counted()
+    with reuse_work():
+        first = shared(("piece", Content(np.linspace(0.0, 1.0, 11))), compute)
+        first[0] = 99.0  # a run that writes into its copy
+        second = shared(("piece", Content(np.linspace(0.0, 1.0, 11))), compute)
+        shared(("piece", Content(np.linspace(0.0, 1.0, 12))), compute)
+        shared(("piece", Content(np.linspace(0.0, 1.0, 11).astype(np.float32))), compute)
+    assert second[0] == 0.0 and len(calls) == 3
+
+
+def test_frames_tuples_and_dicts_come_back_as_copies():
+    frame = pd.DataFrame({"a": [1.0, 2.0]})
+    with reuse_work():
+        got = shared(("x",), lambda: (frame, {"alarm": np.zeros(2)}, "text"))
+        got[0].loc[0, "a"] = 5.0
+        got[1]["alarm"][0] = 5.0
+        again = shared(("x",), lambda: None)
+    assert again[0].loc[0, "a"] == 1.0 and again[1]["alarm"][0] == 0.0 and again[2] == "text"
+
+
+def test_threads_given_a_copy_of_the_context_share_one_memory():
+    calls, lock = [], threading.Lock()
+
+    def compute():
+        with lock:
+            calls.append(1)
+        return np.ones(3)
+
+    with reuse_work():
+        shared(("piece",), compute)
+        contexts = [contextvars.copy_context() for _ in range(16)]  # copied here, run there
+        with ThreadPoolExecutor(4) as pool:
+            answers = list(pool.map(lambda context: context.run(shared, ("piece",), compute), contexts))
+    assert len(calls) == 1 and all((a == 1.0).all() for a in answers)
