@@ -2,7 +2,9 @@
 or on a running scheduler. Sweeps (`hybridtrack.sweep`) and fields (`hybridtrack.fields`) use it.
 
 Worker processes, one thread each: a run holds the GIL in the reference loop and in pandas, so
-threads would take turns; processes use every core.
+threads would take turns; processes use every core. (A field in one process runs its collectors on
+threads all the same: there the compiled kernel, a third of a run, lets go of the GIL, and the
+collectors share one computation of their sky; `hybridtrack.fields`.)
 """
 
 from __future__ import annotations
@@ -12,10 +14,18 @@ import os
 from . import params
 from .errors import HybridtrackError
 
-__all__ = ["dask_client", "close", "MAX_WORKERS"]
+__all__ = ["dask_client", "close", "cores", "MAX_WORKERS"]
 
 #: The most worker processes a local cluster is asked for.
 MAX_WORKERS = 1024
+
+
+def cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system has one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
 
 
 def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
@@ -41,7 +51,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
             return Client(scheduler, timeout="10s"), None
         except (OSError, TimeoutError, ValueError) as exc:
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else (os.cpu_count() or 1)
+    count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else cores()
     try:
         cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=50)  # a failed task is reported by its result, not logged

@@ -3,9 +3,11 @@
 A field is a list of collectors at positions (metres east, north, up from the field's origin),
 each with its own imperfections drawn from seeded distributions (`ImperfectionSpread`):
 no two rows of a real field are aligned alike. `simulate_field` runs the controller for every
-collector on the same weather and site and scores each one and the field. For now it runs
-`hybridtrack.simulate` once per collector (the reference path), with the sun positions every
-collector shares computed once (`hybridtrack.sun.reuse_positions`).
+collector on the same weather and site and scores each one and the field. It runs
+`hybridtrack.simulate` once per collector (with the compiled kernel where the engine takes it),
+on threads of this process by default, with what every collector's run shares computed once:
+the sun positions (`hybridtrack.sun.reuse_positions`) and the sky they stand under, the field
+controller's clock and its plan's sun (`hybridtrack.reuse`).
 
 The field geometry itself is vectorised over collectors: `FresnelField.targets`,
 `TroughLoop.targets` and `HeliostatField.targets` give every collector's nominal target at
@@ -14,6 +16,7 @@ every step in one call of the broadcasting functions of `hybridtrack.collectors`
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import sys
 from dataclasses import dataclass, field
@@ -24,7 +27,7 @@ import pandas as pd
 
 from . import params, sites
 from .budget import BYTES_PER_STEP, check_steps
-from .cluster import MAX_WORKERS
+from .cluster import MAX_WORKERS, cores
 from .collectors import (
     AXIS_AZIMUTH,
     MAX_DISTANCE,
@@ -519,8 +522,8 @@ def _end_loss_columns(field: FresnelField, dni, altitude, azimuth) -> dict[str, 
 
 
 def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None, seed: int = 0,
-                   keep_log: bool = True, progress: bool | None = None, workers: int | None = None,
-                   scheduler: str | None = None) -> FieldResult:
+                   keep_log: bool = True, progress: bool | None = None, threads: int | None = None,
+                   workers: int | None = None, scheduler: str | None = None) -> FieldResult:
     """Run the tracker for every collector of a field on the same weather.
 
     Parameters
@@ -541,10 +544,15 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         and step, 80 for a heliostat); False keeps only the metrics.
     progress : bool, optional
         A progress bar over collectors (on stderr); by default when there are more than four.
+    threads : int, optional
+        Run the collectors on this many threads of this process, sharing one computation of
+        the sky they stand under (`hybridtrack.reuse`); by default one per core the process
+        may use, fewer where the memory would not hold that many runs at once. The compiled
+        kernel runs without Python's lock, so the threads' loops run side by side.
     workers : int, optional
         Run the collectors on a local Dask cluster of this many worker processes
-        (`hybridtrack.cluster`); by default they run one after another in this process. The
-        result is the same either way: each collector's run depends only on its own draws.
+        (`hybridtrack.cluster`) instead, one at a time on each. The result is the same
+        wherever the collectors run: each collector's run depends only on its own draws.
     scheduler : str, optional
         Run them on the Dask scheduler at this address instead.
 
@@ -552,6 +560,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     -------
     FieldResult
     """
+    from .reuse import reuse_work
     from .simulation import SimulationConfig, _check_frame
     from .sun import reuse_positions, solar_position
 
@@ -565,24 +574,21 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     if workers is not None:
         params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()
-    if keep_log:
-        first, last = frame.index[0], frame.index[-1]
-        check_steps(first, last, (last - first) / (len(frame) - 1), what=f"a field of {len(collectors)} collectors",
-                    bytes_per_step=BYTES_PER_STEP + LOG_BYTES * len(collectors))
+    threads = _thread_count(threads, frame, len(collectors), keep_log, dask=workers is not None or scheduler is not None)
     runs = [(i, name, collector, imperfect) for i, (name, collector, imperfect)
             in enumerate(zip(field.names, collectors, field.spread.draw(config.imperfections, len(collectors), seed)))]
     bar = _bar(len(runs), progress)
     rows, events, store = [None] * len(runs), [None] * len(runs), None
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
-    with bar, reuse_positions():  # in this process, every run shares the sun with the others and the table
-        for block in _blocks(frame, runs, job, workers, scheduler):
+    with bar, reuse_positions(), reuse_work():  # in this process, every run shares the sky with the others
+        truth = solar_position(frame.index, site, config.truth)  # the table's, and the runs' from memory
+        for block in _blocks(frame, runs, job, threads, workers, scheduler):
             for i, row, run_events, log in block:
                 rows[i], events[i] = row, run_events
                 if keep_log:
                     store = store or _LogStore(field.names, frame, log)
                     store.add(i, log)
                 bar.update()
-        truth = solar_position(frame.index, site, config.truth)
     table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
@@ -597,13 +603,38 @@ def _bar(total: int, progress: bool | None):
                 disable=not (progress if progress is not None else total > 4))
 
 
-def _blocks(frame: pd.DataFrame, runs: list, job: dict, workers: int | None, scheduler: str | None):
-    """Each block of collectors' results as it is done: one after another here, or on Dask in
-    blocks of up to 16 collectors per task, two tasks per worker (each block shares its sun
-    positions)."""
+def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, keep_log: bool, *, dask: bool) -> int:
+    """The threads the collectors run on in this process (1 when they go to Dask), checked against
+    the memory: each thread holds one run, and a kept log every collector's columns. The default
+    takes the most, up to one per core, that fit."""
+    if threads is not None:
+        threads = params.whole(threads, "threads", 1, MAX_WORKERS)
+        if dask and threads > 1:
+            raise HybridtrackError("threads runs the collectors in this process; with workers or a scheduler each "
+                                   "worker runs its collectors one at a time: give one or the other")
+    first, last = frame.index[0], frame.index[-1]
+    step = (last - first) / (len(frame) - 1)
+    log = LOG_BYTES * collectors if keep_log else 0
+    what = f"a field of {collectors} collectors"
+    if threads is None:
+        for count in range(min(cores(), collectors), 1, -1) if not dask else ():
+            try:
+                check_steps(first, last, step, what=what, bytes_per_step=BYTES_PER_STEP * count + log)
+                return count
+            except HybridtrackError:
+                continue
+        threads = 1
+    check_steps(first, last, step, what=what + (f" on {threads} threads" if threads > 1 else ""),
+                bytes_per_step=BYTES_PER_STEP * threads + log)
+    return threads
+
+
+def _blocks(frame: pd.DataFrame, runs: list, job: dict, threads: int, workers: int | None, scheduler: str | None):
+    """Each block of collectors' results as it is done: here, on `threads` threads, one collector
+    a task; or on Dask in blocks of up to 16 collectors per task, two tasks per worker (each block
+    shares its sky)."""
     if workers is None and scheduler is None:
-        for run in runs:
-            yield run_collectors(frame, [run], **job)
+        yield from _threaded(frame, runs, job, threads)
         return
     from dask.distributed import as_completed
 
@@ -621,17 +652,38 @@ def _blocks(frame: pd.DataFrame, runs: list, job: dict, workers: int | None, sch
         close(client, cluster)
 
 
+def _threaded(frame: pd.DataFrame, runs: list, job: dict, threads: int):
+    """Each collector's result as it is done, on `threads` threads sharing this context's memory
+    of the sky (each task runs in a copy of the context, whose memories are the same objects)."""
+    if threads == 1:
+        for run in runs:
+            yield run_collectors(frame, [run], **job)
+        return
+    from concurrent.futures import ThreadPoolExecutor, as_completed
+
+    with ThreadPoolExecutor(threads, thread_name_prefix="hybridtrack-field") as pool:
+        futures = [pool.submit(contextvars.copy_context().run, run_collectors, frame, [run], **job) for run in runs]
+        try:
+            for future in as_completed(futures):
+                yield future.result()
+        finally:
+            for future in futures:  # an error, or the caller stopped: start no more runs
+                future.cancel()
+
+
 def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, seed: int, keep_log: bool) -> list:
     """Run a block of a field's collectors, each ``(i, name, collector, imperfections)``, and
     return for each ``(i, row, events, log)``: its row of the collector table, its events and
-    its log's kept columns (`LOG_VARIABLES`, as arrays; None unless `keep_log`). The sun every
-    run of the block asks for is computed once (`hybridtrack.sun.reuse_positions`)."""
+    its log's kept columns (`LOG_VARIABLES`, as arrays; None unless `keep_log`). The sun and sky
+    every run of the block asks for are computed once (`hybridtrack.sun.reuse_positions`,
+    `hybridtrack.reuse`)."""
     from .metrics import offered_light
+    from .reuse import reuse_work
     from .simulation import simulate
     from .sun import reuse_positions
 
     done = []
-    with reuse_positions():
+    with reuse_positions(), reuse_work():
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))

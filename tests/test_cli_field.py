@@ -10,7 +10,7 @@ from hybridtrack.cli import main
 def test_field_runs_a_fresnel_field_and_writes_its_files(tmp_path, capsys):
     out = tmp_path / "field"
     assert main(["field", "fresnel", "--site", "lanzhou", "--date", "2021-06-21", "--weather", "sunny",
-                 "--rows=-4,0,4", "--metric", "energy_capture", "--out", str(out)]) == 0
+                 "--rows=-4,0,4", "--metric", "energy_capture", "--threads", "2", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "FresnelField of 3 (fresnel)" in printed and "energy capture (field)" in printed and "row 3" in printed
     summary = json.loads((out / "summary.json").read_text())
@@ -49,6 +49,8 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
     (["fresnel", "--receiver-height", "0"], "receiver height must be finite and positive"),
     (["trough", "--count", "0"], "count must be a whole number"),
     (["heliostat", "--positions", "/no/such/file.csv"], "no such file"),
+    (["trough", "--count", "2", "--threads", "0"], "threads must be a whole number within [1,"),
+    (["trough", "--count", "2", "--threads", "2", "--workers", "1"], "give one or the other"),
 ])
 def test_bad_field_flags(capsys, flags, message):
     assert main(["field", *flags, "--site", "lanzhou", "--date", "2021-06-21"]) == 2

@@ -119,6 +119,59 @@ def test_a_field_run_is_each_collectors_own_run(day):
     assert len(result.events) > 0 and set(result.events["collector"]) == set(field.names)
 
 
+def test_collectors_with_their_own_clocks_and_sites_share_no_sky(day):
+    """Shared work is keyed on what it depends on: collectors whose controllers' clocks and site
+    coordinates differ get their own plan and clear sky (here two collectors on two threads, each
+    equal to its own run alone)."""
+    field = TroughLoop(count=2, spread=ImperfectionSpread(clock_error=20.0, latitude_error=0.3))
+    config = SimulationConfig()
+    result = simulate_field(day, "lanzhou", field, seed=5, config=config, threads=2)
+    drawn = field.spread.draw(config.imperfections, 2, 5)
+    assert drawn[0].clock_error != drawn[1].clock_error and drawn[0].latitude_error != drawn[1].latitude_error
+    for i, (name, collector) in enumerate(zip(field.names, field.collectors())):
+        alone = simulate(day, "lanzhou", collector=collector, config=dataclasses.replace(
+            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([5, i]).generate_state(1)[0])))
+        np.testing.assert_array_equal(result.dataset["angle"].sel(collector=name).to_numpy(), alone.log["angle"])
+        np.testing.assert_array_equal(result.dataset["target"].sel(collector=name).to_numpy(), alone.log["target"])
+        assert result.collectors.loc[name, "rms"] == alone.summary["tracking_error_deg"]["rms"]
+
+
+def test_a_field_on_one_thread_or_three_is_the_same_field(day):
+    field = FresnelField(row_distances=[-6.0, -2.0, 1.0, 5.0])
+    one = simulate_field(day, "lanzhou", field, seed=8, threads=1)
+    three = simulate_field(day, "lanzhou", field, seed=8, threads=3)
+    pd.testing.assert_frame_equal(one.collectors, three.collectors)
+    assert one.summary == three.summary
+    pd.testing.assert_frame_equal(one.events, three.events)
+    assert one.dataset.equals(three.dataset)
+
+
+@pytest.mark.parametrize("threads, extra, message", [
+    (0, {}, "threads must be a whole number within"),
+    (2.0, {}, "threads must be a whole number"),
+    (2, {"workers": 1}, "give one or the other"),
+])
+def test_bad_thread_counts_are_refused(day, threads, extra, message):
+    with pytest.raises(HybridtrackError, match=message):
+        simulate_field(day, "lanzhou", TroughLoop(count=2), threads=threads, **extra)
+
+
+def test_the_default_threads_fit_the_memory(day, monkeypatch):
+    """Each thread holds a run: where the memory holds only one, the field runs on one thread
+    rather than being refused, and an explicit count that does not fit is refused."""
+    from hybridtrack import budget
+    from hybridtrack.fields import _thread_count
+
+    steps = len(day)
+    monkeypatch.setattr(budget, "available_memory", lambda: int(2 * budget.BYTES_PER_STEP * steps * 1.5))
+    assert _thread_count(None, day, 4, False, dask=False) == 1
+    with pytest.raises(HybridtrackError, match="on 2 threads"):
+        _thread_count(2, day, 4, False, dask=False)
+    monkeypatch.setattr(budget, "available_memory", lambda: 2**40)
+    assert _thread_count(None, day, 1, False, dask=False) == 1
+    assert _thread_count(None, day, 4, False, dask=True) == 1
+
+
 def test_field_figures_weigh_each_collector_by_the_light_it_is_offered(day):
     result = simulate_field(day, "lanzhou", HeliostatField(), seed=2, keep_log=False)
     table = result.collectors

@@ -50,8 +50,10 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
                                                      "energy_capture, moves, p95, end_loss_share, ...)")
     run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
     run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
-    add_dask_arguments(run, default="the collectors one after another in this process; --workers N runs them on "
-                                    "a local cluster of N processes")
+    run.add_argument("--threads", type=int, help="threads of this process the collectors run on (default: one per "
+                                                 "core, fewer if memory would not hold that many runs)")
+    add_dask_arguments(run, default="the collectors on threads of this process (--threads); --workers N runs them "
+                                    "on a local cluster of N processes")
     add_force_argument(run)
 
 
@@ -168,7 +170,7 @@ def _field(args: argparse.Namespace) -> int:
         claim(FieldResult.files(args.out, log=not args.no_log).values())
     result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
                             seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True,
-                            workers=args.workers, scheduler=args.scheduler)
+                            threads=args.threads, workers=args.workers, scheduler=args.scheduler)
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
           f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {args.strategy}")
     print(field_table(result.summary))

@@ -71,7 +71,7 @@ def kernel(function=None, *, allocates: bool = False, entry: bool = False):
     if not _STAMPED:
         _STAMPED.append(True)
         _empty_stale_cache()
-    return numba.njit(cache=True, error_model="numpy", _nrt=allocates or entry)(function)
+    return numba.njit(cache=True, error_model="numpy", _nrt=allocates or entry, nogil=entry)(function)
 
 
 def available() -> bool:
