@@ -6,13 +6,15 @@ at 1-minute steps (525,600 steps, climate weather, seed 1):
 
 * ``SPA site-year``: pvlib's SPA over the year's stamps, the reference of the ratios;
 * ``one Fresnel row``: ``simulate`` for one row;
-* ``20-row Fresnel field``: ``simulate_field`` of the default 20-row field, metrics only
-  (``keep_log=False``), running ``simulate`` per row in the process;
+* ``20-row Fresnel field, 1 thread``: ``simulate_field`` of the default 20-row field, metrics only
+  (``keep_log=False``), one row after another in the process (``threads=1``), sharing the sky;
+* ``20-row Fresnel field``: the same on the default threads (one per core);
 * ``20-row Fresnel field, 2 workers``: the same on a local Dask cluster of two worker processes
   (``workers=2``; starting the cluster is timed too);
-* ``N heliostats, 2 workers``: a field of ``--heliostats`` mirrors (``HeliostatField.rings``,
-  100 by default) on two workers, metrics only; the table also gives its time per mirror and
-  what 1,000 mirrors would take at that rate (an extrapolation, marked as one);
+* ``N heliostats``: a field of ``--heliostats`` mirrors (``HeliostatField.rings``, 100 by
+  default) in process on the default threads, metrics only; the table also gives its time per
+  mirror and, for fewer than 1,000, what 1,000 would take at that rate (an extrapolation,
+  marked as one);
 * ``1,000 heliostats, geometry, per mirror``: every mirror's normal, azimuth and elevation for
   the year, one mirror per call, as the per-collector loop does it;
 * ``1,000 heliostats, geometry, vectorised``: the same numbers for all mirrors in one call a day
@@ -63,6 +65,13 @@ def _one_row(frame):
     simulate(frame, "lanzhou", collector=Collector("fresnel"))
 
 
+def _fresnel_field_one_thread(frame):
+    from hybridtrack import simulate_field
+    from hybridtrack.fields import FresnelField
+
+    simulate_field(frame, "lanzhou", FresnelField(), keep_log=False, progress=False, threads=1)
+
+
 def _fresnel_field(frame):
     from hybridtrack import simulate_field
     from hybridtrack.fields import FresnelField
@@ -77,11 +86,11 @@ def _fresnel_field_on_workers(frame):
     simulate_field(frame, "lanzhou", FresnelField(), keep_log=False, progress=False, workers=2)
 
 
-def _heliostats_on_workers(frame):
+def _heliostats(frame):
     from hybridtrack import simulate_field
     from hybridtrack.fields import HeliostatField
 
-    simulate_field(frame, "lanzhou", HeliostatField.rings(HELIOSTATS), keep_log=False, progress=False, workers=2)
+    simulate_field(frame, "lanzhou", HeliostatField.rings(HELIOSTATS), keep_log=False, progress=False)
 
 
 def _sun(frame):
@@ -110,9 +119,10 @@ def _geometry_vectorised(sun):
 
 
 CASES = {"SPA site-year": (_year, _spa), "one Fresnel row": (_year, _one_row),
+         "20-row Fresnel field, 1 thread": (_year, _fresnel_field_one_thread),
          "20-row Fresnel field": (_year, _fresnel_field),
          "20-row Fresnel field, 2 workers": (_year, _fresnel_field_on_workers),
-         "N heliostats, 2 workers": (_year, _heliostats_on_workers),
+         "N heliostats": (_year, _heliostats),
          "1,000 heliostats, geometry, per mirror": (lambda: _sun(_year()), _geometry_per_mirror),
          "1,000 heliostats, geometry, vectorised": (lambda: _sun(_year()), _geometry_vectorised)}
 
@@ -153,11 +163,20 @@ def main() -> None:
     rows = [[case, f"{seconds:.2f}", f"{seconds / spa:.2f}x", f"{per_mirror / seconds:.1f}x" if "geometry" in case
              else "", f"{peak:,.0f}"] for case, (seconds, peak) in measured.items()]
     rows = [[case.replace("N heliostats", f"{args.heliostats:,} heliostats"), *rest] for case, *rest in rows]
-    mirrors = measured["N heliostats, 2 workers"][0]
-    print(f"Lanzhou site-year at 1 min (525,600 steps), median of {args.repeats} run(s) each, one process per case")
+    mirrors = measured["N heliostats"][0]
+    print(f"Lanzhou site-year at 1 min (525,600 steps), median of {args.repeats} run(s) each, one process per case; "
+          f"default threads: {_default_threads()}")
     print_table(["case", "wall s", "/ SPA", "per-mirror / this", "peak RSS MiB"], rows)
-    print(f"heliostat field-year on 2 workers: {mirrors / args.heliostats:.2f} s a mirror; 1,000 mirrors at that rate "
-          f"(extrapolated, not run): {1000 * mirrors / args.heliostats:.0f} s")
+    line = f"heliostat field-year: {mirrors / args.heliostats:.2f} s a mirror"
+    if args.heliostats < 1000:
+        line += f"; 1,000 mirrors at that rate (extrapolated, not run): {1000 * mirrors / args.heliostats:.0f} s"
+    print(line)
+
+
+def _default_threads() -> int:
+    from hybridtrack.cluster import cores
+
+    return cores()
 
 
 if __name__ == "__main__":
