@@ -560,6 +560,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     -------
     FieldResult
     """
+    from .kernel import uses_kernel
     from .reuse import reuse_work
     from .simulation import SimulationConfig, _check_frame
     from .sun import reuse_positions, solar_position
@@ -574,7 +575,8 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     if workers is not None:
         params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()
-    threads = _thread_count(threads, frame, len(collectors), keep_log, dask=workers is not None or scheduler is not None)
+    threads = _thread_count(threads, frame, len(collectors), keep_log, dask=workers is not None or scheduler is not None,
+                            compiled=uses_kernel(config, len(frame)))
     runs = [(i, name, collector, imperfect) for i, (name, collector, imperfect)
             in enumerate(zip(field.names, collectors, field.spread.draw(config.imperfections, len(collectors), seed)))]
     bar = _bar(len(runs), progress)
@@ -603,10 +605,12 @@ def _bar(total: int, progress: bool | None):
                 disable=not (progress if progress is not None else total > 4))
 
 
-def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, keep_log: bool, *, dask: bool) -> int:
+def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, keep_log: bool, *, dask: bool,
+                  compiled: bool = True) -> int:
     """The threads the collectors run on in this process (1 when they go to Dask), checked against
     the memory: each thread holds one run, and a kept log every collector's columns. The default
-    takes the most, up to one per core, that fit."""
+    takes the most, up to one per core, that fit; one where the runs take the reference loop,
+    which holds Python's lock throughout (`compiled` False)."""
     if threads is not None:
         threads = params.whole(threads, "threads", 1, MAX_WORKERS)
         if dask and threads > 1:
@@ -617,7 +621,7 @@ def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, kee
     log = LOG_BYTES * collectors if keep_log else 0
     what = f"a field of {collectors} collectors"
     if threads is None:
-        for count in range(min(cores(), collectors), 1, -1) if not dask else ():
+        for count in range(min(cores(), collectors), 1, -1) if compiled and not dask else ():
             try:
                 check_steps(first, last, step, what=what, bytes_per_step=BYTES_PER_STEP * count + log)
                 return count

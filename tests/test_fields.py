@@ -136,10 +136,12 @@ def test_collectors_with_their_own_clocks_and_sites_share_no_sky(day):
         assert result.collectors.loc[name, "rms"] == alone.summary["tracking_error_deg"]["rms"]
 
 
-def test_a_field_on_one_thread_or_three_is_the_same_field(day):
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
+def test_a_field_on_one_thread_or_three_is_the_same_field(day, engine):
     field = FresnelField(row_distances=[-6.0, -2.0, 1.0, 5.0])
-    one = simulate_field(day, "lanzhou", field, seed=8, threads=1)
-    three = simulate_field(day, "lanzhou", field, seed=8, threads=3)
+    config = SimulationConfig(engine=engine)
+    one = simulate_field(day, "lanzhou", field, seed=8, threads=1, config=config)
+    three = simulate_field(day, "lanzhou", field, seed=8, threads=3, config=config)
     pd.testing.assert_frame_equal(one.collectors, three.collectors)
     assert one.summary == three.summary
     pd.testing.assert_frame_equal(one.events, three.events)
@@ -156,9 +158,10 @@ def test_bad_thread_counts_are_refused(day, threads, extra, message):
         simulate_field(day, "lanzhou", TroughLoop(count=2), threads=threads, **extra)
 
 
-def test_the_default_threads_fit_the_memory(day, monkeypatch):
+def test_the_default_threads_fit_the_memory_and_the_engine(day, monkeypatch):
     """Each thread holds a run: where the memory holds only one, the field runs on one thread
-    rather than being refused, and an explicit count that does not fit is refused."""
+    rather than being refused, and an explicit count that does not fit is refused. The reference
+    loop holds Python's lock, so its runs default to one thread."""
     from hybridtrack import budget
     from hybridtrack.fields import _thread_count
 
@@ -170,6 +173,8 @@ def test_the_default_threads_fit_the_memory(day, monkeypatch):
     monkeypatch.setattr(budget, "available_memory", lambda: 2**40)
     assert _thread_count(None, day, 1, False, dask=False) == 1
     assert _thread_count(None, day, 4, False, dask=True) == 1
+    assert _thread_count(None, day, 4, False, dask=False, compiled=False) == 1  # the reference loop holds the GIL
+    assert _thread_count(3, day, 4, False, dask=False, compiled=False) == 3  # as asked
 
 
 def test_field_figures_weigh_each_collector_by_the_light_it_is_offered(day):
