@@ -12,7 +12,7 @@ A request names its inputs in a key. Scalars are compared by value; a frame or a
 values (`Content`, a few milliseconds for a year). Every request gets its own copy of the answer's
 arrays (a millisecond for a year's array), so a run that wrote into one could not change another's.
 The memory is shared by the threads of a field (`contextvars.copy_context`) and guarded by a lock;
-it is dropped when the block ends.
+it keeps the pieces used most recently (`ENTRIES`) and is dropped when the block ends.
 """
 
 from __future__ import annotations
@@ -26,10 +26,14 @@ from typing import Callable, Iterator, TypeVar
 import numpy as np
 import pandas as pd
 
-__all__ = ["Content", "Same", "reuse_work", "shared"]
+__all__ = ["Content", "Same", "reuse_work", "shared", "ENTRIES"]
 
 T = TypeVar("T")
-_MEMORY: ContextVar[tuple[threading.Lock, dict] | None] = ContextVar("hybridtrack_reuse_work", default=None)
+#: Pieces a `reuse_work` block keeps: the ones every run shares are used by each run and stay; a
+#: field whose collectors each have their own clock adds a few per run, which must not pile up
+#: (a year's plan is some 40 MB) but only outlive the runs on the other threads.
+ENTRIES = 16
+_MEMORY: ContextVar[tuple[threading.Lock, dict, int] | None] = ContextVar("hybridtrack_reuse_work", default=None)
 
 
 class Same:
@@ -49,13 +53,13 @@ class Same:
 
 
 @contextmanager
-def reuse_work() -> Iterator[None]:
-    """Within this block, `shared` computes each piece once per key. A block inside another
-    shares the outer block's memory."""
+def reuse_work(entries: int = ENTRIES) -> Iterator[None]:
+    """Within this block, `shared` computes each piece once per key, keeping the `entries` pieces
+    used most recently. A block inside another shares the outer block's memory."""
     if _MEMORY.get() is not None:
         yield
         return
-    token = _MEMORY.set((threading.Lock(), {}))
+    token = _MEMORY.set((threading.Lock(), {}, max(int(entries), 1)))
     try:
         yield
     finally:
@@ -71,13 +75,17 @@ def shared(key: tuple, compute: Callable[[], T]) -> T:
     memory = _MEMORY.get()
     if memory is None:
         return compute()
-    lock, answers = memory
+    lock, answers, entries = memory
     with lock:
         if key in answers:
+            answers[key] = answers.pop(key)  # the most recently used last
             return _handed(answers[key])
     answer = compute()
     with lock:
-        return _handed(answers.setdefault(key, answer))
+        answer = answers.setdefault(key, answer)
+        for oldest in list(answers)[:-entries]:
+            del answers[oldest]
+        return _handed(answer)
 
 
 def _handed(answer):

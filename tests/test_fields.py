@@ -236,10 +236,11 @@ def test_a_field_on_two_dask_workers_is_the_same_field(day):
     assert here.dataset.equals(there.dataset)
 
 
-def test_a_collector_that_fails_on_a_worker_fails_the_field_with_its_own_error_and_no_log(day, capfd):
+@pytest.mark.parametrize("where", [{"workers": 1}, {"threads": 2}])
+def test_a_collector_that_fails_fails_the_field_with_its_own_error_and_no_log(day, capfd, where):
     without_sky = day.drop(columns=["sky"])
     with pytest.raises(HybridtrackError, match="needs the frame's true 'sky' column"):
-        simulate_field(without_sky, "lanzhou", TroughLoop(count=2), strategy="hybrid-oracle", workers=1)
+        simulate_field(without_sky, "lanzhou", TroughLoop(count=3), strategy="hybrid-oracle", **where)
     assert "Traceback" not in capfd.readouterr().err
 
 

@@ -73,3 +73,19 @@ def test_threads_given_a_copy_of_the_context_share_one_memory():
         with ThreadPoolExecutor(4) as pool:
             answers = list(pool.map(lambda context: context.run(shared, ("piece",), compute), contexts))
     assert len(calls) == 1 and all((a == 1.0).all() for a in answers)
+
+
+def test_the_memory_keeps_the_pieces_used_most_recently():
+    """A field whose collectors each have their own clock adds pieces with every run: they must not
+    pile up, while the pieces every run uses stay."""
+    calls, compute = counted()
+    with reuse_work(entries=3):
+        for run in range(10):
+            shared(("every run's",), compute)
+            shared(("this run's", run), compute)
+        assert len(calls) == 11  # the shared piece once, each run's own once
+        shared(("this run's", 9), compute)
+        shared(("this run's", 8), compute)
+        assert len(calls) == 11
+        shared(("this run's", 0), compute)  # long forgotten
+        assert len(calls) == 12
