@@ -101,14 +101,22 @@ def _handed(answer):
 
 
 class Content:
-    """A key part that matches an array of the same shape, type and values (by a digest)."""
+    """A key part that matches an array of the same shape, type and values (by a digest, taken when
+    the key is first looked up: outside a `reuse_work` block it never is)."""
 
-    __slots__ = ("digest",)
+    __slots__ = ("_values", "_digest")
 
     def __init__(self, values) -> None:
-        values = np.ascontiguousarray(values)
-        self.digest = (values.shape, values.dtype.str, hashlib.blake2b(memoryview(values).cast("B"),
-                                                                          digest_size=16).digest())
+        self._values, self._digest = values, None
+
+    @property
+    def digest(self) -> tuple:
+        if self._digest is None:
+            values = np.ascontiguousarray(self._values)
+            self._digest = (values.shape, values.dtype.str,
+                            hashlib.blake2b(memoryview(values).cast("B"), digest_size=16).digest())
+            self._values = None
+        return self._digest
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Content) and other.digest == self.digest
