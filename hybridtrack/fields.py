@@ -683,11 +683,11 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
     `hybridtrack.reuse`)."""
     from .metrics import offered_light
     from .reuse import reuse_work
-    from .simulation import simulate
+    from .simulation import one_thread, simulate
     from .sun import reuse_positions
 
     done = []
-    with reuse_positions(), reuse_work():
+    with reuse_positions(), reuse_work(), one_thread():  # the field spreads its runs over the cores itself
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))

@@ -243,7 +243,7 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
     """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``."""
     from . import sites
     from .collectors import Collector
-    from .simulation import simulate
+    from .simulation import one_thread, simulate
 
     spec = _spec(base, grid_values)
     row = _row(spec)
@@ -257,7 +257,8 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
         collector = Collector(spec["collector"], **geometry)
         frame = _frame(site, _plain(spec["start"]), spec["days"], _plain(spec["weather"]), spec["freq"],
                        seed, float(spec["gusts_per_day"]))
-        summary = simulate(frame, site, collector=collector, strategy=spec["strategy"], config=config).summary
+        with one_thread():  # the sweep spreads its runs over the cores itself
+            summary = simulate(frame, site, collector=collector, strategy=spec["strategy"], config=config).summary
         error = summary["tracking_error_deg"]
         row.update({m: error[m] if m in error else summary[m] for m in METRICS})
         row["error"] = None

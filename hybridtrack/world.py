@@ -42,7 +42,7 @@ from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SensorModel, circumsola
 from .sun import solar_position
 from .times import HOUR_NS
 
-__all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site"]
+__all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site", "controller_clock", "scan_timer"]
 
 #: Degrees the mechanism's hard stops lie beyond the drive's software limits.
 HARD_STOP_MARGIN = 1.0
@@ -126,6 +126,27 @@ def installed_site(site: sites.Site, imperfections: Imperfections) -> sites.Site
     return sites.Site(site.name, latitude, longitude, site.altitude, site.tz)
 
 
+def scan_timer(index: pd.DatetimeIndex) -> np.ndarray:
+    """The controller's scan timer at each scan: minutes since the run began."""
+    return np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+
+
+def controller_clock(index: pd.DatetimeIndex, imperfections: Imperfections, faults: dict) -> pd.DatetimeIndex:
+    """What the controller's clock shows at each scan of `index`: true time plus its error, its
+    drift since it was set, and any clock fault (``faults["clock"]``, seconds per scan). The same
+    for every collector of a field controller (`hybridtrack.reuse`)."""
+    imp = imperfections
+
+    def reading(fault_seconds):
+        age = imp.commissioned_days_ago + np.asarray((index - index[0]) / pd.Timedelta(days=1), float)
+        return index + pd.to_timedelta(imp.clock_error + imp.clock_drift * age + fault_seconds, unit="s")
+
+    if "clock" in faults:
+        return reading(np.nan_to_num(np.asarray(faults["clock"], float)))
+    key = ("controller clock", Same(index), imp.clock_error, imp.clock_drift, imp.commissioned_days_ago)
+    return shared(key, lambda: reading(np.zeros(len(index))))
+
+
 class World:
     """The plant one collector lives in, over one weather frame.
 
@@ -192,7 +213,7 @@ class World:
         self.frame_dni = frame["dni"].to_numpy(float)
         self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
         self.true_sky = self._true_sky(frame)
-        self.minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+        self.minutes = scan_timer(index)
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.actual = [d.stow - imperfections.encoder_offset for d in drives]  # parked where stow reads
         self.angles = np.full((self.axes, self.n), np.nan)
@@ -280,18 +301,8 @@ class World:
         return self.true_sky is not None
 
     def controller_clock(self) -> pd.DatetimeIndex:
-        """What the controller's clock shows at each scan: true time plus its error, its drift since
-        it was set, and any clock fault."""
-        imp = self.imperfections
-        if "clock" not in self.faults:  # the same clock for every collector of a field controller
-            key = ("controller clock", Same(self.index), imp.clock_error, imp.clock_drift, imp.commissioned_days_ago)
-            return shared(key, lambda: self._clock_reading(np.zeros(self.n)))
-        return self._clock_reading(np.nan_to_num(np.asarray(self.faults["clock"], float)))
-
-    def _clock_reading(self, fault_seconds: np.ndarray) -> pd.DatetimeIndex:
-        imp = self.imperfections
-        age = imp.commissioned_days_ago + np.asarray((self.index - self.index[0]) / pd.Timedelta(days=1), float)
-        return self.index + pd.to_timedelta(imp.clock_error + imp.clock_drift * age + fault_seconds, unit="s")
+        """What the controller's clock shows at each scan (`controller_clock`)."""
+        return controller_clock(self.index, self.imperfections, self.faults)
 
     def controller_site(self) -> sites.Site:
         """The site as the installer told the controller."""

@@ -306,3 +306,32 @@ def test_the_logs_sky_is_the_classifiers_label_and_a_band_named_otherwise_is_mis
                    config=SimulationConfig(engine="reference")).log
     clear = renamed.label(log["sky_score"].to_numpy()) == "clear"
     assert clear.any() and log["sky"][clear].isna().all() and log["sky"][~clear].notna().all()
+
+
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_a_run_built_side_by_side_is_the_run_built_in_turn(monkeypatch, collector):
+    """A long run builds its world on a second thread while the controller plans; nothing either
+    reads comes from the other, so every log column, event and summary figure is the same."""
+    import hybridtrack.simulation as simulation
+
+    frame = synthetic("nanjing", "2013-06-20", "2013-06-21", weather="mixed", seed=4)
+    config = SimulationConfig(imperfections=Imperfections(clock_error=20.0, latitude_error=0.2))
+    monkeypatch.setattr(simulation, "SIDE_BY_SIDE_FROM", 10**12)
+    in_turn = simulate(frame, "nanjing", collector=collector, config=config)
+    monkeypatch.setattr(simulation, "SIDE_BY_SIDE_FROM", 0)
+    beside = simulate(frame, "nanjing", collector=collector, config=config)
+    pd.testing.assert_frame_equal(in_turn.log, beside.log)
+    pd.testing.assert_frame_equal(in_turn.events, beside.events)
+    assert json.dumps(in_turn.summary, sort_keys=True, default=str) == json.dumps(beside.summary, sort_keys=True,
+                                                                                    default=str)
+    with simulation.one_thread():  # and a caller that spreads runs itself keeps each on its thread
+        assert not simulation._SECOND_THREAD.get()
+
+
+def test_the_worlds_error_reaches_the_caller_from_a_second_thread(monkeypatch):
+    import hybridtrack.simulation as simulation
+
+    monkeypatch.setattr(simulation, "SIDE_BY_SIDE_FROM", 0)
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny").assign(pointing=0.0)  # one axis of two
+    with pytest.raises(HybridtrackError, match="a recorded pointing signal needs a column per axis"):
+        simulate(frame, "lanzhou", collector="heliostat")
