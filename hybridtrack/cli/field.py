@@ -51,7 +51,8 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
     run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
     run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
     run.add_argument("--threads", type=int, help="threads of this process the collectors run on (default: one per "
-                                                 "core, fewer if memory would not hold that many runs)")
+                                                 "core where the compiled kernel runs them, fewer if memory would not "
+                                                 "hold that many runs; otherwise one)")
     add_dask_arguments(run, default="the collectors on threads of this process (--threads); --workers N runs them "
                                     "on a local cluster of N processes")
     add_force_argument(run)
