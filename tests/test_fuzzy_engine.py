@@ -282,3 +282,26 @@ def test_every_compiled_path_matches_the_numpy_engine(parallel_from, monkeypatch
         np.testing.assert_allclose(fused, reference, atol=1e-9, rtol=0)
         np.testing.assert_array_equal(fused, two_pass)
         np.testing.assert_allclose(firing, compiled_system.firing(x), atol=1e-12, rtol=0)
+
+
+def test_threads_that_first_use_the_compiled_engine_at_once_take_turns():
+    """A field's threads may make a process's first fuzzy call at the same moment: compiling the
+    engine's helpers twice raised numba's "jit decorator was called on an already jitted function"
+    in the thread that lost (a fresh process, as the engine is set up once per process)."""
+    import subprocess
+    import sys
+
+    script = ("import threading\n"
+              "from hybridtrack.fuzzy import compiled\n"
+              "errors = []\n"
+              "def go():\n"
+              "    try:\n"
+              "        compiled.available()\n"
+              "    except Exception as exc:\n"
+              "        errors.append(repr(exc))\n"
+              "threads = [threading.Thread(target=go) for _ in range(4)]\n"
+              "[t.start() for t in threads]\n"
+              "[t.join() for t in threads]\n"
+              "print(errors)\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and done.stdout.strip() == "[]", done.stdout + done.stderr

@@ -20,6 +20,7 @@ engine with one warning.
 
 from __future__ import annotations
 
+import threading
 import types
 import warnings
 
@@ -33,6 +34,11 @@ __all__ = ["kernel_for", "available", "MAX_SUBSET_UNITS"]
 MAX_SUBSET_UNITS = 8
 
 _STATE: dict = {}
+_SETUP_LOCK = threading.Lock()
+#: Held while a parallel kernel runs: numba's parallel kernels may not be launched from two threads
+#: at once on every threading layer (its ``workqueue`` layer aborts the process), and one launch uses
+#: every core already.
+_PARALLEL_LOCK = threading.Lock()
 _TOLERANCE = 1e-12  # as engine.MAXIMUM_TOLERANCE
 _CHUNKS = 64
 #: Readings below which the kernels run on one thread: starting threads costs more.
@@ -41,7 +47,16 @@ _STEPS = 1024  # even level steps indexing the sorted tables, so that a look-up 
 
 
 def available() -> bool:
-    """Whether numba imports here (warns once when it does not)."""
+    """Whether numba imports here (warns once when it does not). The first call compiles the
+    kernels' helpers into this module's namespace; threads that make it at once (a field's) take
+    turns, as compiling a function twice fails."""
+    if "numba" in _STATE:
+        return _STATE["numba"]
+    with _SETUP_LOCK:
+        return _set_up()
+
+
+def _set_up() -> bool:
     if "numba" not in _STATE:
         try:
             import numba
@@ -469,7 +484,12 @@ class _Kernel:
 
     def evaluate(self, x: np.ndarray, with_firing: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Every output (N, outputs) and every rule's firing (N, rules; None unless `with_firing`)."""
-        suffix = "" if len(x) >= PARALLEL_FROM else "_serial"  # the serial twins are made in `available`
+        if len(x) < PARALLEL_FROM:
+            return self._evaluate(x, with_firing, "_serial")  # the serial twins are made in `available`
+        with _PARALLEL_LOCK:
+            return self._evaluate(x, with_firing, "")
+
+    def _evaluate(self, x: np.ndarray, with_firing: bool, suffix: str) -> tuple[np.ndarray, np.ndarray | None]:
         kernels = globals()
         inputs = (self.lo, self.scale, self.last, self.samples, self.nterms, self.ante, self.weights, self.is_or,
                   self.and_prod, self.or_probor)
