@@ -613,7 +613,7 @@ def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, kee
     which holds Python's lock throughout (`compiled` False)."""
     if threads is not None:
         threads = params.whole(threads, "threads", 1, MAX_WORKERS)
-        if dask and threads > 1:
+        if dask:
             raise HybridtrackError("threads runs the collectors in this process; with workers or a scheduler each "
                                    "worker runs its collectors one at a time: give one or the other")
     first, last = frame.index[0], frame.index[-1]
@@ -754,7 +754,7 @@ class _LogStore:
             self.arrays[column] = np.empty((len(names), len(values)), values.dtype)
             if categories is not None:
                 self.attrs[column] = {"flag_values": np.arange(len(categories), dtype=np.int8),
-                                      "flag_meanings": " ".join(categories)}
+                                      "flag_meanings": " ".join(c.replace(" ", "_") for c in categories)}
 
     def add(self, i: int, log: dict) -> None:
         for column, array in self.arrays.items():

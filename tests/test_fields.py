@@ -152,6 +152,8 @@ def test_a_field_on_one_thread_or_three_is_the_same_field(day, engine):
     (0, {}, "threads must be a whole number within"),
     (2.0, {}, "threads must be a whole number"),
     (2, {"workers": 1}, "give one or the other"),
+    (1, {"workers": 1}, "give one or the other"),
+    (1, {"scheduler": "tcp://127.0.0.1:1"}, "give one or the other"),
 ])
 def test_bad_thread_counts_are_refused(day, threads, extra, message):
     with pytest.raises(HybridtrackError, match=message):
@@ -210,6 +212,12 @@ def test_field_result_map_dataset_and_files(day, tmp_path):
     np.testing.assert_array_equal(dataset["east"], [-5.0, 0.0, 5.0])
     assert pd.DatetimeIndex(dataset["time"].to_numpy()).tz_localize("UTC").equals(day.index.tz_convert("UTC"))
     assert 0 < result.summary["end_loss_share"] < 1 and (result.collectors["end_loss_m"] > 0).all()
+    from hybridtrack.control import SENSOR_STATUS
+
+    for name in ("mode", "sky", "sensor_status"):  # CF: one blank-separated word per flag value
+        attrs = dataset[name].attrs
+        assert len(attrs["flag_meanings"].split()) == len(attrs["flag_values"]), name
+    assert dataset["sensor_status"].attrs["flag_meanings"].split() == [s.replace(" ", "_") for s in SENSOR_STATUS]
     written = result.save(tmp_path / "field")
     assert {p.name for p in written.values()} == {"collectors.csv", "events.csv", "summary.json", "field_map.png",
                                                   "log.nc"}
