@@ -490,6 +490,7 @@ def _history(site, collector, config, start, classifier, warm_start):
     from .commissioning import commission, warm_memory
 
     if isinstance(warm_start, dict):  # an earlier run carried on
+        _check_memory(warm_start, collector)
         memory = dict(warm_start)
         mount = memory.pop("commissioned", None)
         if config.controller.strategy == "astronomical-commissioned" and mount is None:
@@ -502,6 +503,18 @@ def _history(site, collector, config, start, classifier, warm_start):
     if warm_start and config.controller.calibrates:
         return None, warm_memory(site, collector, config, start, classifier=classifier)
     return None, None
+
+
+def _check_memory(memory: dict, collector: Collector) -> None:
+    """Refuse an earlier run's memory that another kind of collector left (its fit and offsets have
+    another number of terms)."""
+    names, axes = parameter_names(collector), 1 if collector.single_axis else 2
+    theta, offsets = memory.get("theta"), memory.get("offsets")
+    if (theta is not None and len(theta) != len(names)) or (offsets is not None and len(offsets) != axes):
+        raise HybridtrackError(f"warm_start: this memory was left by a run of another kind of collector "
+                               f"({len(theta) if theta is not None else len(offsets)} terms; a {collector.kind} "
+                               f"has {len(names) if theta is not None else axes}); pass the memory of a "
+                               f"{collector.kind} run")
 
 
 def _calibration_summary(mount: MountEstimate | None, fitted: dict | None, out, collector: Collector) -> dict | None:

@@ -335,3 +335,13 @@ def test_the_worlds_error_reaches_the_caller_from_a_second_thread(monkeypatch):
     frame = synthetic("lanzhou", "2021-06-21", weather="sunny").assign(pointing=0.0)  # one axis of two
     with pytest.raises(HybridtrackError, match="a recorded pointing signal needs a column per axis"):
         simulate(frame, "lanzhou", collector="heliostat")
+
+
+@pytest.mark.parametrize("left_by, used_by", [("heliostat", "trough-ns"), ("trough-ns", "heliostat"),
+                                              ("fresnel", "heliostat")])
+def test_a_memory_left_by_another_kind_of_collector_is_refused_in_one_line(left_by, used_by):
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="5min")
+    memory = simulate(day, "lanzhou", collector=left_by).memory
+    with pytest.raises(HybridtrackError, match=f"another kind of collector .* pass the memory of a {used_by} run"):
+        simulate(day, "lanzhou", collector=used_by, warm_start=memory)
+    simulate(day, "lanzhou", collector=left_by, warm_start=memory)  # its own kind carries on
