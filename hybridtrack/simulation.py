@@ -283,6 +283,12 @@ def _drives(collector: Collector, config: SimulationConfig) -> list[Drive]:
             dataclasses.replace(drive, limits=(0.0, 90.0), stow=90.0)]
 
 
+#: The longest typical (median) step a run takes: hourly records (a TMY or EPW file) are the coarsest
+#: a tracking controller is replayed over; a longer step, in which the sun turns more than 15°, is
+#: not a scan (a 13-hour step made a day of two scans and a meaningless score).
+LONGEST_STEP = pd.Timedelta(hours=1)
+
+
 def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     if not isinstance(frame, pd.DataFrame) or not isinstance(frame.index, pd.DatetimeIndex):
         raise HybridtrackError("the weather frame must be a DataFrame on a DatetimeIndex")
@@ -300,6 +306,12 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
             _physical_column(frame, column)
     first, last = frame.index[0], frame.index[-1]
     check_steps(first, last, (last - first) / (len(frame) - 1), what="the weather frame")
+    typical = pd.Timedelta(int(np.median(np.diff(frame.index.as_unit("ns").asi8))), "ns")
+    if typical > LONGEST_STEP:
+        hours = typical / pd.Timedelta(hours=1)
+        raise HybridtrackError(f"the weather frame's steps are {hours:g} h apart (median), in which the sun turns "
+                               f"{15 * hours:.0f}°: a tracking controller is replayed at steps of "
+                               f"{LONGEST_STEP / pd.Timedelta(hours=1):g} h or finer; resample the frame")
     return frame
 
 

@@ -345,3 +345,18 @@ def test_a_memory_left_by_another_kind_of_collector_is_refused_in_one_line(left_
     with pytest.raises(HybridtrackError, match=f"another kind of collector .* pass the memory of a {used_by} run"):
         simulate(day, "lanzhou", collector=used_by, warm_start=memory)
     simulate(day, "lanzhou", collector=left_by, warm_start=memory)  # its own kind carries on
+
+
+def test_a_frame_of_steps_longer_than_an_hour_is_refused_and_night_gaps_are_not():
+    """A 13-hour step made a day of two scans and a score of them; hourly records (TMY, EPW) run,
+    and so does a logger file with its nights left out (its median step is a minute)."""
+    from hybridtrack.cli import main
+
+    coarse = synthetic("lanzhou", "2021-06-21", "2021-06-23", weather="mixed", freq="13h")
+    with pytest.raises(HybridtrackError, match=r"steps are 13 h apart \(median\), in which the sun turns 195°"):
+        simulate(coarse, "lanzhou")
+    assert simulate(synthetic("lanzhou", "2021-06-21", weather="mixed", freq="1h"), "lanzhou").summary["steps"] == 24
+    days = synthetic("lanzhou", "2021-06-21", "2021-06-22", weather="sunny", freq="1min")
+    daytime = days[(days.index.hour >= 6) & (days.index.hour < 20)]
+    assert simulate(daytime, "lanzhou").summary["steps"] == len(daytime)
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "2h"]) == 2
