@@ -6,8 +6,8 @@ no two rows of a real field are aligned alike. `simulate_field` runs the control
 collector on the same weather and site and scores each one and the field. It runs
 `hybridtrack.simulate` once per collector (with the compiled kernel where the engine takes it),
 on threads of this process by default, with what every collector's run shares computed once:
-the sun positions (`hybridtrack.sun.reuse_positions`) and the sky they stand under, the field
-controller's clock and its plan's sun (`hybridtrack.reuse`).
+the sun positions and the sky they stand under, the field controller's clock and its plan's sun
+(`hybridtrack.reuse.reuse_work`).
 
 The field geometry itself is vectorised over collectors: `FresnelField.targets`,
 `TroughLoop.targets` and `HeliostatField.targets` give every collector's nominal target at
@@ -563,7 +563,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     from .kernel import uses_kernel
     from .reuse import reuse_work
     from .simulation import SimulationConfig, _check_frame
-    from .sun import reuse_positions, solar_position
+    from .sun import solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
@@ -582,7 +582,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     bar = _bar(len(runs), progress)
     rows, events, store = [None] * len(runs), [None] * len(runs), None
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
-    with bar, reuse_positions(), reuse_work():  # in this process, every run shares the sky with the others
+    with bar, reuse_work():  # in this process, every run shares the sun and sky with the others
         truth = solar_position(frame.index, site, config.truth)  # the table's, and the runs' from memory
         for block in _blocks(frame, runs, job, threads, workers, scheduler):
             for i, row, run_events, log in block:
@@ -679,15 +679,13 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
     """Run a block of a field's collectors, each ``(i, name, collector, imperfections)``, and
     return for each ``(i, row, events, log)``: its row of the collector table, its events and
     its log's kept columns (`LOG_VARIABLES`, as arrays; None unless `keep_log`). The sun and sky
-    every run of the block asks for are computed once (`hybridtrack.sun.reuse_positions`,
-    `hybridtrack.reuse`)."""
+    every run of the block asks for are computed once (`hybridtrack.reuse.reuse_work`)."""
     from .metrics import offered_light
     from .reuse import reuse_work
     from .simulation import one_thread, simulate
-    from .sun import reuse_positions
 
     done = []
-    with reuse_positions(), reuse_work(), one_thread():  # the field spreads its runs over the cores itself
+    with reuse_work(), one_thread():  # the field spreads its runs over the cores itself
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))

@@ -26,6 +26,8 @@ from typing import Callable, Iterator, TypeVar
 import numpy as np
 import pandas as pd
 
+from .sun import reuse_positions
+
 __all__ = ["Content", "Same", "reuse_work", "shared", "ENTRIES"]
 
 T = TypeVar("T")
@@ -55,13 +57,15 @@ class Same:
 @contextmanager
 def reuse_work(entries: int = ENTRIES) -> Iterator[None]:
     """Within this block, `shared` computes each piece once per key, keeping the `entries` pieces
-    used most recently. A block inside another shares the outer block's memory."""
+    used most recently, and `hybridtrack.sun.solar_position` answers from its own memory
+    (`hybridtrack.sun.reuse_positions`). A block inside another shares the outer block's memory."""
     if _MEMORY.get() is not None:
         yield
         return
     token = _MEMORY.set((threading.Lock(), {}, max(int(entries), 1)))
     try:
-        yield
+        with reuse_positions():
+            yield
     finally:
         _MEMORY.reset(token)
 

@@ -295,11 +295,6 @@ class World:
         found, names = pd.factorize(frame["sky"])  # -1 for a missing label: the table's last entry
         return np.array([sky_code(name, UNKNOWN) for name in names] + [UNKNOWN], np.int64)[found]
 
-    @property
-    def has_true_sky(self) -> bool:
-        """Whether the frame carries the true sky label (needed by the oracle policy)."""
-        return self.true_sky is not None
-
     def controller_clock(self) -> pd.DatetimeIndex:
         """What the controller's clock shows at each scan (`controller_clock`)."""
         return controller_clock(self.index, self.imperfections, self.faults)
