@@ -22,7 +22,7 @@ from .clockwatch import ClockWatch
 from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import EncoderMonitor
-from .mountfit import MountEstimator, pull_spread
+from .mountfit import MountEstimator, ordered_dot, pull_spread
 from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR,
                     SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
@@ -440,7 +440,7 @@ class Controller:
 
     def _mount_corrections(self, i: int, j: int) -> np.ndarray:
         """The fitted mount's correction of scans `i` to `j` - 1, (j - i, axes)."""
-        return self.jacobian[i:j] @ self.theta
+        return ordered_dot(self.jacobian[i:j], self.theta)
 
     def _offer(self, i: int, a: int, dt: float, z: float, trusted: bool) -> int:
         """Offer the sensor's sun angle on axis `a` to the gate, and let a trusted one calibrate."""
@@ -497,8 +497,9 @@ class Controller:
         time of day and a checkpoint's offset belongs to another hour."""
         fit = self.checkpoint if self.checkpoint is not None else {"theta": self.theta, "p": self.fit.p}
         row = self.jacobian[i, a]
-        miss = self._turn(a, z - m0 - float(row @ fit["theta"])) * w
-        return miss, math.sqrt(self._reading_variance(i) + w * w * float(row @ fit["p"] @ row))
+        miss = self._turn(a, z - m0 - float(ordered_dot(row, fit["theta"]))) * w
+        spread = float(ordered_dot(row, ordered_dot(fit["p"], row)))
+        return miss, math.sqrt(self._reading_variance(i) + w * w * spread)
 
     def _reading_variance(self, i: int) -> float:
         """deg²: the variance of a sensor reading at scan `i`: the datasheet noise, stated at

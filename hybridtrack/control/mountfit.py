@@ -79,7 +79,7 @@ import numpy as np
 
 from ..mounting import angles_on_mount, pointing_vectors, rotate
 
-__all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
+__all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "ordered_dot", "ordered_matmul", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
            "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
 
 #: Above this condition number of the information matrix, axis azimuth and tilt are frozen.
@@ -226,7 +226,7 @@ class MountEstimator:
 
     def predict(self, row) -> float:
         """The correction the fitted mount makes to a computed target: row · theta."""
-        return float(np.dot(row, self.theta))
+        return float(ordered_dot(row, self.theta))
 
     def forget(self, dt: float) -> None:
         """Let `dt` minutes of forgetting pass: the covariance grows (bounded by the prior)."""
@@ -249,17 +249,17 @@ class MountEstimator:
         r = self.r if variance is None else variance
         self.information += np.outer(row, row) / r  # what it tells of every parameter, frozen or not
         self.evidence += row * residual / r
-        pr = self.p @ row
-        s = r + float(row @ pr)
+        pr = ordered_dot(self.p, row)
+        s = r + float(ordered_dot(row, pr))
         gain = pr / s
         if self.axis_frozen:
             gain[:2] = 0.0
         bound = self.clip * math.sqrt(s)
-        innovation = residual - float(row @ self.theta)
+        innovation = residual - float(ordered_dot(row, self.theta))
         error = max(-bound, min(bound, innovation))
         self.theta = self.theta + gain * error
         a = np.eye(self.n) - np.outer(gain, row)  # Joseph form, right for any gain
-        self.p = a @ self.p @ a.T + r * np.outer(gain, gain)
+        self.p = ordered_matmul(ordered_matmul(a, self.p), a.T) + r * np.outer(gain, gain)
         self.updates += 1
         if self.updates % self.check_every == 0:
             self._check()
@@ -289,6 +289,29 @@ class MountEstimator:
     def std(self) -> list[float]:
         """1σ of each parameter, degrees."""
         return np.sqrt(np.clip(np.diag(self.p), 0.0, None)).tolist()
+
+
+def ordered_dot(a, b) -> np.ndarray:
+    """Σₖ a[..., k] · b[k], added in turn from k = 0, each product and each sum rounded on its own.
+
+    For a vector `a` the dot product; for a matrix (or a stack of them) the matrix-vector
+    product; `ordered_matmul` the matrix product. BLAS promises neither an order nor whether it
+    fuses a multiply with an add, and numpy's and numba's BLAS builds differ. The compiled
+    controller (`hybridtrack.kernel.controller`) takes these same steps in scalar loops, so the
+    two controllers get the same bits: a difference in the last bit grows over a year of
+    closed-loop runs (a move made one scan sooner). It also spares the kernel a BLAS call at
+    every scan.
+    """
+    b = np.asarray(b, float)
+    total = a[..., 0] * b[0]
+    for k in range(1, b.shape[0]):
+        total = total + a[..., k] * b[k]
+    return total
+
+
+def ordered_matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The matrix product a @ b as `ordered_dot` sums it: Σₖ a[i, k] · b[k, j] in turn."""
+    return ordered_dot(np.asarray(a, float)[:, None, :], b)
 
 
 def spd_inverse(a: np.ndarray) -> np.ndarray:

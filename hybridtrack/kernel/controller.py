@@ -152,14 +152,20 @@ def _lead(rate, period, deadband):
     return math.copysign(min(step * (scans - 1) / 2.0, deadband / 2.0), rate)
 
 
-@kernel(allocates=True)
+@kernel
+def ordered_dot(x, y):
+    """mountfit.ordered_dot of two vectors: Σₖ x[k] · y[k] added in turn, so the same bits."""
+    total = x[0] * y[0]
+    for k in range(1, y.shape[0]):
+        total = total + x[k] * y[k]
+    return total
+
+
+@kernel
 def _mount_corrections(jacobian, theta, i, mount):
-    """Controller._mount_corrections of scan `i` into `mount`, by the same BLAS call numpy makes
-    (a dot product for one axis, a matrix-vector product for two), so the sums round alike."""
-    if jacobian.shape[1] == 1:
-        mount[0] = np.dot(jacobian[i, 0], theta)
-    else:
-        mount[:] = jacobian[i] @ theta
+    """Controller._mount_corrections of scan `i` into `mount`."""
+    for a in range(mount.shape[0]):
+        mount[a] = ordered_dot(jacobian[i, a], theta)
 
 
 @kernel
@@ -573,17 +579,32 @@ def fit_update(theta, p, information, evidence, r, clip, frozen, derivatives, we
     n = row.shape[0]
     information[:, :] = information + np.outer(row, row) / r
     evidence[:] = evidence + row * residual / r
-    pr = p @ row
-    s = r + np.dot(row, pr)
+    pr = np.empty(n)
+    for m in range(n):
+        pr[m] = ordered_dot(p[m], row)
+    s = r + ordered_dot(row, pr)
     gain = pr / s
     if frozen:
         gain[:2] = 0.0
     bound = clip * math.sqrt(s)
-    innovation = residual - np.dot(row, theta)
+    innovation = residual - ordered_dot(row, theta)
     error = max(-bound, min(bound, innovation))
     theta[:] = theta + gain * error
     a = np.eye(n) - np.outer(gain, row)
-    p[:, :] = a @ p @ a.T + r * np.outer(gain, gain)
+    p[:, :] = _ordered_matmul(_ordered_matmul(a, p), a.T) + r * np.outer(gain, gain)
+
+
+@kernel(allocates=True)
+def _ordered_matmul(a, b):
+    """mountfit.ordered_matmul: Σₖ a[i, k] · b[k, j] added in turn."""
+    out = np.empty((a.shape[0], b.shape[1]))
+    for i in range(a.shape[0]):
+        for j in range(b.shape[1]):
+            total = a[i, 0] * b[0, j]
+            for k in range(1, a.shape[1]):
+                total = total + a[i, k] * b[k, j]
+            out[i, j] = total
+    return out
 
 
 @kernel
@@ -658,11 +679,14 @@ def _recall(cfg, state):
     state.k[UPDATES] = state.k[CHECKPOINT_UPDATES]
 
 
-@kernel(allocates=True)
+@kernel
 def _against_checkpoint(row, theta, p, r, w):
     """Controller._against_checkpoint: the fit's correction at `row` and the spread in pointing
-    terms (sqrt(r + w²·row·p·row))."""
-    return np.dot(row, theta), math.sqrt(r + w * w * np.dot(row @ p, row))
+    terms (sqrt(r + w²·row·(p·row)))."""
+    spread = row[0] * ordered_dot(p[0], row)
+    for m in range(1, row.shape[0]):
+        spread = spread + row[m] * ordered_dot(p[m], row)
+    return ordered_dot(row, theta), math.sqrt(r + w * w * spread)
 
 
 @kernel
