@@ -55,6 +55,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 from .params import duration
+from .rolling import trailing_range
 from .sensor import SensorModel
 from .sites import Site, get
 from .sky import clear_sky as ineichen_clear_sky
@@ -230,11 +231,6 @@ def _smoothed(values: pd.Series, smoothing: str | None) -> pd.Series:
     return values.rolling(pd.Timedelta(smoothing), min_periods=1).mean()
 
 
-def _range(values: pd.Series, window: str) -> pd.Series:
-    rolling = values.rolling(pd.Timedelta(window), min_periods=1)
-    return rolling.max() - rolling.min()
-
-
 def sky_inputs(frame: pd.DataFrame, site: Site | str, sensor: SensorModel | None = None,
                config: SkyInputConfig | None = None, *, intensity: pd.Series | None = None,
                clear: pd.DataFrame | None = None) -> tuple[pd.Series, pd.Series]:
@@ -272,7 +268,7 @@ def sky_inputs(frame: pd.DataFrame, site: Site | str, sensor: SensorModel | None
         raise HybridtrackError("the sky inputs need a weather frame on a time-zone-aware DatetimeIndex")
     current = sensor.photocurrent(frame) if intensity is None else intensity.astype(float)
     absolute = _smoothed(current, config.smoothing)
-    absolute_variation = _range(absolute, config.window)
+    absolute_variation = trailing_range(absolute, config.window)
     if config.mode == "absolute":
         return absolute.rename("intensity_input"), absolute_variation.rename("variation_input")
     fuzzy = fuzzy_config(config)
@@ -284,7 +280,7 @@ def sky_inputs(frame: pd.DataFrame, site: Site | str, sensor: SensorModel | None
     # a sky brighter than the model's clear sky is clear: the excess is the model's error
     # (Linke turbidity looked up, not measured), and its ramp must not read as variation
     relative = ((absolute - sensor.dark_current) / expected.where(~low)).clip(upper=1.0)
-    relative_variation = _range(relative, config.window)
+    relative_variation = trailing_range(relative, config.window)
     floor = config.relative_floor
     intensity_input = lo + (hi - lo) * ((relative - floor) / (1.0 - floor)).clip(0.0, 1.0)
     variation_input = vlo + (vhi - vlo) * relative_variation / config.full_variation
