@@ -38,8 +38,9 @@ ACCEPTANCE_HALF_ANGLE = {"trough-ns": 1.0, "trough-ew": 1.0, "fresnel": 0.8, "he
 
 def acceptance(error, half_angle: float) -> np.ndarray:
     """Share of the direct light an aperture intercepts at a pointing error (degrees)."""
-    e = np.asarray(error, float)
-    return 1.0 / (1.0 + (e / half_angle) ** 4)
+    ratio = np.asarray(error, float) / half_angle
+    squared = ratio * ratio  # squared twice: numpy's general power is ten times slower
+    return 1.0 / (1.0 + squared * squared)
 
 
 def weighted_quantile(values, weights, q: float) -> float:
