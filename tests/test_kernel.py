@@ -446,6 +446,41 @@ def test_the_mount_fit_compiled_updates_as_the_reference():
     assert releases >= 1
 
 
+def test_the_ordered_sums_are_the_same_bits_compiled_and_a_matrix_product_in_numbers():
+    from hybridtrack.control.mountfit import ordered_dot, ordered_matmul
+    from hybridtrack.kernel.controller import _against_checkpoint, _mount_corrections, _ordered_matmul
+    from hybridtrack.kernel.controller import ordered_dot as compiled_dot
+
+    rng = np.random.default_rng(9)
+    for n in (3, 4):
+        jacobian, theta = rng.normal(size=(50, 2, n)) * 10.0 ** rng.integers(-8, 3, size=(50, 2, n)), rng.normal(size=n)
+        a, p = rng.normal(size=(n, n)), rng.normal(size=(n, n))
+        mount = np.empty(2)
+        for i in range(50):
+            _mount_corrections(jacobian, theta, i, mount)
+            assert np.array_equal(mount, ordered_dot(jacobian[i], theta))
+            assert compiled_dot(jacobian[i, 0], theta) == ordered_dot(jacobian[i, 0], theta)
+        np.testing.assert_allclose(ordered_dot(jacobian, theta), jacobian @ theta, rtol=1e-12, atol=1e-12)
+        assert np.array_equal(_ordered_matmul(a, p.T), ordered_matmul(a, p.T))
+        np.testing.assert_allclose(ordered_matmul(a, p.T), a @ p.T, rtol=1e-12, atol=1e-12)
+        row, cov = jacobian[0, 0], p @ p.T
+        fitted, spread = _against_checkpoint(row, theta, cov, 0.01, 0.5)
+        assert fitted == ordered_dot(row, theta)
+        assert spread == np.sqrt(0.01 + 0.25 * float(ordered_dot(row, ordered_dot(cov, row))))
+        assert spread == pytest.approx(np.sqrt(0.01 + 0.25 * row @ cov @ row), rel=1e-12)
+
+
+def test_the_trailing_windows_queue_size_is_the_most_scans_a_window_holds():
+    from hybridtrack.kernel.controller import most_in_window
+
+    rng = np.random.default_rng(2)
+    minutes = np.cumsum(rng.choice([0.5, 1.0, 1.0, 7.0, 60.0], 3000))
+    for width in (0.25, 1.0, 3.0, 20.0, 600.0):
+        start = np.searchsorted(minutes, minutes - width, side="right")
+        assert most_in_window(minutes, width) == int(np.max(np.arange(len(minutes)) - start + 1))
+    assert most_in_window(np.arange(10.0), 3.0) == 3  # (t − 3, t] at 1-minute scans: t − 2, t − 1 and t
+
+
 @pytest.mark.parametrize("days", [1.0, 40.0])  # within DRIFT_DAYS the drift is held; beyond it is fitted
 def test_the_kernels_clock_fit_sums_its_normal_equations_to_the_references_answer(days):
     """The kernel keeps running sums of the clock fit's normal equations, its residuals' squares

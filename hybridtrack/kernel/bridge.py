@@ -15,7 +15,6 @@ import numpy as np
 
 from ..control.controller import CLASSIFYING, FIT_EVERY, Controller, ControllerOutputs
 from ..control.modes import MODES
-from ..reuse import Content, shared
 from ..world import World
 from . import controller as kc
 from .events import wording
@@ -118,15 +117,8 @@ def _plan(controller: Controller) -> kc.ControllerPlanArrays:
 
 
 def _window_capacity(minutes: np.ndarray, windows: list[float]) -> int:
-    """The most scans any trailing window can hold, with room for the one being added (the same
-    for every collector of a field: `hybridtrack.reuse`)."""
-    return shared(("window capacity", Content(minutes), tuple(windows)), lambda: _most_in_window(minutes, windows))
-
-
-def _most_in_window(minutes: np.ndarray, windows: list[float]) -> int:
-    scans = np.arange(len(minutes))
-    most = max(int(np.max(scans - np.searchsorted(minutes, minutes - w, side="right") + 1)) for w in windows)
-    return most + 2
+    """The most scans any trailing window can hold, with room for the one being added."""
+    return max(kc.most_in_window(minutes, float(width)) for width in windows) + 2
 
 
 def _clock_capacity(controller: Controller, minutes: np.ndarray) -> int:

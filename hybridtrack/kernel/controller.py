@@ -320,6 +320,18 @@ def _empty(state, q):
 
 
 @kernel
+def most_in_window(minutes, width):
+    """The most scans a trailing window of `width` minutes, ``(t − width, t]``, holds over the run:
+    the size `trailing_range` and `trailing_mean` need for their queues."""
+    most, start = 0, 0
+    for i in range(minutes.shape[0]):
+        while start <= i and minutes[start] <= minutes[i] - width:
+            start += 1
+        most = max(most, i - start + 1)
+    return most
+
+
+@kernel
 def trailing_range(state, highs, lows, window, t, value):
     """TrailingRange.add over the queues `highs` and `lows`."""
     if not math.isnan(value):
