@@ -392,17 +392,25 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
-    if uses_kernel(config, world.n):
-        out = run_compiled(world, controller, progress, bulk_nights and not faults)
-    else:
+    compiled = uses_kernel(config, world.n)
+
+    def run_scans():
+        if compiled:
+            return run_compiled(world, controller, progress, bulk_nights and not faults)
         _run(world, controller, progress, bulk_nights and not faults)
-        out = controller.outputs()
+        return controller.outputs()
+
+    def score_ahead():
+        return incidence_cosine(world.altitude, world.azimuth, collector)
+
+    # the compiled loop lets go of Python's lock, so the scoring's geometry is done beside it
+    out, incidence = _side_by_side(run_scans, score_ahead, len(frame) if compiled else 0)
     index = frame.index
     log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
                                                        world.controller_site()))
     events = _events_frame(index, out.events)
-    scoring = {"sun_up": world.altitude > 0, "incidence": incidence_cosine(world.altitude, world.azimuth, collector),
-               "moves": int(out.moves.sum()), "travel": float(out.travel.sum())}
+    scoring = {"sun_up": world.altitude > 0, "incidence": incidence, "moves": int(out.moves.sum()),
+               "travel": float(out.travel.sum())}
     summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                         events=events, **scoring)
     summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
