@@ -308,14 +308,16 @@ def test_the_logs_sky_is_the_classifiers_label_and_a_band_named_otherwise_is_mis
     assert clear.any() and log["sky"][clear].isna().all() and log["sky"][~clear].notna().all()
 
 
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
 @pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
-def test_a_run_built_side_by_side_is_the_run_built_in_turn(monkeypatch, collector):
-    """A long run builds its world on a second thread while the controller plans; nothing either
-    reads comes from the other, so every log column, event and summary figure is the same."""
+def test_a_run_built_side_by_side_is_the_run_built_in_turn(monkeypatch, collector, engine):
+    """A long run builds its world on a second thread while the controller plans, and scores its
+    geometry beside the compiled loop; nothing either reads comes from the other, so every log
+    column, event and summary figure is the same."""
     import hybridtrack.simulation as simulation
 
     frame = synthetic("nanjing", "2013-06-20", "2013-06-21", weather="mixed", seed=4)
-    config = SimulationConfig(imperfections=Imperfections(clock_error=20.0, latitude_error=0.2))
+    config = SimulationConfig(imperfections=Imperfections(clock_error=20.0, latitude_error=0.2), engine=engine)
     monkeypatch.setattr(simulation, "SIDE_BY_SIDE_FROM", 10**12)
     in_turn = simulate(frame, "nanjing", collector=collector, config=config)
     monkeypatch.setattr(simulation, "SIDE_BY_SIDE_FROM", 0)
