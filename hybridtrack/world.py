@@ -40,7 +40,7 @@ from .reuse import Same, shared
 from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SensorModel, circumsolar_light, coarse_offset,
                      read_photocurrent, read_pointing, sensor_scene)
 from .sun import solar_position
-from .times import HOUR_NS
+from .times import HOUR_NS, plus_seconds
 
 __all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site", "controller_clock", "scan_timer"]
 
@@ -139,7 +139,7 @@ def controller_clock(index: pd.DatetimeIndex, imperfections: Imperfections, faul
 
     def reading(fault_seconds):
         age = imp.commissioned_days_ago + np.asarray((index - index[0]) / pd.Timedelta(days=1), float)
-        return index + pd.to_timedelta(imp.clock_error + imp.clock_drift * age + fault_seconds, unit="s")
+        return plus_seconds(index, imp.clock_error + imp.clock_drift * age + fault_seconds)
 
     if "clock" in faults:
         return reading(np.nan_to_num(np.asarray(faults["clock"], float)))

@@ -24,3 +24,19 @@ def test_clock_fields_of_a_coarser_unit_and_a_naive_index():
     naive = pd.DatetimeIndex(["2021-12-31 23:30", "2022-01-01 00:15"])
     np.testing.assert_array_equal(calendar_days(naive)[0], [365, 1])
     np.testing.assert_allclose(clock_hours(naive), [23.5, 0.25])
+
+
+def test_plus_seconds_is_pandas_to_timedelta_to_the_nanosecond():
+    import numpy as np
+
+    from hybridtrack.times import plus_seconds
+
+    index = pd.date_range("2021-03-27 22:00", periods=6000, freq="1min", tz="Europe/Berlin")  # over a DST change
+    seconds = np.random.default_rng(3).normal(20.0, 500.0, len(index))
+    for start, expected in ((index, index + pd.to_timedelta(seconds, unit="s")),
+                            (index[:1], index[0] + pd.to_timedelta(seconds, unit="s"))):
+        got = plus_seconds(start, seconds)
+        assert got.tz == index.tz and len(got) == len(index)
+        assert np.abs(got.asi8 - expected.asi8).max() <= 1
+    whole = plus_seconds(index[:3].as_unit("s"), np.array([0.0, 20.0, -1.5]))
+    assert list(whole) == [index[0], index[1] + pd.Timedelta(seconds=20), index[2] - pd.Timedelta(seconds=1.5)]

@@ -31,7 +31,7 @@ from ..mounting import angles_on_mount, mounting_rotation, pointing_vectors
 from ..sites import Site
 from ..sun import solar_position
 from ..reuse import Content, Same, shared
-from ..times import clock_hours, parse_clock
+from ..times import clock_hours, parse_clock, plus_seconds
 from .config import ControllerConfig
 
 __all__ = ["MountEstimate", "ControllerPlan", "make_plan", "east_park", "CLOCK_STEP_SECONDS"]
@@ -126,7 +126,7 @@ def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeI
                      f"({drift[i] - drift[hour_ago[i]]:+.0f} s in the last hour); "
                      "clock re-based on the timer from here")
         drift[i:] = drift[i]  # from here the clock runs with the timer
-    rebased = clock[0] + pd.to_timedelta(60.0 * minutes + drift, unit="s")
+    rebased = plus_seconds(clock[:1], 60.0 * minutes + drift)
     return rebased, steps, alarms
 
 
