@@ -625,7 +625,8 @@ def _plot_timeline(result, log: pd.DataFrame, title: str):
     ax.text(1.005, controller.wind_release, f"release ≤ {controller.wind_release:g}",
             transform=ax.get_yaxis_transform(), color="tab:green", fontsize="x-small", va="center")
     ax.set_ylabel("wind (m/s)")
-    ax.set_ylim(0, max(controller.wind_stow * 1.15, float(np.nanmax(log["wind_speed"], initial=0)) * 1.05))
+    wind = log["wind_speed"].to_numpy(float)
+    ax.set_ylim(0, max(controller.wind_stow * 1.15, float(np.max(wind[np.isfinite(wind)], initial=0)) * 1.05))
     if fitted:
         draw_mount_fit(axes[6], local, log, true_fit_parameters(result.config.imperfections, result.collector))
     for ax in axes:
