@@ -362,3 +362,17 @@ def test_a_frame_of_steps_longer_than_an_hour_is_refused_and_night_gaps_are_not(
     daytime = days[(days.index.hour >= 6) & (days.index.hour < 20)]
     assert simulate(daytime, "lanzhou").summary["steps"] == len(daytime)
     assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "2h"]) == 2
+
+
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_the_log_can_be_edited_in_place_and_edits_nothing_else(collector):
+    """The log takes the run's arrays as they are: an edit of it must work (no read-only column
+    from the weather frame) and leave the frame as it was."""
+    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=1)
+    before = frame.copy()
+    log = simulate(frame, "lanzhou", collector=collector).log
+    for column in ("dni", "wind_speed", "target_true", "angle", "target", "error"):
+        log.loc[log.index[0], column] = 5.0
+        log[column] *= 2.0
+    assert (log.loc[log.index[0], ["dni", "angle"]] == 10.0).all()
+    pd.testing.assert_frame_equal(frame, before)
