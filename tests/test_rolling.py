@@ -10,7 +10,7 @@ from hybridtrack.rolling import _range_pass_python, trailing_range
 
 def _series(seed, n=3000, nan_share=0.1, irregular=True):
     rng = np.random.default_rng(seed)
-    steps = rng.choice([30, 60, 60, 60, 90, 600, 3600], size=n) if irregular else np.full(n, 60)
+    steps = rng.choice([0, 30, 60, 60, 60, 90, 600, 3600], size=n) if irregular else np.full(n, 60)  # 0: a repeat
     index = pd.Timestamp("2021-06-01", tz="Asia/Shanghai") + pd.to_timedelta(np.cumsum(steps), unit="s")
     values = np.round(rng.normal(100.0, 30.0, n), 1)  # rounded: ties, which the deques must keep right
     values[rng.random(n) < nan_share] = np.nan
