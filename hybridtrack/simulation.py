@@ -681,8 +681,8 @@ def _sky_categorical(codes: np.ndarray, names: tuple[str, ...]) -> pd.Categorica
 def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> pd.DataFrame:
     """The run's log, one row a scan. Its columns are taken as they are, not copied into one
     block (a heliostat's 26 columns over a year took 0.06 s to copy): every array is the run's
-    own, and the two read from the weather frame are copied, so an edit of the log edits nothing
-    else."""
+    own, and those read from a frame (which pandas hands out read-only) are copied, so an edit of
+    the log works and edits nothing else."""
     from .collectors import sun_vector
 
     truth = world.truth
@@ -697,9 +697,9 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
     columns = {
         "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": angle[:, main].copy(),
         "error": error, "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)),
-        "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(), "sensor_valid": out.sensor_status == 0,
+        "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(copy=True), "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical.from_codes(out.sensor_status, categories=list(SENSOR_STATUS)),
-        "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(),
+        "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(copy=True),
         "wind_speed": world.wind.copy(), "dni": world.frame_dni.copy(), "calibration": out.calibration[:, main],
         "sensor_sun": out.sun[:, main],
     }

@@ -371,8 +371,10 @@ def test_the_log_can_be_edited_in_place_and_edits_nothing_else(collector):
     frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=1)
     before = frame.copy()
     log = simulate(frame, "lanzhou", collector=collector).log
-    for column in ("dni", "wind_speed", "target_true", "angle", "target", "error"):
-        log.loc[log.index[0], column] = 5.0
-        log[column] *= 2.0
-    assert (log.loc[log.index[0], ["dni", "angle"]] == 10.0).all()
+    for column in log.columns:  # every column takes an edit in place
+        log.loc[log.index[0], column] = log[column].iloc[1]
+        if pd.api.types.is_float_dtype(log[column]):
+            log.loc[log.index[2], column] = 5.0
+            log[column] *= 2.0
+            assert log.loc[log.index[2], column] == 10.0
     pd.testing.assert_frame_equal(frame, before)
