@@ -94,7 +94,7 @@ def test_each_refusal_is_one_line_from_the_api_and_the_cli(tmp_path, capsys, mon
 
 @pytest.mark.parametrize("args, message", [
     (["--map", "dni=Direct", "--map", "dni=Beam"], "--map names dni twice ('Direct' and 'Beam')"),
-    (["--site", "lanzhou", "--site-tz", "UTC"], "give either --site or --lat/--lon/--site-tz, not both"),
+    (["--site", "lanzhou", "--site-tz", "UTC"], "give either --site or --lat/--lon/--altitude/--site-tz, not both"),
     (["--lat", "36.1"], "--lat, --lon go together; one of them is missing"),
     (["--site-tz", "UTC"], "--site-tz goes with --lat/--lon"),
     (["--map", "time"], "--map takes NAME=VALUE, got 'time'"),
@@ -153,8 +153,19 @@ def test_a_dead_pyrheliometer_column_is_derived_from_ghi_and_dhi_and_counted(tmp
 
 def test_site_flags_keep_their_meaning_for_commands_without_a_file(capsys):
     assert main(["sun", "--site", "lanzhou", "--tz", "UTC", "--date", "2021-06-21"]) == 2
-    assert "give either --site or --lat/--lon/--tz, not both" in capsys.readouterr().err
+    assert "give either --site or --lat/--lon/--altitude/--tz, not both" in capsys.readouterr().err
     assert main(["sun", "--lat", "36.1", "--lon", "103.7", "--tz", "Asia/Shanghai", "--date", "2021-06-21"]) == 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--site", "lanzhou", "--altitude", "nan"], "give either --site or --lat/--lon/--altitude/--tz, not both"),
+    (["--altitude", "1500"], "--altitude goes with --lat/--lon"),
+])
+def test_an_altitude_without_coordinates_is_refused_not_ignored(capsys, args, message):
+    """A site's altitude given beside a named site (or none) was silently dropped."""
+    assert main(["simulate", *args, "--date", "2021-06-21", "--out", "unused"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and "Traceback" not in err
 
 
 def test_a_file_whose_header_places_it_far_from_the_site_is_refused_or_warned(capsys):

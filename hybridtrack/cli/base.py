@@ -45,7 +45,7 @@ def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None =
         group.add_argument("--site-tz", help="with --lat/--lon: the site's clock when it differs from the file's --tz")
     else:
         group.add_argument("--tz", help="IANA time zone of the local clock, e.g. Asia/Shanghai")
-    group.add_argument("--altitude", type=float, default=0.0, help="metres above sea level (with --lat/--lon)")
+    group.add_argument("--altitude", type=float, help="metres above sea level (with --lat/--lon; default 0)")
     parser.set_defaults(_default_site=default, _record_site=record)
 
 
@@ -60,9 +60,9 @@ def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True
     record = getattr(args, "_record_site", False)
     site_tz = getattr(args, "site_tz", None) if record else None
     if args.site is not None:
-        given = (args.lat, args.lon, site_tz) if record else (args.lat, args.lon, args.tz)
+        given = (args.lat, args.lon, args.altitude, site_tz if record else args.tz)
         if any(value is not None for value in given):
-            raise HybridtrackError("give either --site or --lat/--lon" + ("/--site-tz" if record else "/--tz")
+            raise HybridtrackError("give either --site or --lat/--lon/--altitude" + ("/--site-tz" if record else "/--tz")
                                    + ", not both")
         return sites.get(args.site)
     clock = (site_tz or args.tz) if record else args.tz
@@ -70,12 +70,12 @@ def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True
         if clock is None and (clock_required or not record):
             raise HybridtrackError("--lat and --lon need the site's clock: --tz ZONE" + (" (or --site-tz)" if record
                                                                                           else ""))
-        return sites.custom(args.lat, args.lon, clock or "UTC", args.altitude)
+        return sites.custom(args.lat, args.lon, clock or "UTC", 0.0 if args.altitude is None else args.altitude)
     if args.lat is not None or args.lon is not None or (args.tz is not None and not record):
         together = "--lat, --lon" + ("" if record else " and --tz")
         raise HybridtrackError(f"{together} go together; one of them is missing")
-    if site_tz is not None:
-        raise HybridtrackError("--site-tz goes with --lat/--lon")
+    if site_tz is not None or args.altitude is not None:
+        raise HybridtrackError(f"{'--site-tz' if site_tz is not None else '--altitude'} goes with --lat/--lon")
     if args._default_site:
         return sites.get(args._default_site)
     if not clock_required:
