@@ -5,9 +5,10 @@ The sky's variation input is the range of the photocurrent over a trailing time 
 two passes, each finding the window's bounds again, about 40 ms a site-year at 1-minute steps,
 twice per run. `trailing_range` finds the bounds once and keeps both extremes in monotonic
 deques (Lemire 2006), in one compiled pass. It takes the same window as pandas (right-closed,
-``(t − window, t]``, stamps ascending), skips NaN as pandas does and is NaN where the window has
-no value, so it returns the same numbers; a test holds the two equal bit for bit. Without numba,
-or on an index that is not ascending, it is pandas' own.
+``(t − window, t]`` in the index's own unit, stamps ascending), skips NaN and ±inf as pandas does
+and is NaN where the window has no value, so it returns the same numbers; a test holds the two
+equal bit for bit. Without numba, for a DataFrame, or on an index that is not ascending, it is
+pandas' own.
 
 References
 ----------
@@ -60,18 +61,21 @@ def trailing_range(values: pd.Series, window: str | pd.Timedelta, *, engine: str
     width = pd.Timedelta(window)
     index = values.index
     compiled = engine == "compiled" or (engine == "auto" and numba is not None)
-    if not compiled or not isinstance(index, pd.DatetimeIndex) or not index.is_monotonic_increasing:
+    if not (compiled and isinstance(values, pd.Series) and isinstance(index, pd.DatetimeIndex)
+            and index.is_monotonic_increasing):
         rolling = values.rolling(width, min_periods=1)
         return rolling.max() - rolling.min()
-    stamps = index.as_unit("ns").asi8
-    spread = _range_pass(stamps, values.to_numpy(float), width.value)
+    # pandas takes the window in the index's unit, truncated: 1500 ms is 1 s on an index of seconds
+    in_unit = pd.Timedelta(width.value).as_unit(index.unit).value
+    spread = _range_pass(index.as_unit("ns").asi8, values.to_numpy(float), in_unit)
     return pd.Series(spread, index=index, name=values.name)
 
 
 def _range_pass_python(stamps: np.ndarray, values: np.ndarray, width: int) -> np.ndarray:
     """The window's max − min at every stamp: the window's start moves up as the stamps pass
-    it; each deque keeps the indexes of values that may yet be the window's max (min), in
-    order, so its front is the extreme."""
+    it (never past the stamp itself, as in pandas); each deque keeps the indexes of values that
+    may yet be the window's max (min), in order, so its front is the extreme. Infinite values
+    are missing, as pandas' rolling takes them."""
     n = values.shape[0]
     out = np.empty(n)
     highs, lows = np.empty(n, np.int64), np.empty(n, np.int64)
@@ -79,7 +83,7 @@ def _range_pass_python(stamps: np.ndarray, values: np.ndarray, width: int) -> np
     start = 0
     for i in range(n):
         value = values[i]
-        if value == value:
+        if np.isfinite(value):
             while high_back > high_front and values[highs[high_back - 1]] <= value:
                 high_back -= 1
             highs[high_back] = i
@@ -88,7 +92,7 @@ def _range_pass_python(stamps: np.ndarray, values: np.ndarray, width: int) -> np
                 low_back -= 1
             lows[low_back] = i
             low_back += 1
-        while stamps[start] <= stamps[i] - width:
+        while start < i and stamps[i] - stamps[start] >= width:
             start += 1
         while high_back > high_front and highs[high_front] < start:
             high_front += 1

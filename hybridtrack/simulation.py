@@ -353,7 +353,10 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     faults : dict, optional
         Injected faults for testing, one array value per step; see `FAULTS`.
     progress : callable, optional
-        Called with the number of steps done since its last call (e.g. a tqdm bar's update).
+        Called with the number of steps done since its last call (e.g. a tqdm bar's update),
+        from the thread that runs the scan loop: for a long compiled run
+        (`SIDE_BY_SIDE_FROM` scans or more) a second thread, so it must be safe to call from
+        one (tqdm's is).
     bulk_nights : bool
         Record a night asleep at stow in one go (the same result, faster; a test keeps it so).
     warm_start : bool or dict

@@ -22,17 +22,25 @@ def clock_nanoseconds(local: pd.DatetimeIndex):
 
 
 def plus_seconds(times: pd.DatetimeIndex, seconds) -> pd.DatetimeIndex:
-    """`times` plus `seconds` (floats, one per time; a single time takes them all), rounded to
-    the nanosecond.
+    """`times` plus `seconds` (finite floats within ±9e9, one per time; a single time takes them
+    all), in nanoseconds.
 
-    Integer arithmetic: ``times + pd.to_timedelta(seconds, unit="s")`` at a seventh of its cost
-    (17 ms for a year of minutes); the two differ by at most a nanosecond in rounding.
+    ``times + pd.to_timedelta(seconds, unit="s")`` to the nanosecond, at a seventh of its cost
+    (17 ms for a year of minutes): the seconds are cast as pandas casts them (whole seconds, then
+    the fraction rounded to 9 digits and truncated to nanoseconds). A NaN second gives NaT.
     """
     import numpy as np
 
+    seconds = np.asarray(seconds, float)
+    finite = np.isfinite(seconds)
+    if np.any(np.abs(seconds[finite]) > 9e9):
+        raise HybridtrackError(f"a time shift of {np.max(np.abs(seconds[finite])):.3g} s is beyond ±9e9 s")
+    whole = np.trunc(np.where(finite, seconds, 0.0))
+    fraction = np.round(np.where(finite, seconds, 0.0) - whole, 9)
+    shift = whole.astype(np.int64) * 1_000_000_000 + (fraction * 1e9).astype(np.int64)
     stamps = times.as_unit("ns")
-    shift = np.rint(np.asarray(seconds, float) * 1e9).astype(np.int64)
-    return pd.DatetimeIndex(stamps.asi8 + shift, dtype=stamps.dtype)
+    nanoseconds = np.where(finite & ~np.asarray(stamps.isna()), stamps.asi8 + shift, np.iinfo(np.int64).min)
+    return pd.DatetimeIndex(nanoseconds, dtype=stamps.dtype, name=times.name)
 
 
 def clock_hours(local: pd.DatetimeIndex):

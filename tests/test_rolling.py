@@ -27,8 +27,39 @@ def _pandas(values, window):
 def test_compiled_range_is_pandas_bit_for_bit(seed, window):
     values = _series(seed, irregular=seed % 2 == 0, nan_share=0.1 * (seed % 3))
     expected = _pandas(values, window)
-    pd.testing.assert_series_equal(trailing_range(values, window, engine="compiled"), expected, check_exact=True)
-    pd.testing.assert_series_equal(trailing_range(values, window, engine="pandas"), expected, check_exact=True)
+    _same_bits(trailing_range(values, window, engine="compiled"), expected)
+    _same_bits(trailing_range(values, window, engine="pandas"), expected)
+
+
+def _same_bits(got, expected):
+    pd.testing.assert_series_equal(got, expected, check_exact=True)
+    assert np.array_equal(got.to_numpy().view(np.int64), expected.to_numpy().view(np.int64))  # NaN's sign too
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_infinite_values_are_missing_as_in_pandas(seed):
+    values = _series(seed, n=400)
+    rng = np.random.default_rng(seed)
+    values[rng.random(len(values)) < 0.15] = np.inf
+    values[rng.random(len(values)) < 0.15] = -np.inf
+    for window in ("1min", "20min"):
+        _same_bits(trailing_range(values, window, engine="compiled"), _pandas(values, window))
+    runs = pd.Series([np.inf, -np.inf] * 3 + [1.0, np.nan, np.inf], index=values.index[:9])
+    _same_bits(trailing_range(runs, "3min", engine="compiled"), _pandas(runs, "3min"))
+
+
+@pytest.mark.parametrize("unit", ["s", "ms", "us", "ns"])
+@pytest.mark.parametrize("window", ["1ns", "1500ms", "0min", "-5min", pd.Timedelta.max])
+def test_odd_windows_and_units_are_pandas(unit, window):
+    index = pd.date_range("1900-01-01", periods=40, freq="1s", unit=unit).repeat(2)  # repeated stamps
+    values = pd.Series(np.random.default_rng(1).normal(size=80).round(1), index=index)
+    values.iloc[[3, 4, 5]] = np.nan
+    _same_bits(trailing_range(values, window, engine="compiled"), _pandas(values, window))
+
+
+def test_a_frame_is_left_to_pandas():
+    values = _series(4, n=100).to_frame()
+    pd.testing.assert_frame_equal(trailing_range(values, "20min", engine="compiled"), _pandas(values, "20min"))
 
 
 def test_python_pass_is_the_compiled_pass():

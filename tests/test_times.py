@@ -29,14 +29,20 @@ def test_clock_fields_of_a_coarser_unit_and_a_naive_index():
 def test_plus_seconds_is_pandas_to_timedelta_to_the_nanosecond():
     import numpy as np
 
+    from hybridtrack.errors import HybridtrackError
     from hybridtrack.times import plus_seconds
 
     index = pd.date_range("2021-03-27 22:00", periods=6000, freq="1min", tz="Europe/Berlin")  # over a DST change
-    seconds = np.random.default_rng(3).normal(20.0, 500.0, len(index))
-    for start, expected in ((index, index + pd.to_timedelta(seconds, unit="s")),
-                            (index[:1], index[0] + pd.to_timedelta(seconds, unit="s"))):
-        got = plus_seconds(start, seconds)
-        assert got.tz == index.tz and len(got) == len(index)
-        assert np.abs(got.asi8 - expected.asi8).max() <= 1
+    rng = np.random.default_rng(3)
+    for scale in (1.0, 500.0, 3.2e7):  # up to a year's clock fault with drift, where float seconds lose digits
+        seconds = rng.normal(0.0, scale, len(index))
+        seconds[7] = np.nan
+        for start, expected in ((index, index + pd.to_timedelta(seconds, unit="s")),
+                                (index[:1], index[0] + pd.to_timedelta(seconds, unit="s"))):
+            got = plus_seconds(start, seconds)
+            assert got.tz == index.tz and len(got) == len(index)
+            assert np.array_equal(got.asi8, expected.asi8) and got[7] is pd.NaT
     whole = plus_seconds(index[:3].as_unit("s"), np.array([0.0, 20.0, -1.5]))
     assert list(whole) == [index[0], index[1] + pd.Timedelta(seconds=20), index[2] - pd.Timedelta(seconds=1.5)]
+    with pytest.raises(HybridtrackError, match="beyond"):
+        plus_seconds(index[:1], [1e10])
