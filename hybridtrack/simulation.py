@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextvars
 import dataclasses
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -396,10 +397,11 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
     compiled = uses_kernel(config, world.n)
+    stop = threading.Event()
 
     def run_scans():
         if compiled:
-            return run_compiled(world, controller, progress, bulk_nights and not faults)
+            return run_compiled(world, controller, progress, bulk_nights and not faults, stop)
         _run(world, controller, progress, bulk_nights and not faults)
         return controller.outputs()
 
@@ -407,7 +409,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         return incidence_cosine(world.altitude, world.azimuth, collector)
 
     # the compiled loop lets go of Python's lock, so the scoring's geometry is done beside it
-    out, incidence = _side_by_side(run_scans, score_ahead, len(frame) if compiled else 0)
+    out, incidence = _side_by_side(run_scans, score_ahead, len(frame) if compiled else 0, cancel=stop.set)
     index = frame.index
     log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
                                                        world.controller_site()))
@@ -446,10 +448,11 @@ def one_thread() -> Iterator[None]:
         _SECOND_THREAD.reset(token)
 
 
-def _side_by_side(first, second, scans: int):
+def _side_by_side(first, second, scans: int, cancel=None):
     """``(first(), second())``, the first on a second thread for a long run. The results are the
     same either way (neither reads the other's); so is the error raised, the first's before the
-    second's, as when they run in turn."""
+    second's, as when they run in turn. On Ctrl-C (or another exit that is not an error) `cancel`
+    is called, so that a first that can stop early does, before the first is waited for."""
     if scans < SIDE_BY_SIDE_FROM or not _SECOND_THREAD.get():
         return first(), second()
     from concurrent.futures import ThreadPoolExecutor
@@ -458,10 +461,12 @@ def _side_by_side(first, second, scans: int):
         started = pool.submit(contextvars.copy_context().run, first)
         try:
             done = second()
-        except BaseException:
+            return started.result(), done
+        except BaseException as error:
+            if cancel is not None and not isinstance(error, Exception):
+                cancel()
             started.result()  # the first's error, if it had one, is the one a run in turn raises
             raise
-        return started.result(), done
 
 
 def _controller_side(index: pd.DatetimeIndex, site: sites.Site, collector: Collector, config: SimulationConfig,

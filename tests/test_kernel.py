@@ -340,6 +340,36 @@ def packed():
     return controller, bridge._settings(controller), bridge._state(controller, world.minutes)
 
 
+def test_a_set_stop_event_ends_the_compiled_run_before_its_next_chunk():
+    """What `simulate` sets on Ctrl-C while the loop runs beside it: the run stops at a chunk's
+    end; without it every scan is run."""
+    import threading
+
+    from hybridtrack import sites
+    from hybridtrack.collectors import Collector
+    from hybridtrack.control import Controller, make_plan
+    from hybridtrack.control.plan import east_park
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+    from hybridtrack.kernel import bridge
+    from hybridtrack.simulation import _drives
+    from hybridtrack.world import World
+
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
+    site, collector, config = sites.get("lanzhou"), Collector("trough-ns"), SimulationConfig()
+    stopped = threading.Event()
+    stopped.set()
+    for stop, scans in ((stopped, 0), (threading.Event(), len(frame))):
+        drives = _drives(collector, config)
+        world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
+        plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
+                         config.controller)
+        controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
+                                east_park(collector))
+        done = []
+        bridge.run_compiled(world, controller, done.append, True, stop)
+        assert sum(done) == scans
+
+
 def test_the_sky_table_compiled_scores_as_the_reference(packed):
     from hybridtrack.kernel.controller import table_code, table_score
 

@@ -378,3 +378,25 @@ def test_the_log_can_be_edited_in_place_and_edits_nothing_else(collector):
             log[column] *= 2.0
             assert log.loc[log.index[2], column] == 10.0
     pd.testing.assert_frame_equal(frame, before)
+
+
+def test_ctrl_c_beside_the_loop_stops_the_loop_rather_than_waiting_for_it():
+    """A Ctrl-C reaching the caller while the compiled loop runs on the second thread tells the
+    loop to stop at its next chunk (`cancel`), and the caller gets its KeyboardInterrupt."""
+    import threading
+
+    import hybridtrack.simulation as simulation
+
+    stop, seen = threading.Event(), {}
+
+    def loop():
+        seen["stopped"] = stop.wait(timeout=30.0)  # a loop that would run for 30 s unless told
+        return "partial"
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        simulation._side_by_side(loop, interrupted, 10**6, cancel=stop.set)
+    assert seen["stopped"] is True
+

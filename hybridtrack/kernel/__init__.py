@@ -77,8 +77,8 @@ def uses_kernel(config, scans: int = 0) -> bool:
     return compiled() or scans >= COMPILE_PAYS_AT or (scans >= LOAD_PAYS_AT and cached())
 
 
-def run_compiled(world, controller, progress, bulk_nights):
+def run_compiled(world, controller, progress, bulk_nights, stop=None):
     """Run the scans through the kernel (`hybridtrack.kernel.bridge.run_compiled`)."""
     from .bridge import run_compiled as run
 
-    return run(world, controller, progress, bulk_nights)
+    return run(world, controller, progress, bulk_nights, stop)

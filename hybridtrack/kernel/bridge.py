@@ -235,9 +235,11 @@ def _write_back(controller: Controller, state: kc.ControllerState) -> None:
                         if state.k[slot]}
 
 
-def run_compiled(world: World, controller: Controller, progress, bulk_nights: bool) -> ControllerOutputs:
+def run_compiled(world: World, controller: Controller, progress, bulk_nights: bool, stop=None) -> ControllerOutputs:
     """Run the scans through the compiled kernels; return the controller's outputs, with the
-    world's angles and the controller's memory written back into `world` and `controller`."""
+    world's angles and the controller's memory written back into `world` and `controller`.
+    A `stop` event (`threading.Event`) that is set ends the run at its next chunk of scans, its
+    outputs cut short: for a caller that is giving up (Ctrl-C while the loop runs on a thread)."""
     n, axes = world.n, world.axes
     arrays, world_state = pack_world(world)
     cfg, plan = _settings(controller), _plan(controller)
@@ -249,13 +251,13 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
     wind_ok = np.concatenate([[0], np.cumsum(gusts)])
     obs, obs_axes, moves = np.zeros(5), np.zeros((axes, 3)), np.zeros(axes)
     i = 0
-    while i < n:
-        stop = min(i + CHUNK, n)
-        done = run_scans(i, stop, bulk_nights, wind_ok, arrays, world_state, cfg, plan, state, out, events,
+    while i < n and not (stop is not None and stop.is_set()):
+        end = min(i + CHUNK, n)
+        done = run_scans(i, end, bulk_nights, wind_ok, arrays, world_state, cfg, plan, state, out, events,
                          obs, obs_axes, moves)
         if progress is not None and done > i:
             progress(done - i)
-        if done < stop:
+        if done < end:
             events = _grown(events)
         i = done
     controller.events = _worded(controller, events, int(state.k[kc.EVENTS]))
