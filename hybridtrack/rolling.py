@@ -39,7 +39,7 @@ def trailing_range(values: pd.Series, window: str | pd.Timedelta, *, engine: str
     Parameters
     ----------
     values : pandas.Series
-        On a DatetimeIndex; NaN are skipped.
+        On a DatetimeIndex; NaN and ±inf are skipped (as pandas' rolling skips them).
     window : str or pandas.Timedelta
         The window's length, e.g. ``"20min"``.
     engine : {"auto", "compiled", "pandas"}
