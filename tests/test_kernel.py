@@ -83,7 +83,7 @@ def _strategies_on_collectors():
                                id=f"{strategy}-{collector}")
 
 
-@pytest.mark.parametrize("strategy,collector", _strategies_on_collectors())
+@pytest.mark.parametrize("strategy,collector", list(_strategies_on_collectors()))
 def test_every_strategy_on_every_collector_runs_the_same_compiled(mixed_day, strategy, collector):
     assert_same_run(*both(mixed_day, "lanzhou", strategy=strategy, collector=collector))
 
