@@ -19,10 +19,8 @@ def test_remembered_positions_equal_fresh_ones(model):
     pd.testing.assert_frame_equal(remembered, solar_position(some, "nanjing", model))
 
 
-def test_each_request_is_computed_once_and_only_inside_the_block(monkeypatch):
-    calls = []
-    original = pvlib.solarposition.spa_python
-    monkeypatch.setattr(pvlib.solarposition, "spa_python", lambda *a, **k: calls.append(1) or original(*a, **k))
+def test_each_request_is_computed_once_and_only_inside_the_block(spa_calls):
+    calls = spa_calls
     times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="Asia/Shanghai")
     with reuse_positions():
         solar_position(times, "nanjing")
@@ -40,10 +38,8 @@ def test_each_request_is_computed_once_and_only_inside_the_block(monkeypatch):
     assert len(calls) == 6
 
 
-def test_memory_keeps_only_the_newest_answers(monkeypatch):
-    calls = []
-    original = pvlib.solarposition.spa_python
-    monkeypatch.setattr(pvlib.solarposition, "spa_python", lambda *a, **k: calls.append(1) or original(*a, **k))
+def test_memory_keeps_only_the_newest_answers(spa_calls):
+    calls = spa_calls
     times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="UTC")
     with reuse_positions(entries=2):
         for temperature in (10.0, 20.0, 30.0, 10.0):
