@@ -318,25 +318,34 @@ def test_a_changed_source_empties_the_kernels_cache(tmp_path):
 
 # -- piece by piece: each compiled piece against the reference class it restates --------------------
 
-@pytest.fixture(scope="module")
-def packed():
-    """A reference controller of a hybrid heliostat, and its settings and state as the kernel has them."""
+def _reference_pair(frame, kind):
+    """A reference world and controller of a hybrid `kind` at Lanzhou over `frame`, built as
+    `simulate` builds them (without a warm start)."""
     from hybridtrack import sites
     from hybridtrack.collectors import Collector
     from hybridtrack.control import Controller, make_plan
     from hybridtrack.control.plan import east_park
     from hybridtrack.fuzzy import FuzzyWeatherClassifier
-    from hybridtrack.kernel import bridge
     from hybridtrack.simulation import _drives
-    from hybridtrack.world import World
+    from hybridtrack.world import World, controller_clock, installed_site
 
-    frame = synthetic("lanzhou", "2021-06-21 10:00", "2021-06-21 12:00", weather="sunny", seed=1)
-    site, collector, config = sites.get("lanzhou"), Collector("heliostat"), SimulationConfig()
+    site, collector, config = sites.get("lanzhou"), Collector(kind), SimulationConfig()
     drives = _drives(collector, config)
     world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
-    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
+    plan = make_plan(controller_clock(frame.index, config.imperfections, {}), world.minutes,
+                     installed_site(site, config.imperfections), collector, config.controller)
     controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
                             east_park(collector))
+    return world, controller
+
+
+@pytest.fixture(scope="module")
+def packed():
+    """A reference controller of a hybrid heliostat, and its settings and state as the kernel has them."""
+    from hybridtrack.kernel import bridge
+
+    frame = synthetic("lanzhou", "2021-06-21 10:00", "2021-06-21 12:00", weather="sunny", seed=1)
+    world, controller = _reference_pair(frame, "heliostat")
     return controller, bridge._settings(controller), bridge._state(controller, world.minutes)
 
 
@@ -345,26 +354,13 @@ def test_a_set_stop_event_ends_the_compiled_run_before_its_next_chunk():
     end; without it every scan is run."""
     import threading
 
-    from hybridtrack import sites
-    from hybridtrack.collectors import Collector
-    from hybridtrack.control import Controller, make_plan
-    from hybridtrack.control.plan import east_park
-    from hybridtrack.fuzzy import FuzzyWeatherClassifier
     from hybridtrack.kernel import bridge
-    from hybridtrack.simulation import _drives
-    from hybridtrack.world import World
 
     frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
-    site, collector, config = sites.get("lanzhou"), Collector("trough-ns"), SimulationConfig()
     stopped = threading.Event()
     stopped.set()
     for stop, scans in ((stopped, 0), (threading.Event(), len(frame))):
-        drives = _drives(collector, config)
-        world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
-        plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector,
-                         config.controller)
-        controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
-                                east_park(collector))
+        world, controller = _reference_pair(frame, "trough-ns")
         done = []
         bridge.run_compiled(world, controller, done.append, True, stop)
         assert sum(done) == scans
