@@ -390,8 +390,10 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         return World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults,
                      truth=config.truth)
 
+    told = installed_site(site, config.imperfections)  # the site as the installer told the controller
+
     def plan_ahead():
-        return _controller_side(frame.index, site, collector, config, classifier, faults, warm_start)
+        return _controller_side(frame.index, site, told, collector, config, classifier, faults, warm_start)
 
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
@@ -411,8 +413,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     # the compiled loop lets go of Python's lock, so the scoring's geometry is done beside it
     out, incidence = _side_by_side(run_scans, score_ahead, len(frame) if compiled else 0, cancel=stop.set)
     index = frame.index
-    log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear,
-                                                       world.controller_site()))
+    log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear, told))
     events = _events_frame(index, out.events)
     scoring = {"sun_up": world.altitude > 0, "incidence": incidence, "moves": int(out.moves.sum()),
                "travel": float(out.travel.sum())}
@@ -469,14 +470,14 @@ def _side_by_side(first, second, scans: int, cancel=None):
             raise
 
 
-def _controller_side(index: pd.DatetimeIndex, site: sites.Site, collector: Collector, config: SimulationConfig,
-                     classifier, faults: dict, warm_start):
+def _controller_side(index: pd.DatetimeIndex, site: sites.Site, told: sites.Site, collector: Collector,
+                     config: SimulationConfig, classifier, faults: dict, warm_start):
     """What the controller brings and plans before its first scan, from what it has (its clock, the
-    site it was told, its memory; nothing of the world's): the commissioned mount and warm memory,
-    the plan, the classifier and the clear sky it expects (None where it expects none)."""
+    site it was `told`, its memory; nothing of the world's, whose `site` only sets its warm-start
+    day): the commissioned mount and warm memory, the plan, the classifier and the clear sky it
+    expects (None where it expects none)."""
     mount, memory = _history(site, collector, config, index[0], classifier, warm_start)
     clock = controller_clock(index, config.imperfections, faults)
-    told = installed_site(site, config.imperfections)
     plan = make_plan(clock, scan_timer(index), told, collector, config.controller, mount)
     clf = classifier or FuzzyWeatherClassifier(fuzzy_config(config.sky))
     clear = _expected_clear_sky(index, told, config, plan, clock)
@@ -705,7 +706,8 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
     columns = {
         "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": angle[:, main].copy(),
         "error": error, "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)),
-        "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(copy=True), "sensor_valid": out.sensor_status == 0,
+        "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(copy=True),
+        "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical.from_codes(out.sensor_status, categories=list(SENSOR_STATUS)),
         "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(copy=True),
         "wind_speed": world.wind.copy(), "dni": world.frame_dni.copy(), "calibration": out.calibration[:, main],

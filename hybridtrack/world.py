@@ -295,14 +295,6 @@ class World:
         found, names = pd.factorize(frame["sky"])  # -1 for a missing label: the table's last entry
         return np.array([sky_code(name, UNKNOWN) for name in names] + [UNKNOWN], np.int64)[found]
 
-    def controller_clock(self) -> pd.DatetimeIndex:
-        """What the controller's clock shows at each scan (`controller_clock`)."""
-        return controller_clock(self.index, self.imperfections, self.faults)
-
-    def controller_site(self) -> sites.Site:
-        """The site as the installer told the controller."""
-        return installed_site(self.site, self.imperfections)
-
     # -- each scan -------------------------------------------------------------------------------
 
     def _offset(self, truth: list, a: int, i: int) -> float:

@@ -20,7 +20,7 @@ from hybridtrack.sensor import SensorModel, sensor_scene
 from hybridtrack.simulation import SimulationConfig, _drives
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import solar_position
-from hybridtrack.world import Imperfections, World
+from hybridtrack.world import Imperfections, World, controller_clock, installed_site
 
 WORLD_MODULES = {"world", "sky", "sensor", "simulation", "commissioning", "io", "metrics", "ablation"}
 
@@ -50,7 +50,8 @@ def test_the_controller_cannot_reach_the_worlds_state():
     site, collector, config = sites.get("lanzhou"), Collector("trough-ns"), SimulationConfig()
     drives = _drives(collector, config)
     world = World(frame, site, collector, config.imperfections, config.sensor, drives, 0, {})
-    plan = make_plan(world.controller_clock(), world.minutes, world.controller_site(), collector, config.controller)
+    plan = make_plan(controller_clock(frame.index, config.imperfections, {}), world.minutes,
+                     installed_site(site, config.imperfections), collector, config.controller)
     controller = Controller(config.controller, drives, plan, FuzzyWeatherClassifier(), config.sky, 30.0,
                             east_park(collector))
     forbidden = (World, Imperfections, pd.DataFrame, SensorModel)

@@ -62,8 +62,8 @@ def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True
     if args.site is not None:
         given = (args.lat, args.lon, args.altitude, site_tz if record else args.tz)
         if any(value is not None for value in given):
-            raise HybridtrackError("give either --site or --lat/--lon/--altitude" + ("/--site-tz" if record else "/--tz")
-                                   + ", not both")
+            flags = "--lat/--lon/--altitude" + ("/--site-tz" if record else "/--tz")
+            raise HybridtrackError(f"give either --site or {flags}, not both")
         return sites.get(args.site)
     clock = (site_tz or args.tz) if record else args.tz
     if args.lat is not None and args.lon is not None:

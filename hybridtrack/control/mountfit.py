@@ -79,8 +79,8 @@ import numpy as np
 
 from ..mounting import angles_on_mount, pointing_vectors, rotate
 
-__all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "ordered_dot", "ordered_matmul", "parameter_names", "MAX_CONDITION", "ROTATION_STEP",
-           "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
+__all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "ordered_dot", "ordered_matmul",
+           "parameter_names", "MAX_CONDITION", "ROTATION_STEP", "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
 
 #: Above this condition number of the information matrix, axis azimuth and tilt are frozen.
 MAX_CONDITION = 1e3
