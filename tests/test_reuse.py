@@ -89,14 +89,3 @@ def test_the_memory_keeps_the_pieces_used_most_recently():
         assert len(calls) == 11
         shared(("this run's", 0), compute)  # long forgotten
         assert len(calls) == 12
-
-
-def test_a_reuse_block_shares_the_suns_positions_too(spa_calls):
-    from hybridtrack.sun import REMEMBERED_FROM, solar_position
-
-    calls = spa_calls
-    times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="Asia/Shanghai")
-    with reuse_work():
-        solar_position(times, "nanjing")
-        solar_position(times[5:9], "nanjing")
-    assert len(calls) == 1

@@ -5,6 +5,7 @@ import pandas as pd
 import pvlib
 import pytest
 
+from hybridtrack.reuse import reuse_work
 from hybridtrack.sites import get
 from hybridtrack.sun import REMEMBERED_FROM, reuse_positions, solar_position
 
@@ -19,10 +20,11 @@ def test_remembered_positions_equal_fresh_ones(model):
     pd.testing.assert_frame_equal(remembered, solar_position(some, "nanjing", model))
 
 
-def test_each_request_is_computed_once_and_only_inside_the_block(spa_calls):
+@pytest.mark.parametrize("block", [reuse_positions, reuse_work])  # a field's block opens the sun's memory too
+def test_each_request_is_computed_once_and_only_inside_the_block(spa_calls, block):
     calls = spa_calls
     times = pd.date_range("2021-06-21", periods=REMEMBERED_FROM, freq="1min", tz="Asia/Shanghai")
-    with reuse_positions():
+    with block():
         solar_position(times, "nanjing")
         solar_position(times[10:50], "nanjing")
         solar_position(times, "nanjing")
