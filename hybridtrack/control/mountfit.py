@@ -77,7 +77,7 @@ import math
 
 import numpy as np
 
-from ..mounting import angles_on_mount, pointing_vectors, rotate
+from ..mounting import pointing_vectors, rotate
 
 __all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "ordered_dot", "ordered_matmul",
            "parameter_names", "MAX_CONDITION", "ROTATION_STEP", "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
