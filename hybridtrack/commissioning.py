@@ -31,6 +31,7 @@ def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy:
               classifier=None):
     """The run of `strategy` over a clear day at `site`, `days_before` local days before `start`,
     with the controller's clock as it was then."""
+    from .reuse import apart
     from .simulation import simulate
     from .sky import synthetic
 
@@ -39,7 +40,8 @@ def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy:
     age = max(config.imperfections.commissioned_days_ago - days_before, 0.0)
     setup = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy),
                                 imperfections=dataclasses.replace(config.imperfections, commissioned_days_ago=age))
-    return simulate(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
+    with apart():  # the day's frame is this run's own: nothing of it is another run's to share
+        return simulate(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
 
 
 def commission(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> MountEstimate:

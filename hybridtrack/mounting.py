@@ -11,7 +11,7 @@ import numpy as np
 from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
 
 __all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine",
-           "rotate"]
+           "geometry_key", "rotate"]
 
 
 def _about(direction: np.ndarray, angle: float) -> np.ndarray:
@@ -40,15 +40,18 @@ def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_az
 
 
 def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,
-                 night: bool = False) -> np.ndarray:
+                 night: bool = False, vectors: np.ndarray | None = None) -> np.ndarray:
     """Target angles of a collector on a mount turned by `rotation` (`mounting_rotation`), degrees.
 
     Returns shape (N, 1) for single-axis collectors (trough convention) and (N, 2) for a
     heliostat (normal azimuth and elevation). NaN while the sun is down, unless `night`:
     then the geometry is followed below the horizon too (to pre-position before sunrise).
+    `vectors` are this sun's `pointing_vectors` (with the same `night`) when the caller has them.
     """
     alt = np.asarray(altitude, float)
-    out = angles_on_mount(pointing_vectors(alt, azimuth, collector, night=night), collector, rotation)
+    if vectors is None:
+        vectors = pointing_vectors(alt, azimuth, collector, night=night)
+    out = angles_on_mount(vectors, collector, rotation)
     if not night:
         out[alt < 0] = np.nan
     return out
@@ -63,6 +66,18 @@ def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = F
     if collector.kind == "heliostat":
         return heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim)
     return sun_vector(alt, np.asarray(azimuth, float))
+
+
+def geometry_key(base: tuple, what: str, collector: Collector) -> tuple | None:
+    """A `hybridtrack.reuse.shared` key for `what` of a collector's geometry under the sun that
+    `base` keys: what `pointing_vectors`, `incidence_cosine` and the mount fit's derivatives
+    (`hybridtrack.control.mountfit.vector_jacobian`) read of a collector, its kind and axis, so
+    that a field's rows or troughs on one axis line share them. None for a heliostat: its
+    geometry turns on its own aim point, which no other heliostat of its field has, and keeping
+    what no other run asks for would only push out what they do."""
+    if collector.kind == "heliostat":
+        return None
+    return (*base, what, collector.kind, collector.axis)
 
 
 def rotate(vectors: np.ndarray, rotation: np.ndarray) -> np.ndarray:

@@ -28,14 +28,15 @@ import pandas as pd
 
 from .sun import reuse_positions
 
-__all__ = ["Content", "Same", "reuse_work", "shared", "ENTRIES"]
+__all__ = ["Content", "Same", "apart", "reuse_work", "shared", "ENTRIES"]
 
 T = TypeVar("T")
-#: Pieces a `reuse_work` block keeps: the ones every run shares are used by each run and stay; a
-#: field whose collectors each have their own clock adds a few per run, which must not pile up
-#: (a year's plan is some 40 MB) but only outlive the runs on the other threads.
-ENTRIES = 16
-_MEMORY: ContextVar[tuple[threading.Lock, dict, int] | None] = ContextVar("hybridtrack_reuse_work", default=None)
+#: Pieces a `reuse_work` block keeps: the ones every run shares are used by each run and stay (ten
+#: for a field of rows or troughs on one axis line); a field whose collectors each have their own
+#: clock adds five per run (its plan and what follows from it), which must not pile up (a year's
+#: plan is some 40 MB) but only outlive the runs on the other threads.
+ENTRIES = 20
+_MEMORY: ContextVar[tuple[threading.Lock, dict, int, dict] | None] = ContextVar("hybridtrack_reuse_work", default=None)
 
 
 class Same:
@@ -62,7 +63,7 @@ def reuse_work(entries: int = ENTRIES) -> Iterator[None]:
     if _MEMORY.get() is not None:
         yield
         return
-    token = _MEMORY.set((threading.Lock(), {}, max(int(entries), 1)))
+    token = _MEMORY.set((threading.Lock(), {}, max(int(entries), 1), {}))
     try:
         with reuse_positions():
             yield
@@ -70,26 +71,53 @@ def reuse_work(entries: int = ENTRIES) -> Iterator[None]:
         _MEMORY.reset(token)
 
 
-def shared(key: tuple, compute: Callable[[], T]) -> T:
-    """``compute()``, or its earlier answer for the same `key` inside a `reuse_work` block.
+@contextmanager
+def apart() -> Iterator[None]:
+    """Within this block `shared` neither finds nor keeps pieces: for a run whose pieces no other
+    run will ask for (a collector's own warm-start day, `hybridtrack.commissioning.clear_day`),
+    which would otherwise push the field's shared pieces out of the memory. The sun's own memory
+    (`hybridtrack.sun.reuse_positions`) stays."""
+    token = _MEMORY.set(None)
+    try:
+        yield
+    finally:
+        _MEMORY.reset(token)
 
-    Two threads asking for a piece at once may both compute it; the first answer stored is the one
-    every later request gets (the two are equal: a piece depends only on its key).
+
+def shared(key: tuple | None, compute: Callable[[], T]) -> T:
+    """``compute()``, or its earlier answer for the same `key` inside a `reuse_work` block; a key
+    of None is a piece no other run will ask for (`hybridtrack.mounting.geometry_key`), computed
+    and not kept.
+
+    A thread that asks for a piece another thread is computing waits for that answer rather than
+    computing it too (a field's threads start together and ask for the same pieces at once); if
+    that computation fails, the waiting thread computes the piece itself.
     """
     memory = _MEMORY.get()
-    if memory is None:
+    if memory is None or key is None:
         return compute()
-    lock, answers, entries = memory
+    lock, answers, entries, computing = memory
     with lock:
         if key in answers:
             answers[key] = answers.pop(key)  # the most recently used last
             return _handed(answers[key])
-    answer = compute()
-    with lock:
-        answer = answers.setdefault(key, answer)
-        for oldest in list(answers)[:-entries]:
-            del answers[oldest]
-        return _handed(answer)
+        underway = computing.get(key)
+        if underway is None:
+            computing[key] = done = threading.Event()
+    if underway is not None:
+        underway.wait()
+        return shared(key, compute)  # found now, unless that computation failed
+    try:
+        answer = compute()
+        with lock:
+            answers[key] = answer
+            for oldest in list(answers)[:-entries]:
+                del answers[oldest]
+            return _handed(answer)
+    finally:
+        with lock:
+            del computing[key]
+        done.set()
 
 
 def _handed(answer):

@@ -37,7 +37,6 @@ from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
-from .mounting import incidence_cosine
 from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
@@ -408,7 +407,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         return controller.outputs()
 
     def score_ahead():
-        return incidence_cosine(world.altitude, world.azimuth, collector)
+        return world.incidence()
 
     # the compiled loop lets go of Python's lock, so the scoring's geometry is done beside it
     out, incidence = _side_by_side(run_scans, score_ahead, len(frame) if compiled else 0, cancel=stop.set)

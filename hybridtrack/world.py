@@ -35,7 +35,7 @@ from .control.modes import UNKNOWN, sky_code
 from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
-from .mounting import mount_targets, mounting_rotation
+from .mounting import geometry_key, incidence_cosine, mount_targets, mounting_rotation, pointing_vectors
 from .reuse import Same, shared
 from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SensorModel, circumsolar_light, coarse_offset,
                      read_photocurrent, read_pointing, sensor_scene)
@@ -197,7 +197,10 @@ class World:
         self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
                                      imperfections.axis_roll_error)
-        self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation)
+        self._sun_key = (Same(index), site, truth)  # what the true sun turns on (`_true_sun`)
+        vectors = shared(geometry_key(self._sun_key, "pointing", collector),
+                         lambda: pointing_vectors(self.altitude, self.azimuth, collector))
+        self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation, vectors=vectors)
         clear_dni, clear_dhi = self._clear_sky(frame, position, truth)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
         circumsolar = shared(("circumsolar", Same(frame), site, truth), lambda: circumsolar_light(weather, position))
@@ -294,6 +297,13 @@ class World:
             return None
         found, names = pd.factorize(frame["sky"])  # -1 for a missing label: the table's last entry
         return np.array([sky_code(name, UNKNOWN) for name in names] + [UNKNOWN], np.int64)[found]
+
+    def incidence(self) -> np.ndarray:
+        """Cosine of the true sun's incidence on a perfectly tracking aperture at each scan
+        (`hybridtrack.mounting.incidence_cosine`), for the scoring; shared by a field's
+        collectors of one geometry (`hybridtrack.mounting.geometry_key`)."""
+        return shared(geometry_key(self._sun_key, "incidence", self.collector),
+                      lambda: incidence_cosine(self.altitude, self.azimuth, self.collector))
 
     # -- each scan -------------------------------------------------------------------------------
 

@@ -119,6 +119,30 @@ def test_a_field_run_is_each_collectors_own_run(day):
     assert len(result.events) > 0 and set(result.events["collector"]) == set(field.names)
 
 
+@pytest.mark.parametrize("field, computed", [
+    (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (4, 1)),  # pointing (world, plan), incidence, the
+    # field's end loss; derivatives
+    (TroughLoop(count=3), (3, 1)),
+    (HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0], [-30.0, -80.0]]), (3, 3)),  # each its own
+])
+def test_rows_on_one_axis_line_share_their_geometry_and_heliostats_keep_their_own(monkeypatch, field, computed):
+    """Under one sun, the sun's direction (the world's and the plan's) and its incidence on the
+    aperture are computed once for a field's rows or troughs on one axis line, and so are the
+    mount fit's derivatives; a heliostat's pointing turns on its own aim point, so each of those
+    is its own. Each collector's warm-start day is its own run, apart from the field's memory."""
+    import hybridtrack.control.plan as plan
+    import hybridtrack.mounting as mounting
+
+    frame = synthetic("lanzhou", "2021-06-21", "2021-06-22", weather="mixed", seed=3)  # two days: not a warm start
+    suns, derivatives = [], []
+    sun_vector, lit_jacobian = mounting.sun_vector, plan._lit_jacobian
+    monkeypatch.setattr(mounting, "sun_vector", lambda alt, az: suns.append(np.size(alt)) or sun_vector(alt, az))
+    monkeypatch.setattr(plan, "_lit_jacobian", lambda vectors, lit, collector: derivatives.append(len(lit))
+                        or lit_jacobian(vectors, lit, collector))
+    simulate_field(frame, "lanzhou", field, threads=2, keep_log=False)
+    assert (suns.count(len(frame)), derivatives.count(len(frame))) == computed
+
+
 def test_collectors_with_their_own_clocks_and_sites_share_no_sky(day):
     """Shared work is keyed on what it depends on: collectors whose controllers' clocks and site
     coordinates differ get their own plan and clear sky (here two collectors on two threads, each

@@ -2,12 +2,14 @@
 
 import contextvars
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pandas as pd
+import pytest
 
-from hybridtrack.reuse import Content, Same, reuse_work, shared
+from hybridtrack.reuse import Content, Same, apart, reuse_work, shared
 
 
 def counted():
@@ -89,3 +91,46 @@ def test_the_memory_keeps_the_pieces_used_most_recently():
         assert len(calls) == 11
         shared(("this run's", 0), compute)  # long forgotten
         assert len(calls) == 12
+
+
+def test_a_piece_without_a_key_and_a_block_apart_are_computed_every_time_and_not_kept():
+    """A heliostat's own geometry (no key) and a run's own warm-start day (`apart`) would only push
+    the field's shared pieces out of the memory."""
+    calls, compute = counted()
+    with reuse_work(entries=2):
+        shared(("field's",), compute)
+        shared(None, compute)
+        shared(None, compute)
+        with apart():
+            for run in range(3):
+                shared(("this run's own", run), compute)
+                shared(("field's",), compute)  # not found apart either
+        assert len(calls) == 9
+        shared(("field's",), compute)  # still kept: nothing apart was
+        assert len(calls) == 9
+
+
+def test_threads_asking_at_once_wait_for_one_computation_and_a_failed_one_is_not_kept():
+    calls, started = [], threading.Barrier(4)
+
+    def slow():
+        calls.append(1)
+        time.sleep(0.2)
+        return np.ones(3)
+
+    def ask(context):
+        started.wait()
+        return context.run(shared, ("piece",), slow)
+
+    with reuse_work():
+        contexts = [contextvars.copy_context() for _ in range(4)]
+        with ThreadPoolExecutor(4) as pool:
+            answers = list(pool.map(ask, contexts))
+        assert len(calls) == 1 and all((a == 1.0).all() for a in answers)
+
+        def failing():
+            raise ValueError("no sun")
+
+        with pytest.raises(ValueError, match="no sun"):
+            shared(("broken",), failing)
+        assert (shared(("broken",), lambda: np.zeros(2)) == 0.0).all()  # computed anew, not waited for

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from ..collectors import Collector
-from ..mounting import angles_on_mount, mounting_rotation, pointing_vectors
+from ..mounting import angles_on_mount, geometry_key, mounting_rotation, pointing_vectors
 from ..sites import Site
 from ..sun import solar_position
 from ..reuse import Content, Same, shared
@@ -153,13 +153,17 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     mount : MountEstimate, optional
         The controller's belief about its mount; nominal by default.
     """
+    sun_key = ("plan's sun", Same(clock), Content(minutes), site, config)
     clock, steps, alarms, altitude, azimuth, apparent, awake = shared(
-        ("plan's sun", Same(clock), Content(minutes), site, config), lambda: _plan_sun(clock, minutes, site, config))
-    vectors = pointing_vectors(altitude, azimuth, collector, night=True)
+        sun_key, lambda: _plan_sun(clock, minutes, site, config))
+    vectors = shared(geometry_key(sun_key, "pointing", collector),
+                     lambda: pointing_vectors(altitude, azimuth, collector, night=True))
     model = (mount or MountEstimate()).vector_targets(vectors, collector)
     plan = ControllerPlan(np.asarray(minutes, float), model, awake, steps, alarms=alarms, apparent_altitude=apparent)
     if config.calibrates:
-        plan.jacobian = _lit_jacobian(vectors, model, collector)
+        lit = np.isfinite(model).all(axis=1)
+        plan.jacobian = shared(geometry_key((*sun_key, Content(lit)), "derivatives", collector),
+                               lambda: _lit_jacobian(vectors, lit, collector))
         plan.weight = np.ones(model.shape)
         if not collector.single_axis:  # an azimuth error counts cos(elevation) in pointing terms
             plan.weight[:, 0] = np.cos(np.radians(np.clip(model[:, 1], 0.0, 90.0)))
@@ -200,14 +204,14 @@ def _sun_day(clock: pd.DatetimeIndex, altitude: np.ndarray, site: Site, config: 
     return awake
 
 
-def _lit_jacobian(vectors: np.ndarray, model: np.ndarray, collector: Collector) -> np.ndarray:
-    """`mountfit.jacobian` where the computed target exists; zero elsewhere, as it comes out there
-    anyway (no target, no derivative): a year's nights are half its scans, not worth four mounts."""
+def _lit_jacobian(vectors: np.ndarray, lit: np.ndarray, collector: Collector) -> np.ndarray:
+    """`mountfit.jacobian` at the scans `lit` (where the computed target exists); zero elsewhere,
+    as it comes out there anyway (no target, no derivative): a year's nights are half its scans,
+    not worth four mounts."""
     from .mountfit import vector_jacobian
 
-    lit = np.isfinite(model).all(axis=1)
     derivatives = vector_jacobian(vectors[lit], collector)
-    out = np.zeros((len(model), *derivatives.shape[1:]))
+    out = np.zeros((len(lit), *derivatives.shape[1:]))
     out[lit] = derivatives
     return out
 
