@@ -507,6 +507,15 @@ def test_the_trailing_windows_queue_size_is_the_most_scans_a_window_holds():
     assert most_in_window(np.arange(10.0), 3.0) == 3  # (t − 3, t] at 1-minute scans: t − 2, t − 1 and t
 
 
+def test_the_queues_hold_a_power_of_two_with_room_for_the_scan_being_added():
+    """The queues mask their counts by their capacity, which must be a power of two."""
+    from hybridtrack.kernel.bridge import _window_capacity
+
+    minutes = np.arange(600.0)
+    assert [_window_capacity(minutes, [w]) for w in (0.5, 1.0, 2.0, 6.0, 7.0, 30.0)] == [4, 4, 4, 8, 16, 32]
+    assert _window_capacity(minutes, [6.0, 30.0]) == 32  # the widest window: 30 scans + 2
+
+
 @pytest.mark.parametrize("days", [1.0, 40.0])  # within DRIFT_DAYS the drift is held; beyond it is fitted
 def test_the_kernels_clock_fit_sums_its_normal_equations_to_the_references_answer(days):
     """The kernel keeps running sums of the clock fit's normal equations, its residuals' squares

@@ -117,8 +117,10 @@ def _plan(controller: Controller) -> kc.ControllerPlanArrays:
 
 
 def _window_capacity(minutes: np.ndarray, windows: list[float]) -> int:
-    """The most scans any trailing window can hold, with room for the one being added."""
-    return max(kc.most_in_window(minutes, float(width)) for width in windows) + 2
+    """The most scans any trailing window can hold, with room for the one being added, rounded up
+    to a power of two (the queues mask their counts by it)."""
+    need = max(kc.most_in_window(minutes, float(width)) for width in windows) + 2
+    return 1 << (need - 1).bit_length()
 
 
 def _clock_capacity(controller: Controller, minutes: np.ndarray) -> int:

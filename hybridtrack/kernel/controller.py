@@ -293,24 +293,26 @@ def wind_released(cfg, state, t):
 
 # -- the sky watch --------------------------------------------------------------------------------
 
+# A queue's places are its counts masked by its capacity, a power of two (`bridge._window_capacity`):
+# a mask where a remainder would divide, several times a scan.
+
 @kernel
 def _push(state, q, t, value):
-    capacity = state.window_t.shape[1]
+    mask = state.window_t.shape[1] - 1
     tail = state.window_ends[q, TAIL]
-    state.window_t[q, tail % capacity] = t
-    state.window_v[q, tail % capacity] = value
+    state.window_t[q, tail & mask] = t
+    state.window_v[q, tail & mask] = value
     state.window_ends[q, TAIL] = tail + 1
 
 
 @kernel
 def _back(state, q):
-    return state.window_v[q, (state.window_ends[q, TAIL] - 1) % state.window_t.shape[1]]
+    return state.window_v[q, (state.window_ends[q, TAIL] - 1) & (state.window_t.shape[1] - 1)]
 
 
 @kernel
 def _front(state, q):
-    capacity = state.window_t.shape[1]
-    head = state.window_ends[q, HEAD] % capacity
+    head = state.window_ends[q, HEAD] & (state.window_t.shape[1] - 1)
     return state.window_t[q, head], state.window_v[q, head]
 
 
