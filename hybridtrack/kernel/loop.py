@@ -38,9 +38,9 @@ def run_scans(start, stop, bulk_nights, wind_ok, world, world_state, cfg, plan, 
 @kernel
 def _scans(start, stop, bulk_nights, wind_ok, world, world_state, cfg, plan, state, out, log, obs, obs_axes, moves,
            offsets, reported, reading, targets, valid):
-    """`run_scans`' loop, compiled without reference counting (`jit.kernel`): called from the loop,
-    each piece would count a reference to every array of the tuples it is handed, in and out,
-    at every scan (about a tenth of the loop's time, measured with perf)."""
+    """`run_scans`' loop, compiled without reference counting (`jit.kernel`): called from a loop
+    that counts references, each piece would count one for every array of the tuples it is handed,
+    in and out, at every scan (`docs/kernel.md`, "The loop without reference counting")."""
     capacity = log.scan.shape[0]
     i = start
     while i < stop:
