@@ -91,7 +91,9 @@ def shared(key: tuple | None, compute: Callable[[], T]) -> T:
 
     A thread that asks for a piece another thread is computing waits for that answer rather than
     computing it too (a field's threads start together and ask for the same pieces at once); if
-    that computation fails, the waiting thread computes the piece itself.
+    that computation fails, the waiting thread computes the piece itself. A thread that is itself
+    computing a piece never waits (it computes the other piece too): a piece whose computation
+    asks for another, or for itself, cannot close a circle of threads waiting on each other.
     """
     memory = _MEMORY.get()
     if memory is None or key is None:
@@ -104,9 +106,27 @@ def shared(key: tuple | None, compute: Callable[[], T]) -> T:
         underway = computing.get(key)
         if underway is None:
             computing[key] = done = threading.Event()
-    if underway is not None:
-        underway.wait()
-        return shared(key, compute)  # found now, unless that computation failed
+    if underway is None:
+        return _compute_and_keep(key, compute, memory, done)
+    if _BUSY.depth:
+        return compute()
+    underway.wait()
+    return shared(key, compute)  # found now, unless that computation failed
+
+
+class _Busy(threading.local):
+    """How many pieces this thread is computing (`shared`), one inside another."""
+
+    depth = 0
+
+
+_BUSY = _Busy()
+
+
+def _compute_and_keep(key: tuple, compute: Callable[[], T], memory: tuple, done: threading.Event) -> T:
+    """`compute` a piece this thread has marked as under way, keep it, and wake those waiting."""
+    lock, answers, entries, computing = memory
+    _BUSY.depth += 1
     try:
         answer = compute()
         with lock:
@@ -115,6 +135,7 @@ def shared(key: tuple | None, compute: Callable[[], T]) -> T:
                 del answers[oldest]
             return _handed(answer)
     finally:
+        _BUSY.depth -= 1
         with lock:
             del computing[key]
         done.set()
