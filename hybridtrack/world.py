@@ -193,15 +193,16 @@ class World:
         self.drives = drives
         self.faults = faults
         rng = np.random.default_rng(seed)
-        position = self._true_sun(truth)
+        self._sun_model = truth
+        self._sun_key = (Same(index), site, truth)  # what the true sun turns on, in every shared key of it
+        position = self._true_sun()
         self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
                                      imperfections.axis_roll_error)
-        self._sun_key = (Same(index), site, truth)  # what the true sun turns on (`_true_sun`)
         vectors = shared(geometry_key(self._sun_key, "pointing", collector),
                          lambda: pointing_vectors(self.altitude, self.azimuth, collector))
         self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation, vectors=vectors)
-        clear_dni, clear_dhi = self._clear_sky(frame, position, truth)
+        clear_dni, clear_dhi = self._clear_sky(frame, position)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
         circumsolar = shared(("circumsolar", Same(frame), site, truth), lambda: circumsolar_light(weather, position))
         scene = sensor_scene(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi, rng=rng,
@@ -253,16 +254,16 @@ class World:
                                    f"the frame has {', '.join(present)}")
         return np.array([frame[name].to_numpy(float) for name in names])
 
-    def _true_sun(self, model: str) -> pd.DataFrame:
+    def _true_sun(self) -> pd.DataFrame:
         """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere.
         Computed once for the runs of a field (`hybridtrack.reuse`)."""
-        return shared(("true sun", Same(self.index), self.site, model), lambda: self._sun_where_up(model))
+        return shared(("true sun", *self._sun_key), self._sun_where_up)
 
-    def _sun_where_up(self, model: str) -> pd.DataFrame:
+    def _sun_where_up(self) -> pd.DataFrame:
         candidate = self._sun_may_be_up()
         altitude, azimuth = np.full(self.n, -90.0), np.zeros(self.n)
         if candidate.any():
-            spa = solar_position(self.index[candidate], self.site, model)
+            spa = solar_position(self.index[candidate], self.site, self._sun_model)
             altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
         return pd.DataFrame({"altitude": altitude, "azimuth": azimuth, "zenith": 90.0 - altitude}, index=self.index)
 
@@ -279,8 +280,8 @@ class World:
         altitude = solar_position(knots, self.site, "plc")["altitude"].to_numpy()
         return altitude[(stamps + HOUR_NS // 2) // HOUR_NS - first] > -3.0 - 7.5 - 0.5
 
-    def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame, model: str) -> tuple[np.ndarray, np.ndarray]:
-        """The frame's clear-sky DNI and DHI, or Ineichen's under the true sun (`model`'s)."""
+    def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+        """The frame's clear-sky DNI and DHI, or Ineichen's under the true sun (`position`)."""
         if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:
             return frame["dni_clear"].to_numpy(float), frame["dhi_clear"].to_numpy(float)
         from .sky import clear_sky
@@ -288,7 +289,7 @@ class World:
         def ineichen():
             return clear_sky(self.index, self.site, position["zenith"].to_numpy(float))[1:]
 
-        return shared(("clear sky", Same(self.index), self.site, model), ineichen)
+        return shared(("clear sky", *self._sun_key), ineichen)
 
     @staticmethod
     def _true_sky(frame: pd.DataFrame) -> np.ndarray | None:
