@@ -110,32 +110,6 @@ def test_a_piece_without_a_key_and_a_block_apart_are_computed_every_time_and_not
         assert len(calls) == 9
 
 
-def test_threads_asking_at_once_wait_for_one_computation_and_a_failed_one_is_not_kept():
-    calls, started = [], threading.Barrier(4)
-
-    def slow():
-        calls.append(1)
-        time.sleep(0.2)
-        return np.ones(3)
-
-    def ask(context):
-        started.wait()
-        return context.run(shared, ("piece",), slow)
-
-    with reuse_work():
-        contexts = [contextvars.copy_context() for _ in range(4)]
-        with ThreadPoolExecutor(4) as pool:
-            answers = list(pool.map(ask, contexts))
-        assert len(calls) == 1 and all((a == 1.0).all() for a in answers)
-
-        def failing():
-            raise ValueError("no sun")
-
-        with pytest.raises(ValueError, match="no sun"):
-            shared(("broken",), failing)
-        assert (shared(("broken",), lambda: np.zeros(2)) == 0.0).all()  # computed anew, not waited for
-
-
 def _in_threads(*calls) -> list:
     """Each call on a thread of its own, each in a copy of this context; the threads still running
     after 30 s (a wait that would never end) are left behind as daemons and counted."""
@@ -150,8 +124,32 @@ def _in_threads(*calls) -> list:
         thread.start()
     for thread in threads:
         thread.join(timeout=30)
-    assert not any(thread.is_alive() for thread in threads), "a piece waited for itself"
+    assert not any(thread.is_alive() for thread in threads), "a thread still waits"
     return answers
+
+
+def test_threads_asking_at_once_wait_for_one_computation_and_a_failed_one_is_not_kept():
+    calls, started = [], threading.Barrier(4)
+
+    def slow():
+        calls.append(1)
+        time.sleep(0.2)
+        return np.ones(3)
+
+    def ask():
+        started.wait()
+        return shared(("piece",), slow)
+
+    with reuse_work():
+        answers = _in_threads(*[ask] * 4)
+        assert len(calls) == 1 and all((a == 1.0).all() for a in answers)
+
+        def failing():
+            raise ValueError("no sun")
+
+        with pytest.raises(ValueError, match="no sun"):
+            shared(("broken",), failing)
+        assert (shared(("broken",), lambda: np.zeros(2)) == 0.0).all()  # computed anew, not waited for
 
 
 def test_a_piece_that_asks_for_itself_or_for_another_under_way_does_not_wait_forever():
