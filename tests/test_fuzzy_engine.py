@@ -305,3 +305,31 @@ def test_threads_that_first_use_the_compiled_engine_at_once_take_turns():
               "print(errors)\n")
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and done.stdout.strip() == "[]", done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("shape", ["tri", "gauss", "flat top", "complement", "random"])
+def test_term_tables_integrate_the_clipped_term_exactly(shape):
+    """A term's table (area and first moment of min(s, term), piecewise cubic in s) against the
+    clipped curve integrated directly: every cell split where the clip level cuts it, and each
+    piece (linear, so its moment quadratic) integrated by Simpson's rule, exact for both."""
+    from hybridtrack.fuzzy.engine import _TermTable
+
+    rng = np.random.default_rng(7)
+    y = np.linspace(0.0, 30.0, 301)
+    curve = {"tri": np.clip(1 - abs(y - 12) / 5, 0, 1), "gauss": np.exp(-(y - 20) ** 2 / 8),
+             "flat top": np.clip(np.minimum((y - 3) / 4, (25 - y) / 6), 0, 1),
+             "complement": 1 - np.clip(1 - abs(y - 12) / 5, 0, 1),
+             "random": np.interp(y, np.linspace(0, 30, 40), rng.random(40))}[shape]
+    cells = np.flatnonzero(rng.random(300) < 0.7)  # a term's own cells need not be contiguous
+    levels = np.concatenate([rng.random(40), [0.0, 0.5, 1.0]])
+    area, moment = _TermTable.build(y, curve, cells, "min")(levels)
+    for s, got_area, got_moment in zip(levels, area, moment):
+        want = np.zeros(2)
+        for c in cells:
+            x = [y[c], y[c + 1]]
+            if (curve[c] - s) * (curve[c + 1] - s) < 0:
+                x.insert(1, y[c] + (s - curve[c]) * (y[c + 1] - y[c]) / (curve[c + 1] - curve[c]))
+            for a, b in zip(x[:-1], x[1:]):
+                v = np.minimum(s, np.interp([a, (a + b) / 2, b], [y[c], y[c + 1]], [curve[c], curve[c + 1]]))
+                want += (b - a) / 6 * np.array([v[0] + 4 * v[1] + v[2], a * v[0] + 2 * (a + b) * v[1] + b * v[2]])
+        np.testing.assert_allclose([got_area, got_moment], want, rtol=1e-11, atol=1e-12)

@@ -67,6 +67,39 @@ def _cell_integrals(y1, y2, v1, v2, s):
     return area, moment
 
 
+def _level_integrals(y1, y2, v1, v2, levels, s):
+    """Area and first moment of min(s, L) summed over the cells, at the levels `s` (intervals, 4)
+    taken inside each interval between consecutive `levels` (every v1 and v2 is one of them).
+
+    In an interval a cell lies wholly below the level (its whole area counts), wholly above it
+    (s times its width), or crosses it; only the crossing cells are integrated, each over the
+    intervals it spans. That is linear in the cells, where integrating every cell at every level
+    was quadratic (0.2-0.4 s an output term at 3,001 points, paid by every new process)."""
+    intervals = len(levels) - 1
+    first = np.searchsorted(levels, np.minimum(v1, v2))  # the cell crosses intervals first .. last - 1
+    last = np.searchsorted(levels, np.maximum(v1, v2))
+    dy = y2 - y1
+
+    def below(weights):  # the sum over cells wholly below each interval
+        return np.cumsum(np.bincount(last, weights=weights, minlength=intervals + 1))[:intervals]
+
+    def above(weights):  # the sum over cells wholly above each interval
+        return np.cumsum(np.bincount(first, weights=weights, minlength=intervals + 1)[::-1])[::-1][1:]
+
+    area = below(0.5 * dy * (v1 + v2))[:, None] + s * above(dy)[:, None]
+    moment = (below(dy * (v1 * (2 * y1 + y2) + v2 * (y1 + 2 * y2)) / 6.0)[:, None]
+              + s * above(0.5 * dy * (y1 + y2))[:, None])
+    spans = last - first
+    cell = np.repeat(np.arange(len(dy)), spans)
+    interval = first[cell] + np.arange(len(cell)) - np.repeat(np.cumsum(spans) - spans, spans)
+    crossing_area, crossing_moment = _cell_integrals(y1[cell, None], y2[cell, None], v1[cell, None],
+                                                     v2[cell, None], s[interval])
+    for j in range(s.shape[1]):
+        area[:, j] += np.bincount(interval, weights=crossing_area[:, j], minlength=intervals)
+        moment[:, j] += np.bincount(interval, weights=crossing_moment[:, j], minlength=intervals)
+    return area, moment
+
+
 @dataclass
 class _TermTable:
     """Area and moment of one implied term over some cells, piecewise cubic in the firing level."""
@@ -85,10 +118,9 @@ class _TermTable:
         levels = np.unique(np.concatenate([[0.0], v1, v2]))
         if len(levels) == 1:
             levels = np.array([0.0, 1.0])
-        s = (levels[:-1, None] + _T[None, :] * np.diff(levels)[:, None]).reshape(-1, 1)
-        area, moment = _cell_integrals(y1, y2, v1, v2, s)
-        shape = (len(levels) - 1, 4)
-        return cls(levels, area.sum(axis=1).reshape(shape) @ _FIT.T, moment.sum(axis=1).reshape(shape) @ _FIT.T)
+        s = levels[:-1, None] + _T[None, :] * np.diff(levels)[:, None]  # 4 levels in each interval
+        area, moment = _level_integrals(y1, y2, v1, v2, levels, s)
+        return cls(levels, area @ _FIT.T, moment @ _FIT.T)
 
     def __call__(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         level = np.clip(s, 0.0, self.levels[-1])
