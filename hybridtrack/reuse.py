@@ -1,7 +1,7 @@
 """Work that runs on one weather frame share, done once inside a `reuse_work` block.
 
-A field's collectors stand under one sky. The true sun where it may be up, its clear sky, the
-circumsolar light of the sky, the controller's clock and the sun its plan computes from that clock
+A field's collectors stand under one sky. The true sun where it may be up, the light in the sun
+sensor's view (its clear sky and circumsolar light included), the controller's clock and the sun its plan computes from that clock
 are the same for every collector that shares the frame, the site, the field controller's clock
 and its sun model; only the mount, the sensor's own noise and what the controller does with them
 differ. Inside ``with reuse_work():`` each such piece is computed by the first run that asks for it

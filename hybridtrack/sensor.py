@@ -51,9 +51,10 @@ import pandas as pd
 
 from .errors import HybridtrackError
 from .params import duration, number
+from .sky import MinuteGrid, smooth_noise
 
-__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "sensor_scene",
-           "circumsolar_light", "read_pointing", "read_photocurrent", "coarse_offset"]
+__all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "SceneLight",
+           "scene_light", "sensor_scene", "circumsolar_light", "read_pointing", "read_photocurrent", "coarse_offset"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
@@ -245,35 +246,64 @@ def circumsolar_light(frame: pd.DataFrame, position: pd.DataFrame) -> np.ndarray
     return np.maximum(out, 0.0)
 
 
-def _patch_side(index: pd.DatetimeIndex, clearness: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Which side of the sun the bright cloud light is on, -1 to 1, continuous in time.
+@dataclass
+class SceneLight:
+    """What a sun-facing sensor has in view that follows from the weather and the sun alone, the
+    same for every collector under them (a field's collectors share it): `SensorScene`'s light,
+    and the unsigned cloud-edge pattern the patch's side follows (`sensor_scene`)."""
+
+    beam: np.ndarray
+    aureole: np.ndarray
+    patch: np.ndarray
+    diffuse: np.ndarray
+    edges: np.ndarray | None  # the side at the first cloud edge taken as +1; None for fewer than 2 stamps
+    grid: MinuteGrid
+
+
+def scene_light(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel, *, clear_dni, clear_dhi,
+                circumsolar=None) -> SceneLight:
+    """The weather's and the sun's part of `sensor_scene` (its parameters); `model` gives only its
+    ``view_share``."""
+    dni = np.clip(frame["dni"].to_numpy(float), 0.0, None)  # NaN stays NaN: light nobody knows
+    dhi = np.clip(frame["dhi"].to_numpy(float), 0.0, None)
+    clear_dni = np.nan_to_num(np.asarray(clear_dni, float))
+    clear_dhi = np.nan_to_num(np.asarray(clear_dhi, float))
+    if circumsolar is None:
+        circumsolar = circumsolar_light(frame, position)
+    circumsolar = np.asarray(circumsolar, float) * model.view_share
+    cloud_share = np.divide(np.clip(np.nan_to_num(dhi) - clear_dhi, 0.0, None), dhi, out=np.zeros_like(dhi),
+                            where=np.nan_to_num(dhi) > 0)
+    clearness = np.clip(np.divide(np.nan_to_num(dni), np.maximum(clear_dni, 50.0)), 0.0, 1.2)
+    grid = MinuteGrid.of(frame.index)
+    return SceneLight(beam=dni, aureole=circumsolar * (1.0 - cloud_share), patch=circumsolar * cloud_share,
+                      diffuse=dhi, edges=_cloud_edges(grid.minutes, clearness), grid=grid)
+
+
+def _cloud_edges(minutes: np.ndarray, clearness: np.ndarray) -> np.ndarray | None:
+    """Which side of the sun the bright cloud light is on, -1 to 1, continuous in time, taking the
+    first side as +1 (None for fewer than two stamps: no side).
 
     The side flips at every cloud passage's edge, where the beam's clearness (DNI over clear-sky
     DNI) crosses one half: the nearest sunlit edge moves from one side of the sun to the other
     as the cloud crosses it. The flip is smoothed with a 2-minute time constant so the patch
-    moves through the sun rather than jumping.
+    moves through the sun rather than jumping. A collector's patch takes a random first side:
+    this times -1 or 1, which is the filter of the flipped steps exactly (the filter is linear,
+    and a sign change is exact in floating point).
     """
     from scipy.signal import lfilter
 
-    minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
     if len(minutes) < 2:
-        return np.zeros(len(minutes))
+        return None
     clear = clearness >= 0.5
     crossings = np.concatenate([[0], np.cumsum(clear[1:] != clear[:-1])])
-    sign = rng.choice([-1.0, 1.0]) * np.where(crossings % 2 == 0, 1.0, -1.0)
+    sign = np.where(crossings % 2 == 0, 1.0, -1.0)
     keep = np.exp(-float(np.median(np.diff(minutes))) / 2.0)
     return lfilter([1.0 - keep], [1.0, -keep], sign, zi=[keep * sign[0]])[0]
 
 
-def _smooth(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float) -> np.ndarray:
-    """A unit-variance AR(1) process with time constant `minutes`, on the index."""
-    from .sky import smooth_noise
-
-    return smooth_noise(index, rng, minutes, 1.0)
-
-
 def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel, *, clear_dni=None,
-                 clear_dhi=None, rng: np.random.Generator, circumsolar=None) -> SensorScene:
+                 clear_dhi=None, rng: np.random.Generator, circumsolar=None,
+                 light: SceneLight | None = None) -> SensorScene:
     """What a sun-facing sensor has in view at each step of a weather frame (world side).
 
     Parameters
@@ -289,8 +319,10 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     rng : numpy.random.Generator
         Seeds the patch's distance from the sun and its direction.
     circumsolar : array-like, optional
-        `circumsolar_light` for this frame and sun, if computed already (a field's collectors
-        share it); computed here otherwise.
+        `circumsolar_light` for this frame and sun, if computed already; computed here otherwise.
+    light : SceneLight, optional
+        `scene_light` for this frame, sun and model, if computed already (a field's collectors
+        share it); then the clear sky and `circumsolar` are not needed.
 
     Notes
     -----
@@ -298,25 +330,18 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     its circumsolar share (Perez et al. 1990) is the patch, off the sun. The rest of the
     circumsolar light is the aureole, centred on the sun. The patch sits `patch_distance` from
     the sun (a seeded AR(1) between the bounds, time constant 30 min) in a direction that turns
-    as the clouds move (AR(1), 20 min), on the side `_patch_side` says.
+    as the clouds move (AR(1), 20 min), on the side `_cloud_edges` says.
     """
-    dni = np.clip(frame["dni"].to_numpy(float), 0.0, None)  # NaN stays NaN: light nobody knows
-    dhi = np.clip(frame["dhi"].to_numpy(float), 0.0, None)
-    clear_dni = np.nan_to_num(np.asarray(clear_dni, float))
-    clear_dhi = np.nan_to_num(np.asarray(clear_dhi, float))
-    if circumsolar is None:
-        circumsolar = circumsolar_light(frame, position)
-    circumsolar = np.asarray(circumsolar, float) * model.view_share
-    cloud_share = np.divide(np.clip(np.nan_to_num(dhi) - clear_dhi, 0.0, None), dhi, out=np.zeros_like(dhi),
-                            where=np.nan_to_num(dhi) > 0)
-    clearness = np.clip(np.divide(np.nan_to_num(dni), np.maximum(clear_dni, 50.0)), 0.0, 1.2)
-    side = _patch_side(frame.index, clearness, rng)
+    if light is None:
+        light = scene_light(frame, position, model, clear_dni=clear_dni, clear_dhi=clear_dhi, circumsolar=circumsolar)
+    index, grid = frame.index, light.grid
+    side = np.zeros(len(index)) if light.edges is None else rng.choice([-1.0, 1.0]) * light.edges
     low, high = model.patch_distance
-    distance = low + (high - low) * 0.5 * (1.0 + np.tanh(_smooth(frame.index, rng, 30.0)))
-    direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * _smooth(frame.index, rng, 20.0)
+    distance = low + (high - low) * 0.5 * (1.0 + np.tanh(smooth_noise(index, rng, 30.0, 1.0, grid=grid)))
+    direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * smooth_noise(index, rng, 20.0, 1.0, grid=grid)
     offset = (side * distance)[:, None] * np.stack([np.cos(direction), np.sin(direction)], axis=1)
-    return SensorScene(beam=dni, aureole=circumsolar * (1.0 - cloud_share), patch=circumsolar * cloud_share,
-                       patch_offset=offset, diffuse=dhi)
+    return SensorScene(beam=light.beam, aureole=light.aureole, patch=light.patch, patch_offset=offset,
+                       diffuse=light.diffuse)
 
 
 def read_pointing(offsets, beam: float, aureole: float, patch: float, patch_offset, noise, model: SensorModel):

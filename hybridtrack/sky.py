@@ -41,9 +41,8 @@ from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_midnight, local_range, parse_freq
 
-__all__ = ["synthetic", "clear_sky", "smooth_noise", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS", "RegimeParameters",
-           "REGIMES",
-           "daily_summary"]
+__all__ = ["synthetic", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS",
+           "RegimeParameters", "REGIMES", "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
 WEATHERS = (*DAY_TYPES, "mixed", "climate")
@@ -221,16 +220,48 @@ def _cloud_passages(t0: pd.Timestamp, t1: pd.Timestamp, regime: str, rng: np.ran
     return out
 
 
-def smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float, sigma: float) -> np.ndarray:
-    """Zero-mean AR(1) noise with time constant `minutes`, on a 1-minute grid, then interpolated."""
-    t = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
-    n = int(np.ceil(t[-1])) + 2 if len(t) else 2
+@dataclass(frozen=True)
+class MinuteGrid:
+    """The 1-minute grid `smooth_noise` draws its noise on, for an index.
+
+    Attributes
+    ----------
+    minutes : numpy.ndarray
+        Each stamp's minutes since the first.
+    knots : int
+        Grid points drawn: the span in whole minutes, and two more.
+    on_knots : bool
+        Every stamp is the next grid point (an index at 1-minute steps): the noise is taken
+        as drawn, which is what interpolating it at its own points gives.
+    """
+
+    minutes: np.ndarray
+    knots: int
+    on_knots: bool
+
+    @classmethod
+    def of(cls, index: pd.DatetimeIndex) -> MinuteGrid:
+        minutes = np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+        knots = int(np.ceil(minutes[-1])) + 2 if len(minutes) else 2
+        return cls(minutes, knots, bool(np.array_equal(minutes, np.arange(len(minutes)))))
+
+    def place(self, values: np.ndarray) -> np.ndarray:
+        """Values on the grid's points, at the index's stamps."""
+        if self.on_knots:
+            return values[:len(self.minutes)]
+        return np.interp(self.minutes, np.arange(self.knots), values)
+
+
+def smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: float, sigma: float, *,
+                 grid: MinuteGrid | None = None) -> np.ndarray:
+    """Zero-mean AR(1) noise with time constant `minutes`, on a 1-minute grid, then interpolated
+    (`grid`, the index's `MinuteGrid`, if made already)."""
+    grid = grid or MinuteGrid.of(index)
     phi = np.exp(-1.0 / minutes)
-    shocks = rng.normal(0.0, sigma * np.sqrt(1 - phi**2), n)
+    shocks = rng.normal(0.0, sigma * np.sqrt(1 - phi**2), grid.knots)
     from scipy.signal import lfilter
 
-    grid = lfilter([1.0], [1.0, -phi], shocks)
-    return np.interp(t, np.arange(n), grid)
+    return grid.place(lfilter([1.0], [1.0, -phi], shocks))
 
 
 def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith, *,

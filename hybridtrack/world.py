@@ -37,8 +37,8 @@ from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
 from .mounting import geometry_key, incidence_cosine, mount_targets, mounting_rotation, pointing_vectors
 from .reuse import Same, shared
-from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SensorModel, circumsolar_light, coarse_offset,
-                     read_photocurrent, read_pointing, sensor_scene)
+from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SceneLight, SensorModel, coarse_offset, read_photocurrent,
+                     read_pointing, scene_light, sensor_scene)
 from .sun import solar_position
 from .times import HOUR_NS, plus_seconds
 
@@ -202,11 +202,10 @@ class World:
         vectors = shared(geometry_key(self._sun_key, "pointing", collector),
                          lambda: pointing_vectors(self.altitude, self.azimuth, collector))
         self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation, vectors=vectors)
-        clear_dni, clear_dhi = self._clear_sky(frame, position)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
-        circumsolar = shared(("circumsolar", Same(frame), site, truth), lambda: circumsolar_light(weather, position))
-        scene = sensor_scene(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi, rng=rng,
-                             circumsolar=circumsolar)
+        light = shared(("scene light", Same(frame), *self._sun_key, self.sensor.view_share),
+                       lambda: self._scene_light(weather, position))
+        scene = sensor_scene(weather, position, self.sensor, rng=rng, light=light)
         self.scene = (scene.beam, scene.aureole, scene.patch, np.ascontiguousarray(scene.patch_offset.T), scene.diffuse)
         self.truth_axes = np.ascontiguousarray(np.nan_to_num(self.truth[:, :self.axes].T))
         self.noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
@@ -286,10 +285,13 @@ class World:
             return frame["dni_clear"].to_numpy(float), frame["dhi_clear"].to_numpy(float)
         from .sky import clear_sky
 
-        def ineichen():
-            return clear_sky(self.index, self.site, position["zenith"].to_numpy(float))[1:]
+        return clear_sky(self.index, self.site, position["zenith"].to_numpy(float))[1:]
 
-        return shared(("clear sky", *self._sun_key), ineichen)
+    def _scene_light(self, weather: pd.DataFrame, position: pd.DataFrame) -> SceneLight:
+        """The light in the sensor's view from the weather and the true sun: the same for every
+        collector under them."""
+        clear_dni, clear_dhi = self._clear_sky(weather, position)
+        return scene_light(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi)
 
     @staticmethod
     def _true_sky(frame: pd.DataFrame) -> np.ndarray | None:

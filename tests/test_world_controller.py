@@ -268,3 +268,32 @@ def test_the_world_computes_spa_wherever_the_sun_is_near_or_above_the_horizon(si
     assert near.sum() > 0.4 * len(index)
     np.testing.assert_allclose(world.altitude[near], spa["elevation"].to_numpy()[near], atol=1e-9)
     assert (world.altitude[~near] < -2.0 + 1e-9).all()
+
+
+def test_the_patch_offset_is_the_filtered_signed_cloud_edges_and_the_interpolated_noise_bit_for_bit():
+    """A field shares the unsigned cloud-edge pattern, and noise on a 1-minute index is taken as
+    drawn; each collector draws its own first side. The offset must be exactly what filtering the
+    collector's signed steps, and interpolating its noise at every stamp, gives."""
+    from scipy.signal import lfilter
+
+    frame, position, light = scene("mixed", seed=5)
+    rng = np.random.default_rng(5)
+    clearness = np.clip(np.nan_to_num(frame["dni"].to_numpy()) / np.maximum(frame["dni_clear"].to_numpy(), 50.0),
+                        0.0, 1.2)
+    clear = clearness >= 0.5
+    signed = rng.choice([-1.0, 1.0]) * np.where(np.concatenate([[0], np.cumsum(clear[1:] != clear[:-1])]) % 2 == 0,
+                                                 1.0, -1.0)
+    keep = np.exp(-1.0 / 2.0)  # 1-minute steps, a 2-minute time constant
+    side = lfilter([1.0 - keep], [1.0, -keep], signed, zi=[keep * signed[0]])[0]
+
+    def noise(minutes):  # AR(1) on a grid of whole minutes, interpolated at the stamps
+        t = np.arange(len(frame), dtype=float)
+        phi = np.exp(-1.0 / minutes)
+        grid = lfilter([1.0], [1.0, -phi], rng.normal(0.0, np.sqrt(1 - phi ** 2), len(frame) + 1))
+        return np.interp(t, np.arange(len(frame) + 1), grid)
+
+    low, high = SensorModel().patch_distance
+    distance = low + (high - low) * 0.5 * (1.0 + np.tanh(noise(30.0)))
+    direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * noise(20.0)
+    want = (side * distance)[:, None] * np.stack([np.cos(direction), np.sin(direction)], axis=1)
+    assert np.array_equal(light.patch_offset, want)
