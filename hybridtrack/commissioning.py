@@ -17,12 +17,15 @@ errors), run through the same controller:
 from __future__ import annotations
 
 import dataclasses
+import datetime as dt
 
 import pandas as pd
 
 from .collectors import Collector
 from .control import MountEstimate
 from .control.mountfit import parameter_names
+from .errors import HybridtrackError
+from .times import FIRST_DATE
 
 __all__ = ["commission", "warm_memory", "clear_day"]
 
@@ -35,13 +38,28 @@ def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy:
     from .simulation import simulate
     from .sky import synthetic
 
-    day = (start.tz_convert(site.tz) - pd.Timedelta(days=days_before)).date()
+    day = _day_before(start.tz_convert(site.tz), days_before)
     frame = synthetic(site, day, weather="sunny", seed=config.seed)
     age = max(config.imperfections.commissioned_days_ago - days_before, 0.0)
     setup = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy),
                                 imperfections=dataclasses.replace(config.imperfections, commissioned_days_ago=age))
     with apart():  # the day's frame is this run's own: nothing of it is another run's to share
         return simulate(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
+
+
+def _day_before(start: pd.Timestamp, days: float) -> dt.date:
+    """The local date `days` before `start`, refused with the reason where it is before the first
+    date a run can cover (a run early in that span, commissioned long before)."""
+    try:
+        day = (start - pd.Timedelta(days=days)).date()
+    except (OverflowError, pd.errors.OutOfBoundsDatetime):  # before pandas' first timestamp
+        day = start.date() - dt.timedelta(days=days)
+    if day < FIRST_DATE:
+        raise HybridtrackError(f"the run starts on {start.date()}; its clear day {days:g} days before ({day}, "
+                               f"for warm start or commissioning, imperfections.commissioned_days_ago) is before "
+                               f"{FIRST_DATE}, the first date a run can cover: start later or commission it more "
+                               "recently")
+    return day
 
 
 def commission(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> MountEstimate:

@@ -41,6 +41,7 @@ from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
 from .world import Imperfections, World, controller_clock, installed_site, scan_timer
+from .times import check_dates
 
 __all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
 #: The faults `simulate` can inject, with what each array holds.
@@ -299,6 +300,8 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     if not frame.index.is_monotonic_increasing or frame.index.has_duplicates:
         raise HybridtrackError("the weather frame's index must be increasing without repeats "
                                "(read files with hybridtrack.io.read_weather, which sorts and de-duplicates)")
+    check_dates(frame.index[0].date(), frame.index[-1].date(), f"the weather frame ({frame.index[0]} to "
+                f"{frame.index[-1]})")
     if "dni" not in frame.columns:
         raise HybridtrackError(f"the weather frame has no 'dni' column; it has {', '.join(map(str, frame.columns))}")
     for column in ("dni", "dhi", "wind_speed"):

@@ -9,7 +9,7 @@ import pandas as pd
 from .budget import check_steps
 from .errors import HybridtrackError
 
-__all__ = ["parse_date", "parse_clock", "parse_freq", "local_range", "local_midnight", "check_tz", "clock_hours",
+__all__ = ["parse_date", "check_dates", "FIRST_DATE", "LAST_DATE", "parse_clock", "parse_freq", "local_range", "local_midnight", "check_tz", "clock_hours",
            "clock_nanoseconds", "calendar_days", "day_of_year", "plus_seconds", "HOUR_NS", "DAY_NS"]
 
 
@@ -89,16 +89,32 @@ def check_tz(tz: str, where: str = "") -> str:
     return str(tz)
 
 
+#: The first and last dates a run may cover: whole years inside pandas' nanosecond timestamps
+#: (1677-09-21 to 2262-04-11), which leaves any time zone room.
+FIRST_DATE, LAST_DATE = dt.date(1678, 1, 1), dt.date(2261, 12, 31)
+
+
 def parse_date(text) -> dt.date:
-    """Parse ``YYYY-MM-DD`` (or pass a date through), refusing dates that do not exist."""
+    """Parse ``YYYY-MM-DD`` (or pass a date through), refusing dates that do not exist or that a
+    run cannot cover (`FIRST_DATE` to `LAST_DATE`)."""
     if isinstance(text, dt.datetime):
-        return text.date()
-    if isinstance(text, dt.date):
-        return text
-    try:
-        return dt.date.fromisoformat(str(text).strip())
-    except ValueError:
-        raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD") from None
+        day = text.date()
+    elif isinstance(text, dt.date):
+        day = text
+    else:
+        try:
+            day = dt.date.fromisoformat(str(text).strip())
+        except ValueError:
+            raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD") from None
+    check_dates(day, day, f"date {text!r}")
+    return day
+
+
+def check_dates(first: dt.date, last: dt.date, what: str) -> None:
+    """Refuse a span that reaches outside `FIRST_DATE` to `LAST_DATE`, naming `what` it is."""
+    if first < FIRST_DATE or last > LAST_DATE:
+        raise HybridtrackError(f"{what} is outside the dates a run can cover, {FIRST_DATE} to {LAST_DATE} "
+                               "(pandas' nanosecond timestamps)")
 
 
 def parse_clock(text: str) -> dt.time:

@@ -8,9 +8,10 @@ and checks both say the same thing.
 import dataclasses
 import math
 
+import pandas as pd
 import pytest
 
-from hybridtrack import HybridtrackError, sites
+from hybridtrack import HybridtrackError, simulate, sites
 from hybridtrack.cli import main
 from hybridtrack.collectors import Collector
 from hybridtrack.control import ControllerConfig
@@ -151,6 +152,21 @@ MATRIX = [
      lambda p: ["simulate", "--site", "nanjing", "--date", "2021-02-29"], "date '2021-02-29' does not exist"),
     ("month that does not exist", lambda tmp: None, lambda p: local_range("2021-13-01", "UTC"),
      lambda p: ["sky", "--site", "nanjing", "--date", "2021-13-01"], "date '2021-13-01' does not exist"),
+    # dates past pandas' nanosecond timestamps (1677-09-21 to 2262-04-11) had raised OutOfBoundsDatetime
+    ("a date after the last a run covers", lambda tmp: None, lambda p: synthetic("lanzhou", "2262-04-12"),
+     lambda p: ["field", "trough", "--site", "lanzhou", "--date", "2262-04-12", "--count", "1"],
+     "date '2262-04-12' is outside the dates a run can cover, 1678-01-01 to 2261-12-31"),
+    ("a date before the first a run covers", lambda tmp: None, lambda p: local_range("0001-01-01", "UTC"),
+     lambda p: SIMULATE[:-2] + ["--date", "0001-01-01"], "date '0001-01-01' is outside the dates a run can cover"),
+    ("a frame of stamps in seconds in 2500", lambda tmp: None,
+     lambda p: simulate(pd.DataFrame({"dni": [0.0, 0.0]}, index=pd.date_range("2500-01-01", periods=2, freq="min",
+                                                                             unit="s", tz="UTC")), "lanzhou"),
+     None, "the weather frame (2500-01-01 00:00:00+00:00 to 2500-01-01 00:01:00+00:00) is outside the dates"),
+    ("a commissioning before the first date", lambda tmp: None,
+     lambda p: simulate(synthetic("lanzhou", "1680-01-01", weather="sunny"), "lanzhou",
+                        strategy="astronomical-commissioned",
+                        config=SimulationConfig(imperfections=Imperfections(commissioned_days_ago=3000.0))),
+     None, "its clear day 3000 days before (1671-10-15, for warm start or commissioning"),
     ("naive times to the sun model", lambda tmp: None,
      lambda p: solar_position(__import__("pandas").date_range("2021-06-21", periods=2, freq="h"), "nanjing"),
      None, "naive"),
