@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 
 from hybridtrack.cli import main
@@ -25,9 +26,27 @@ def test_field_reads_heliostat_positions_and_aims(tmp_path, capsys):
     assert "HeliostatField of 2 (heliostat)" in capsys.readouterr().out
 
 
+def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
+    from hybridtrack.cli.field import read_positions
+
+    want = np.array([[0.0, -80.0], [40.0, -70.5]])
+    for name, text in (("comma", "east,north\n0,-80\n40,-70.5\n"), ("semicolon", "east;north\n0;-80\n40;-70.5\n"),
+                       ("tab", "east\tnorth\n0\t-80\n40\t-70.5\n"),
+                       ("comments and trailing separators", "# site survey\neast,north,\n0,-80,\n40,-70.5,\n")):
+        path = tmp_path / f"{name}.csv"
+        path.write_text(text)
+        positions, aims = read_positions(str(path))
+        np.testing.assert_array_equal(positions, want, err_msg=name)
+        assert aims is None
+
+
 @pytest.mark.parametrize("content, extra, message", [
     ("east,north\n0,-100\n50,abc\n", [], "row 3, column 'north': 'abc' is not a number"),
-    ("east,north\n0,-100\n50,\n", [], "row 3, column 'north': empty or not finite"),
+    ("east,north\n0,-100\n50,\n", [], "row 3, column 'north': empty"),
+    ("east,north\n0,-100\n50,1e400\n", [], "row 3, column 'north': inf is not a finite number"),
+    ("# mirrors\neast,north\n0,-100\n50,abc\n", [], "row 4, column 'north': 'abc' is not a number"),
+    # a row longer than its header had been read with its first field as the index: every mirror moved
+    ("east,north\n0,-100,5\n30,-90,5\n", [], "line 2: 3 fields, but the header on line 1 names 2"),
     ("x,y\n0,1\n", [], "no column 'east'"),
     ("east,north,aim_up\n0,-100,4\n", [], "aim points need all of"),
     ("east,north\n0,-100\n", ["--metric", "shine"], "--metric: no collector metric 'shine'"),

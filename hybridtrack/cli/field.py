@@ -6,7 +6,6 @@ import argparse
 import dataclasses
 
 import numpy as np
-import pandas as pd
 
 from ..errors import HybridtrackError
 from .base import (
@@ -88,16 +87,12 @@ def _numbers(text: str, flag: str) -> list[float]:
 
 
 def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
-    """Mirror centres (N, 2 or 3) and optional aim points (N, 3) from a CSV file."""
-    import io
+    """Mirror centres (N, 2 or 3) and optional aim points (N, 3) from a CSV file (comma,
+    semicolon, tab or bar; ``#`` comments), as `hybridtrack.io.read_table` reads small tables."""
+    from ..io import numeric_columns
+    from ..io.tables import read_table
 
-    from ..io import numeric_columns, read_text
-
-    try:
-        table = pd.read_csv(io.StringIO(read_text(path)), skipinitialspace=True)
-    except pd.errors.ParserError as exc:
-        raise HybridtrackError(f"{path}: not a CSV table: {exc}") from None
-    table.columns = [str(c).strip().lower() for c in table.columns]
+    table = read_table(path)
     for column in ("east", "north"):
         if column not in table.columns:
             raise HybridtrackError(f"{path}: no column {column!r}; columns are {', '.join(table.columns)}")
@@ -105,14 +100,8 @@ def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
     aim_columns = [c for c in ("aim_east", "aim_north", "aim_up") if c in table.columns]
     if aim_columns and len(aim_columns) != 3:
         raise HybridtrackError(f"{path}: aim points need all of aim_east, aim_north, aim_up")
-    table = numeric_columns(table, position_columns + aim_columns, str(path))
-    for column in position_columns + aim_columns:
-        bad = ~np.isfinite(table[column].to_numpy(float))
-        if bad.any():
-            row = int(np.flatnonzero(bad)[0])
-            raise HybridtrackError(f"{path}: row {row + 2}, column {column!r}: empty or not finite")
-    if table.empty:
-        raise HybridtrackError(f"{path}: no heliostats in the file")
+    columns = position_columns + aim_columns
+    table = numeric_columns(table, columns, str(path), required=columns)
     aims = table[aim_columns].to_numpy(float) if aim_columns else None
     return table[position_columns].to_numpy(float), aims
 

@@ -191,8 +191,10 @@ def read_table(path) -> pd.DataFrame:
             raise HybridtrackError(f"{path}: expected an array of [[case]] tables")
         frame = pd.DataFrame(rows)
     else:
+        _refuse_long_rows(path, text)
         try:
-            frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", skipinitialspace=True)
+            frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", skipinitialspace=True,
+                                index_col=False)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as exc:
             raise HybridtrackError(f"{path}: cannot read as CSV: {str(exc).splitlines()[0]}") from None
     frame.columns = [str(c).strip().lower() for c in frame.columns]
@@ -204,6 +206,24 @@ def read_table(path) -> pd.DataFrame:
         if len(lines) == len(frame):
             frame.attrs["lines"] = lines
     return frame
+
+
+def _refuse_long_rows(path: Path, text: str) -> None:
+    """Refuse a row with more fields than its header names: pandas would take the first column for
+    an index and shift every value one column left (or, told not to, drop the last ones)."""
+    kept = _kept_lines(text)[0]
+    if len(kept) < 2:
+        return
+    try:
+        sep = csv.Sniffer().sniff(kept[0][1]).delimiter  # as pandas finds it: from the header line
+    except csv.Error:
+        return  # pandas cannot tell either, and says so
+    width = len(_split(kept[0][1], sep))
+    for number, line in kept[1:]:
+        fields = _split(line, sep)
+        if len(fields) > width and any(f.strip() for f in fields[width:]):
+            raise HybridtrackError(f"{path}: line {number}: {len(fields)} fields, but the header on line "
+                                   f"{kept[0][0]} names {width}")
 
 
 def table_row(frame: pd.DataFrame, position: int) -> int:
