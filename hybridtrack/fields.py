@@ -51,8 +51,14 @@ LOG_VARIABLES = ("target_true", "target", "angle", "error", "mode", "sky", "sens
                  "calibration")
 #: Log columns every collector shares (the weather and the sky class); kept once, over time.
 SHARED_VARIABLES = ("dni", "wind_speed")
+#: The dataset's units (UDUNITS names, as CF asks), by variable; a heliostat's ``*_azimuth`` twins too.
+UNITS = {"target_true": "degree", "target": "degree", "angle": "degree", "error": "degree", "calibration": "degree",
+         "intensity_ma": "mA", "dni": "W m-2", "wind_speed": "m s-1"}
 #: Bytes a kept log takes per collector and step, at most (a heliostat's two axes).
 LOG_BYTES = 80
+#: The closest `HeliostatField.rings` places mirrors, metres: heliostats are built from about 1 m² up
+#: (Pfahl et al. 2017's review; docs/fields.md), so centres closer than 1 m would overlap mirrors.
+MIN_SPACING = 1.0
 
 
 @dataclass(frozen=True)
@@ -128,12 +134,21 @@ def _across_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
     return _along_axis(offsets, axis_azimuth + 90.0)
 
 
-def _finite_vector(values, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> np.ndarray:
-    """`values` as a 1-D float array, refused unless finite, within ±`bound` (and positive)."""
+def _as_numbers(values) -> np.ndarray | None:
+    """`values` as a float array if they are numbers (not text, not True/False), else None."""
     try:
-        array = np.atleast_1d(np.asarray(values, float))
-    except (TypeError, ValueError):
-        raise HybridtrackError(f"{name} must be numbers, got {values!r}") from None
+        raw = np.asarray(values)
+    except (TypeError, ValueError):  # ragged
+        return None
+    return raw.astype(float) if raw.dtype.kind in "iuf" else None
+
+
+def _finite_vector(values, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> np.ndarray:
+    """`values` as a 1-D float array, refused unless numbers, finite, within ±`bound` (and positive)."""
+    array = _as_numbers(values)
+    if array is None:
+        raise HybridtrackError(f"{name} must be numbers, got {values!r:.80}")
+    array = np.atleast_1d(array)
     if array.ndim != 1 or array.size == 0:
         raise HybridtrackError(f"{name} must be a non-empty list of numbers, got shape {array.shape}")
     if not np.all(np.isfinite(array)) or (positive and not np.all(array > 0)):
@@ -189,6 +204,7 @@ class FresnelField:
     kind = "fresnel"
 
     def __post_init__(self) -> None:
+        _spread_of(self)
         distances = _finite_vector(self.row_distances, "row distances")
         _distinct(distances, "rows", "m from the receiver line")
         object.__setattr__(self, "row_distances", tuple(distances.tolist()))
@@ -242,6 +258,7 @@ class TroughLoop:
     spread: ImperfectionSpread = field(default_factory=ImperfectionSpread)
 
     def __post_init__(self) -> None:
+        _spread_of(self)
         whole = isinstance(self.count, (int, np.integer)) and not isinstance(self.count, bool)
         if not whole or not 1 <= self.count <= 100_000:
             raise HybridtrackError(f"trough loop: count must be a whole number from 1 to 100000, got {self.count!r}")
@@ -294,7 +311,8 @@ class HeliostatField:
     kind = "heliostat"
 
     def __post_init__(self) -> None:
-        xyz = np.asarray(self.positions, float) if _is_numeric(self.positions) else None
+        _spread_of(self)
+        xyz = _as_numbers(self.positions)
         if xyz is None or xyz.ndim != 2 or xyz.shape[1] not in (2, 3) or len(xyz) == 0:
             raise HybridtrackError(f"heliostat positions must be (N, 2) or (N, 3) metres, got {self.positions!r:.80}")
         if xyz.shape[1] == 2:
@@ -304,8 +322,10 @@ class HeliostatField:
                                    "position is not finite")
         _distinct(xyz, "heliostats", "m (east, north, up)")
         object.__setattr__(self, "positions", xyz)
-        aims = np.broadcast_to(np.asarray(self.aim, float), xyz.shape) if self.aims is None else self.aims
-        aims = np.asarray(aims, float) if _is_numeric(aims) else None
+        aim = _as_numbers(self.aim)
+        if aim is None or aim.shape != (3,):
+            raise HybridtrackError(f"heliostat aim must be three numbers (east, north, up), m, got {self.aim!r:.80}")
+        aims = np.broadcast_to(aim, xyz.shape) if self.aims is None else _as_numbers(self.aims)
         if aims is None or aims.shape != xyz.shape:
             raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
         far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
@@ -317,11 +337,11 @@ class HeliostatField:
         if bad.any():
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(bad)[0]) + 1}: its aim point is not finite or is "
                                    "the mirror itself")
-        object.__setattr__(self, "aim", tuple(float(v) for v in np.asarray(self.aim, float)))
+        object.__setattr__(self, "aim", tuple(aim.tolist()))
         object.__setattr__(self, "aims", aims)
 
     @classmethod
-    def rings(cls, count: int, *, first_radius: float = 60.0, spacing: float = 12.0,
+    def rings(cls, count: int = 12, *, first_radius: float = 60.0, spacing: float = 12.0,
               aim: tuple[float, float, float] = (0.0, 0.0, 100.0), spread: ImperfectionSpread | None = None
               ) -> HeliostatField:
         """`count` heliostats on concentric rings round the tower's foot, `spacing` metres apart
@@ -331,6 +351,9 @@ class HeliostatField:
             raise HybridtrackError(f"heliostat count must be a whole number from 1 to 100000, got {count!r}")
         first_radius = _finite_number(first_radius, "first ring radius", positive=True)
         spacing = _finite_number(spacing, "heliostat spacing", positive=True)
+        if spacing < MIN_SPACING:
+            raise HybridtrackError(f"heliostat spacing must be at least {MIN_SPACING:g} m (heliostats are built from "
+                                   f"about 1 m² up: closer, mirrors would overlap), got {spacing:g}")
         placed, ring = [], 0
         while sum(len(p) for p in placed) < count:
             radius = first_radius + ring * spacing
@@ -367,19 +390,18 @@ class HeliostatField:
         return np.stack(normal_angles(self.normals(altitude, azimuth)), axis=-1)
 
 
-def _is_numeric(values) -> bool:
-    try:
-        np.asarray(values, float)
-    except (TypeError, ValueError):
-        return False
-    return True
+def _spread_of(field) -> None:
+    """Refuse a spread that is not an `ImperfectionSpread` (it is only used at run time)."""
+    if not isinstance(field.spread, ImperfectionSpread):
+        raise HybridtrackError(f"{type(field).__name__}: spread must be an ImperfectionSpread, got "
+                               f"{type(field.spread).__name__}")
 
 
 #: The field kinds, by the name the CLI and sweeps use.
 FIELD_KINDS = {"fresnel": FresnelField, "trough": TroughLoop, "heliostat": HeliostatField}
 
 
-@dataclass
+@dataclass(repr=False)
 class FieldResult:
     """A finished field run.
 
@@ -405,6 +427,14 @@ class FieldResult:
     dataset: object
     field: object
     site: sites.Site
+
+    def __repr__(self) -> str:
+        summary = self.summary
+        figures = ", ".join(f"{label} {summary[key]:.4g}" for key, label in
+                            (("energy_capture", "energy capture"), ("rms", "RMS error (°)"))
+                            if summary.get(key) is not None)
+        return (f"<FieldResult: {summary['field']} of {summary['collectors']} at {self.site.name}, {summary['strategy']}, "
+                f"{summary['steps']:,} steps from {summary['start']}{': ' + figures if figures else ''}>")
 
     def _repr_html_(self) -> str:
         return f"<p><b>{self.summary['field']}</b> at {self.site.name}</p>" + self.collectors.to_html(max_rows=20)
@@ -562,7 +592,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     """
     from .kernel import uses_kernel
     from .reuse import reuse_work
-    from .simulation import SimulationConfig, _check_frame
+    from .simulation import _check_frame, checked_config
     from .sun import solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
@@ -571,7 +601,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     seed = params.seed(seed)
     site = sites.get(site)
     frame = _check_frame(frame)
-    config = config or SimulationConfig()
+    config = checked_config(config)
     if workers is not None:
         params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()
@@ -691,9 +721,16 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
             result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
             offered = offered_light(result.log["dni"], result.scoring["sun_up"], result.scoring["incidence"])
-            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary), "offered": float(offered.sum())}
+            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary), "offered": _energy(offered, frame.index)}
             done.append((i, row, result.events.assign(collector=name), _kept(result.log) if keep_log else None))
     return done
+
+
+def _energy(light: np.ndarray, index: pd.DatetimeIndex) -> float:
+    """kWh/m² of `light` (W/m² at each stamp), each stamp standing for the frame's typical step
+    (its median: a gap in the frame is light nobody saw, not light to count)."""
+    step_hours = float(np.median(np.diff(index.as_unit("ns").asi8))) / 3.6e12
+    return float(light.sum()) * step_hours / 1000.0
 
 
 def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:
@@ -730,7 +767,7 @@ def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, 
 def _kept(log: pd.DataFrame) -> dict:
     """The log columns a field keeps per collector (`LOG_VARIABLES`, a heliostat's ``*_azimuth``
     too), as arrays: categories as their codes."""
-    kept = [c for c in log.columns if c in LOG_VARIABLES or c.endswith("_azimuth")]
+    kept = [c for c in log.columns if c in LOG_VARIABLES or c.removesuffix("_azimuth") in LOG_VARIABLES]
     return {c: (_values(log[c]), list(log[c].cat.categories) if isinstance(log[c].dtype, pd.CategoricalDtype)
                 else None) for c in kept}
 
@@ -762,13 +799,18 @@ class _LogStore:
         """The logs as an xarray Dataset; categories as codes with CF flag attributes, time in UTC."""
         import xarray as xr
 
-        variables = {c: (("collector", "time"), a, self.attrs.get(c, {})) for c, a in self.arrays.items()}
-        variables.update({c: (("time",), a, {}) for c, a in self.shared.items()})
+        variables = {c: (("collector", "time"), a, self.attrs.get(c, {}) | _units(c)) for c, a in self.arrays.items()}
+        variables.update({c: (("time",), a, _units(c)) for c, a in self.shared.items()})
         coords = {"collector": self.names, "time": self.time,
                   **{axis: ("collector", table[axis].to_numpy()) for axis in ("east", "north", "up")}}
         return xr.Dataset(variables, coords=coords,
                           attrs={"site": site.name, "timezone": site.tz, "field": type(field).__name__,
                                  "time_note": "UTC; the site's clock is in the timezone attribute"})
+
+
+def _units(variable: str) -> dict:
+    unit = UNITS.get(variable.removesuffix("_azimuth"))
+    return {"units": unit} if unit else {}
 
 
 def _values(column: pd.Series) -> np.ndarray:

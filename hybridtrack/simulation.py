@@ -333,6 +333,16 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
                                "such values")
 
 
+def checked_config(config) -> SimulationConfig:
+    """`config`, or the default for None; anything but a `SimulationConfig` (a dict, say) is refused."""
+    if config is None:
+        return SimulationConfig()
+    if not isinstance(config, SimulationConfig):
+        raise HybridtrackError(f"config must be a SimulationConfig (SimulationConfig.from_dict for a dict), "
+                               f"got {type(config).__name__}")
+    return config
+
+
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
              config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
              faults: dict | None = None, progress=None, bulk_nights: bool = True,
@@ -373,10 +383,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     -------
     Result
     """
-    config = config or SimulationConfig()
-    if not isinstance(config, SimulationConfig):
-        raise HybridtrackError(f"config must be a SimulationConfig (SimulationConfig.from_dict for a dict), "
-                               f"got {type(config).__name__}")
+    config = checked_config(config)
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     site = sites.get(site)

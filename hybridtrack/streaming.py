@@ -606,12 +606,12 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     Apache Parquet file format: row groups, https://parquet.apache.org/docs/file-format/
     """
     from .kernel import uses_kernel
-    from .simulation import SimulationConfig, simulate
+    from .simulation import checked_config, simulate
 
     if not isinstance(source, DaySource):
         raise HybridtrackError("source must be a DaySource (synthetic_days, recorded_days or frame_days)")
     site = source.site
-    config = config or SimulationConfig()
+    config = checked_config(config)
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     collector = Collector(collector) if isinstance(collector, str) else collector

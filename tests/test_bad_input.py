@@ -167,6 +167,17 @@ MATRIX = [
                         strategy="astronomical-commissioned",
                         config=SimulationConfig(imperfections=Imperfections(commissioned_days_ago=3000.0))),
      None, "its clear day 3000 days before (1671-10-15, for warm start or commissioning"),
+    # a dict for a config: simulate refused it, a field and a stream leaked AttributeError ({}: silently the default)
+    ("a dict for a field's config", lambda tmp: None,
+     lambda p: __import__("hybridtrack").simulate_field(synthetic("lanzhou", "2021-06-21"), "lanzhou",
+                                                        __import__("hybridtrack.fields").fields.TroughLoop(count=1),
+                                                        config={"drive": {}}),
+     None, "config must be a SimulationConfig (SimulationConfig.from_dict for a dict), got dict"),
+    ("an empty dict for a stream's config", lambda tmp: tmp,
+     lambda p: __import__("hybridtrack.streaming").streaming.stream(
+         __import__("hybridtrack.streaming").streaming.synthetic_days("lanzhou", "2021-06-21", freq="1min"), p / "s",
+         config={}),
+     None, "config must be a SimulationConfig (SimulationConfig.from_dict for a dict), got dict"),
     ("naive times to the sun model", lambda tmp: None,
      lambda p: solar_position(__import__("pandas").date_range("2021-06-21", periods=2, freq="h"), "nanjing"),
      None, "naive"),

@@ -70,6 +70,16 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
     (["heliostat", "--positions", "/no/such/file.csv"], "no such file"),
     (["trough", "--count", "2", "--threads", "0"], "threads must be a whole number within [1,"),
     (["trough", "--count", "2", "--threads", "2", "--workers", "1"], "give one or the other"),
+    (["fresnel", "--rows=1,,2"], "--rows takes numbers separated by commas, got '1,,2'"),  # not two rows
+    # a flag that describes another kind of field had been ignored
+    (["fresnel", "--positions", "/no/such/file.csv"], "--positions describes a heliostat field, not a fresnel one"),
+    (["fresnel", "--count", "99"], "--count describes a trough or heliostat field, not a fresnel one"),
+    (["fresnel", "--aim", "1", "2", "3"], "--aim describes a heliostat field, not a fresnel one"),
+    (["trough", "--rows=0,1"], "--rows describes a fresnel field, not a trough one"),
+    (["trough", "--receiver-height", "5"], "--receiver-height describes a fresnel field, not a trough one"),
+    (["heliostat", "--axis-azimuth", "3"], "--axis-azimuth describes a fresnel or trough field, not a heliostat"),
+    (["heliostat", "--collector-length", "3"], "--collector-length describes a trough field"),
+    (["heliostat", "--count", "3", "--positions", "m.csv"], "give one or the other"),
 ])
 def test_bad_field_flags(capsys, flags, message):
     assert main(["field", *flags, "--site", "lanzhou", "--date", "2021-06-21"]) == 2

@@ -77,6 +77,23 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: TroughLoop(count=2.5), "count must be a whole number"),
     (lambda: ImperfectionSpread(encoder_offset=-0.1), "encoder_offset must be a finite number >= 0"),
     (lambda: ImperfectionSpread(sensor_bias=float("nan")), "sensor_bias must be a finite number >= 0"),
+    # aims that are not three numbers had leaked numpy's broadcasting error; a tiny spacing, a MemoryError
+    (lambda: HeliostatField(aim=(0, 0)), r"aim must be three numbers \(east, north, up\)"),
+    (lambda: HeliostatField(aim=(0, 0, 1, 2)), "aim must be three numbers"),
+    (lambda: HeliostatField(aim="abc"), "aim must be three numbers"),
+    (lambda: HeliostatField.rings(3, aim=(0, 0)), "aim must be three numbers"),
+    (lambda: HeliostatField.rings(3, spacing=1e-9), "spacing must be at least 1 m"),
+    # text and True/False had been read as numbers
+    (lambda: FresnelField(row_distances=[True, False]), "row distances must be numbers"),
+    (lambda: FresnelField(receiver_height="10"), "receiver height must be numbers"),
+    (lambda: FresnelField(axis_azimuth=True), "axis azimuth must be numbers"),
+    (lambda: HeliostatField(positions=[["1", "2"]]), r"\(N, 2\) or \(N, 3\)"),
+    (lambda: HeliostatField(positions=[[True, False]]), r"\(N, 2\) or \(N, 3\)"),
+    (lambda: HeliostatField(positions=[[1, 2]], aims=[["0", "0", "1"]]), "one \\(x, y, z\\) per heliostat"),
+    # a spread of another type had been accepted, to fail at run time with an AttributeError
+    (lambda: FresnelField(spread=None), "FresnelField: spread must be an ImperfectionSpread, got NoneType"),
+    (lambda: TroughLoop(spread={"encoder_offset": 0.1}), "TroughLoop: spread must be an ImperfectionSpread"),
+    (lambda: HeliostatField(spread=0.2), "HeliostatField: spread must be an ImperfectionSpread, got float"),
 ])
 def test_bad_fields_are_refused_with_what_is_wrong(make, message):
     with pytest.raises(HybridtrackError, match=message):
@@ -242,10 +259,13 @@ def test_field_result_map_dataset_and_files(day, tmp_path):
         attrs = dataset[name].attrs
         assert len(attrs["flag_meanings"].split()) == len(attrs["flag_values"]), name
     assert dataset["sensor_status"].attrs["flag_meanings"].split() == [s.replace(" ", "_") for s in SENSOR_STATUS]
+    assert {name: dataset[name].attrs.get("units") for name in ("angle", "error", "intensity_ma", "dni", "wind_speed")} \
+        == {"angle": "degree", "error": "degree", "intensity_ma": "mA", "dni": "W m-2", "wind_speed": "m s-1"}
     written = result.save(tmp_path / "field")
     assert {p.name for p in written.values()} == {"collectors.csv", "events.csv", "summary.json", "field_map.png",
                                                   "log.nc"}
     assert "<b>FresnelField</b>" in result._repr_html_()
+    assert repr(result).startswith("<FieldResult: FresnelField of 3 at lanzhou, hybrid, 1,440 steps from 2021-06-21")
 
 
 def test_simulate_field_refuses_what_is_not_a_field(day):
@@ -255,6 +275,30 @@ def test_simulate_field_refuses_what_is_not_a_field(day):
         simulate_field(day, "lanzhou", TroughLoop(count=1), seed=-1)
     with pytest.raises(HybridtrackError, match="naive"):
         simulate_field(day.tz_localize(None), "lanzhou", TroughLoop(count=1))
+    with pytest.raises(HybridtrackError, match="config must be a SimulationConfig .* got dict"):
+        simulate_field(day, "lanzhou", TroughLoop(count=1), config={"drive": {"deadband": 0.2}})
+
+
+def test_the_offered_light_is_the_energy_on_a_perfect_trackers_aperture_whatever_the_step():
+    """A north-south trough's offered light against pvlib's single-axis tracker: DNI on its
+    aperture (cos of pvlib's angle of incidence) while the sun is up, in kWh/m², at 1 and 5 min."""
+    import pvlib
+
+    from hybridtrack import sites
+
+    site = sites.get("lanzhou")
+    offered = {}
+    for freq in ("1min", "5min"):
+        frame = synthetic(site, "2021-06-21", weather="sunny", seed=1, freq=freq)
+        offered[freq] = simulate_field(frame, site, TroughLoop(count=1), keep_log=False).collectors["offered"].iloc[0]
+        sun = pvlib.solarposition.get_solarposition(frame.index, site.latitude, site.longitude, site.altitude)
+        aoi = pvlib.tracking.singleaxis(sun["apparent_zenith"], sun["azimuth"], axis_tilt=0, axis_azimuth=0,
+                                        max_angle=90, backtrack=False)["aoi"].to_numpy()
+        up = (sun["elevation"] > 0).to_numpy()
+        beam = frame["dni"].to_numpy() * np.cos(np.radians(aoi))
+        want = np.nansum(np.where(up, beam, 0.0)) * pd.Timedelta(freq) / pd.Timedelta(hours=1) / 1000.0
+        assert offered[freq] == pytest.approx(want, rel=2e-3), freq
+    assert offered["5min"] == pytest.approx(offered["1min"], rel=5e-3)
 
 
 def test_a_field_on_two_dask_workers_is_the_same_field(day):
@@ -294,3 +338,14 @@ def test_a_script_without_a_main_guard_is_told_why_its_workers_did_not_start(tmp
     assert done.returncode != 0
     assert last.startswith("hybridtrack.errors.HybridtrackError: cannot start 1 local Dask workers"), last
     assert 'if __name__ == "__main__":' in last
+
+
+def test_a_heliostat_dataset_keeps_each_angle_with_its_azimuth_twin_and_nothing_else(day):
+    """Every kept angle's azimuth axis comes with it; the log's other azimuth columns (the fit's, the
+    sensor's sun) had come too, without their elevation twins."""
+    from hybridtrack.fields import LOG_VARIABLES
+
+    dataset = simulate_field(day, "lanzhou", HeliostatField(positions=[[0.0, -100.0]])).dataset
+    twins = {"target_true_azimuth", "target_azimuth", "angle_azimuth", "calibration_azimuth"}
+    assert set(dataset.data_vars) == set(LOG_VARIABLES) | twins | {"dni", "wind_speed"}
+    assert dataset["angle_azimuth"].attrs["units"] == "degree"

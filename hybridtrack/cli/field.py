@@ -25,17 +25,16 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--rows", help="Fresnel: row distances from the receiver line, m, comma-separated "
                                       "(default 20 rows, -9.5 to 9.5 every 1 m); write --rows=-4,0,4 when the first is "
                                       "negative")
-    group.add_argument("--receiver-height", type=float, default=10.0, help="Fresnel: receiver height, m (default 10)")
-    group.add_argument("--row-length", type=float, default=100.0, help="Fresnel: row length, m (default 100)")
-    group.add_argument("--count", type=int, default=12, help="trough: collectors in the loop (default 12); "
-                                                             "heliostat: mirrors on rings when no --positions")
-    group.add_argument("--collector-length", type=float, default=150.0,
-                       help="trough: collector length, m (default 150)")
-    group.add_argument("--axis-azimuth", type=float, default=0.0,
+    group.add_argument("--receiver-height", type=float, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--row-length", type=float, help="Fresnel: row length, m (default 100)")
+    group.add_argument("--count", type=int, help="trough: collectors in the loop (default 12); "
+                                                 "heliostat: mirrors on rings when no --positions (default 12)")
+    group.add_argument("--collector-length", type=float, help="trough: collector length, m (default 150)")
+    group.add_argument("--axis-azimuth", type=float,
                        help="Fresnel/trough: axis azimuth, degrees from north (default 0, north-south)")
     group.add_argument("--positions", help="heliostat: CSV of mirror centres with columns east, north (and up), m; "
                                            "aim_east, aim_north, aim_up give each its own aim point")
-    group.add_argument("--aim", type=float, nargs=3, default=(0.0, 0.0, 100.0), metavar=("E", "N", "U"),
+    group.add_argument("--aim", type=float, nargs=3, metavar=("E", "N", "U"),
                        help="heliostat: the receiver's aim point from the tower foot, m (default 0 0 100)")
     group.add_argument("--spread", action="append", metavar="NAME=SD",
                        help="standard deviation of a per-collector imperfection, e.g. --spread encoder_offset=0.3 "
@@ -78,12 +77,9 @@ def _spread(args: argparse.Namespace):
 
 def _numbers(text: str, flag: str) -> list[float]:
     try:
-        numbers = [float(part) for part in text.split(",") if part.strip()]
+        return [float(part) for part in text.split(",")]  # an empty item is refused, not skipped
     except ValueError:
-        numbers = []
-    if not numbers:
-        raise HybridtrackError(f"{flag} takes numbers separated by commas, got {text!r}")
-    return numbers
+        raise HybridtrackError(f"{flag} takes numbers separated by commas, got {text!r}") from None
 
 
 def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
@@ -110,18 +106,42 @@ def field_from_arguments(args: argparse.Namespace):
     """The field the flags describe."""
     from ..fields import FresnelField, HeliostatField, TroughLoop
 
+    _refuse_other_kinds_flags(args)
     spread = _spread(args)
     if args.kind == "fresnel":
-        rows = _numbers(args.rows, "--rows") if args.rows is not None else FresnelField().row_distances
-        return FresnelField(row_distances=rows, receiver_height=args.receiver_height, row_length=args.row_length,
-                            axis_azimuth=args.axis_azimuth, spread=spread)
+        rows = _numbers(args.rows, "--rows") if args.rows is not None else None
+        return FresnelField(**_given(row_distances=rows, receiver_height=args.receiver_height,
+                                     row_length=args.row_length, axis_azimuth=args.axis_azimuth), spread=spread)
     if args.kind == "trough":
-        return TroughLoop(count=args.count, collector_length=args.collector_length, axis_azimuth=args.axis_azimuth,
-                          spread=spread)
+        return TroughLoop(**_given(count=args.count, collector_length=args.collector_length,
+                                   axis_azimuth=args.axis_azimuth), spread=spread)
+    aim = tuple(args.aim) if args.aim is not None else None
     if args.positions:
         positions, aims = read_positions(args.positions)
-        return HeliostatField(positions=positions, aim=tuple(args.aim), aims=aims, spread=spread)
-    return HeliostatField.rings(args.count, aim=tuple(args.aim), spread=spread)
+        return HeliostatField(positions=positions, aims=aims, spread=spread, **_given(aim=aim))
+    return HeliostatField.rings(**_given(count=args.count, aim=aim), spread=spread)
+
+
+#: The field flags, and the kinds of field each describes.
+_FLAG_KINDS = {"rows": ("fresnel",), "receiver_height": ("fresnel",), "row_length": ("fresnel",),
+               "count": ("trough", "heliostat"), "collector_length": ("trough",),
+               "axis_azimuth": ("fresnel", "trough"), "positions": ("heliostat",), "aim": ("heliostat",)}
+
+
+def _refuse_other_kinds_flags(args: argparse.Namespace) -> None:
+    """Refuse a flag the chosen kind of field has no use for (it would be ignored), and a ring
+    count beside a positions file."""
+    for name, kinds in _FLAG_KINDS.items():
+        if getattr(args, name) is not None and args.kind not in kinds:
+            raise HybridtrackError(f"--{name.replace('_', '-')} describes a {' or '.join(kinds)} field, not a "
+                                   f"{args.kind} one")
+    if args.kind == "heliostat" and args.positions is not None and args.count is not None:
+        raise HybridtrackError("--count places mirrors on rings; --positions gives them: give one or the other")
+
+
+def _given(**values) -> dict:
+    """The values a flag gave (the field's own defaults stand for the others)."""
+    return {name: value for name, value in values.items() if value is not None}
 
 
 def field_table(summary: dict) -> str:
