@@ -337,6 +337,7 @@ class HeliostatField:
         if bad.any():
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(bad)[0]) + 1}: its aim point is not finite or is "
                                    "the mirror itself")
+        _refuse_unreachable_aims(relative)
         object.__setattr__(self, "aim", tuple(aim.tolist()))
         object.__setattr__(self, "aims", aims)
 
@@ -388,6 +389,21 @@ class HeliostatField:
     def targets(self, altitude, azimuth) -> np.ndarray:
         """Every mirror's nominal normal azimuth and elevation (T, N, 2), degrees."""
         return np.stack(normal_angles(self.normals(altitude, azimuth)), axis=-1)
+
+
+def _refuse_unreachable_aims(relative: np.ndarray) -> None:
+    """Refuse an aim point a heliostat cannot serve, naming the first such mirror: one not above it
+    (a heliostat sends the sun up to its receiver; aimed down, it would catch nothing the field
+    counts), or farther along an axis than a collector's aim may lie (`MAX_DISTANCE`)."""
+    below = np.flatnonzero(relative[:, 2] <= 0)
+    if len(below):
+        k = int(below[0])
+        raise HybridtrackError(f"heliostat {k + 1}: its aim point is not above the mirror ({relative[k, 2]:g} m up "
+                               "from it): a heliostat reflects the sun up to its receiver")
+    far = np.flatnonzero((np.abs(relative) > MAX_DISTANCE).any(axis=1))
+    if len(far):
+        raise HybridtrackError(f"heliostat {int(far[0]) + 1}: its aim point is more than {MAX_DISTANCE:g} m from "
+                               "the mirror along an axis")
 
 
 def _spread_of(field) -> None:

@@ -83,6 +83,12 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: HeliostatField(aim="abc"), "aim must be three numbers"),
     (lambda: HeliostatField.rings(3, aim=(0, 0)), "aim must be three numbers"),
     (lambda: HeliostatField.rings(3, spacing=1e-9), "spacing must be at least 1 m"),
+    # aims a heliostat cannot serve had run (capture 0), or failed in the run without naming the mirror
+    (lambda: HeliostatField(positions=[[0, -100], [0, -50]], aim=(0, 0, -50)),
+     r"heliostat 1: its aim point is not above the mirror \(-50 m up from it\)"),
+    (lambda: HeliostatField(positions=[[0, -100, 0], [0, -50, 120]]), "heliostat 2: its aim point is not above"),
+    (lambda: HeliostatField(positions=[[0, -100], [-4000, 0]], aim=(4500, 0, 100)),
+     "heliostat 2: its aim point is more than 5000 m from the mirror"),
     # text and True/False had been read as numbers
     (lambda: FresnelField(row_distances=[True, False]), "row distances must be numbers"),
     (lambda: FresnelField(receiver_height="10"), "receiver height must be numbers"),
