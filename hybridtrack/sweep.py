@@ -318,15 +318,26 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
 
 
 def _table(rows: list[dict]) -> pd.DataFrame:
+    """The runs' rows as one typed table, sorted by run, that Parquet can hold."""
     table = pd.DataFrame(rows).sort_values("run", kind="stable").reset_index(drop=True)
     for metric in METRICS:
         table[metric] = pd.to_numeric(table[metric], errors="coerce").astype("Int64" if metric in COUNTS else float)
     table["error"] = table["error"].astype("string")
     for column in table.columns.difference([*METRICS, "error"]):
         values = table[column]
-        if values.dtype == object and len({type(v) for v in values.dropna()}) > 1:  # [0.1, "wide"]: Parquet holds one type
-            table[column] = values.map(lambda v: v if v is None else str(v)).astype("string")
+        if values.dtype == object and not all(isinstance(v, str) for v in values.dropna()):
+            table[column] = _as_text(values)
     return table
+
+
+def _as_text(values: pd.Series) -> pd.Series:
+    """A grid key's values as text, each as the sweep gave it.
+
+    For the columns pandas cannot make one native column of, which Parquet cannot store: values of
+    several types (``[0.1, "wide"]``), whole numbers beyond 64 bits (a seed of 1e20, which fails
+    its run but must not lose the table), tables. Text keeps every digit, where a float would not.
+    """
+    return values.map(lambda v: v if v is None else str(v)).astype("string")
 
 
 def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:
@@ -391,8 +402,8 @@ def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
     """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them)."""
     written = sweep_files(folder)
     claim(written.values())
+    write(written["table"], lambda path: table.to_parquet(path, index=False))  # first: the finished runs
     sweep.to_toml(written["sweep"])
-    write(written["table"], lambda path: table.to_parquet(path, index=False))
     colour = next(iter(sweep.grid))
     figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
     write(written["plot"], lambda path: figure.savefig(path, dpi=120))

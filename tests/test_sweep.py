@@ -96,6 +96,18 @@ def test_a_grid_of_mixed_types_makes_a_table_parquet_can_hold(tmp_path):
     assert table["error"].isna().tolist() == [True, False]
 
 
+def test_a_seed_beyond_64_bits_fails_its_run_and_the_table_keeps_every_digit(tmp_path):
+    """seed = [0, 1e20]: pyarrow cannot store 10**20 as an integer and the whole table was lost."""
+    huge = 10**20
+    rows = [run_one(Sweep.from_dict(TINY).base, {"run": k, "seed": seed}) for k, seed in enumerate([0, huge])]
+    table = _table(rows)
+    table.to_parquet(tmp_path / "runs.parquet", index=False)
+    back = pd.read_parquet(tmp_path / "runs.parquet")
+    assert list(back["seed"]) == ["0", "100000000000000000000"]
+    assert back["error"].isna().tolist() == [True, False] and "seed must be a whole number" in back["error"][1]
+    assert back["rms"][0] == rows[0]["rms"]
+
+
 def test_pareto_front_hand_case():
     table = pd.DataFrame({"moves": [10, 20, 30, 15, 40], "rms": [0.5, 0.3, 0.1, 0.6, 0.1],
                           "energy_capture": [0.9, 0.95, 0.97, 0.99, 0.96]})
