@@ -23,8 +23,10 @@ Run keys are ``site``, ``collector``, ``strategy``, ``start``, ``days``, ``weath
 field of the run config in its TOML layout (``drive.deadband``, ``controller.sun_model``,
 ``imperfections.encoder_offset``), or of the collector (``collector.row_distance``). A base
 ``[base.config]`` table is a whole run config. Keys and their places are checked before the sweep
-starts, and so are the base values the grid leaves alone (every run would fail on them); a bad
-grid value is checked by its run, so it fails that run only.
+starts, and so are the base values the grid leaves alone (every run would fail on them), by the
+code the runs check them with: each run key alone, then the collector, the synthetic weather (its
+dates, one weather a day, its span against the memory budget) and the config as a whole when the
+grid sets none of their keys. A bad grid value is checked by its run, so it fails that run only.
 
 Every run is independent and seeded, and the table is sorted by run number, so it is the same
 whatever the number of workers. A run that fails is kept, with its error, and the sweep goes on.
@@ -154,16 +156,28 @@ def _check_key(key: str, source: str, table: str) -> None:
 
 
 def _check_base(base: dict, config: dict, grid, source: str) -> None:
-    """Refuse a base value every run would fail on before a cluster starts: the run keys and the
-    config's dotted keys that the grid does not set (a grid value fails its own run only)."""
+    """Refuse, before a cluster starts, a base value every run would fail on, checked as the runs
+    check it: each run key the grid does not set, then the collector and the weather when the grid
+    sets none of their keys, and the config without the dotted keys the grid sets. A value checked
+    with a key the grid sets is left to the runs (a grid value fails its own run only)."""
     grid = grid if isinstance(grid, dict) else {}
-    for key in RUN_KEYS.keys() & base.keys() - grid.keys():
-        try:
-            _checks()[key](base[key])
-        except HybridtrackError as exc:
-            raise HybridtrackError(f"{source}: base.{key}: {exc}") from None
-    dotted = {k: v for k, v in base.items() if "." in k and not k.startswith("collector.") and k not in grid}
+    fixed = {key: value for key, value in base.items() if key not in grid}
+    for key in RUN_KEYS.keys() & fixed.keys():
+        _refuse_in_base([key], source, functools.partial(_key_checks()[key], fixed[key]))
+    spec = {**RUN_KEYS, **fixed}
+    for keys, make in ((_collector_keys(spec), _collector), (WEATHER_KEYS, _weather_arguments)):
+        if not grid.keys() & set(keys):
+            _refuse_in_base([key for key in fixed if key in keys], source, functools.partial(make, spec))
+    dotted = {k: v for k, v in fixed.items() if "." in k and not k.startswith("collector.")}
     _config_from(config, dotted, f"{source}: base")  # the base config must stand on its own
+
+
+def _refuse_in_base(keys: list, source: str, check) -> None:
+    """Call `check`; its refusal names the sweep and the base `keys` it came from."""
+    try:
+        check()
+    except HybridtrackError as exc:
+        raise HybridtrackError(f"{source}: {', '.join(f'base.{key}' for key in keys) or 'base'}: {exc}") from None
 
 
 def _whole_days(days) -> int:
@@ -180,23 +194,81 @@ def _strategy(name) -> str:
     return name
 
 
-def _weather(value):
+def _weather_names(value) -> list[str]:
+    """The weather's names: one for every day, or one per day (a list, or text with commas)."""
     from .sky import WEATHERS
 
-    for name in (value if isinstance(value, list) else str(value).split(",")):
+    names = value if isinstance(value, list) else str(value).split(",")
+    for name in names:
         if name not in WEATHERS:
             raise HybridtrackError(f"unknown weather {name!r}; choose from {', '.join(WEATHERS)} or a per-day list")
-    return value
+    return names
 
 
-def _checks() -> dict:
+def _step(freq) -> str:
+    """The step as the text `hybridtrack.sky.synthetic` takes, such as ``"1min"``."""
+    from .times import parse_freq
+
+    if not isinstance(freq, str):
+        raise HybridtrackError(f"freq must be a step such as '1min' or '10s', got {freq!r}")
+    parse_freq(freq)
+    return freq
+
+
+def _first_day(start):
+    """The first day of a run: a date (a date and time is refused, as a time of day would be lost)."""
+    from .times import parse_date
+
+    return parse_date(_plain(start))
+
+
+def _key_checks() -> dict:
+    """Each run key's check on its own, as its run converts it."""
     from . import sites
     from .collectors import Collector
-    from .times import parse_date, parse_freq
 
-    return {"site": sites.get, "collector": Collector, "strategy": _strategy, "start": parse_date,
-            "days": _whole_days, "weather": _weather, "freq": parse_freq, "seed": params.seed,
-            "gusts_per_day": lambda value: params.number(value, "gusts_per_day", 0, 200)}
+    return {"site": sites.get, "collector": Collector, "strategy": _strategy, "start": _first_day,
+            "days": _whole_days, "weather": _weather_names, "freq": _step, "seed": params.seed,
+            "gusts_per_day": _gusts}
+
+
+def _gusts(value) -> float:
+    return params.number(value, "gusts_per_day", 0, 200)
+
+
+#: The run keys a run's synthetic weather is made from (`_weather_arguments`).
+WEATHER_KEYS = ("site", "start", "days", "weather", "freq", "gusts_per_day")
+
+
+def _weather_arguments(spec: dict) -> tuple:
+    """The arguments of a run's synthetic weather (`_frame` but its seed), checked as the run uses
+    them, its span's size against the memory budget included, without making the weather."""
+    import datetime as dt
+
+    from . import sites
+    from .times import local_range
+
+    site, first, days = sites.get(spec["site"]), _first_day(spec["start"]), _whole_days(spec["days"])
+    names, freq = _weather_names(spec["weather"]), _step(spec["freq"])
+    if len(names) > 1 and (len(names) != days or "climate" in names):
+        raise HybridtrackError(f"weather gives {len(names)} days' weathers ({','.join(names)}) for days = {days}; "
+                               "give one of sunny, cloudy, overcast, mixed per day")
+    last = (first + dt.timedelta(days=days - 1)).isoformat()
+    local_range(first, site.tz, end_date=last, freq=freq)  # refuses a span past 2261 or over the memory budget
+    return site, first.isoformat(), days, ",".join(names), freq, _gusts(spec["gusts_per_day"])
+
+
+def _collector_keys(spec: dict) -> list[str]:
+    return ["collector", *(key for key in spec if key.startswith("collector."))]
+
+
+def _collector(spec: dict):
+    """A run's collector: its kind and the geometry its ``collector.FIELD`` keys give."""
+    from .collectors import Collector
+
+    geometry = {k.partition(".")[2]: (tuple(v) if isinstance(v, list) else v)
+                for k, v in spec.items() if k.startswith("collector.")}
+    return Collector(spec["collector"], **geometry)
 
 
 def _config_from(base: dict, dotted: dict, source: str):
@@ -216,15 +288,14 @@ def _config_from(base: dict, dotted: dict, source: str):
 
 
 @functools.lru_cache(maxsize=8)
-def _frame(site, start: str, days: int, weather: str, freq: str, seed: int, gusts_per_day: float) -> pd.DataFrame:
-    """The synthetic weather of a run; runs that differ only in their config share it (per worker)."""
+def _frame(site, start: str, days: int, weather: str, freq: str, gusts_per_day: float, seed: int) -> pd.DataFrame:
+    """The synthetic weather of a run, from `_weather_arguments`; runs that differ only in their
+    config share it (per worker)."""
     import datetime as dt
 
     from .sky import synthetic
-    from .times import parse_date
 
-    _whole_days(days)
-    first = parse_date(start)
+    first = dt.date.fromisoformat(start)
     sky = weather.split(",") if "," in weather else weather
     return synthetic(site, first, first + dt.timedelta(days=days - 1), weather=sky, freq=freq, seed=seed,
                      gusts_per_day=gusts_per_day)
@@ -241,24 +312,19 @@ def _plain(value):
 
 def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
     """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``."""
-    from . import sites
-    from .collectors import Collector
     from .simulation import one_thread, simulate
 
     spec = _spec(base, grid_values)
     row = _row(spec)
     try:
-        site = sites.get(spec["site"])
         seed = params.seed(spec["seed"])  # 1.5 or true is refused, not truncated to another run's seed
         dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
         config = dataclasses.replace(_config_from(base.get("config", {}), dotted, source), seed=seed)
-        geometry = {k.partition(".")[2]: (tuple(v) if isinstance(v, list) else v)
-                    for k, v in spec.items() if k.startswith("collector.")}
-        collector = Collector(spec["collector"], **geometry)
-        frame = _frame(site, _plain(spec["start"]), spec["days"], _plain(spec["weather"]), spec["freq"],
-                       seed, float(spec["gusts_per_day"]))
+        weather = _weather_arguments(spec)
+        frame = _frame(*weather, seed)
         with one_thread():  # the sweep spreads its runs over the cores itself
-            summary = simulate(frame, site, collector=collector, strategy=spec["strategy"], config=config).summary
+            summary = simulate(frame, weather[0], collector=_collector(spec), strategy=spec["strategy"],
+                               config=config).summary
         error = summary["tracking_error_deg"]
         row.update({m: error[m] if m in error else summary[m] for m in METRICS})
         row["error"] = None

@@ -1,6 +1,7 @@
 """Sweeps: the grid, a run's row against a direct run, failures kept, the same table on 1 and 2 workers."""
 
 import dataclasses
+import datetime as dt
 
 import numpy as np
 import pandas as pd
@@ -56,10 +57,31 @@ def test_the_grid_is_every_combination_in_order():
     ({"base": {"freq": "soon"}, "grid": {"seed": [0]}}, "base.freq: "),
     ({"base": {"gusts_per_day": -1.0}, "grid": {"seed": [0]}}, "base.gusts_per_day: "),
     ({"base": {"drive.deadband": -1}, "grid": {"seed": [0]}}, "s.toml: base: drive: deadband .* = -1 is outside"),
+    # ... checked as its runs check it: each of these started the cluster and failed every run
+    ({"base": {"collector.row_distance": "x"}, "grid": {"seed": [0]}},
+     "s.toml: base.collector.row_distance: collector: row_distance .* got 'x'"),
+    ({"base": {"start": dt.datetime(2021, 6, 21, 10)}, "grid": {"seed": [0]}},
+     "s.toml: base.start: date '2021-06-21T10:00:00' does not exist or is not YYYY-MM-DD"),
+    ({"base": {"freq": "1ns"}, "grid": {"seed": [0]}}, "s.toml: base.freq: .* 86,400,000,000,000 steps of 1ns"),
+    ({"base": {"days": 3660, "freq": "1s"}, "grid": {"seed": [0]}},  # 3660 days x 86,400 s
+     "s.toml: base.days, base.freq: 2021-06-21 to 2031-06-28: 316,224,000 steps of 1s would need"),
+    ({"base": {"days": 3, "weather": ["sunny", "cloudy"]}, "grid": {"seed": [0]}},
+     "s.toml: base.days, base.weather: weather gives 2 days' weathers"),
+    ({"base": {"freq": ["1min"]}, "grid": {"seed": [0]}}, r"s.toml: base.freq: freq must be a step .* got \['1min'\]"),
 ])
 def test_bad_sweeps_are_refused_before_any_run(data, message):
     with pytest.raises(HybridtrackError, match=message):
         Sweep.from_dict(data, source="s.toml")
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("days", [1], "HybridtrackError: days must be a whole number from 1 to 3660, got [1]"),
+    ("freq", ["1min"], "HybridtrackError: freq must be a step such as '1min' or '10s', got ['1min']"),
+    ("weather", "sunny,cloudy", "HybridtrackError: weather gives 2 days' weathers (sunny,cloudy) for days = 1"),
+])
+def test_a_bad_grid_value_fails_its_run_naming_its_key(key, value, message):
+    """A list where days or freq is one value failed its run with "unhashable type: 'list'"."""
+    assert run_one(Sweep.from_dict(TINY).base, {"run": 0, key: value})["error"].startswith(message)
 
 
 def test_a_bad_base_value_the_grid_overrides_fails_no_run():
@@ -145,6 +167,8 @@ def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
     ("[grid]\nseed = [0]\n", ["--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
     ("[grid\n", [], "not valid TOML"),
     ("[grid]\nwind = [1]\n", [], "grid.wind: unknown key"),
+    ("[base]\nstart = 2021-06-21T10:00:00\n[grid]\nseed = [0]\n", ["--workers", "1"],
+     "s.toml: base.start: date '2021-06-21T10:00:00' does not exist"),
     ("[base]\nfreq = '30min'\n[grid]\nstart = ['2021-02-30']\n", ["--workers", "1"],
      "every run failed; run 0: HybridtrackError: date '2021-02-30' does not exist"),
 ])
