@@ -84,19 +84,17 @@ class Sweep:
 
     @classmethod
     def from_dict(cls, data: dict, *, source: str = "sweep") -> Sweep:
-        unknown = sorted(set(data) - {"base", "grid", "plot"})
+        _table_of_text_keys(data, source, "the sweep")
+        unknown = [key for key in data if key not in ("base", "grid", "plot")]
         if unknown:
             raise HybridtrackError(f"{source}: {unknown[0]}: unknown table; a sweep has [base], [grid] and [plot]")
-        base = dict(data.get("base", {}))
-        config = base.pop("config", {})
-        grid = data.get("grid", {})
-        plot = data.get("plot", {})
-        for name, table in (("base", base), ("grid", grid), ("plot", plot), ("base.config", config)):
-            if not isinstance(table, dict):
-                raise HybridtrackError(f"{source}: [{name}] must be a table")
+        base = dict(_table_of_text_keys(data.get("base", {}), source, "[base]"))
+        config = _table_of_text_keys(base.pop("config", {}), source, "[base.config]")
+        grid = _table_of_text_keys(data.get("grid", {}), source, "[grid]")
+        plot = _table_of_text_keys(data.get("plot", {}), source, "[plot]")
         for key in base:
             _check_key(key, source, "base")
-        _check_base(base, config, data.get("grid", {}), source)
+        _check_base(base, config, grid, source)
         if not grid:
             raise HybridtrackError(f"{source}: [grid] is empty; give at least one key with a list of values")
         for key, values in grid.items():
@@ -135,6 +133,16 @@ class Sweep:
                 for i, values in enumerate(itertools.product(*(self.grid[k] for k in keys)))]
 
 
+def _table_of_text_keys(table, source: str, name: str) -> dict:
+    """`table`, refused unless a table (a dict) whose keys are text, as TOML makes them."""
+    if not isinstance(table, dict):
+        raise HybridtrackError(f"{source}: {name} must be a table, got {table!r:.80}")
+    for key in table:
+        if not isinstance(key, str):
+            raise HybridtrackError(f"{source}: {name}: key {key!r} is not text; keys are names such as drive.deadband")
+    return table
+
+
 def _check_key(key: str, source: str, table: str) -> None:
     """A run key, a collector field or a config field that exists; its value is checked by the run."""
     from .collectors import Collector
@@ -155,12 +163,11 @@ def _check_key(key: str, source: str, table: str) -> None:
         raise HybridtrackError(f"{source}: {table}.{key}: is a whole table; name one of its fields")
 
 
-def _check_base(base: dict, config: dict, grid, source: str) -> None:
+def _check_base(base: dict, config: dict, grid: dict, source: str) -> None:
     """Refuse, before a cluster starts, a base value every run would fail on, checked as the runs
     check it: each run key the grid does not set, then the collector and the weather when the grid
     sets none of their keys, and the config without the dotted keys the grid sets. A value checked
     with a key the grid sets is left to the runs (a grid value fails its own run only)."""
-    grid = grid if isinstance(grid, dict) else {}
     fixed = {key: value for key, value in base.items() if key not in grid}
     for key in RUN_KEYS.keys() & fixed.keys():
         _refuse_in_base([key], source, functools.partial(_key_checks()[key], fixed[key]))
@@ -366,6 +373,8 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     from dask.distributed import as_completed
     from tqdm import tqdm
 
+    if not isinstance(sweep, Sweep):
+        raise HybridtrackError(f"run_sweep: sweep must be a Sweep (Sweep.from_toml, Sweep.from_dict), got {sweep!r:.80}")
     runs = sweep.runs()
     client, cluster = dask_client(scheduler, workers, what="sweeps")
     rows = []
@@ -408,6 +417,7 @@ def _as_text(values: pd.Series) -> pd.Series:
 
 def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:
     """The runs no other run beats on both `x` and `y` (each minimised, or maximised if in `MAXIMISED`)."""
+    _check_columns(table, [x, y], "pareto_front", numbers=True)
     ok = table.dropna(subset=[x, y])
     sx = -1.0 if x in MAXIMISED else 1.0
     sy = -1.0 if y in MAXIMISED else 1.0
@@ -421,6 +431,19 @@ def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:
     return ok.loc[keep]
 
 
+def _check_columns(table, names: list, what: str, *, numbers: bool = False) -> None:
+    """Refuse a `table` that is not a DataFrame with the columns `names` (of numbers, if `numbers`)."""
+    if not isinstance(table, pd.DataFrame):
+        raise HybridtrackError(f"{what}: the table must be a pandas DataFrame (run_sweep's), got {table!r:.80}")
+    for name in names:
+        if name not in table.columns:
+            raise HybridtrackError(f"{what}: the table has no column {name!r}; its columns: "
+                                   f"{', '.join(map(str, table.columns))}")
+        if numbers and not pd.api.types.is_numeric_dtype(table[name]):
+            raise HybridtrackError(f"{what}: column {name!r} holds {table[name].dtype}, not numbers; "
+                                   f"choose a metric: {', '.join(METRICS)}")
+
+
 def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colour: str | None = None,
                   title: str = ""):
     """Every run as a point of `x` against `y`, coloured by a grid key, with the Pareto front drawn.
@@ -432,6 +455,8 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
     """
     from matplotlib.figure import Figure
 
+    _check_columns(table, [x, y], "plot_tradeoff", numbers=True)
+    _check_columns(table, [] if colour is None else [colour], "plot_tradeoff: colour")
     fig = Figure(figsize=(7.5, 5), layout="constrained")
     ax = fig.add_subplot()
     ok = table.dropna(subset=[x, y])
@@ -453,7 +478,7 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
     ax.plot(front[x], front[y], color="tab:red", lw=1.2, drawstyle="steps-post", label="Pareto front", zorder=0)
     ax.set_xlabel(x + (" (more is better)" if x in MAXIMISED else ""))
     ax.set_ylabel(y + (" (more is better)" if y in MAXIMISED else ""))
-    failed = int(table["error"].notna().sum())
+    failed = int(table["error"].notna().sum()) if "error" in table else 0
     ax.set_title(title + (f" ({failed} failed run{'s' if failed != 1 else ''} left out)" if failed else ""))
     return fig
 

@@ -36,6 +36,11 @@ def test_the_grid_is_every_combination_in_order():
 
 @pytest.mark.parametrize("data, message", [
     ({"grid": {"seed": [0]}, "runs": {}}, "runs: unknown table"),
+    (None, "s.toml: the sweep must be a table, got None"),
+    ({"base": "x", "grid": {"seed": [0]}}, "s.toml: \\[base\\] must be a table, got 'x'"),
+    ({"grid": {"seed": [0]}, 1: {}}, "s.toml: the sweep: key 1 is not text"),
+    ({"grid": {1: [0]}}, "s.toml: \\[grid\\]: key 1 is not text"),
+    ({"base": {("site",): "x"}, "grid": {"seed": [0]}}, "s.toml: \\[base\\]: key \\('site',\\) is not text"),
     ({"grid": {}}, r"\[grid\] is empty"),
     ({"grid": {"seed": 3}}, "grid.seed: must be a non-empty list"),
     ({"grid": {"drive.deadbnd": [0.1]}}, "grid.drive.deadbnd: unknown key"),
@@ -135,6 +140,22 @@ def test_pareto_front_hand_case():
                           "energy_capture": [0.9, 0.95, 0.97, 0.99, 0.96]})
     assert list(pareto_front(table, "moves", "rms").index) == [0, 1, 2]
     assert list(pareto_front(table, "moves", "energy_capture").index) == [0, 3]  # 15 moves at 0.99 beats 20 and 30
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda table: pareto_front(table, "moves", "p95"), "pareto_front: the table has no column 'p95'; its columns: "
+                                                        "moves, rms, site"),
+    (lambda table: pareto_front(table, "site", "rms"), "pareto_front: column 'site' holds .*, not numbers"),
+    (lambda table: pareto_front(table.to_dict(), "moves", "rms"), "pareto_front: the table must be a pandas DataFrame"),
+    (lambda table: plot_tradeoff(table, "rms", "max"), "plot_tradeoff: the table has no column 'max'"),
+    (lambda table: plot_tradeoff(table, colour="seed"), "plot_tradeoff: colour: the table has no column 'seed'"),
+    (lambda table: run_sweep("abc"), "run_sweep: sweep must be a Sweep .* got 'abc'"),
+])
+def test_the_api_refuses_what_it_cannot_use_naming_the_argument(call, message):
+    """These raised KeyError, TypeError and AttributeError; a colour not in the table was ignored unsaid."""
+    table = pd.DataFrame({"moves": [10, 20], "rms": [0.5, 0.3], "site": ["lanzhou", "nanjing"]})
+    with pytest.raises(HybridtrackError, match=message):
+        call(table)
 
 
 def test_the_table_is_the_same_on_one_and_two_workers_and_failures_are_kept():
