@@ -10,6 +10,11 @@ Every function that writes a result file first passes the paths it is about to w
   with ``--force``, the files it replaced); from Python the files are replaced as `open` would,
   unless the call runs inside ``with replacing(False):``.
 
+`write` writes a whole file under a temporary name beside it and renames it into place only
+when it is complete, so a failure (a full disk, an interrupt) leaves no half file and keeps any
+file it would have replaced; `write_in_place` is for a file that grows as a run goes (a streamed
+log).
+
 `strict_json` writes JSON that any parser reads: a missing or non-finite number is ``null``,
 never ``NaN`` or ``Infinity``.
 """
@@ -21,6 +26,8 @@ import contextvars
 import json
 import math
 import os
+import secrets
+import shutil
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
@@ -29,7 +36,8 @@ import numpy as np
 
 from .errors import HybridtrackError
 
-__all__ = ["claim", "replacing", "write", "strict_json", "plain_numbers", "reader_may_leave"]
+__all__ = ["claim", "replacing", "write", "write_in_place", "strict_json", "plain_numbers",
+           "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
 _REPLACED: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_replaced", default=None)
@@ -101,14 +109,51 @@ def _make_folder(folder: Path) -> None:
 
 
 def write(path, writer: Callable[[Path], object]) -> Path:
-    """Call ``writer(path)``; a failure to write (a full disk, no permission) becomes a
-    `HybridtrackError` that names `path`."""
+    """Write the whole file `path` with ``writer(partial)``, where ``partial`` is a new file beside
+    it, renamed to `path` once `writer` has returned.
+
+    A failure (a full disk, an interrupt) removes the partial file: no half-written `path` is left,
+    and a file `path` held already is kept. The new file takes an existing one's permissions. A
+    path that is not a regular file (a device such as ``/dev/stdout``) is written in place.
+
+    Raises
+    ------
+    HybridtrackError
+        If writing fails with an `OSError` (a full disk, no permission); it names `path`.
+    """
     path = Path(path)
+    if path.exists() and not path.is_file():
+        return write_in_place(path, writer)
+    partial = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.partial{path.suffix}")  # the suffix tells the format
     try:
+        with _naming(path):
+            os.close(os.open(partial, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))  # new, never through a link
+            if path.exists():
+                shutil.copymode(path, partial)
+            writer(partial)
+            os.replace(partial, path)
+    finally:
+        with contextlib.suppress(OSError):
+            partial.unlink(missing_ok=True)
+    return path
+
+
+def write_in_place(path, writer: Callable[[Path], object]) -> Path:
+    """Call ``writer(path)`` on `path` itself, for a file that grows as a run goes (a streamed log);
+    a failure to write becomes a `HybridtrackError` that names `path`."""
+    path = Path(path)
+    with _naming(path):
         writer(path)
+    return path
+
+
+@contextlib.contextmanager
+def _naming(path: Path) -> Iterator[None]:
+    """An `OSError` in the block becomes a one-line `HybridtrackError` naming `path`."""
+    try:
+        yield
     except OSError as exc:
         raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
-    return path
 
 
 def plain_numbers(value):

@@ -38,8 +38,10 @@ Weather comes from a source that yields one local day at a time:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime as dt
+import os
 import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -54,11 +56,11 @@ from .errors import HybridtrackError
 from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
-from .outputs import claim, strict_json, write
+from .outputs import claim, strict_json, write, write_in_place
 from .times import local_midnight, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
-           "read_log", "stream_files"]
+           "read_log", "stream_files", "partial_files"]
 
 #: Rows read from a recorded file at a time (a day at 1 s is 86,400).
 CHUNK_ROWS = 200_000
@@ -535,32 +537,75 @@ def read_log(path, *, columns=None, day=None, tz=None) -> pd.DataFrame:
     raise HybridtrackError(f"{path}: no segment on {wanted}")
 
 
-class _LogWriter:
-    """Appends each segment's log to one Parquet file, one row group a segment, one schema."""
+class _PartialRun:
+    """A streamed run's log and events under partial names (`partial_files`) until it finishes.
 
-    def __init__(self, path: Path):
-        self.path, self.writer = path, None
+    The log is appended to one Parquet file, one row group a segment, one schema; the events to
+    one CSV file. `finish` gives them their names; `abandon` keeps them only if they hold whole
+    segments and no write failed (a failed write may have cut a file mid-segment).
+    """
 
-    def append(self, log: pd.DataFrame) -> None:
+    def __init__(self, files: dict):
+        self.files, self.partial = files, partial_files(files)
+        self.writer, self.segments, self.intact = None, 0, True
+
+    def _write(self, path: Path, writer) -> None:
+        try:
+            write_in_place(path, writer)
+        except HybridtrackError:
+            self.intact = False
+            raise
+
+    def append(self, result) -> None:
+        """Add one finished segment's log and events."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        table = pa.Table.from_pandas(log, preserve_index=True)
+        table = pa.Table.from_pandas(result.log, preserve_index=True)
         if self.writer is None:
-            write(self.path, lambda path: setattr(self, "writer", pq.ParquetWriter(path, table.schema)))
+            self._write(self.partial["events"], lambda path: path.write_text("time,from,to,reason\n"))
+            self._write(self.partial["log"], lambda path: setattr(self, "writer", pq.ParquetWriter(path, table.schema)))
         elif not table.schema.equals(self.writer.schema, check_metadata=False):
-            raise HybridtrackError(f"{self.path}: a segment's log has other columns or types than the first's")
-        write(self.path, lambda _: self.writer.write_table(table, row_group_size=len(table)))
+            raise HybridtrackError(f"{self.files['log']}: a segment's log has other columns or types than the first's")
+        self._write(self.partial["log"], lambda _: self.writer.write_table(table, row_group_size=len(table)))
+        if len(result.events):
+            self._write(self.partial["events"],
+                        lambda path: result.events.to_csv(path, mode="a", header=False, index=False))
+        self.segments += 1
 
-    def close(self) -> None:
+    def _close(self) -> None:
         if self.writer is not None:
-            self.writer.close()
+            self._write(self.partial["log"], lambda _: self.writer.close())
+
+    def finish(self) -> None:
+        """Give the log and the events their names; an earlier run's summary goes first, so that
+        no summary is ever beside a log it does not describe (a finished run writes it last)."""
+        self._close()
+        self.files["summary"].unlink(missing_ok=True)
+        for role, path in self.partial.items():
+            write_in_place(self.files[role], lambda target, source=path: os.replace(source, target))
+
+    def abandon(self, keep: bool) -> None:
+        """After a failure: if `keep`, keep the segments done (whole, readable with `read_log`)
+        under their partial names; remove the partial files if not, if there are none, or if a
+        write failed."""
+        with contextlib.suppress(HybridtrackError):
+            self._close()
+        if not (keep and self.segments and self.intact):
+            for path in self.partial.values():
+                path.unlink(missing_ok=True)
 
 
 def stream_files(folder) -> dict[str, Path]:
     """The files `stream` writes into `folder`, by role."""
     folder = Path(folder)
     return {"log": folder / "log.parquet", "events": folder / "events.csv", "summary": folder / "summary.json"}
+
+
+def partial_files(files: dict) -> dict[str, Path]:
+    """Where `stream` writes the log and the events (`stream_files`) until the run finishes:
+    ``log.partial.parquet`` and ``events.partial.csv``."""
+    return {role: files[role].with_name(f"{files[role].stem}.partial{files[role].suffix}") for role in ("log", "events")}
 
 
 def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
@@ -576,6 +621,10 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     out : str or Path
         Folder for ``log.parquet``, ``events.csv`` and ``summary.json``, claimed before the run
         (`hybridtrack.outputs.claim`: no symbolic links; existing files only under ``replacing``).
+        The log and the events are written as ``log.partial.parquet`` and ``events.partial.csv``
+        (`partial_files`) and take their names when the run finishes, so an earlier run's files
+        are kept whole until then. A run that stops keeps its finished days under those partial
+        names (unless no day finished, or a write failed: then they are removed).
     collector, strategy, config, classifier
         As `hybridtrack.simulate` takes them. The config's ``engine = "auto"`` is decided on the
         whole span's steps (where the source knows them), not on one day's: a year at 1 s pays
@@ -621,13 +670,11 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                              resolution=resolution)  # checks `resolution` before anything is written
     files = stream_files(out)
-    claim(files.values())
-    files["summary"].unlink(missing_ok=True)  # a replaced run's summary must not outlive it (written last)
-    write(files["events"], lambda path: path.write_text("time,from,to,reason\n"))
-    logs = _LogWriter(files["log"])
+    claim([*files.values(), *partial_files(files).values()])
+    run = _PartialRun(files)
     memory: bool | dict = warm_start
     start = None
-    segments, whole = 0, False
+    whole = False
     wind, cycle, last = set(), [], None
     try:
         for day, frame in source:
@@ -639,46 +686,35 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
             age = (begin - start) / pd.Timedelta(days=1)
             setup = dataclasses.replace(config, imperfections=dataclasses.replace(
                 config.imperfections, commissioned_days_ago=config.imperfections.commissioned_days_ago + age),
-                seed=config.seed if segments == 0 else day_seed(config.seed, day))
+                seed=config.seed if run.segments == 0 else day_seed(config.seed, day))
             result = simulate(frame, site, collector=collector, config=setup, classifier=classifier,
                               progress=progress, warm_start=memory)
-            logs.append(result.log)
-            if len(result.events):
-                write(files["events"], lambda path: result.events.to_csv(path, mode="a", header=False, index=False))
+            run.append(result)
             running.add(result.log, events=result.events, **result.scoring)
             wind.add(result.summary["wind_data"])
             cycle += result.summary["day_cycle"]
             if on_segment is not None:
                 on_segment(result)
-            memory, segments = result.memory, segments + 1
+            memory = result.memory
             last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"]}
             del result, frame  # nothing of a segment outlives it but its memory and the running sums
+        if run.segments == 0 or not whole:
+            raise HybridtrackError(f"{source.describe}: holds no time steps" if run.segments == 0 else
+                                   f"a streamed run needs at least one whole local day at {site.name}; this span has "
+                                   "none (run it in memory with hybridtrack.simulate)")
     except BaseException:
-        logs.close()
-        if segments == 0:  # nothing finished: leave nothing behind that a retry would have to --force
-            _discard(files)
+        run.abandon(keep=whole)  # a span refused for holding no whole day keeps nothing
         raise
-    logs.close()
-    if segments == 0 or not whole:
-        _discard(files)
-        raise HybridtrackError(f"{source.describe}: holds no time steps" if segments == 0 else
-                               f"a streamed run needs at least one whole local day at {site.name}; this span has "
-                               "none (run it in memory with hybridtrack.simulate)")
+    run.finish()
     summary = running.summary()
     summary["calibration"] = last["calibration"]
     summary["clock"] = last["clock"]
     summary["wind_data"] = wind.pop() if len(wind) == 1 else "partly missing"
     summary["day_cycle"] = cycle
-    summary["streamed"] = {"segments": segments, "segment": "one local day, cut at midnight",
+    summary["streamed"] = {"segments": run.segments, "segment": "one local day, cut at midnight",
                            "p95_resolution_deg": resolution, "weather": source.describe}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
     return StreamResult(summary, files, site, collector, config, memory)
-
-
-def _discard(files: dict) -> None:
-    """Remove what a refused or failed run wrote before its first day was done."""
-    for path in files.values():
-        Path(path).unlink(missing_ok=True)
 
 
 def progress_bar(source: DaySource, *, label: str = "", file=None):

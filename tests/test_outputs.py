@@ -257,3 +257,48 @@ def test_a_full_standard_output_is_one_line_that_names_it():
                                stderr=subprocess.PIPE, env=env)
     assert child.returncode == 2
     assert child.stderr.decode() == "hybridtrack: error: standard output: cannot write (No space left on device)\n"
+
+
+# -- a failed write leaves no half file --------------------------------------------------------------
+
+def _half_then_full(target):
+    """A writer that gets half way and finds the disk full."""
+    import errno
+
+    Path(target).write_text("half a fi")
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def test_a_write_that_fails_leaves_no_half_file_and_keeps_the_old_one(tmp_path):
+    from hybridtrack.outputs import write
+
+    new, old = tmp_path / "new.csv", tmp_path / "old.csv"
+    old.write_text("the earlier result\n")
+    old.chmod(0o640)
+    for path in (new, old):
+        with pytest.raises(HybridtrackError, match=rf"^{path}: cannot write \(No space left on device\)$"):
+            write(path, _half_then_full)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.csv"] and old.read_text() == "the earlier result\n"
+    write(old, lambda target: target.write_text("the new result\n"))
+    assert old.read_text() == "the new result\n" and (old.stat().st_mode & 0o777) == 0o640
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full, a device that is always full")
+def test_a_device_is_written_in_place_not_replaced():
+    from hybridtrack.outputs import write
+
+    with pytest.raises(HybridtrackError, match=r"^/dev/full: cannot write \(No space left on device\)$"):
+        write("/dev/full", lambda target: Path(target).write_text("x" * 10_000))
+    assert Path("/dev/full").is_char_device() and not list(Path("/dev").glob(".full.*"))
+
+
+def test_a_run_whose_log_cannot_be_written_leaves_nothing_behind(tmp_path, monkeypatch, capsys):
+    """A full disk while writing log.parquet left a truncated log, and a retry needed --force."""
+    out = tmp_path / "out"
+    monkeypatch.setattr(pd.DataFrame, "to_parquet", lambda self, path, *a, **k: _half_then_full(path))
+    assert main(SHORT + ["--out", str(out)]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {out / 'log.parquet'}: cannot write "
+                                       "(No space left on device)\n")
+    assert list(out.iterdir()) == []
+    monkeypatch.undo()
+    assert main(SHORT + ["--out", str(out)]) == 0 and pd.read_parquet(out / "log.parquet").shape[0] == 144

@@ -404,15 +404,57 @@ def test_a_streamed_file_without_wind_is_tracked_through_as_in_memory(tmp_path, 
     assert summary["energy_capture"] > 0.9 and summary["mode_share"].get("stow_wind", 0.0) == 0.0
 
 
-def test_a_failed_forced_rerun_leaves_no_earlier_summary_beside_its_log(tmp_path, capsys):
-    """--force replaces a finished run; if the new run stops, the folder must not pair its partial
-    log with the old run's summary.json (a finished run writes it last)."""
+def test_a_failed_forced_rerun_leaves_the_earlier_run_whole(tmp_path, capsys):
+    """--force replaces a finished run when the new one finishes; if the new run stops, the folder
+    must not pair its partial log with the old run's summary.json: the old run is left as it was."""
     out = tmp_path / "run"
     good, bad = tmp_path / "good.csv", tmp_path / "bad.csv"
     day = next(iter(synthetic_days(SITE, "2021-06-21", "2021-06-21", weather="sunny", freq="10min", seed=1)))[1]
     day.rename_axis("time").to_csv(good)
     bad.write_text(good.read_text() + "2021-06-22T00:00:00+08:00" + ",x" * len(day.columns) + "\n")
     assert main(["replay", str(good), "--site", SITE, "--stream", "--out", str(out)]) == 0
-    assert (out / "summary.json").exists()
+    finished = {path.name: path.read_bytes() for path in out.iterdir()}
+    assert sorted(finished) == ["events.csv", "log.parquet", "summary.json"]
     assert main(["replay", str(bad), "--site", SITE, "--stream", "--out", str(out), "--force"]) == 2
-    assert not (out / "summary.json").exists()
+    assert {path.name: path.read_bytes() for path in out.iterdir()} == finished
+
+
+def _two_days():
+    return synthetic_days(SITE, "2021-06-21", "2021-06-22", weather="sunny", freq="30min", seed=1)
+
+
+def test_a_write_that_fails_mid_run_leaves_no_log_and_nothing_to_force_past(tmp_path, monkeypatch):
+    """A full disk on the second day cut log.parquet mid-segment and left it under its own name."""
+    import errno
+
+    import pyarrow.parquet as pq
+
+    real, calls = pq.ParquetWriter.write_table, []
+
+    def full_on_the_second_day(self, table, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, table, *args, **kwargs)
+
+    monkeypatch.setattr(pq.ParquetWriter, "write_table", full_on_the_second_day)
+    with pytest.raises(HybridtrackError, match=r"log.partial.parquet: cannot write \(No space left on device\)"):
+        stream(_two_days(), tmp_path / "run")
+    assert list((tmp_path / "run").iterdir()) == []
+    monkeypatch.undo()
+    assert stream(_two_days(), tmp_path / "run").summary["streamed"]["segments"] == 2  # a retry needs no --force
+
+
+def test_a_stopped_run_keeps_its_finished_days_under_partial_names_only(tmp_path):
+    """Ctrl-C after the second day: the days done are whole and readable, and nothing looks finished."""
+    days = []
+
+    def stop_on_the_second_day(result):
+        days.append(result.log)
+        if len(days) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        stream(_two_days(), tmp_path / "run", on_segment=stop_on_the_second_day)
+    assert sorted(path.name for path in (tmp_path / "run").iterdir()) == ["events.partial.csv", "log.partial.parquet"]
+    pd.testing.assert_frame_equal(read_log(tmp_path / "run" / "log.partial.parquet"), pd.concat(days), check_freq=False)

@@ -69,7 +69,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USAGE
     except KeyboardInterrupt:  # Ctrl-C: one line, no traceback; the shell's status for SIGINT
         print("\nhybridtrack: interrupted; files already written are left as they are (an unfinished streamed "
-              "run has no summary.json)", file=sys.stderr)
+              "run leaves its finished days in log.partial.parquet and events.partial.csv)", file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:
         name = f" {exc.filename}" if exc.filename else ""
