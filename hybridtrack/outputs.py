@@ -13,7 +13,8 @@ Every function that writes a result file first passes the paths it is about to w
 `write` writes a whole file under a temporary name beside it and renames it into place only
 when it is complete, so a failure (a full disk, an interrupt) leaves no half file and keeps any
 file it would have replaced; `write_in_place` is for a file that grows as a run goes (a streamed
-log).
+log). Folders `claim` made are removed again, if still empty, when the command fails
+(`removing_empty_folders`).
 
 `strict_json` writes JSON that any parser reads: a missing or non-finite number is ``null``,
 never ``NaN`` or ``Infinity``.
@@ -36,11 +37,12 @@ import numpy as np
 
 from .errors import HybridtrackError
 
-__all__ = ["claim", "replacing", "write", "write_in_place", "strict_json", "plain_numbers",
+__all__ = ["claim", "replacing", "removing_empty_folders", "write", "write_in_place", "strict_json", "plain_numbers",
            "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
 _REPLACED: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_replaced", default=None)
+_MADE: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_made", default=None)
 
 
 @contextlib.contextmanager
@@ -64,6 +66,23 @@ def replacing(force: bool) -> Iterator[list[Path]]:
     finally:
         _FORCE.reset(force_token)
         _REPLACED.reset(replaced_token)
+
+
+@contextlib.contextmanager
+def removing_empty_folders() -> Iterator[None]:
+    """Within the block, the folders `claim` makes are removed again if the block fails while they
+    are still empty: a command refused after claiming its ``--out`` leaves no empty folder behind."""
+    made: list[Path] = []
+    token = _MADE.set(made)
+    try:
+        yield
+    except BaseException:
+        for folder in reversed(made):  # the innermost first
+            with contextlib.suppress(OSError):  # one that holds anything stays
+                folder.rmdir()
+        raise
+    finally:
+        _MADE.reset(token)
 
 
 def claim(paths: Iterable) -> list[Path]:
@@ -102,10 +121,14 @@ def claim(paths: Iterable) -> list[Path]:
 def _make_folder(folder: Path) -> None:
     if folder.exists() and not folder.is_dir():
         raise HybridtrackError(f"{folder} is a file, not a folder")
+    missing = [candidate for candidate in (folder, *folder.parents) if not candidate.exists()][::-1]
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise HybridtrackError(f"{folder}: cannot make the folder ({exc.strerror or exc})") from None
+    made = _MADE.get()
+    if made is not None:
+        made.extend(missing)
 
 
 def write(path, writer: Callable[[Path], object]) -> Path:

@@ -199,6 +199,7 @@ def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, fla
     assert main(["sweep", str(path), "--out", str(tmp_path / "out"), *flags]) == 2
     error = [line for line in capsys.readouterr().err.splitlines() if "hybridtrack" in line]  # not the progress bar
     assert len(error) == 1 and error[0].strip().startswith("hybridtrack: error:") and message in error[0]
+    assert list(tmp_path.iterdir()) == [path] or list((tmp_path / "out").iterdir())  # no empty --out left behind
 
 
 def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import HybridtrackError
-from ..outputs import reader_may_leave, replacing
+from ..outputs import reader_may_leave, removing_empty_folders, replacing
 from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
 from .base import _COMMANDS, _HELP, EXIT_INTERRUPTED, EXIT_USAGE
 
@@ -54,7 +54,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     try:
         args = build_parser().parse_args(argv)
-        with reader_may_leave(), replacing(getattr(args, "force", False)) as replaced:
+        with reader_may_leave(), replacing(getattr(args, "force", False)) as replaced, removing_empty_folders():
             status = args._run(args)
             if replaced:
                 print("replaced (--force): " + ", ".join(map(str, replaced)))
