@@ -302,3 +302,15 @@ def test_a_run_whose_log_cannot_be_written_leaves_nothing_behind(tmp_path, monke
     assert not out.exists()  # the folder the command made, and nothing in it
     monkeypatch.undo()
     assert main(SHORT + ["--out", str(out)]) == 0 and pd.read_parquet(out / "log.parquet").shape[0] == 144
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full, a device that is always full")
+@pytest.mark.parametrize("args", [["--version"], ["--help"], ["sweep", "--help"], ["field", "--help"]])
+def test_help_and_version_to_a_full_standard_output_are_one_line(args):
+    """argparse swallows the failed write: these exited 0 without a word."""
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    with open("/dev/full", "w") as full:
+        child = subprocess.run([sys.executable, "-m", "hybridtrack", *args], stdout=full, stderr=subprocess.PIPE,
+                               env=env)
+    assert child.returncode == 2
+    assert child.stderr.decode() == "hybridtrack: error: standard output: cannot write (No space left on device)\n"

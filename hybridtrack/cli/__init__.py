@@ -53,12 +53,13 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     try:
-        args = build_parser().parse_args(argv)
-        with reader_may_leave(), replacing(getattr(args, "force", False)) as replaced, removing_empty_folders():
-            status = args._run(args)
-            if replaced:
-                print("replaced (--force): " + ", ".join(map(str, replaced)))
-            return status
+        with reader_may_leave():  # --help and --version print here too: a full standard output is one line
+            args = build_parser().parse_args(argv)
+            with replacing(getattr(args, "force", False)) as replaced, removing_empty_folders():
+                status = args._run(args)
+                if replaced:
+                    print("replaced (--force): " + ", ".join(map(str, replaced)))
+                return status
     except BrokenPipeError:  # the reader went away outside the printing (`| head`): not a mistake, just stop
         import os
 
