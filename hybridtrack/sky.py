@@ -41,7 +41,7 @@ from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_midnight, local_range, parse_freq
 
-__all__ = ["synthetic", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS",
+__all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS",
            "RegimeParameters", "REGIMES", "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
@@ -165,24 +165,30 @@ def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
     return pd.date_range(first, last, freq=parse_freq(freq))
 
 
-def _day_types(days: list, weather, climate: Climate, rng: np.random.Generator) -> list[str]:
+def check_weather(weather, days: int) -> None:
+    """Refuse a weather `synthetic` cannot make for `days` days: an unknown name, or a per-day list
+    of another length or with a name that is not a day's weather (``climate`` draws them)."""
     if isinstance(weather, str):
         if weather not in WEATHERS:
             raise HybridtrackError(f"unknown weather {weather!r}; choose from {', '.join(WEATHERS)} or a per-day list")
-        if weather == "climate":
-            out = []
-            for day in days:
-                fractions = climate.day_fractions(day.month)
-                out.append(str(rng.choice(DAY_TYPES, p=[fractions[t] for t in DAY_TYPES])))
-            return out
-        return [weather] * len(days)
+        return
     weather = list(weather)
-    if len(weather) != len(days):
-        raise HybridtrackError(f"{len(weather)} weathers given for {len(days)} days; give one per day")
+    if len(weather) != days:
+        raise HybridtrackError(f"{len(weather)} weathers given for {days} days; give one per day")
     for value in weather:
         if value not in WEATHERS or value == "climate":
             raise HybridtrackError(f"unknown day weather {value!r}; choose from sunny, cloudy, overcast, mixed")
-    return weather
+
+
+def _day_types(days: list, weather, climate: Climate, rng: np.random.Generator) -> list[str]:
+    check_weather(weather, len(days))
+    if weather == "climate":
+        out = []
+        for day in days:
+            fractions = climate.day_fractions(day.month)
+            out.append(str(rng.choice(DAY_TYPES, p=[fractions[t] for t in DAY_TYPES])))
+        return out
+    return [weather] * len(days) if isinstance(weather, str) else list(weather)
 
 
 def _regime_spells(day_start: pd.Timestamp, day_type: str, rng: np.random.Generator) -> list[tuple]:

@@ -253,13 +253,12 @@ def _weather_arguments(spec: dict) -> tuple:
     import datetime as dt
 
     from . import sites
+    from .sky import check_weather
     from .times import local_range
 
     site, first, days = sites.get(spec["site"]), _first_day(spec["start"]), _whole_days(spec["days"])
     names, freq = _weather_names(spec["weather"]), _step(spec["freq"])
-    if len(names) > 1 and (len(names) != days or "climate" in names):
-        raise HybridtrackError(f"weather gives {len(names)} days' weathers ({','.join(names)}) for days = {days}; "
-                               "give one of sunny, cloudy, overcast, mixed per day")
+    check_weather(names if len(names) > 1 else names[0], days)
     last = (first + dt.timedelta(days=days - 1)).isoformat()
     local_range(first, site.tz, end_date=last, freq=freq)  # refuses a span past 2261 or over the memory budget
     return site, first.isoformat(), days, ",".join(names), freq, _gusts(spec["gusts_per_day"])

@@ -71,7 +71,7 @@ def test_the_grid_is_every_combination_in_order():
     ({"base": {"days": 3660, "freq": "1s"}, "grid": {"seed": [0]}},  # 3660 days x 86,400 s
      "s.toml: base.days, base.freq: 2021-06-21 to 2031-06-28: 316,224,000 steps of 1s would need"),
     ({"base": {"days": 3, "weather": ["sunny", "cloudy"]}, "grid": {"seed": [0]}},
-     "s.toml: base.days, base.weather: weather gives 2 days' weathers"),
+     "s.toml: base.days, base.weather: 2 weathers given for 3 days; give one per day"),
     ({"base": {"freq": ["1min"]}, "grid": {"seed": [0]}}, r"s.toml: base.freq: freq must be a step .* got \['1min'\]"),
 ])
 def test_bad_sweeps_are_refused_before_any_run(data, message):
@@ -82,7 +82,7 @@ def test_bad_sweeps_are_refused_before_any_run(data, message):
 @pytest.mark.parametrize("key, value, message", [
     ("days", [1], "HybridtrackError: days must be a whole number from 1 to 3660, got [1]"),
     ("freq", ["1min"], "HybridtrackError: freq must be a step such as '1min' or '10s', got ['1min']"),
-    ("weather", "sunny,cloudy", "HybridtrackError: weather gives 2 days' weathers (sunny,cloudy) for days = 1"),
+    ("weather", "sunny,cloudy", "HybridtrackError: 2 weathers given for 1 days; give one per day"),
 ])
 def test_a_bad_grid_value_fails_its_run_naming_its_key(key, value, message):
     """A list where days or freq is one value failed its run with "unhashable type: 'list'"."""
