@@ -221,7 +221,7 @@ def fresnel_end_loss(altitude, azimuth, d, h):
     return _like(altitude, np.where(a > 0.0, loss, np.nan), "end_loss")
 
 
-def heliostat_normal(altitude, azimuth, aim) -> np.ndarray:
+def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     """Unit mirror normals of a heliostat reflecting the sun onto an aim point.
 
     Law of reflection: ``n = (s + r) / |s + r|`` with ``r`` the unit vector from the mirror
@@ -241,13 +241,18 @@ def heliostat_normal(altitude, azimuth, aim) -> np.ndarray:
         Unit normals in (east, north, up), of the broadcast shape of the sun position and the
         aim points (a scalar sun gives (1, 3)); NaN while the sun is down. Altitudes of shape
         (T, 1) against aim points (M, 3) give all M mirrors at T steps, (T, M, 3).
+
+    Other Parameters
+    ----------------
+    sun : numpy.ndarray, optional
+        ``sun_vector(altitude, azimuth)``, if computed already (a field's heliostats share it).
     """
     target = np.asarray(aim, float)
     norm = np.linalg.norm(target, axis=-1, keepdims=True) if target.ndim else np.zeros(1)
     if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
     alt = np.asarray(altitude, float)
-    s = sun_vector(alt, azimuth)
+    s = sun_vector(alt, azimuth) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
     n = np.where((alt < 0.0)[..., None], np.nan, n)

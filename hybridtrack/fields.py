@@ -449,7 +449,8 @@ class FieldResult:
         figures = ", ".join(f"{label} {summary[key]:.4g}" for key, label in
                             (("energy_capture", "energy capture"), ("rms", "RMS error (°)"))
                             if summary.get(key) is not None)
-        return (f"<FieldResult: {summary['field']} of {summary['collectors']} at {self.site.name}, {summary['strategy']}, "
+        return (f"<FieldResult: {summary['field']} of {summary['collectors']} at {self.site.name}, "
+                f"{summary['strategy']}, "
                 f"{summary['steps']:,} steps from {summary['start']}{': ' + figures if figures else ''}>")
 
     def _repr_html_(self) -> str:
@@ -737,7 +738,8 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
             result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
             offered = offered_light(result.log["dni"], result.scoring["sun_up"], result.scoring["incidence"])
-            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary), "offered": _energy(offered, frame.index)}
+            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary),
+                   "offered": _energy(offered, frame.index)}
             done.append((i, row, result.events.assign(collector=name), _kept(result.log) if keep_log else None))
     return done
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
+from .reuse import shared
 
 __all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine",
            "geometry_key", "rotate"]
@@ -57,15 +58,28 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     return out
 
 
-def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = False) -> np.ndarray:
+def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = False, sun=None) -> np.ndarray:
     """What a collector's angles follow, as unit vectors in the site frame (N, 3): the sun for a
     single-axis collector, a heliostat's wanted mirror normal (with `night`, the normal for the
     sun mirrored above the horizon). Computed once, they serve any number of mounts
-    (`angles_on_mount`)."""
+    (`angles_on_mount`). `sun`: the sun's unit vectors (`sun_vector`, of the altitude mirrored
+    above the horizon with `night`), if computed already (a heliostat field shares them)."""
     alt = np.asarray(altitude, float)
     if collector.kind == "heliostat":
-        return heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim)
+        return heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim, sun=sun)
     return sun_vector(alt, np.asarray(azimuth, float))
+
+
+def heliostat_sun(base: tuple, altitude, azimuth, collector: Collector, *, night: bool = False) -> np.ndarray | None:
+    """The sun's unit vectors a heliostat's own geometry starts from (the `sun` of
+    `pointing_vectors` and `incidence_cosine`), shared by a field's heliostats under the sun that
+    `base` keys; None for another collector, whose pointing vectors are the sun's own and are
+    shared whole (`geometry_key`)."""
+    if collector.kind != "heliostat":
+        return None
+    alt = np.asarray(altitude, float)
+    return shared((*base, "sun vectors", night),
+                  lambda: sun_vector(np.abs(alt) if night else alt, np.asarray(azimuth, float)))
 
 
 def geometry_key(base: tuple, what: str, collector: Collector) -> tuple | None:
@@ -101,14 +115,15 @@ def angles_on_mount(vectors: np.ndarray, collector: Collector, rotation: np.ndar
     return sun[:, None]
 
 
-def incidence_cosine(altitude, azimuth, collector: Collector) -> np.ndarray:
+def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np.ndarray:
     """Cosine of the sun's incidence on a perfectly tracking aperture.
 
     For a single-axis collector it is the part of the sun vector across the axis; a
     heliostat's is the cosine of half the angle between sun and aim point. Zero at night.
+    `sun`: the sun's unit vectors (`sun_vector`), if computed already.
     """
     alt = np.asarray(altitude, float)
-    s = sun_vector(alt, np.asarray(azimuth, float))
+    s = sun_vector(alt, np.asarray(azimuth, float)) if sun is None else sun
     if collector.kind == "heliostat":
         r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
         cos = np.sqrt(np.clip((1.0 + np.einsum("nc,c->n", s, r)) / 2.0, 0.0, 1.0))

@@ -41,8 +41,8 @@ from .errors import HybridtrackError
 from .sites import Site, get
 from .times import clock_hours, local_midnight, local_range, parse_freq
 
-__all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES", "WEATHERS",
-           "RegimeParameters", "REGIMES", "daily_summary"]
+__all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES",
+           "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
 WEATHERS = (*DAY_TYPES, "mixed", "climate")

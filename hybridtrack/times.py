@@ -9,8 +9,9 @@ import pandas as pd
 from .budget import check_steps
 from .errors import HybridtrackError
 
-__all__ = ["parse_date", "check_dates", "FIRST_DATE", "LAST_DATE", "parse_clock", "parse_freq", "local_range", "local_midnight", "check_tz", "clock_hours",
-           "clock_nanoseconds", "calendar_days", "day_of_year", "plus_seconds", "HOUR_NS", "DAY_NS"]
+__all__ = ["parse_date", "check_dates", "FIRST_DATE", "LAST_DATE", "parse_clock", "parse_freq", "local_range",
+           "local_midnight", "check_tz", "clock_hours", "clock_nanoseconds", "calendar_days", "day_of_year",
+           "plus_seconds", "HOUR_NS", "DAY_NS"]
 
 
 def clock_nanoseconds(local: pd.DatetimeIndex):

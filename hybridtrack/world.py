@@ -35,7 +35,8 @@ from .control.modes import UNKNOWN, sky_code
 from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
-from .mounting import geometry_key, incidence_cosine, mount_targets, mounting_rotation, pointing_vectors
+from .mounting import (geometry_key, heliostat_sun, incidence_cosine, mount_targets, mounting_rotation,
+                       pointing_vectors)
 from .reuse import Same, shared
 from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SceneLight, SensorModel, coarse_offset, read_photocurrent,
                      read_pointing, scene_light, sensor_scene)
@@ -200,7 +201,7 @@ class World:
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
                                      imperfections.axis_roll_error)
         vectors = shared(geometry_key(self._sun_key, "pointing", collector),
-                         lambda: pointing_vectors(self.altitude, self.azimuth, collector))
+                         lambda: pointing_vectors(self.altitude, self.azimuth, collector, sun=self._heliostat_sun()))
         self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation, vectors=vectors)
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
         light = shared(("scene light", Same(frame), *self._sun_key, self.sensor.view_share),
@@ -306,7 +307,10 @@ class World:
         (`hybridtrack.mounting.incidence_cosine`), for the scoring; shared by a field's
         collectors of one geometry (`hybridtrack.mounting.geometry_key`)."""
         return shared(geometry_key(self._sun_key, "incidence", self.collector),
-                      lambda: incidence_cosine(self.altitude, self.azimuth, self.collector))
+                      lambda: incidence_cosine(self.altitude, self.azimuth, self.collector, sun=self._heliostat_sun()))
+
+    def _heliostat_sun(self) -> np.ndarray | None:
+        return heliostat_sun(self._sun_key, self.altitude, self.azimuth, self.collector)
 
     # -- each scan -------------------------------------------------------------------------------
 

@@ -132,7 +132,7 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
         out[:, :, k] = np.einsum("nac,nc->na", gradient, turned)
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
-    return np.nan_to_num(out)
+    return np.nan_to_num(out, copy=False)  # in place: a heliostat-year's copy took 0.03 s
 
 
 def _angle_gradient(vectors: np.ndarray, collector) -> np.ndarray:

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from ..collectors import Collector
-from ..mounting import angles_on_mount, geometry_key, mounting_rotation, pointing_vectors
+from ..mounting import angles_on_mount, geometry_key, heliostat_sun, mounting_rotation, pointing_vectors
 from ..sites import Site
 from ..sun import solar_position
 from ..reuse import Content, Same, shared
@@ -157,7 +157,8 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     clock, steps, alarms, altitude, azimuth, apparent, awake = shared(
         sun_key, lambda: _plan_sun(clock, minutes, site, config))
     vectors = shared(geometry_key(sun_key, "pointing", collector),
-                     lambda: pointing_vectors(altitude, azimuth, collector, night=True))
+                     lambda: pointing_vectors(altitude, azimuth, collector, night=True,
+                                              sun=heliostat_sun(sun_key, altitude, azimuth, collector, night=True)))
     model = (mount or MountEstimate()).vector_targets(vectors, collector)
     plan = ControllerPlan(np.asarray(minutes, float), model, awake, steps, alarms=alarms, apparent_altitude=apparent)
     if config.calibrates:
