@@ -146,13 +146,15 @@ def test_a_field_run_is_each_collectors_own_run(day):
     (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (4, 1)),  # pointing (world, plan), incidence, the
     # field's end loss; derivatives
     (TroughLoop(count=3), (3, 1)),
-    (HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0], [-30.0, -80.0]]), (3, 3)),  # each its own
+    # the sun's unit vectors once for the world and once for the plan; each mirror's derivatives its own
+    (HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0], [-30.0, -80.0]]), (2, 3)),
 ])
 def test_rows_on_one_axis_line_share_their_geometry_and_heliostats_keep_their_own(monkeypatch, field, computed):
     """Under one sun, the sun's direction (the world's and the plan's) and its incidence on the
     aperture are computed once for a field's rows or troughs on one axis line, and so are the
     mount fit's derivatives; a heliostat's pointing turns on its own aim point, so each of those
-    is its own. Each collector's warm-start day is its own run, apart from the field's memory."""
+    is its own, but the sun's unit vectors it starts from are shared. Each collector's warm-start
+    day is its own run, apart from the field's memory."""
     import hybridtrack.control.plan as plan
     import hybridtrack.mounting as mounting
 
