@@ -267,6 +267,16 @@ def test_bad_input_is_one_clear_line_from_api_and_cli(tmp_path, capsys, make, ap
     assert captured.err.startswith("hybridtrack: error: ") and "Traceback" not in captured.err
 
 
+@pytest.mark.parametrize("argv", [["field", "trough", "--date", "2021-06-21", "--count", "1", "--out", ""], SIMULATE + ["--out", " "],
+                                  ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--csv", ""],
+                                  ["demo", "--out", ""]])
+def test_an_empty_output_path_is_refused_not_read_as_no_output(capsys, argv):
+    """``--out "$DIR"`` with DIR unset had run the whole command and written nothing, silently."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is empty: give a file or folder to write" in err
+
+
 @pytest.mark.parametrize("argv", [["ablate", "--policies", "bogus"], ["simulate", "--date", "2021-06-21", "--freq"],
                                   ["sun", "--variation"], [], ["classify", "--intensity", "--variation", "1"],
                                   ["simulate", "--date", "2021-06-21", "--bogus"]])

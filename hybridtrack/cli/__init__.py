@@ -55,6 +55,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with reader_may_leave():  # --help and --version print here too: a full standard output is one line
             args = build_parser().parse_args(argv)
+            _refuse_empty_paths(args)
             with replacing(getattr(args, "force", False)) as replaced, removing_empty_folders():
                 status = args._run(args)
                 if replaced:
@@ -76,6 +77,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         name = f" {exc.filename}" if exc.filename else ""
         print(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_USAGE
+
+
+#: The options that name a file or folder to write.
+_OUTPUT_OPTIONS = ("out", "csv", "plot", "report")
+
+
+def _refuse_empty_paths(args) -> None:
+    """Refuse an output option given an empty path (``--out "$DIR"`` with DIR unset), which would
+    otherwise read as no output at all and write nothing without a word."""
+    for name in _OUTPUT_OPTIONS:
+        value = getattr(args, name, None)
+        if isinstance(value, str) and not value.strip():
+            raise HybridtrackError(f"--{name} is empty: give a file or folder to write (an unset shell variable?)")
 
 
 if __name__ == "__main__":  # pragma: no cover
