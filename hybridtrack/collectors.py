@@ -339,6 +339,9 @@ class Collector:
             number(value, "collector: aim (m)", -MAX_DISTANCE, MAX_DISTANCE)
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
+            if not self.aim[2] > 0:
+                raise HybridtrackError(f"collector: aim (m): the aim point must be above the mirror, got "
+                                       f"{self.aim[2]:g} m up: a heliostat reflects the sun up to its receiver")
 
     @property
     def single_axis(self) -> bool:

@@ -40,7 +40,7 @@ from .collectors import (
 )
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
-from .outputs import claim, strict_json, write
+from .outputs import claim, strict_json, together, write
 from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -135,19 +135,31 @@ def _across_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
 
 
 def _as_numbers(values) -> np.ndarray | None:
-    """`values` as a float array if they are numbers (not text, not True/False), else None."""
+    """`values` as a float array if they are numbers (not text, not True/False, not even one among
+    numbers, which numpy would read as 1 or 0), else None."""
     try:
         raw = np.asarray(values)
     except (TypeError, ValueError):  # ragged
         return None
-    return raw.astype(float) if raw.dtype.kind in "iuf" else None
+    if raw.dtype.kind not in "iuf":
+        return None
+    if not isinstance(values, np.ndarray) and any(isinstance(v, (bool, np.bool_))
+                                                  for v in np.asarray(values, dtype=object).ravel()):
+        return None
+    return raw.astype(float)
+
+
+def _brief(values) -> str:
+    """`values` as one short line for a message (a frame's or an array's repr runs over lines)."""
+    text = " ".join(repr(values).split())
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _finite_vector(values, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> np.ndarray:
     """`values` as a 1-D float array, refused unless numbers, finite, within ±`bound` (and positive)."""
     array = _as_numbers(values)
     if array is None:
-        raise HybridtrackError(f"{name} must be numbers, got {values!r:.80}")
+        raise HybridtrackError(f"{name} must be numbers, got {_brief(values)}")
     array = np.atleast_1d(array)
     if array.ndim != 1 or array.size == 0:
         raise HybridtrackError(f"{name} must be a non-empty list of numbers, got shape {array.shape}")
@@ -314,7 +326,7 @@ class HeliostatField:
         _spread_of(self)
         xyz = _as_numbers(self.positions)
         if xyz is None or xyz.ndim != 2 or xyz.shape[1] not in (2, 3) or len(xyz) == 0:
-            raise HybridtrackError(f"heliostat positions must be (N, 2) or (N, 3) metres, got {self.positions!r:.80}")
+            raise HybridtrackError(f"heliostat positions must be numbers, (N, 2) or (N, 3) metres, got {_brief(self.positions)}")
         if xyz.shape[1] == 2:
             xyz = np.column_stack([xyz, np.zeros(len(xyz))])
         if not np.all(np.isfinite(xyz)):
@@ -324,7 +336,7 @@ class HeliostatField:
         object.__setattr__(self, "positions", xyz)
         aim = _as_numbers(self.aim)
         if aim is None or aim.shape != (3,):
-            raise HybridtrackError(f"heliostat aim must be three numbers (east, north, up), m, got {self.aim!r:.80}")
+            raise HybridtrackError(f"heliostat aim must be three numbers (east, north, up), m, got {_brief(self.aim)}")
         aims = np.broadcast_to(aim, xyz.shape) if self.aims is None else _as_numbers(self.aims)
         if aims is None or aims.shape != xyz.shape:
             raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
@@ -502,13 +514,14 @@ class FieldResult:
         and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`."""
         written = self.files(folder, log=self.dataset is not None)
         claim(written.values())
-        write(written["collectors"],
-              lambda path: self.collectors.to_csv(path, index_label="collector", float_format="%.6g"))
-        write(written["events"], lambda path: self.events.to_csv(path, index=False))
-        write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
-        write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
-        if self.dataset is not None:
-            write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
+        with together():  # all of this field's files, or none
+            write(written["collectors"],
+                  lambda path: self.collectors.to_csv(path, index_label="collector", float_format="%.6g"))
+            write(written["events"], lambda path: self.events.to_csv(path, index=False))
+            write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
+            write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
+            if self.dataset is not None:
+                write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
         return written
 
 

@@ -10,10 +10,10 @@ Every function that writes a result file first passes the paths it is about to w
   with ``--force``, the files it replaced); from Python the files are replaced as `open` would,
   unless the call runs inside ``with replacing(False):``.
 
-`write` writes a whole file under a temporary name beside it and renames it into place only
-when it is complete, so a failure (a full disk, an interrupt) leaves no half file and keeps any
-file it would have replaced; `write_in_place` is for a file that grows as a run goes (a streamed
-log). Folders `claim` made are removed again, if still empty, when the command fails
+`write` writes a whole file in a hidden folder beside it and moves it into place only when it
+is complete (inside `together`, a result's files all at once), so a failure (a full disk, an
+interrupt) leaves no half file and keeps any file it would have replaced; `write_in_place` is for
+a file that grows as a run goes (a streamed log). Folders `claim` made are removed again, if still empty, when the command fails
 (`removing_empty_folders`).
 
 `strict_json` writes JSON that any parser reads: a missing or non-finite number is ``null``,
@@ -27,9 +27,9 @@ import contextvars
 import json
 import math
 import os
-import secrets
 import shutil
 import sys
+import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
@@ -37,12 +37,13 @@ import numpy as np
 
 from .errors import HybridtrackError
 
-__all__ = ["claim", "replacing", "removing_empty_folders", "write", "write_in_place", "strict_json", "plain_numbers",
-           "reader_may_leave"]
+__all__ = ["claim", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
+           "plain_numbers", "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
 _REPLACED: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_replaced", default=None)
 _MADE: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_made", default=None)
+_GROUP: contextvars.ContextVar[list | None] = contextvars.ContextVar("hybridtrack_group", default=None)
 
 
 @contextlib.contextmanager
@@ -132,12 +133,15 @@ def _make_folder(folder: Path) -> None:
 
 
 def write(path, writer: Callable[[Path], object]) -> Path:
-    """Write the whole file `path` with ``writer(partial)``, where ``partial`` is a new file beside
-    it, renamed to `path` once `writer` has returned.
+    """Write the whole file `path` with ``writer(partial)``, where ``partial`` is a new file of the
+    same name in a hidden folder beside it, moved to `path` once `writer` has returned (inside
+    `together`, once every file of the block is written).
 
     A failure (a full disk, an interrupt) removes the partial file: no half-written `path` is left,
-    and a file `path` held already is kept. The new file takes an existing one's permissions. A
-    path that is not a regular file (a device such as ``/dev/stdout``) is written in place.
+    and a file `path` held already is kept. The new file takes an existing one's permissions; its
+    name is the target's own, so a name at the length limit fits and a packed file (``.zip``,
+    ``.gz``) names its member after it. A path that is not a regular file (a device) is written
+    in place, and so is an existing file that may be rewritten in a folder that takes no new file.
 
     Raises
     ------
@@ -147,18 +151,48 @@ def write(path, writer: Callable[[Path], object]) -> Path:
     path = Path(path)
     if path.exists() and not path.is_file():
         return write_in_place(path, writer)
-    partial = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.partial{path.suffix}")  # the suffix tells the format
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=".hybridtrack-", dir=path.parent))
+    except PermissionError:
+        if path.is_file() and os.access(path, os.W_OK):
+            return write_in_place(path, writer)
+        raise HybridtrackError(f"{path}: cannot write (its folder takes no new file)") from None
+    except OSError as exc:
+        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    partial, group = staging / path.name, _GROUP.get()
     try:
         with _naming(path):
-            os.close(os.open(partial, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))  # new, never through a link
             if path.exists():
+                partial.touch()
                 shutil.copymode(path, partial)
             writer(partial)
-            os.replace(partial, path)
+            if group is None:
+                os.replace(partial, path)
+            else:
+                group.append((partial, path))
+                staging = None  # moved, or removed, when the group ends
     finally:
-        with contextlib.suppress(OSError):
-            partial.unlink(missing_ok=True)
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     return path
+
+
+@contextlib.contextmanager
+def together() -> Iterator[None]:
+    """Within the block, the files `write` writes are moved into place together when the block
+    ends without an error, and none of them is if it fails: a result's files are all of one run
+    (a failed ``--force`` run leaves the earlier run's files whole, not half replaced)."""
+    pending: list[tuple[Path, Path]] = []
+    token = _GROUP.set(pending)
+    try:
+        yield
+        for partial, path in pending:
+            with _naming(path):
+                os.replace(partial, path)
+    finally:
+        _GROUP.reset(token)
+        for partial, _ in pending:
+            shutil.rmtree(partial.parent, ignore_errors=True)
 
 
 def write_in_place(path, writer: Callable[[Path], object]) -> Path:

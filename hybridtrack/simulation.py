@@ -32,7 +32,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
-from .outputs import claim, strict_json, write
+from .outputs import claim, strict_json, together, write
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
@@ -233,16 +233,17 @@ class Result:
         for what is refused."""
         written = self.files(folder, plot=plot, log_format=log_format)
         claim(written.values())
-        if log_format == "parquet":
-            write(written["log"], self.log.to_parquet)
-        else:
-            write(written["log"], lambda path: self.log.to_csv(path, float_format="%.5f", index_label="time"))
-        write(written["events"], lambda path: self.events.to_csv(path, index=False))
-        write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
-        if plot:
-            from .report import plot_run, save_figure
+        with together():  # all of this run's files, or none
+            if log_format == "parquet":
+                write(written["log"], self.log.to_parquet)
+            else:
+                write(written["log"], lambda path: self.log.to_csv(path, float_format="%.5f", index_label="time"))
+            write(written["events"], lambda path: self.events.to_csv(path, index=False))
+            write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
+            if plot:
+                from .report import plot_run, save_figure
 
-            save_figure(plot_run(self), written["report"])
+                save_figure(plot_run(self), written["report"])
         return written
 
     # -- for people (hybridtrack.report): a short repr, an HTML repr, pictures, a daily table --

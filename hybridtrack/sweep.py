@@ -47,7 +47,7 @@ import pandas as pd
 from . import params
 from .cluster import close, dask_client
 from .errors import HybridtrackError
-from .outputs import claim, write
+from .outputs import claim, together, write
 
 __all__ = ["Sweep", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
@@ -206,6 +206,8 @@ def _weather_names(value) -> list[str]:
     from .sky import WEATHERS
 
     names = value if isinstance(value, list) else str(value).split(",")
+    if not names:
+        raise HybridtrackError("weather is an empty list; give a weather, or one per day")
     for name in names:
         if name not in WEATHERS:
             raise HybridtrackError(f"unknown weather {name!r}; choose from {', '.join(WEATHERS)} or a per-day list")
@@ -489,12 +491,18 @@ def sweep_files(folder) -> dict[str, Path]:
 
 
 def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
-    """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them)."""
+    """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them).
+
+    The table is written first and on its own: the finished runs are kept even if the plot
+    cannot be drawn or written; the plot and the sweep go in together."""
+    if not isinstance(sweep, Sweep):
+        raise HybridtrackError(f"save_sweep: sweep must be a Sweep, got {type(sweep).__name__}")
     written = sweep_files(folder)
     claim(written.values())
-    write(written["table"], lambda path: table.to_parquet(path, index=False))  # first: the finished runs
-    sweep.to_toml(written["sweep"])
-    colour = next(iter(sweep.grid))
-    figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
-    write(written["plot"], lambda path: figure.savefig(path, dpi=120))
+    write(written["table"], lambda path: table.to_parquet(path, index=False))
+    with together():
+        sweep.to_toml(written["sweep"])
+        colour = next(iter(sweep.grid))
+        figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
+        write(written["plot"], lambda path: figure.savefig(path, dpi=120))
     return written

@@ -107,7 +107,7 @@ def parse_date(text) -> dt.date:
             day = dt.date.fromisoformat(str(text).strip())
         except ValueError:
             raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD") from None
-    check_dates(day, day, f"date {text!r}")
+    check_dates(day, day, f"date {text!r}" if isinstance(text, str) else f"date {day}")
     return day
 
 

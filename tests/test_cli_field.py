@@ -31,7 +31,7 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
 
     want = np.array([[0.0, -80.0], [40.0, -70.5]])
     for name, text in (("comma", "east,north\n0,-80\n40,-70.5\n"), ("semicolon", "east;north\n0;-80\n40;-70.5\n"),
-                       ("tab", "east\tnorth\n0\t-80\n40\t-70.5\n"),
+                       ("tab", "east\tnorth\n0\t-80\n40\t-70.5\n"), ("bar", "east|north\n0|-80\n40|-70.5\n"),
                        ("comments and trailing separators", "# site survey\neast,north,\n0,-80,\n40,-70.5,\n")):
         path = tmp_path / f"{name}.csv"
         path.write_text(text)

@@ -95,6 +95,13 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: FresnelField(axis_azimuth=True), "axis azimuth must be numbers"),
     (lambda: HeliostatField(positions=[["1", "2"]]), r"\(N, 2\) or \(N, 3\)"),
     (lambda: HeliostatField(positions=[[True, False]]), r"\(N, 2\) or \(N, 3\)"),
+    # one True among numbers had been read as 1
+    (lambda: HeliostatField(positions=[[50, True]]), r"positions must be numbers"),
+    (lambda: HeliostatField(positions=[[50, 0], [0, 60]], aim=(True, False, 100)), "aim must be three numbers"),
+    (lambda: FresnelField(row_distances=[True, 0.5]), "row distances must be numbers"),
+    # a frame's repr had run the message over several lines
+    (lambda: HeliostatField(positions=pd.DataFrame({"e": [1.0, 2.0], "n": [3.0, 4.0]}).astype("Float64")),
+     r"^heliostat positions must be numbers, \(N, 2\) or \(N, 3\) metres, got e n 0 1.0 3.0 1 2.0 4.0$"),
     (lambda: HeliostatField(positions=[[1, 2]], aims=[["0", "0", "1"]]), "one \\(x, y, z\\) per heliostat"),
     # a spread of another type had been accepted, to fail at run time with an AttributeError
     (lambda: FresnelField(spread=None), "FresnelField: spread must be an ImperfectionSpread, got NoneType"),

@@ -289,7 +289,7 @@ def test_a_device_is_written_in_place_not_replaced():
 
     with pytest.raises(HybridtrackError, match=r"^/dev/full: cannot write \(No space left on device\)$"):
         write("/dev/full", lambda target: Path(target).write_text("x" * 10_000))
-    assert Path("/dev/full").is_char_device() and not list(Path("/dev").glob(".full.*"))
+    assert Path("/dev/full").is_char_device() and not list(Path("/dev").glob(".hybridtrack-*"))
 
 
 def test_a_run_whose_log_cannot_be_written_leaves_nothing_behind(tmp_path, monkeypatch, capsys):
@@ -314,3 +314,56 @@ def test_help_and_version_to_a_full_standard_output_are_one_line(args):
                                env=env)
     assert child.returncode == 2
     assert child.stderr.decode() == "hybridtrack: error: standard output: cannot write (No space left on device)\n"
+
+
+def test_a_name_at_the_length_limit_and_a_packed_files_member_keep_their_own_names(tmp_path):
+    """The partial file had been named '.NAME.xxxxxxxx.partial.SUFFIX': 18 bytes more, past the
+    255-byte limit for a name the old code wrote, and inside a zip as the member's name."""
+    import zipfile
+
+    from hybridtrack.outputs import write
+
+    longest = tmp_path / ("a" * 251 + ".csv")
+    write(longest, lambda path: path.write_text("x\n"))
+    assert longest.read_text() == "x\n"
+    packed = tmp_path / "t.csv.zip"
+    write(packed, lambda path: pd.DataFrame({"a": [1]}).to_csv(path, index=False))
+    assert zipfile.ZipFile(packed).namelist() == ["t.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([longest.name, "t.csv.zip"])  # no staging left
+
+
+def test_files_written_together_are_replaced_all_or_none(tmp_path):
+    """A failed --force run had left some files of the new run beside the rest of the old one."""
+    from hybridtrack.outputs import together, write
+
+    first, second = tmp_path / "log.csv", tmp_path / "report.png"
+    for path in (first, second):
+        path.write_text("old run\n")
+    with pytest.raises(HybridtrackError, match="No space left on device"), together():
+        write(first, lambda path: path.write_text("new run\n"))
+        write(second, _half_then_full)
+    assert first.read_text() == second.read_text() == "old run\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["log.csv", "report.png"]
+    with together():
+        for path in (first, second):
+            write(path, lambda path: path.write_text("new run\n"))
+    assert first.read_text() == second.read_text() == "new run\n"
+
+
+def test_a_folder_that_takes_no_new_file_still_lets_a_writable_file_be_rewritten(tmp_path, monkeypatch):
+    """The staging folder cannot be made there: an existing file that may be written is rewritten in
+    place, as before; a new file is refused naming why."""
+    import tempfile
+
+    from hybridtrack.outputs import write
+
+    def no_new_file(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    existing = tmp_path / "x.csv"
+    existing.write_text("old\n")
+    monkeypatch.setattr(tempfile, "mkdtemp", no_new_file)
+    write(existing, lambda path: path.write_text("new\n"))
+    assert existing.read_text() == "new\n"
+    with pytest.raises(HybridtrackError, match=r"new.csv: cannot write \(its folder takes no new file\)"):
+        write(tmp_path / "new.csv", lambda path: path.write_text("new\n"))

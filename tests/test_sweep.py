@@ -73,6 +73,7 @@ def test_the_grid_is_every_combination_in_order():
     ({"base": {"days": 3, "weather": ["sunny", "cloudy"]}, "grid": {"seed": [0]}},
      "s.toml: base.days, base.weather: 2 weathers given for 3 days; give one per day"),
     ({"base": {"freq": ["1min"]}, "grid": {"seed": [0]}}, r"s.toml: base.freq: freq must be a step .* got \['1min'\]"),
+    ({"base": {"weather": []}, "grid": {"seed": [0]}}, "s.toml: base.weather: weather is an empty list"),  # IndexError
 ])
 def test_bad_sweeps_are_refused_before_any_run(data, message):
     with pytest.raises(HybridtrackError, match=message):
@@ -232,3 +233,12 @@ def test_the_example_sweep_is_valid_and_runs_one_of_its_runs():
     assert len(runs) == 25 and list(sweep.grid) == ["drive.deadband", "seed"] and (sweep.x, sweep.y) == ("moves", "rms")
     row = run_one({**sweep.base, "days": 1, "freq": "10min"}, runs[0], sweep.source)
     assert row["error"] is None and row["collector"] == "fresnel" and row["start"] == "2021-06-19"
+
+
+def test_saving_with_something_that_is_not_a_sweep_writes_nothing(tmp_path):
+    """save_sweep(table, None, ...) had written runs.parquet, then failed with an AttributeError."""
+    from hybridtrack.sweep import save_sweep
+
+    with pytest.raises(HybridtrackError, match="save_sweep: sweep must be a Sweep, got NoneType"):
+        save_sweep(pd.DataFrame({"run": [0]}), None, tmp_path / "out")
+    assert not (tmp_path / "out").exists()

@@ -191,9 +191,11 @@ def read_table(path) -> pd.DataFrame:
             raise HybridtrackError(f"{path}: expected an array of [[case]] tables")
         frame = pd.DataFrame(rows)
     else:
-        _refuse_long_rows(path, text)
+        kept = _kept_lines(text)[0]
+        sep = _table_separator(path, kept)
+        _refuse_long_rows(path, kept, sep)
         try:
-            frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", skipinitialspace=True,
+            frame = pd.read_csv(io.StringIO(text), sep=sep, engine="python", comment="#", skipinitialspace=True,
                                 index_col=False)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as exc:
             raise HybridtrackError(f"{path}: cannot read as CSV: {str(exc).splitlines()[0]}") from None
@@ -208,16 +210,22 @@ def read_table(path) -> pd.DataFrame:
     return frame
 
 
-def _refuse_long_rows(path: Path, text: str) -> None:
+def _table_separator(path: Path, kept: list[tuple[int, str]]) -> str:
+    """A small table's separator, chosen as for a weather file (`_choose_separator`: comma,
+    semicolon, tab or bar); a comma for a table of one column, which any separator reads."""
+    if len(kept) < 2:
+        return ","
+    try:
+        return _choose_separator(path, kept)[1]
+    except HybridtrackError:
+        return ","
+
+
+def _refuse_long_rows(path: Path, kept: list[tuple[int, str]], sep: str) -> None:
     """Refuse a row with more fields than its header names: pandas would take the first column for
     an index and shift every value one column left (or, told not to, drop the last ones)."""
-    kept = _kept_lines(text)[0]
-    if len(kept) < 2:
+    if not kept:
         return
-    try:
-        sep = csv.Sniffer().sniff(kept[0][1]).delimiter  # as pandas finds it: from the header line
-    except csv.Error:
-        return  # pandas cannot tell either, and says so
     width = len(_split(kept[0][1], sep))
     for number, line in kept[1:]:
         fields = _split(line, sep)
