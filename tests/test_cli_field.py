@@ -47,6 +47,9 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
     ("# mirrors\neast,north\n0,-100\n50,abc\n", [], "row 4, column 'north': 'abc' is not a number"),
     # a row longer than its header had been read with its first field as the index: every mirror moved
     ("east,north\n0,-100,5\n30,-90,5\n", [], "line 2: 3 fields, but the header on line 1 names 2"),
+    # a column named twice had been read as two (a traceback) or one silently dropped (east.1)
+    ("east,north,EAST\n60,0,1\n0,60,2\n", [], "line 1: column 'east' appears more than once in the header"),
+    ("# mirrors\neast,north,east\n60,0,1\n0,60,2\n", [], "line 2: column 'east' appears more than once"),
     ("x,y\n0,1\n", [], "no column 'east'"),
     ("east,north,aim_up\n0,-100,4\n", [], "aim points need all of"),
     ("east,north\n0,-100\n", ["--metric", "shine"], "--metric: no collector metric 'shine'"),

@@ -91,3 +91,11 @@ def test_toml_cases_carry_their_table_line():
     cases = load_cases(ROOT / "tests" / "test_complete.rules.toml")
     text = (ROOT / "tests" / "test_complete.rules.toml").read_text().splitlines()
     assert all(text[case.line - 1].startswith("[[case]]") for case in cases)
+
+
+def test_a_toml_case_naming_a_column_twice_is_refused(tmp_path):
+    # names are read lowered: 'Weather' and 'weather' would be two keys pandas keeps side by side
+    table = tmp_path / "cases.toml"
+    table.write_text('[[case]]\nintensity = 250\nvariation = 10\nweather = "sunny"\nWeather = "cloudy"\n')
+    with pytest.raises(HybridtrackError, match="case 1: column 'weather' appears more than once"):
+        load_cases(table)

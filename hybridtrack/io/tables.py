@@ -189,11 +189,15 @@ def read_table(path) -> pd.DataFrame:
         rows = data.get("case", data.get("cases"))
         if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
             raise HybridtrackError(f"{path}: expected an array of [[case]] tables")
+        for number, row in enumerate(rows, 1):
+            _refuse_repeated_names(path, [str(key).strip().lower() for key in row], f"case {number}")
         frame = pd.DataFrame(rows)
     else:
         kept = _kept_lines(text)[0]
         sep = _table_separator(path, kept)
         _refuse_long_rows(path, kept, sep)
+        if kept:
+            _refuse_repeated_names(path, [f.strip().lower() for f in _split(kept[0][1], sep)], f"line {kept[0][0]}")
         try:
             frame = pd.read_csv(io.StringIO(text), sep=sep, engine="python", comment="#", skipinitialspace=True,
                                 index_col=False)
@@ -219,6 +223,17 @@ def _table_separator(path: Path, kept: list[tuple[int, str]]) -> str:
         return _choose_separator(path, kept)[1]
     except HybridtrackError:
         return ","
+
+
+def _refuse_repeated_names(path: Path, names: list[str], where: str) -> None:
+    """Refuse a header naming a column twice (column names are read stripped and lowered, so
+    ``east`` and ``EAST`` are one name): pandas would keep one and rename or drop the other."""
+    seen = set()
+    for name in names:
+        if name and name in seen:
+            raise HybridtrackError(f"{path}: {where}: column {name!r} appears more than once in the header; "
+                                   "rename one")
+        seen.add(name)
 
 
 def _refuse_long_rows(path: Path, kept: list[tuple[int, str]], sep: str) -> None:
