@@ -276,10 +276,15 @@ def reader_may_leave() -> Iterator[None]:
     """Within the block, a closed standard output (``| head``) ends the printing, not the work:
     the command goes on and writes its files."""
     original = sys.stdout
-    sys.stdout = _PipeSafe(original)
+    # a standard output closed before the start (``>&-``) is None: what is printed goes nowhere, as
+    # after a reader that left
+    sink = open(os.devnull, "w") if original is None else None
+    sys.stdout = _PipeSafe(original if sink is None else sink)
     try:
         yield
     finally:
         with contextlib.suppress(BrokenPipeError):
             sys.stdout.flush()
         sys.stdout = original
+        if sink is not None:
+            sink.close()

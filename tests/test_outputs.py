@@ -259,6 +259,49 @@ def test_a_full_standard_output_is_one_line_that_names_it():
     assert child.stderr.decode() == "hybridtrack: error: standard output: cannot write (No space left on device)\n"
 
 
+class FullDevice:
+    """Standard output on a full disk, unbuffered: every write raises ENOSPC, and a flush has nothing
+    to write (tqdm flushes standard output as a bar starts)."""
+
+    def write(self, text):
+        import errno
+
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    def flush(self):
+        pass
+
+
+@pytest.mark.parametrize("args, files", [
+    (SHORT, RUN_FILES),
+    (["field", "trough", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min", "--count", "2"],
+     ("collectors.csv", "summary.json", "log.nc")),
+    (["compare", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min"],
+     ("comparison.json", "comparison.png", "hybrid/summary.json")),
+], ids=["simulate", "field", "compare"])
+def test_a_full_standard_output_is_one_line_but_keeps_the_run_it_computed(tmp_path, monkeypatch, capsys, args,
+                                                                           files):
+    """The summary was printed before the files were written: a full standard output threw the run away."""
+    out = tmp_path / "out"
+    monkeypatch.setattr(sys, "stdout", FullDevice())
+    assert main(args + ["--out", str(out)]) == 2
+    error = capsys.readouterr().err.splitlines()[-1]  # after the field's progress bar
+    assert error == "hybridtrack: error: standard output: cannot write (No space left on device)"
+    for name in files:
+        assert (out / name).stat().st_size > 0, name
+
+
+def test_a_standard_output_closed_before_the_start_is_a_reader_that_left(tmp_path):
+    """``>&-``: Python's sys.stdout is None, and every command ended in an AttributeError traceback."""
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    for args in (["--version"], SHORT + ["--out", str(out)]):
+        child = subprocess.run([sys.executable, "-m", "hybridtrack", *args], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE, env=env, preexec_fn=lambda: os.close(1))
+        assert child.returncode == 0 and child.stderr.decode() == "", child.stderr.decode()
+    assert (out / "summary.json").stat().st_size > 0
+
+
 # -- a failed write leaves no half file --------------------------------------------------------------
 
 def _half_then_full(target):

@@ -181,13 +181,13 @@ def _field(args: argparse.Namespace) -> int:
     result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
                             seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True,
                             threads=args.threads, workers=args.workers, scheduler=args.scheduler)
+    written = result.save(args.out, metric=args.metric) if args.out else None  # first: a failing standard output
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
           f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {args.strategy}")
     print(field_table(result.summary))
     shown = ["east", "north", "rms", "energy_capture", "moves"] + \
         (["end_loss_share"] if "end_loss_share" in result.collectors else [])
     print(result.collectors[shown].to_string(max_rows=12, float_format=lambda v: f"{v:.4g}"))
-    if args.out:
-        written = result.save(args.out, metric=args.metric)
+    if written:  # loses no run
         print("wrote " + ", ".join(str(p) for p in written.values()))
     return 0

@@ -73,10 +73,10 @@ def _claim_run_folder(args: argparse.Namespace) -> None:
 
 
 def _finish(result, args, *, heading: str) -> None:
+    written = result.save(args.out) if args.out else None  # saved first: a failing standard output loses no run
     print(heading)
     print(summary_table({result.summary["strategy"]: result.summary}))
-    if args.out:
-        written = result.save(args.out)
+    if written:
         print("wrote " + ", ".join(str(p) for p in written.values()))
 
 
@@ -102,11 +102,11 @@ def _demo(args: argparse.Namespace) -> int:
     site = sites.get("lanzhou")
     frame = synthetic(site, "2021-06-21", weather="mixed", seed=5, gusts_per_day=2.0)
     result = simulate(frame, site, collector=Collector("fresnel"), strategy="hybrid")
+    with replacing(True):
+        written = result.save(args.out)
     print("demo: Lanzhou linear Fresnel row, 2021-06-21, mixed sky with gusts (seed 5), hybrid strategy, default "
           "imperfections")
     print(summary_table({"hybrid": result.summary}))
-    with replacing(True):
-        written = result.save(args.out)
     print(f"wrote {written['report']} (the day at a glance), {written['summary']}, {written['log']}, "
           f"{written['events']}" + (" (replacing those of an earlier run)" if replaced else ""))
     return 0
@@ -266,20 +266,26 @@ def _compare(args: argparse.Namespace) -> int:
     if args.out:
         claim(_compare_files(args.out, policies))
     results = {strategy: _run(frame, site, args, strategy, config) for strategy in policies}
+    written = _save_comparison(results, args.out) if args.out else None  # first: a failing standard output loses none
     first = next(iter(results.values()))
     print(f"{site.name}, {first.summary['start'][:10]} to {first.summary['end'][:10]}, {first.collector.kind}: "
           "every strategy on the same weather and world")
     print(summary_table({name: r.summary for name, r in results.items()}))
-    if args.out:
-        from pathlib import Path
-
-        from ..report import plot_compare, save_figure
-
-        folder = Path(args.out)
-        for name, result in results.items():
-            result.save(folder / name, plot=False)
-        summaries = strict_json({n: r.summary for n, r in results.items()}, indent=2) + "\n"
-        write(folder / "comparison.json", lambda file: file.write_text(summaries))
-        print(f"wrote {save_figure(plot_compare(results), folder / 'comparison.png')}, {folder / 'comparison.json'} "
-              f"and one folder per strategy")
+    if written:
+        print(f"wrote {written}")
     return 0
+
+
+def _save_comparison(results: dict, out: str) -> str:
+    """Each strategy's folder, ``comparison.json`` and ``comparison.png`` in `out`; what was written."""
+    from pathlib import Path
+
+    from ..report import plot_compare, save_figure
+
+    folder = Path(out)
+    for name, result in results.items():
+        result.save(folder / name, plot=False)
+    summaries = strict_json({n: r.summary for n, r in results.items()}, indent=2) + "\n"
+    write(folder / "comparison.json", lambda file: file.write_text(summaries))
+    return f"{save_figure(plot_compare(results), folder / 'comparison.png')}, {folder / 'comparison.json'} " \
+           "and one folder per strategy"
