@@ -9,7 +9,11 @@ collectors share one computation of their sky; `hybridtrack.fields`.)
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
+import threading
+from collections.abc import Iterator
 
 from . import params
 from .errors import HybridtrackError
@@ -53,13 +57,30 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
     count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else cores()
     try:
-        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=50)  # a failed task is reported by its result, not logged
+        with _deaf_to_ctrl_c():
+            cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   silence_logs=50)  # a failed task is reported by its result, not logged
     except RuntimeError as exc:  # distributed's "Nanny failed to start", multiprocessing's bootstrapping error
         raise HybridtrackError(f"cannot start {count} local Dask workers for {what} ({' '.join(str(exc).split())[:120]}); "
                                "workers are new processes that import the running script again, so a script "
                                "must start its run under `if __name__ == \"__main__\":`") from None
     return Client(cluster), cluster
+
+
+@contextlib.contextmanager
+def _deaf_to_ctrl_c() -> Iterator[None]:
+    """Start worker processes that ignore Ctrl-C. A terminal sends SIGINT to the whole process
+    group: each worker printed distributed's KeyboardInterrupt traceback while this process,
+    which the user interrupted, stopped them anyway (an ignored signal stays ignored in a child).
+    Only the main thread may set a handler; elsewhere the workers start as they would."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def close(client, cluster) -> None:

@@ -49,7 +49,7 @@ from .cluster import close, dask_client
 from .errors import HybridtrackError
 from .outputs import claim, together, write
 
-__all__ = ["Sweep", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
+__all__ = ["Sweep", "SweepInterrupted", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
 
 #: Keys of a run besides its config, with their defaults.
@@ -388,9 +388,27 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
                 except Exception as exc:  # noqa: BLE001 - the worker died (killed, out of memory): record it
                     rows.append(_failed(_row(_spec(sweep.base, futures[future])), exc))
                 bar.update()
+    except KeyboardInterrupt:
+        raise SweepInterrupted(_table(rows) if rows else None, len(runs)) from None
     finally:
         close(client, cluster)
     return _table(rows)
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during `run_sweep`: a KeyboardInterrupt that keeps the runs finished before it.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame or None
+        The finished runs, one row each as `run_sweep` returns them; None if none had finished.
+    planned : int
+        The runs the sweep had.
+    """
+
+    def __init__(self, table: pd.DataFrame | None, planned: int) -> None:
+        super().__init__(f"{0 if table is None else len(table)} of {planned} runs had finished")
+        self.table, self.planned = table, planned
 
 
 def _table(rows: list[dict]) -> pd.DataFrame:
@@ -488,6 +506,11 @@ def sweep_files(folder) -> dict[str, Path]:
     """The files `save_sweep` writes into `folder`, by role."""
     folder = Path(folder)
     return {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png", "sweep": folder / "sweep.toml"}
+
+
+def partial_file(folder) -> Path:
+    """Where an interrupted sweep's finished runs go (`SweepInterrupted.table`)."""
+    return Path(folder) / "runs.partial.parquet"
 
 
 def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:

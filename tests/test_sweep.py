@@ -242,3 +242,37 @@ def test_saving_with_something_that_is_not_a_sweep_writes_nothing(tmp_path):
     with pytest.raises(HybridtrackError, match="save_sweep: sweep must be a Sweep, got NoneType"):
         save_sweep(pd.DataFrame({"run": [0]}), None, tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_path):
+    """A terminal's Ctrl-C reaches the whole process group: each Dask worker printed distributed's
+    KeyboardInterrupt traceback, and the runs already finished were lost with the folder."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import tomli_w
+
+    spec = {**TINY, "grid": {"seed": list(range(400))}}
+    (tmp_path / "many.toml").write_text(tomli_w.dumps(spec))
+    child = subprocess.Popen([sys.executable, "-m", "hybridtrack", "sweep", "many.toml", "--out", "out",
+                              "--workers", "2"], cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                             start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    seen = b""
+    deadline = time.monotonic() + 120
+    while b" 3/400" not in seen and time.monotonic() < deadline:  # the progress bar: three runs done
+        chunk = os.read(child.stderr.fileno(), 4096)
+        if not chunk:
+            break
+        seen += chunk
+    os.killpg(child.pid, signal.SIGINT)
+    error = (seen + child.stderr.read()).decode()
+    assert child.wait(timeout=60) == 130
+    assert "Traceback" not in error and "KeyboardInterrupt" not in error
+    finished = pd.read_parquet(tmp_path / "out" / "runs.partial.parquet")
+    assert 3 <= len(finished) < 400 and finished["run"].is_unique and finished["error"].isna().all()
+    assert error.rstrip().endswith(f"the {len(finished)} of 400 runs that had finished are in "
+                                   f"{os.path.join('out', 'runs.partial.parquet')}")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["runs.partial.parquet"]

@@ -69,9 +69,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except HybridtrackError as exc:
         print(f"hybridtrack: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:  # Ctrl-C: one line, no traceback; the shell's status for SIGINT
-        print("\nhybridtrack: interrupted; files already written are left as they are (an unfinished streamed "
-              "run leaves its finished days in log.partial.parquet and events.partial.csv)", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback; the shell's status for SIGINT
+        what = str(exc) or ("files already written are left as they are (an unfinished streamed run leaves its "
+                            "finished days in log.partial.parquet and events.partial.csv)")
+        print(f"\nhybridtrack: interrupted; {what}", file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:
         name = f" {exc.filename}" if exc.filename else ""

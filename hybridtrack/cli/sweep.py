@@ -21,13 +21,17 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
          _sweep_arguments)
 def _sweep(args: argparse.Namespace) -> int:
     from ..outputs import claim
-    from ..sweep import Sweep, pareto_front, run_sweep, save_sweep, sweep_files
+    from ..sweep import Sweep, SweepInterrupted, partial_file, pareto_front, run_sweep, save_sweep, sweep_files
 
     sweep = Sweep.from_toml(args.file)
-    claim(sweep_files(args.out).values())  # a folder that cannot be used fails now, not after the runs
+    # a folder that cannot be used fails now, not after the runs
+    claim([*sweep_files(args.out).values(), partial_file(args.out)])
     runs = len(sweep.runs())
     print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
-    table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
+    try:
+        table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
+    except SweepInterrupted as stopped:
+        raise KeyboardInterrupt(_keep_finished(stopped, args.out)) from None
     written = save_sweep(table, sweep, args.out)
     failed = table[table["error"].notna()]
     keys = [k for k in ("run", *sweep.grid) if k in table]
@@ -42,3 +46,15 @@ def _sweep(args: argparse.Namespace) -> int:
     if len(failed) == len(table):
         raise HybridtrackError(f"every run failed; run {failed['run'].iloc[0]}: {failed['error'].iloc[0]}")
     return 0
+
+
+def _keep_finished(stopped, out: str) -> str:
+    """Write an interrupted sweep's finished runs to ``runs.partial.parquet``; what to tell the user."""
+    from ..outputs import write
+    from ..sweep import partial_file
+
+    if stopped.table is None:
+        return f"none of the {stopped.planned} runs had finished; nothing written"
+    path = partial_file(out)
+    write(path, lambda target: stopped.table.to_parquet(target, index=False))
+    return f"the {len(stopped.table)} of {stopped.planned} runs that had finished are in {path}"
