@@ -53,7 +53,8 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
             raise HybridtrackError("give either --scheduler or --workers, not both")
         try:
             return Client(scheduler, timeout="10s"), None
-        except (OSError, TimeoutError, ValueError) as exc:
+        # TypeError: distributed's TLS and UCX connectors refuse to start without their setup
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
     count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else cores()
     try:

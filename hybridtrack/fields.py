@@ -59,6 +59,9 @@ LOG_BYTES = 80
 #: The closest `HeliostatField.rings` places mirrors, metres: heliostats are built from about 1 m² up
 #: (Pfahl et al. 2017's review; docs/fields.md), so centres closer than 1 m would overlap mirrors.
 MIN_SPACING = 1.0
+#: A heliostat field's aim point when none is given: 100 m above the tower's foot, a tower of the
+#: size the rings' default 60 m first radius serves.
+DEFAULT_AIM = (0.0, 0.0, 100.0)
 
 
 @dataclass(frozen=True)
@@ -308,15 +311,18 @@ class HeliostatField:
     ----------
     positions : array_like, shape (N, 2) or (N, 3)
         Mirror centres, metres east, north (and up; 0 when left out) from the tower's foot.
-    aim : tuple of float
-        The receiver's aim point, (east, north, up) metres from the tower's foot.
+    aim : tuple of float, optional
+        The receiver's aim point, (east, north, up) metres from the tower's foot; (0, 0, 100)
+        when neither it nor `aims` is given. With `aims`, it is their mean (where the map draws
+        the receiver).
     aims : array_like, shape (N, 3), optional
-        One aim point per heliostat (aim-point strategies spread the flux on the receiver).
+        One aim point per heliostat (aim-point strategies spread the flux on the receiver);
+        refused beside `aim`, which one of the two would not be used.
     spread : ImperfectionSpread
     """
 
     positions: np.ndarray = field(default_factory=lambda: np.array([[0.0, -100.0], [50.0, -90.0], [-50.0, -90.0]]))
-    aim: tuple[float, float, float] = (0.0, 0.0, 100.0)
+    aim: tuple[float, float, float] | None = None
     aims: np.ndarray | None = None
     spread: ImperfectionSpread = field(default_factory=ImperfectionSpread)
 
@@ -334,12 +340,20 @@ class HeliostatField:
                                    "position is not finite")
         _distinct(xyz, "heliostats", "m (east, north, up)")
         object.__setattr__(self, "positions", xyz)
-        aim = _as_numbers(self.aim)
-        if aim is None or aim.shape != (3,):
-            raise HybridtrackError(f"heliostat aim must be three numbers (east, north, up), m, got {_brief(self.aim)}")
-        aims = np.broadcast_to(aim, xyz.shape) if self.aims is None else _as_numbers(self.aims)
+        if self.aim is not None and self.aims is not None:
+            raise HybridtrackError("heliostat field: give aim (one point for every heliostat) or aims (one each), "
+                                   "not both")
+        if self.aims is None:
+            aim = _as_numbers(DEFAULT_AIM if self.aim is None else self.aim)
+            if aim is None or aim.shape != (3,):
+                raise HybridtrackError(f"heliostat aim must be three numbers (east, north, up), m, got "
+                                       f"{_brief(self.aim)}")
+            aims = np.broadcast_to(aim, xyz.shape)
+        else:
+            aims = _as_numbers(self.aims)
         if aims is None or aims.shape != xyz.shape:
             raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
+        aim = aims.mean(axis=0)
         far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
         if far.any():
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
@@ -355,7 +369,7 @@ class HeliostatField:
 
     @classmethod
     def rings(cls, count: int = 12, *, first_radius: float = 60.0, spacing: float = 12.0,
-              aim: tuple[float, float, float] = (0.0, 0.0, 100.0), spread: ImperfectionSpread | None = None
+              aim: tuple[float, float, float] = DEFAULT_AIM, spread: ImperfectionSpread | None = None
               ) -> HeliostatField:
         """`count` heliostats on concentric rings round the tower's foot, `spacing` metres apart
         along and between the rings, every other ring turned by half a place (a radial stagger)."""

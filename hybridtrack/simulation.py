@@ -305,6 +305,9 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
                 f"{frame.index[-1]})")
     if "dni" not in frame.columns:
         raise HybridtrackError(f"the weather frame has no 'dni' column; it has {', '.join(map(str, frame.columns))}")
+    repeated = frame.columns[frame.columns.duplicated()]
+    if len(repeated):  # which of the two would be the weather?
+        raise HybridtrackError(f"the weather frame has the column {repeated[0]!r} more than once; keep one")
     for column in ("dni", "dhi", "wind_speed"):
         if column in frame.columns:
             _physical_column(frame, column)

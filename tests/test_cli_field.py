@@ -51,6 +51,9 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
     ("east,north,EAST\n60,0,1\n0,60,2\n", [], "line 1: column 'east' appears more than once in the header"),
     ("# mirrors\neast,north,east\n60,0,1\n0,60,2\n", [], "line 2: column 'east' appears more than once"),
     ("x,y\n0,1\n", [], "no column 'east'"),
+    # the file's aim points were used and --aim ignored without a word
+    ("east,north,aim_east,aim_north,aim_up\n60,0,0,0,100\n", ["--aim", "0", "0", "50"],
+     "--aim gives every mirror one aim point; "),
     ("east,north,aim_up\n0,-100,4\n", [], "aim points need all of"),
     ("east,north\n0,-100\n", ["--metric", "shine"], "--metric: no collector metric 'shine'"),
     ("east,north\n0,-100\n", ["--spread", "encoder_offset=-1"], "encoder_offset must be a finite number >= 0"),

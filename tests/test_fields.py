@@ -61,6 +61,8 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     np.testing.assert_array_equal(flat.positions[:, 2], [0.0, 0.0])
     own = HeliostatField(positions=[[0, -100], [80, -60]], aims=[[0, 0, 100], [3, 0, 95]])
     np.testing.assert_array_equal(own.relative_aims, [[0, 100, 100], [-77, 60, 95]])
+    assert own.aim == (1.5, 0.0, 97.5)  # their mean, where the map draws the receiver
+    assert HeliostatField(positions=[[0, -100]]).aim == (0.0, 0.0, 100.0)
 
 
 @pytest.mark.parametrize("make, message", [
@@ -68,6 +70,8 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: HeliostatField(positions=[[0, 0, 0, 0]]), r"\(N, 2\) or \(N, 3\)"),
     (lambda: HeliostatField(positions=[[1, 2], [0, 0]], aim=(0, 0, 0)), "heliostat 2: its aim point"),
     (lambda: HeliostatField(positions=[[1, 2]], aims=[[0, 0, 1], [0, 0, 2]]), "one \\(x, y, z\\) per heliostat"),
+    # the one aim point was dropped for the aims without a word
+    (lambda: HeliostatField(positions=[[1, 2]], aim=(0, 0, 50), aims=[[0, 0, 100]]), "give aim .* or aims .*not both"),
     (lambda: FresnelField(row_distances=[1.0, float("inf")]), "row distances must be finite"),
     (lambda: FresnelField(row_distances=[]), "non-empty"),
     (lambda: FresnelField(row_distances=[-1, 0, 1, 0.0]), "rows 2 and 4 are both at 0 m from the receiver line"),

@@ -261,6 +261,10 @@ def test_result_saves_log_summary_events_and_report(tmp_path, mixed_runs):
      "no 'dni' column"),
     (pd.DataFrame({"dni": [1.0, 2.0]}, index=pd.DatetimeIndex(["2021-06-21 12:01", "2021-06-21 12:00"], tz="UTC")),
      "increasing"),
+    # frame["dni"] was a DataFrame: an AttributeError from the column check
+    (pd.DataFrame([[1.0, 2.0, 3.0]] * 2, columns=["dni", "ghi", "dni"],
+                  index=pd.date_range("2021-06-21", periods=2, freq="min", tz="UTC")),
+     "the weather frame has the column 'dni' more than once"),
 ])
 def test_bad_frames_are_refused(frame, message):
     with pytest.raises(HybridtrackError, match=message):

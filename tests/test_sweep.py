@@ -187,6 +187,9 @@ def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
 @pytest.mark.parametrize("content, flags, message", [
     ("[grid]\nseed = [0]\n", ["--workers", "0"], "workers must be a whole number"),
     ("[grid]\nseed = [0]\n", ["--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
+    # distributed's TLS and UCX connectors raise TypeError without their setup: it was a traceback
+    ("[grid]\nseed = [0]\n", ["--scheduler", "tls://127.0.0.1:1"], "cannot reach the Dask scheduler at tls://"),
+    ("[grid]\nseed = [0]\n", ["--scheduler", "ucx://127.0.0.1:1"], "cannot reach the Dask scheduler at ucx://"),
     ("[grid\n", [], "not valid TOML"),
     ("[grid]\nwind = [1]\n", [], "grid.wind: unknown key"),
     ("[base]\nstart = 2021-06-21T10:00:00\n[grid]\nseed = [0]\n", ["--workers", "1"],

@@ -118,6 +118,9 @@ def field_from_arguments(args: argparse.Namespace):
     aim = tuple(args.aim) if args.aim is not None else None
     if args.positions:
         positions, aims = read_positions(args.positions)
+        if aims is not None and aim is not None:
+            raise HybridtrackError(f"--aim gives every mirror one aim point; {args.positions} gives each its own "
+                                   "(aim_east, aim_north, aim_up): give one or the other")
         return HeliostatField(positions=positions, aims=aims, spread=spread, **_given(aim=aim))
     return HeliostatField.rings(**_given(count=args.count, aim=aim), spread=spread)
 
