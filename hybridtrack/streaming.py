@@ -524,12 +524,22 @@ def read_log(path, *, columns=None, day=None, tz=None) -> pd.DataFrame:
     tz : str, optional
         The site's zone, to find `day`.
     """
+    import pyarrow
     import pyarrow.parquet as pq
 
-    handle = pq.ParquetFile(path)
+    try:
+        handle = pq.ParquetFile(path)
+    except (OSError, pyarrow.ArrowInvalid) as exc:  # missing, a folder, not Parquet, cut short (no footer)
+        raise HybridtrackError(f"{path}: cannot read as a streamed log ({str(exc).splitlines()[0]})") from None
+    unknown = sorted(set(columns or ()) - set(handle.schema_arrow.names))
+    if unknown:
+        raise HybridtrackError(f"{path}: no column {unknown[0]!r} in the log; it has {', '.join(handle.schema_arrow.names)}")
     if day is None:
         return _categorised(handle.read(columns=_with_index(handle, columns)).to_pandas())
-    wanted = pd.Timestamp(day).date()
+    try:
+        wanted = pd.Timestamp(day).date()
+    except (ValueError, TypeError):
+        raise HybridtrackError(f"read_log: day {day!r} is not a date") from None
     for group in range(handle.num_row_groups):
         log = _categorised(handle.read_row_group(group, columns=_with_index(handle, columns)).to_pandas())
         if len(log) and log.index[0].tz_convert(tz or log.index.tz).date() == wanted:

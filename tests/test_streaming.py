@@ -458,3 +458,43 @@ def test_a_stopped_run_keeps_its_finished_days_under_partial_names_only(tmp_path
         stream(_two_days(), tmp_path / "run", on_segment=stop_on_the_second_day)
     assert sorted(path.name for path in (tmp_path / "run").iterdir()) == ["events.partial.csv", "log.partial.parquet"]
     pd.testing.assert_frame_equal(read_log(tmp_path / "run" / "log.partial.parquet"), pd.concat(days), check_freq=False)
+
+
+def test_sigterm_ends_a_streamed_command_as_ctrl_c_does(tmp_path):
+    """``kill``, a batch scheduler's stop: the run died mid-write with an unreadable
+    log.partial.parquet (no Parquet footer), status 143 and not a word."""
+    import os
+    import signal
+    import time
+
+    out = tmp_path / "run"
+    child = subprocess.Popen([sys.executable, "-m", "hybridtrack", "simulate", "--site", SITE, "--date", "2021-06-20",
+                              "--days", "30", "--freq", "10s", "--stream", "--out", str(out)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                             preexec_fn=lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL))
+    deadline = time.monotonic() + 120
+    while not (out / "log.partial.parquet").exists() and time.monotonic() < deadline and child.poll() is None:
+        time.sleep(0.05)
+    child.send_signal(signal.SIGTERM)  # mid-run: the first day is written, later ones are under way
+    error = child.stderr.read().decode().replace("\r", "\n").splitlines()
+    assert child.wait(timeout=60) == 143
+    assert error[-1].startswith("hybridtrack: terminated; ") and not any("Traceback" in line for line in error)
+    log = read_log(out / "log.partial.parquet")
+    assert len(log) % 8640 == 0 and len(log) >= 8640  # whole days of 10-second steps
+    assert sorted(p.name for p in out.iterdir()) == ["events.partial.csv", "log.partial.parquet"]
+
+
+def test_read_log_refuses_what_is_no_streamed_log_by_name(tmp_path, streamed):
+    """Each was pyarrow's or pandas' own error (FileNotFoundError, ArrowInvalid, DateParseError), and
+    an unknown column gave a frame of no columns."""
+    cut = tmp_path / "cut.parquet"
+    cut.write_bytes(b"PAR1" + b"\0" * 100)  # a log cut short: no footer
+    for path, message in [(tmp_path / "none.parquet", "cannot read as a streamed log"), (tmp_path, "cannot read as"),
+                          (cut, "cannot read as a streamed log")]:
+        with pytest.raises(HybridtrackError, match=message):
+            read_log(path)
+    log = streamed[0].files["log"]
+    with pytest.raises(HybridtrackError, match="no column 'nope' in the log"):
+        read_log(log, columns=["error", "nope"])
+    with pytest.raises(HybridtrackError, match="day 'xx' is not a date"):
+        read_log(log, day="xx")

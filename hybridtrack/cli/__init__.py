@@ -14,14 +14,17 @@ importing them here is what puts them on the command line.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
 
 from .. import __version__
 from ..errors import HybridtrackError
 from ..outputs import reader_may_leave, removing_empty_folders, replacing
 from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
-from .base import _COMMANDS, _HELP, EXIT_INTERRUPTED, EXIT_USAGE
+from .base import _COMMANDS, _HELP, EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_USAGE
 
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
 
@@ -50,10 +53,33 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a batch scheduler's or a container's stop), met as Ctrl-C is: what a
+    command was writing is closed or removed, never left half-written."""
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM raises `Terminated` in the main thread (elsewhere, where no
+    handler may be set, it keeps its default)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Terminated()
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     try:
-        with reader_may_leave():  # --help and --version print here too: a full standard output is one line
+        with _terminate_as_interrupt(), reader_may_leave():  # --help and --version print here too: a full standard output is one line
             args = build_parser().parse_args(argv)
             _refuse_empty_paths(args)
             with replacing(getattr(args, "force", False)) as replaced, removing_empty_folders():
@@ -69,11 +95,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except HybridtrackError as exc:
         print(f"hybridtrack: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback; the shell's status for SIGINT
+    except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: one line, no traceback; the shell's status for the signal
         what = str(exc) or ("files already written are left as they are (an unfinished streamed run leaves its "
                             "finished days in log.partial.parquet and events.partial.csv)")
-        print(f"\nhybridtrack: interrupted; {what}", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        stopped = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"\nhybridtrack: {stopped}; {what}", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
     except OSError as exc:
         name = f" {exc.filename}" if exc.filename else ""
         print(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}", file=sys.stderr)

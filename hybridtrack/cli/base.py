@@ -12,6 +12,8 @@ from ..errors import HybridtrackError
 EXIT_USAGE = 2
 #: The shell's status for a run stopped by SIGINT (128 + 2).
 EXIT_INTERRUPTED = 130
+#: The shell's status for a command ended by SIGTERM (128 + 15).
+EXIT_TERMINATED = 143
 
 _COMMANDS: dict[str, tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = {}
 _HELP: dict[str, str] = {}
