@@ -205,6 +205,9 @@ def _compose(*, site, collector, strategy, steps, start, end, stats, within, cap
 HISTOGRAM_RESOLUTION = 0.001
 #: Degrees: the histogram's range, 0 to this; a larger error counts in the last bin (max stays exact).
 HISTOGRAM_SPAN = 180.0
+#: The most bins the histogram may have (8 MB of counts): at 1e-9° a span of 180° asked numpy for
+#: 1.3 TiB and died with MemoryError. A finer p95 would resolve no tracker's pointing either.
+HISTOGRAM_BINS = 1_000_000
 
 
 class RunningSummary:
@@ -233,7 +236,7 @@ class RunningSummary:
     def __init__(self, *, site: str, collector: str, strategy: str, resolution: float = HISTOGRAM_RESOLUTION,
                  span: float = HISTOGRAM_SPAN):
         span = params.number(span, "span", 0.0, 180.0, above=True)
-        resolution = params.number(resolution, "resolution", 0.0, min(1.0, span), above=True)  # degrees
+        resolution = params.number(resolution, "resolution", span / HISTOGRAM_BINS, min(1.0, span))  # degrees
         self.site, self.collector, self.strategy = site, collector, strategy
         self.resolution, self.span = float(resolution), float(span)
         self.histogram = np.zeros(int(np.ceil(span / resolution)))

@@ -37,7 +37,7 @@ import numpy as np
 
 from .errors import HybridtrackError
 
-__all__ = ["claim", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
+__all__ = ["claim", "held", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
            "plain_numbers", "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
@@ -117,6 +117,45 @@ def claim(paths: Iterable) -> list[Path]:
     for folder in dict.fromkeys(path.parent for path in paths):
         _make_folder(folder)
     return paths
+
+
+#: The hidden file a run that writes a folder over its whole span holds locked (`held`).
+LOCK_NAME = ".hybridtrack.lock"
+
+
+@contextlib.contextmanager
+def held(folder) -> Iterator[None]:
+    """Hold `folder` for this run alone while the block runs (call it after `claim`).
+
+    A run whose files grow as it goes (a streamed log) is refused a folder another run is
+    writing now: two streamed runs into one folder had appended to one Parquet file and left it
+    unreadable, and the later one removed the first one's summary. The lock is the operating
+    system's (``flock``) on a hidden file, so a run killed outright holds nothing; where there is
+    no ``flock`` (Windows) the folder is not held.
+    """
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    path = Path(folder) / LOCK_NAME
+    try:
+        descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as exc:
+        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    try:
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise HybridtrackError(f"{folder}: another run is writing there now; wait for it to finish, or write "
+                                   "elsewhere") from None
+        try:
+            yield
+        finally:
+            with contextlib.suppress(OSError):
+                path.unlink()
+    finally:
+        os.close(descriptor)
 
 
 def _make_folder(folder: Path) -> None:

@@ -56,7 +56,7 @@ from .errors import HybridtrackError
 from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
-from .outputs import claim, strict_json, write, write_in_place
+from .outputs import claim, held, strict_json, write, write_in_place
 from .times import local_midnight, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
@@ -665,7 +665,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     Apache Parquet file format: row groups, https://parquet.apache.org/docs/file-format/
     """
     from .kernel import uses_kernel
-    from .simulation import checked_config, simulate
+    from .simulation import checked_config
 
     if not isinstance(source, DaySource):
         raise HybridtrackError("source must be a DaySource (synthetic_days, recorded_days or frame_days)")
@@ -681,6 +681,16 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
                              resolution=resolution)  # checks `resolution` before anything is written
     files = stream_files(out)
     claim([*files.values(), *partial_files(files).values()])
+    with held(files["log"].parent):  # no other run may append to this folder's log while this one does
+        return _stream_segments(source, files, site, collector, config, classifier, warm_start, progress,
+                                on_segment, running)
+
+
+def _stream_segments(source: DaySource, files: dict, site, collector: Collector, config, classifier,
+                     warm_start: bool, progress, on_segment: Callable | None, running: RunningSummary) -> StreamResult:
+    """`stream`'s segments, run and written into the folder it holds."""
+    from .simulation import simulate
+
     run = _PartialRun(files)
     memory: bool | dict = warm_start
     start = None
@@ -722,7 +732,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     summary["wind_data"] = wind.pop() if len(wind) == 1 else "partly missing"
     summary["day_cycle"] = cycle
     summary["streamed"] = {"segments": run.segments, "segment": "one local day, cut at midnight",
-                           "p95_resolution_deg": resolution, "weather": source.describe}
+                           "p95_resolution_deg": running.resolution, "weather": source.describe}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
     return StreamResult(summary, files, site, collector, config, memory)
 

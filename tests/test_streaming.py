@@ -475,7 +475,8 @@ def test_sigterm_ends_a_streamed_command_as_ctrl_c_does(tmp_path):
     deadline = time.monotonic() + 120
     while not (out / "log.partial.parquet").exists() and time.monotonic() < deadline and child.poll() is None:
         time.sleep(0.05)
-    child.send_signal(signal.SIGTERM)  # mid-run: the first day is written, later ones are under way
+    time.sleep(1.0)  # the first day written (a tenth of that), later ones under way
+    child.send_signal(signal.SIGTERM)
     error = child.stderr.read().decode().replace("\r", "\n").splitlines()
     assert child.wait(timeout=60) == 143
     assert error[-1].startswith("hybridtrack: terminated; ") and not any("Traceback" in line for line in error)
@@ -498,3 +499,31 @@ def test_read_log_refuses_what_is_no_streamed_log_by_name(tmp_path, streamed):
         read_log(log, columns=["error", "nope"])
     with pytest.raises(HybridtrackError, match="day 'xx' is not a date"):
         read_log(log, day="xx")
+
+
+@pytest.mark.parametrize("resolution, message", [
+    (1e-9, r"resolution = 1e-09 is outside \[0.00018, 1\]"),  # numpy was asked for 1.3 TiB of bins
+    (0.0, "is outside"), (2.0, "is outside"), (float("nan"), "must be a finite number")])
+def test_the_histograms_resolution_is_refused_outside_its_range_before_anything_is_written(tmp_path, resolution,
+                                                                                          message):
+    with pytest.raises(HybridtrackError, match=message):
+        stream(_two_days(), tmp_path / "run", resolution=resolution)
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_second_streamed_run_into_the_folder_another_is_writing_is_refused(tmp_path):
+    """Two streamed runs into one --out appended to one log.partial.parquet (unreadable after), and
+    the later removed the first one's summary, which had said it wrote it."""
+    days = []
+
+    def second_run_meanwhile(result):
+        days.append(result)
+        if len(days) == 1:
+            with pytest.raises(HybridtrackError, match="another run is writing there now"):
+                stream(_two_days(), tmp_path / "run", on_segment=None)
+
+    first = stream(_two_days(), tmp_path / "run", on_segment=second_run_meanwhile)
+    assert len(days) == 2 and len(read_log(first.files["log"])) == sum(len(d.log) for d in days)
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["events.csv", "log.parquet", "summary.json"]
+    again = stream(_two_days(), tmp_path / "run")  # the lock went with the run that held it: replaced, as open would
+    assert again.files["summary"].exists() and not (tmp_path / "run" / ".hybridtrack.lock").exists()
