@@ -85,3 +85,18 @@ def test_run_commands_bad_input_one_line_status_2(capsys, args, message):
     assert main(args) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
+
+
+def test_a_config_files_seed_is_the_runs_unless_seed_is_given(tmp_path, capsys):
+    """--seed's default 0 overrode the file's seed without a word."""
+    config = tmp_path / "seeded.toml"
+    config.write_text("seed = 3\n")
+    day = ["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min"]
+
+    def printed(*flags):
+        assert main(day + list(flags)) == 0
+        return capsys.readouterr().out
+
+    by_file, by_flag = printed("--config", str(config)), printed("--seed", "3")
+    assert by_file == by_flag
+    assert printed("--config", str(config), "--seed", "0") == printed() != by_file

@@ -193,7 +193,8 @@ def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: b
     parser.add_argument("--weather", default="mixed",
                         help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
     parser.add_argument("--freq", default="1min", help="step (default 1min)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of sky and sensor (default 0)")
+    parser.add_argument("--seed", type=int, help="random seed of sky and sensor (default: the --config file's seed, "
+                                                 "else 0)")
     parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
 
 
@@ -206,10 +207,20 @@ def synthetic_span(args: argparse.Namespace):
 
     if not 1 <= args.days <= 3660:
         raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
+    if args.seed is None:  # a config file's seed is the run's, unless --seed says otherwise
+        args.seed = _config_seed(args)
     params.seed(args.seed, "--seed")
     params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
     first = parse_date(args.date)
     return first, first + dt.timedelta(days=args.days - 1)
+
+
+def _config_seed(args: argparse.Namespace) -> int:
+    """The seed of the ``--config`` file, if the command has one and it was given; else 0."""
+    from ..simulation import SimulationConfig
+
+    path = getattr(args, "config", None)
+    return SimulationConfig.from_toml(path).seed if path else 0
 
 
 def synthetic_frame(args: argparse.Namespace, site):
