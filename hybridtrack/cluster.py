@@ -52,20 +52,38 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         if workers is not None:
             raise HybridtrackError("give either --scheduler or --workers, not both")
         try:
-            return Client(scheduler, timeout="10s"), None
+            client = Client(scheduler, timeout="10s")
         # TypeError: distributed's TLS and UCX connectors refuse to start without their setup
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+        _refuse_no_workers(client, scheduler)
+        return client, None
     count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else cores()
     try:
+        # the dashboard on a free port: None still takes 8787, and a second cluster on this machine
+        # (another sweep, a test run) warned on stderr that the port was in use
         with _deaf_to_ctrl_c():
-            cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+            cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=":0",
                                    silence_logs=50)  # a failed task is reported by its result, not logged
     except RuntimeError as exc:  # distributed's "Nanny failed to start", multiprocessing's bootstrapping error
         raise HybridtrackError(f"cannot start {count} local Dask workers for {what} ({' '.join(str(exc).split())[:120]}); "
                                "workers are new processes that import the running script again, so a script "
                                "must start its run under `if __name__ == \"__main__\":`") from None
     return Client(cluster), cluster
+
+
+#: Seconds a running scheduler is given to have a worker: its runs would wait for one forever.
+WORKER_WAIT = 10.0
+
+
+def _refuse_no_workers(client, scheduler: str) -> None:
+    """Refuse a scheduler with no worker after `WORKER_WAIT` seconds (a sweep sat at 0 runs)."""
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT)
+    except (TimeoutError, OSError) as exc:
+        client.close()
+        raise HybridtrackError(f"the Dask scheduler at {scheduler} has no workers (waited {WORKER_WAIT:g} s): "
+                               f"start some with `dask worker {scheduler}`") from None
 
 
 @contextlib.contextmanager

@@ -228,6 +228,19 @@ def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):
     assert table.loc[1, "error"] == "MemoryError: the worker ran out of memory" and pd.isna(table.loc[1, "rms"])
 
 
+def test_a_scheduler_without_workers_is_refused_not_waited_on(monkeypatch):
+    """A sweep sat at 0 runs for ever; a field ended in distributed's 'No valid workers found'."""
+    from dask.distributed import LocalCluster
+
+    import hybridtrack.cluster as cluster_module
+
+    monkeypatch.setattr(cluster_module, "WORKER_WAIT", 0.5)
+    sweep = Sweep.from_dict({"base": {"freq": "30min"}, "grid": {"seed": [0]}})
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        with pytest.raises(HybridtrackError, match=f"the Dask scheduler at {cluster.scheduler_address} has no workers"):
+            run_sweep(sweep, scheduler=cluster.scheduler_address, progress=False)
+
+
 def test_the_example_sweep_is_valid_and_runs_one_of_its_runs():
     from pathlib import Path
 
