@@ -18,7 +18,7 @@ shape (N,). A pandas Series comes back as a Series when the result has its shape
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 import pandas as pd
@@ -303,6 +303,11 @@ KINDS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
 MAX_DISTANCE = 5_000.0
 
 
+#: The kinds of collector each geometry field of `Collector` describes.
+GEOMETRY_KINDS = {"axis_azimuth": ("trough-ns", "trough-ew", "fresnel"), "row_distance": ("fresnel",),
+                  "receiver_height": ("fresnel",), "aim": ("heliostat",)}
+
+
 @dataclass(frozen=True)
 class Collector:
     """A collector's kind and geometry: everything needed to turn a sun position into targets.
@@ -337,11 +342,24 @@ class Collector:
         number(self.receiver_height, "collector: receiver_height (m)", 0, MAX_DISTANCE, above=True)
         for value in self.aim:
             number(value, "collector: aim (m)", -MAX_DISTANCE, MAX_DISTANCE)
+        self._refuse_other_kinds_geometry()
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
             if not self.aim[2] > 0:
                 raise HybridtrackError(f"collector: aim (m): the aim point must be above the mirror, got "
                                        f"{self.aim[2]:g} m up: a heliostat reflects the sun up to its receiver")
+
+    def _refuse_other_kinds_geometry(self) -> None:
+        """Refuse geometry this kind has no use for (a trough's row distance, a heliostat's axis),
+        set away from its default: it would be ignored without a word."""
+        for f in fields(self):
+            kinds = GEOMETRY_KINDS.get(f.name)
+            value = getattr(self, f.name)
+            if kinds is None or self.kind in kinds or value is None or np.array_equal(np.asarray(value, float),
+                                                                     np.asarray(f.default, float)):
+                continue
+            raise HybridtrackError(f"collector: {f.name} describes a {' or '.join(kinds)} collector, "
+                                   f"not a {self.kind}; it would be ignored")
 
     @property
     def single_axis(self) -> bool:

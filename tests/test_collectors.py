@@ -172,3 +172,16 @@ def test_rotate_is_the_matrix_product_row_by_row():
     vectors = np.random.default_rng(3).standard_normal((1000, 3))
     rotation = mounting_rotation(0.7, -1.3, 20.0, 0.4)
     np.testing.assert_allclose(rotate(vectors, rotation), vectors @ rotation.T, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("kind, geometry, message", [
+    ("trough-ns", {"row_distance": 2.0}, "row_distance describes a fresnel collector, not a trough-ns"),
+    ("heliostat", {"axis_azimuth": 10.0}, "axis_azimuth describes a trough-ns or trough-ew or fresnel collector"),
+    ("fresnel", {"aim": (0.0, 0.0, 50.0)}, "aim describes a heliostat collector, not a fresnel"),
+])
+def test_geometry_of_another_kind_is_refused_not_ignored(kind, geometry, message):
+    """A trough given a row distance ran as if it had none (the CLI's --row-distance, a sweep's
+    collector.row_distance grid gave identical runs)."""
+    with pytest.raises(HybridtrackError, match=message):
+        Collector(kind, **geometry)
+    assert Collector(kind, row_distance=5.0, aim=[0, 20, 100]).kind == kind  # the defaults, however spelled
