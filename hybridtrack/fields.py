@@ -105,8 +105,10 @@ class ImperfectionSpread:
         """Every collector gets the config's imperfections exactly."""
         return cls(**{f.name: 0.0 for f in dataclasses.fields(cls)})
 
-    def draw(self, mean: Imperfections, count: int, seed: int) -> list[Imperfections]:
-        """`count` imperfection records; collector ``i``'s draw depends only on `seed` and ``i``."""
+    def draw(self, mean: Imperfections, count: int, seed: int, names: list[str] | None = None) -> list[Imperfections]:
+        """`count` imperfection records; collector ``i``'s draw depends only on `seed` and ``i``.
+        A draw beyond an imperfection's limits is refused naming the collector (by `names`, as the
+        field's table does; else by its number from 1)."""
         records = []
         for i in range(count):
             rng = np.random.default_rng([seed, i])
@@ -116,7 +118,8 @@ class ImperfectionSpread:
             try:
                 records.append(Imperfections(**values))
             except HybridtrackError as exc:
-                raise HybridtrackError(f"collector {i}: the drawn {exc}; narrow the spread") from None
+                name = names[i] if names is not None else f"collector {i + 1}"
+                raise HybridtrackError(f"{name}: the drawn {exc}; narrow the spread") from None
         return records
 
 
@@ -652,7 +655,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     threads = _thread_count(threads, frame, len(collectors), keep_log, dask=workers is not None or scheduler is not None,
                             compiled=uses_kernel(config, len(frame)))
     runs = [(i, name, collector, imperfect) for i, (name, collector, imperfect)
-            in enumerate(zip(field.names, collectors, field.spread.draw(config.imperfections, len(collectors), seed)))]
+            in enumerate(zip(field.names, collectors, field.spread.draw(config.imperfections, len(collectors), seed, field.names)))]
     bar = _bar(len(runs), progress)
     rows, events, store = [None] * len(runs), [None] * len(runs), None
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
@@ -685,8 +688,8 @@ def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, kee
     the memory: each thread holds one run, and a kept log every collector's columns. The default
     takes the most, up to one per core, that fit; one where the runs take the reference loop,
     which holds Python's lock throughout (`compiled` False)."""
-    if threads is not None:
-        threads = params.whole(threads, "threads", 1, MAX_WORKERS)
+    if threads is not None:  # more threads than collectors would have nothing to run, nor hold memory
+        threads = min(params.whole(threads, "threads", 1, MAX_WORKERS), collectors)
         if dask:
             raise HybridtrackError("threads runs the collectors in this process; with workers or a scheduler each "
                                    "worker runs its collectors one at a time: give one or the other")
@@ -792,6 +795,8 @@ def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFra
 
 
 def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, frame: pd.DataFrame) -> dict:
+    from .simulation import _wind_data
+
     weight = table["offered"]
     worst = table["rms"].astype(float).idxmax() if table["rms"].notna().any() else None
     summary = {
@@ -803,6 +808,8 @@ def _field_summary(table: pd.DataFrame, field, site: sites.Site, strategy: str, 
         "rms_worst_collector": worst, "rms_worst": None if worst is None else round(float(table.at[worst, "rms"]), 5),
         "moves": int(table["moves"].sum()), "travel_deg": round(float(table["travel_deg"].sum()), 3),
         "stow_events": int(table["stow_events"].sum()), "faults": int(table["faults"].sum()),
+        # a frame without wind stows all day by default (never a calm): the summary says why
+        "wind_data": _wind_data(frame),
     }
     if "end_loss_share" in table:
         summary["end_loss_share"] = _weighted(table["end_loss_share"], weight)

@@ -130,8 +130,13 @@ def test_imperfection_draws_are_seeded_per_collector_and_spread_as_asked():
     assert {m.clock_error for m in many} == {mean.clock_error}  # no spread: every collector gets the config's
     with pytest.raises(HybridtrackError, match="axis_tilt_error = 10000.0 is beyond the imperfection's own limit"):
         ImperfectionSpread(axis_tilt_error=1e4)  # refused at the door: no collector could be that far off
-    with pytest.raises(HybridtrackError, match=r"collector \d+: the drawn imperfections"):
-        ImperfectionSpread(axis_tilt_error=9.0).draw(mean, 100, seed=0)  # 1σ = 9°: some draw passes the 10° limit
+    wide = ImperfectionSpread(axis_tilt_error=9.0)  # 1σ = 9°: some draw passes the 10° limit
+    first = next(i for i in range(100) if abs(mean.axis_tilt_error + 9.0 * np.random.default_rng(
+        [0, i]).standard_normal(len(dataclasses.fields(Imperfections)))[1]) > 10)  # collector i's second draw: tilt
+    with pytest.raises(HybridtrackError, match=rf"^collector {first + 1}: the drawn imperfections"):
+        wide.draw(mean, 100, seed=0)  # counted from 1, as the field's names are (it said 'collector 43' for H44)
+    with pytest.raises(HybridtrackError, match=rf"^H{first + 1}: the drawn imperfections"):
+        wide.draw(mean, 100, seed=0, names=[f"H{i + 1}" for i in range(100)])
 
 
 def test_a_field_run_is_each_collectors_own_run(day):
@@ -237,6 +242,8 @@ def test_the_default_threads_fit_the_memory_and_the_engine(day, monkeypatch):
     assert _thread_count(None, day, 4, False, dask=True) == 1
     assert _thread_count(None, day, 4, False, dask=False, compiled=False) == 1  # the reference loop holds the GIL
     assert _thread_count(3, day, 4, False, dask=False, compiled=False) == 3  # as asked
+    monkeypatch.setattr(budget, "available_memory", lambda: int(2 * budget.BYTES_PER_STEP * steps * 1.5))
+    assert _thread_count(1024, day, 1, False, dask=False) == 1  # one collector: 1,023 threads would idle, not hold runs
 
 
 def test_field_figures_weigh_each_collector_by_the_light_it_is_offered(day):
@@ -368,3 +375,12 @@ def test_a_heliostat_dataset_keeps_each_angle_with_its_azimuth_twin_and_nothing_
     twins = {"target_true_azimuth", "target_azimuth", "angle_azimuth", "calibration_azimuth"}
     assert set(dataset.data_vars) == set(LOG_VARIABLES) | twins | {"dni", "wind_speed"}
     assert dataset["angle_azimuth"].attrs["units"] == "degree"
+
+
+def test_a_field_on_a_frame_without_wind_says_so(day):
+    """Without wind a controller stows (never a calm): the field's summary showed a day of zero
+    energy and no reason."""
+    calm_unknown = day.drop(columns=["wind_speed"])
+    result = simulate_field(calm_unknown, "lanzhou", TroughLoop(count=2), seed=1, keep_log=False)
+    assert result.summary["wind_data"] == "missing" and result.summary["energy_capture"] == 0.0
+    assert simulate_field(day, "lanzhou", TroughLoop(count=2), seed=1, keep_log=False).summary["wind_data"] == "measured"

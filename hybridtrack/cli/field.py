@@ -153,7 +153,7 @@ def field_table(summary: dict) -> str:
               "rms": "pointing error RMS (°, field)", "rms_worst": "worst collector RMS (°)",
               "rms_worst_collector": "worst collector", "moves": "moves (all collectors)",
               "travel_deg": "travel (°, all)", "stow_events": "wind stow events", "faults": "faults",
-              "end_loss_share": "end loss (share of the light)"}
+              "end_loss_share": "end loss (share of the light)", "wind_data": "wind data"}
     rows = [(label, summary[key]) for key, label in labels.items() if key in summary]
     width = max(len(label) for label, _ in rows)
     return "\n".join(f"{label:<{width}}  {_format(value)}" for label, value in rows)
