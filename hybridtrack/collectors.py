@@ -28,6 +28,7 @@ from .params import number
 
 __all__ = [
     "Collector",
+    "as_collector",
     "KINDS",
     "sun_vector",
     "across_angle",
@@ -397,3 +398,13 @@ class Collector:
         if self.kind == "fresnel" and self.axis % 180.0 == 0.0:
             out["end_loss"] = fresnel_end_loss(altitude, azimuth, self.row_distance, self.receiver_height)
         return out
+
+
+def as_collector(value) -> Collector:
+    """A `Collector` from its kind's name, or the `Collector` itself; anything else is refused
+    (a number had raised an AttributeError deep in a run)."""
+    if isinstance(value, str):
+        return Collector(value)
+    if not isinstance(value, Collector):
+        raise HybridtrackError(f"collector must be a kind's name ({', '.join(KINDS)}) or a Collector, got {value!r:.60}")
+    return value

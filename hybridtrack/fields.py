@@ -40,7 +40,7 @@ from .collectors import (
 )
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
-from .outputs import claim, strict_json, together, write
+from .outputs import claim, output_folder, strict_json, together, write
 from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -521,7 +521,7 @@ class FieldResult:
     @staticmethod
     def files(folder, *, log: bool = True) -> dict[str, Path]:
         """The files `save` writes into `folder`, by role (`log`: the logs were kept)."""
-        folder = Path(folder)
+        folder = output_folder(folder)
         files = {"collectors": folder / "collectors.csv", "events": folder / "events.csv",
                  "summary": folder / "summary.json", "map": folder / "field_map.png"}
         return {**files, "log": folder / "log.nc"} if log else files
@@ -646,6 +646,11 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
                                f"got {type(field).__name__}")
     seed = params.seed(seed)
+    for name, flag in (("keep_log", keep_log), ("progress", progress)):
+        if not isinstance(flag, (bool, np.bool_)) and not (name == "progress" and flag is None):
+            raise HybridtrackError(f"{name} must be True or False, got {flag!r:.60}")
+    if scheduler is not None and not isinstance(scheduler, str):  # before the sky is computed
+        raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
     site = sites.get(site)
     frame = _check_frame(frame)
     config = checked_config(config)

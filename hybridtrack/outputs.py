@@ -37,7 +37,7 @@ import numpy as np
 
 from .errors import HybridtrackError
 
-__all__ = ["claim", "held", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
+__all__ = ["claim", "held", "output_folder", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
            "plain_numbers", "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
@@ -117,6 +117,17 @@ def claim(paths: Iterable) -> list[Path]:
     for folder in dict.fromkeys(path.parent for path in paths):
         _make_folder(folder)
     return paths
+
+
+def output_folder(folder) -> Path:
+    """`folder` as a Path, refused unless it is a non-empty path: ``save(None)`` raised a
+    TypeError, and ``save("")`` wrote into the working folder (the command line refuses an empty
+    ``--out`` too)."""
+    if isinstance(folder, bytes):
+        folder = os.fsdecode(folder)
+    if not isinstance(folder, (str, os.PathLike)) or not str(os.fspath(folder)).strip():
+        raise HybridtrackError(f"the output folder must be a path, got {folder!r}")
+    return Path(folder)
 
 
 #: The hidden file a run that writes a folder over its whole span holds locked (`held`).

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from . import params, sites
-from .collectors import Collector
+from .collectors import Collector, as_collector
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
 from .control.clockwatch import ClockWatch
@@ -32,7 +32,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
-from .outputs import claim, strict_json, together, write
+from .outputs import claim, output_folder, strict_json, together, write
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
@@ -222,7 +222,7 @@ class Result:
         """The files `save` writes into `folder`, by role."""
         if log_format not in ("parquet", "csv"):
             raise HybridtrackError(f"log_format {log_format!r}: choose 'parquet' or 'csv'")
-        folder = Path(folder)
+        folder = output_folder(folder)
         files = {"log": folder / f"log.{log_format}", "events": folder / "events.csv",
                  "summary": folder / "summary.json"}
         return {**files, "report": folder / "report.png"} if plot else files
@@ -391,7 +391,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     site = sites.get(site)
-    collector = Collector(collector) if isinstance(collector, str) else collector
+    collector = as_collector(collector)
     frame = _check_frame(frame)
     faults = _check_faults(faults or {}, len(frame), 2 if collector.kind == "heliostat" else 1)
     drives = _drives(collector, config)

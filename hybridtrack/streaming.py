@@ -51,12 +51,12 @@ import numpy as np
 import pandas as pd
 
 from . import params, sites
-from .collectors import Collector
+from .collectors import Collector, as_collector
 from .errors import HybridtrackError
 from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
-from .outputs import claim, held, strict_json, write, write_in_place
+from .outputs import claim, held, output_folder, strict_json, write, write_in_place
 from .times import local_midnight, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
@@ -608,7 +608,7 @@ class _PartialRun:
 
 def stream_files(folder) -> dict[str, Path]:
     """The files `stream` writes into `folder`, by role."""
-    folder = Path(folder)
+    folder = output_folder(folder)
     return {"log": folder / "log.parquet", "events": folder / "events.csv", "summary": folder / "summary.json"}
 
 
@@ -673,7 +673,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     config = checked_config(config)
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
-    collector = Collector(collector) if isinstance(collector, str) else collector
+    collector = as_collector(collector)
     if config.engine == "auto" and source.steps and uses_kernel(config, source.steps):
         # whether the kernel pays is a question of the whole span, not of one day's segment
         config = dataclasses.replace(config, engine="compiled")

@@ -47,7 +47,7 @@ import pandas as pd
 from . import params
 from .cluster import close, dask_client
 from .errors import HybridtrackError
-from .outputs import claim, together, write
+from .outputs import claim, output_folder, together, write
 
 __all__ = ["Sweep", "SweepInterrupted", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
@@ -504,7 +504,7 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
 
 def sweep_files(folder) -> dict[str, Path]:
     """The files `save_sweep` writes into `folder`, by role."""
-    folder = Path(folder)
+    folder = output_folder(folder)
     return {"table": folder / "runs.parquet", "plot": folder / "tradeoff.png", "sweep": folder / "sweep.toml"}
 
 

@@ -384,3 +384,18 @@ def test_a_field_on_a_frame_without_wind_says_so(day):
     result = simulate_field(calm_unknown, "lanzhou", TroughLoop(count=2), seed=1, keep_log=False)
     assert result.summary["wind_data"] == "missing" and result.summary["energy_capture"] == 0.0
     assert simulate_field(day, "lanzhou", TroughLoop(count=2), seed=1, keep_log=False).summary["wind_data"] == "measured"
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda day: simulate_field(day, "lanzhou", TroughLoop(count=1), scheduler=123), "scheduler must be an address"),
+    (lambda day: simulate_field(day, "lanzhou", TroughLoop(count=1), keep_log="yes"), "keep_log must be True or False"),
+    (lambda day: simulate_field(day, "lanzhou", TroughLoop(count=1), keep_log=False).save(None),
+     "the output folder must be a path, got None"),
+    (lambda day: simulate_field(day, "lanzhou", TroughLoop(count=1), keep_log=False).save(" "),
+     "the output folder must be a path, got ' '"),  # '' had written into the working folder
+    (lambda day: simulate(day, "lanzhou", collector=5), "collector must be a kind's name"),
+])
+def test_api_arguments_of_the_wrong_kind_are_hybridtrack_errors(day, call, message):
+    """Each was a TypeError or AttributeError from deep inside, or wrote where it was not asked to."""
+    with pytest.raises(HybridtrackError, match=message):
+        call(day)
