@@ -82,7 +82,7 @@ def _refuse_no_workers(client, scheduler: str) -> None:
     """Refuse a scheduler with no worker after `WORKER_WAIT` seconds (a sweep sat at 0 runs)."""
     try:
         client.wait_for_workers(1, timeout=WORKER_WAIT)
-    except (TimeoutError, OSError) as exc:
+    except (TimeoutError, OSError):
         client.close()
         raise HybridtrackError(f"the Dask scheduler at {scheduler} has no workers (waited {WORKER_WAIT:g} s): "
                                f"start some with `dask worker {scheduler}`") from None
