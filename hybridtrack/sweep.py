@@ -517,15 +517,22 @@ def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
     """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them).
 
     The table is written first and on its own: the finished runs are kept even if the plot
-    cannot be drawn or written; the plot and the sweep go in together."""
+    cannot be drawn or written; the plot and the sweep go in together. If they cannot, an
+    earlier sweep's plot and sweep file are removed rather than left beside this table (which
+    they do not describe), and the error says where the runs are."""
     if not isinstance(sweep, Sweep):
         raise HybridtrackError(f"save_sweep: sweep must be a Sweep, got {type(sweep).__name__}")
     written = sweep_files(folder)
     claim(written.values())
     write(written["table"], lambda path: table.to_parquet(path, index=False))
-    with together():
-        sweep.to_toml(written["sweep"])
-        colour = next(iter(sweep.grid))
-        figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
-        write(written["plot"], lambda path: figure.savefig(path, dpi=120))
+    try:
+        with together():
+            sweep.to_toml(written["sweep"])
+            colour = next(iter(sweep.grid))
+            figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
+            write(written["plot"], lambda path: figure.savefig(path, dpi=120))
+    except HybridtrackError as exc:
+        for stale in (written["sweep"], written["plot"]):
+            stale.unlink(missing_ok=True)
+        raise HybridtrackError(f"{exc}; the runs are in {written['table']}") from None
     return written

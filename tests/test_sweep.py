@@ -260,6 +260,32 @@ def test_saving_with_something_that_is_not_a_sweep_writes_nothing(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_a_plot_that_cannot_be_written_leaves_no_earlier_sweeps_files_beside_the_new_table(tmp_path, monkeypatch):
+    """A --force sweep on a full disk left its new table beside the earlier sweep's sweep.toml and
+    plot, which did not describe it."""
+    import errno
+
+    import hybridtrack.sweep as sweep_module
+    from hybridtrack.sweep import save_sweep
+
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("runs.parquet", "sweep.toml", "tradeoff.png"):
+        (out / name).write_text("the earlier sweep's\n")
+
+    class FullDisk:
+        def savefig(self, path, **options):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(sweep_module, "plot_tradeoff", lambda *args, **kwargs: FullDisk())
+    table = pd.DataFrame({"run": [0, 1], "seed": [0, 1], "rms": [0.1, 0.2], "moves": [3, 4]})
+    with pytest.raises(HybridtrackError, match=r"tradeoff.png: cannot write \(No space left on device\); the runs "
+                                               r"are in .*runs.parquet$"):
+        save_sweep(table, Sweep.from_dict({"grid": {"seed": [0, 1]}}), out)
+    assert sorted(p.name for p in out.iterdir()) == ["runs.parquet"]
+    pd.testing.assert_frame_equal(pd.read_parquet(out / "runs.parquet"), table)
+
+
 def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_path):
     """A terminal's Ctrl-C reaches the whole process group: each Dask worker printed distributed's
     KeyboardInterrupt traceback, and the runs already finished were lost with the folder."""
