@@ -322,6 +322,30 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     return frame
 
 
+def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
+    """Refuse a frame whose direct light comes while the sun is down at `site`: another place's
+    weather, or an index in another time zone (a Denver day run at Lanzhou scored 0.9999).
+
+    The rule is the records' sun check (`hybridtrack.io.suncheck`: more than 3 steps, and more
+    than 2 % of the lit ones, with DNI above its `LIGHT` threshold) on the true sun the world has
+    computed: down throughout the stamp's tolerance (45 minutes or the step) either side is an
+    altitude below the most the sun climbs in that time, 15° an hour.
+    """
+    from .io.suncheck import LIGHT
+
+    dni = frame["dni"].to_numpy(float)
+    lit = dni > LIGHT
+    step = (frame.index[-1] - frame.index[0]) / (len(frame) - 1)
+    hours = max(pd.Timedelta(minutes=45), step) / pd.Timedelta(hours=1)
+    night = lit & (altitude < -15.0 * hours)
+    if night.sum() > max(3, 0.02 * lit.sum()):
+        first = int(np.flatnonzero(night)[0])
+        raise HybridtrackError(f"the weather frame's direct light comes while the sun is down at {site.name}: "
+                               f"{int(night.sum())} of {int(lit.sum())} lit steps, the first {dni[first]:g} W/m² at "
+                               f"{frame.index[first]}; is it another place's weather, or its index in another time "
+                               "zone? (hybridtrack.io.read_weather with the site finds the offset that fits)")
+
+
 def _physical_column(frame: pd.DataFrame, column: str) -> None:
     """Refuse a column that is not numbers, or light that is infinite (no world has it), naming
     the first such row. A negative or missing reading is a sensor's fault the controller must
@@ -409,6 +433,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         return _controller_side(frame.index, site, told, collector, config, classifier, faults, warm_start)
 
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
+    _refuse_light_at_night(frame, site, world.altitude)
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
     compiled = uses_kernel(config, world.n)
