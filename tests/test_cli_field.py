@@ -43,6 +43,7 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
 @pytest.mark.parametrize("content, extra, message", [
     ("east,north\n0,-100\n50,abc\n", [], "row 3, column 'north': 'abc' is not a number"),
     ("east,north\n0,-100\n50,\n", [], "row 3, column 'north': empty"),
+    ("east,north\n0,-100\n50,nan\n", [], "row 3, column 'north': empty or NaN"),  # it said 'empty' of a NaN
     ("east,north\n0,-100\n50,1e400\n", [], "row 3, column 'north': inf is not a finite number"),
     ("# mirrors\neast,north\n0,-100\n50,abc\n", [], "row 4, column 'north': 'abc' is not a number"),
     # a row longer than its header had been read with its first field as the index: every mirror moved

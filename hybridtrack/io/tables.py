@@ -280,7 +280,7 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) ->
         refused = np.isinf(values.to_numpy()) | (values.isna().to_numpy() if column in required else False)
         if refused.any():
             row = int(np.flatnonzero(refused)[0])
-            what = "empty" if np.isnan(values.iloc[row]) else f"{values.iloc[row]} is not a finite number"
+            what = "empty or NaN" if np.isnan(values.iloc[row]) else f"{values.iloc[row]} is not a finite number"
             raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: {what}")
         frame[column] = values
     return frame
