@@ -59,6 +59,9 @@ LOG_BYTES = 80
 #: The closest `HeliostatField.rings` places mirrors, metres: heliostats are built from about 1 m² up
 #: (Pfahl et al. 2017's review; docs/fields.md), so centres closer than 1 m would overlap mirrors.
 MIN_SPACING = 1.0
+#: The most heliostats a field (one tower) may have, as `HeliostatField.rings` takes: Ivanpah's
+#: 173,500 heliostats serve three towers, some 58,000 each.
+MAX_HELIOSTATS = 100_000
 #: A heliostat field's aim point when none is given: 100 m above the tower's foot, a tower of the
 #: size the rings' default 60 m first radius serves.
 DEFAULT_AIM = (0.0, 0.0, 100.0)
@@ -188,6 +191,20 @@ def _distinct(points: np.ndarray, what: str, unit: str) -> None:
         place = ", ".join(f"{v:g}" for v in rows[again])
         raise HybridtrackError(f"{what} {before + 1} and {again + 1} are both at {place} {unit}: two collectors "
                                "cannot share a place")
+
+
+def _refuse_overlapping(xyz: np.ndarray) -> None:
+    """Refuse heliostats whose centres are closer than `MIN_SPACING`, as `HeliostatField.rings`
+    does: their mirrors would overlap (a positions file 0.5 m apart was taken)."""
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(xyz).query_pairs(MIN_SPACING, output_type="ndarray")
+    close = pairs[np.linalg.norm(xyz[pairs[:, 0]] - xyz[pairs[:, 1]], axis=1) < MIN_SPACING] if len(pairs) else pairs
+    if len(close):
+        i, j = sorted(min(close.tolist()))
+        raise HybridtrackError(f"heliostats {i + 1} and {j + 1} are {np.linalg.norm(xyz[i] - xyz[j]):.3g} m apart: "
+                               f"closer than {MIN_SPACING:g} m, their mirrors would overlap (heliostats are built from "
+                               "about 1 m² up)")
 
 
 def _finite_number(value, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> float:
@@ -341,7 +358,10 @@ class HeliostatField:
         if not np.all(np.isfinite(xyz)):
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(~np.isfinite(xyz).all(1))[0]) + 1}: "
                                    "position is not finite")
+        if len(xyz) > MAX_HELIOSTATS:
+            raise HybridtrackError(f"a heliostat field has at most {MAX_HELIOSTATS:,} mirrors, got {len(xyz):,}")
         _distinct(xyz, "heliostats", "m (east, north, up)")
+        _refuse_overlapping(xyz)
         object.__setattr__(self, "positions", xyz)
         if self.aim is not None and self.aims is not None:
             raise HybridtrackError("heliostat field: give aim (one point for every heliostat) or aims (one each), "
@@ -377,8 +397,8 @@ class HeliostatField:
         """`count` heliostats on concentric rings round the tower's foot, `spacing` metres apart
         along and between the rings, every other ring turned by half a place (a radial stagger)."""
         whole = isinstance(count, (int, np.integer)) and not isinstance(count, bool)
-        if not whole or not 1 <= count <= 100_000:
-            raise HybridtrackError(f"heliostat count must be a whole number from 1 to 100000, got {count!r}")
+        if not whole or not 1 <= count <= MAX_HELIOSTATS:
+            raise HybridtrackError(f"heliostat count must be a whole number from 1 to {MAX_HELIOSTATS}, got {count!r}")
         first_radius = _finite_number(first_radius, "first ring radius", positive=True)
         spacing = _finite_number(spacing, "heliostat spacing", positive=True)
         if spacing < MIN_SPACING:

@@ -76,6 +76,10 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: FresnelField(row_distances=[]), "non-empty"),
     (lambda: FresnelField(row_distances=[-1, 0, 1, 0.0]), "rows 2 and 4 are both at 0 m from the receiver line"),
     (lambda: HeliostatField(positions=[[10, 20], [30, 40], [10, 20]]), "heliostats 1 and 3 are both at 10, 20, 0 m"),
+    # rings refused mirrors closer than 1 m; a positions file 0.5 m apart was taken
+    (lambda: HeliostatField(positions=[[60, 0], [0, 60], [60.5, 0]]), "heliostats 1 and 3 are 0.5 m apart: closer"),
+    (lambda: HeliostatField(positions=np.column_stack([np.arange(100_001.0), np.zeros(100_001)])),
+     "at most 100,000 mirrors"),
     (lambda: FresnelField(receiver_height=-2), "receiver height must be finite and positive"),
     (lambda: TroughLoop(count=0), "count must be a whole number"),
     (lambda: TroughLoop(count=2.5), "count must be a whole number"),
