@@ -94,6 +94,7 @@ class Sweep:
         plot = _table_of_text_keys(data.get("plot", {}), source, "[plot]")
         for key in base:
             _check_key(key, source, "base")
+        _refuse_given_twice(base, config, source)
         _check_base(base, config, grid, source)
         if not grid:
             raise HybridtrackError(f"{source}: [grid] is empty; give at least one key with a list of values")
@@ -161,6 +162,23 @@ def _check_key(key: str, source: str, table: str) -> None:
         node = getattr(node, part)
     if dataclasses.is_dataclass(node):
         raise HybridtrackError(f"{source}: {table}.{key}: is a whole table; name one of its fields")
+
+
+def _refuse_given_twice(base: dict, config: dict, source: str) -> None:
+    """Refuse a config value the base gives twice, dotted (``drive.deadband``) and in
+    ``[base.config]``, and a ``[base.config]`` seed, which each run's ``seed`` replaces: one of
+    the two would be dropped without a word."""
+    if "seed" in config:
+        raise HybridtrackError(f"{source}: [base.config] seed: each run's seed is the run key seed; set it in [base] "
+                               "or [grid]")
+    for key in base:
+        if key in RUN_KEYS or key.startswith("collector."):
+            continue
+        node = config
+        for part in key.split("."):
+            node = node.get(part) if isinstance(node, dict) else None
+        if node is not None:
+            raise HybridtrackError(f"{source}: base.{key} and [base.config] both set {key}; give it once")
 
 
 def _check_base(base: dict, config: dict, grid: dict, source: str) -> None:

@@ -36,6 +36,10 @@ def test_the_grid_is_every_combination_in_order():
 
 @pytest.mark.parametrize("data, message", [
     ({"grid": {"seed": [0]}, "runs": {}}, "runs: unknown table"),
+    # one of the two was dropped without a word
+    ({"base": {"drive.deadband": 0.2, "config": {"drive": {"deadband": 0.3}}}, "grid": {"seed": [0]}},
+     "base.drive.deadband and \\[base.config\\] both set drive.deadband; give it once"),
+    ({"base": {"config": {"seed": 4}}, "grid": {"drive.deadband": [0.1]}}, "\\[base.config\\] seed: each run's seed"),
     (None, "s.toml: the sweep must be a table, got None"),
     ({"base": "x", "grid": {"seed": [0]}}, "s.toml: \\[base\\] must be a table, got 'x'"),
     ({"grid": {"seed": [0]}, 1: {}}, "s.toml: the sweep: key 1 is not text"),
