@@ -273,7 +273,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 
         def pieces():
             try:
-                for k, piece in enumerate(pd.read_csv(path, sep=separator, chunksize=chunk_rows)):
+                for k, piece in enumerate(pd.read_csv(path, sep=separator, chunksize=chunk_rows, low_memory=False)):
                     yield stamped(piece, 2 + k * chunk_rows)  # the file's line: the header is line 1
             except HybridtrackError:
                 raise
@@ -354,7 +354,7 @@ def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> set[
         if separator is not None:
             header = pd.read_csv(path, sep=separator, nrows=0).columns
             chunks = pd.read_csv(path, sep=separator, usecols=[header[0], *(n for n in names if n in header)],
-                                 chunksize=CHUNK_ROWS)
+                                 chunksize=CHUNK_ROWS, low_memory=False)  # each chunk typed whole: no DtypeWarning
         else:
             import pyarrow.parquet as pq
 
