@@ -39,6 +39,7 @@ from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import summarize
 from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
+from .sky import LIGHT_AT_NIGHT
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
 from .world import Imperfections, World, controller_clock, installed_site, scan_timer
 from .times import check_dates
@@ -327,14 +328,12 @@ def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.n
     weather, or an index in another time zone (a Denver day run at Lanzhou scored 0.9999).
 
     The rule is the records' sun check (`hybridtrack.io.suncheck`: more than 3 steps, and more
-    than 2 % of the lit ones, with DNI above its `LIGHT` threshold) on the true sun the world has
+    than 2 % of the lit ones, with DNI above `LIGHT_AT_NIGHT`) on the true sun the world has
     computed: down throughout the stamp's tolerance (45 minutes or the step) either side is an
     altitude below the most the sun climbs in that time, 15° an hour.
     """
-    from .io.suncheck import LIGHT
-
     dni = frame["dni"].to_numpy(float)
-    lit = dni > LIGHT
+    lit = dni > LIGHT_AT_NIGHT
     step = (frame.index[-1] - frame.index[0]) / (len(frame) - 1)
     hours = max(pd.Timedelta(minutes=45), step) / pd.Timedelta(hours=1)
     night = lit & (altitude < -15.0 * hours)

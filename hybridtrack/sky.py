@@ -45,6 +45,10 @@ __all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGri
            "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
+#: W/m²: irradiance no sensor reads with the sun below the horizon (twilight gives a few W/m²):
+#: more of it at night says the weather is another place's, or its clock another zone's
+#: (`hybridtrack.io.suncheck` for files, `hybridtrack.simulate` for frames).
+LIGHT_AT_NIGHT = 20.0
 WEATHERS = (*DAY_TYPES, "mixed", "climate")
 
 

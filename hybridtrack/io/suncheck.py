@@ -30,12 +30,13 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
+from ..sky import LIGHT_AT_NIGHT
 from .checks import first_lines, span
 
 __all__ = ["sun_check", "place_check", "LIGHT", "BIN", "FAR"]
 
-#: W/m²: light a sensor cannot read with the sun below the horizon (twilight gives a few W/m²).
-LIGHT = 20.0
+#: W/m²: light a sensor cannot read with the sun below the horizon (`hybridtrack.sky.LIGHT_AT_NIGHT`).
+LIGHT = LIGHT_AT_NIGHT
 #: The resolution of the offset search.
 BIN = pd.Timedelta(minutes=10)
 _SEARCH = pd.Timedelta(hours=14)
