@@ -77,6 +77,7 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
     (["heliostat", "--positions", "/no/such/file.csv"], "no such file"),
     (["trough", "--count", "2", "--threads", "0"], "threads must be a whole number within [1,"),
     (["trough", "--count", "2", "--threads", "2", "--workers", "1"], "give one or the other"),
+    (["trough", "--count", "2", "--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler or --workers, not both"),
     (["fresnel", "--rows=1,,2"], "--rows takes numbers separated by commas, got '1,,2'"),  # not two rows
     # a flag that describes another kind of field had been ignored
     (["fresnel", "--positions", "/no/such/file.csv"], "--positions describes a heliostat field, not a fresnel one"),

@@ -173,6 +173,11 @@ def _field(args: argparse.Namespace) -> int:
     from ..fields import FieldResult, collector_columns, simulate_field
     from ..outputs import claim
 
+    if args.scheduler is not None and args.workers is not None:  # at the door, not after the weather is made
+        raise HybridtrackError("give either --scheduler or --workers, not both")
+    if args.threads is not None and (args.scheduler is not None or args.workers is not None):
+        raise HybridtrackError("--threads runs the collectors in this process; --workers and --scheduler send them "
+                               "to Dask: give one or the other")
     site = site_from_arguments(args)
     field = field_from_arguments(args)
     if args.metric not in collector_columns(field):
