@@ -51,6 +51,10 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
     # a column named twice had been read as two (a traceback) or one silently dropped (east.1)
     ("east,north,EAST\n60,0,1\n0,60,2\n", [], "line 1: column 'east' appears more than once in the header"),
     ("# mirrors\neast,north,east\n60,0,1\n0,60,2\n", [], "line 2: column 'east' appears more than once"),
+    # as pandas reads the header: a comment after a name, a quoted name after a space (found by helper-2)
+    ("east,north,east #comment\n60,0,1\n0,60,2\n", [], "line 1: column 'east' appears more than once"),
+    ('east,north, "east"\n60,0,1\n0,60,2\n', [], "line 1: column 'east' appears more than once"),
+    ("east,north,#up\n60,0,1\n0,60,2\n", [], "line 2: 3 fields, but the header on line 1 names 2"),  # 'up' was dropped
     ("x,y\n0,1\n", [], "no column 'east'"),
     # the file's aim points were used and --aim ignored without a word
     ("east,north,aim_east,aim_north,aim_up\n60,0,0,0,100\n", ["--aim", "0", "0", "50"],

@@ -15,9 +15,11 @@ Line numbers in every message are the file's own, 1-based, as an editor shows th
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -195,14 +197,13 @@ def read_table(path) -> pd.DataFrame:
     else:
         kept = _kept_lines(text)[0]
         sep = _table_separator(path, kept)
-        _refuse_long_rows(path, kept, sep)
-        if kept:
-            _refuse_repeated_names(path, [f.strip().lower() for f in _split(kept[0][1], sep)], f"line {kept[0][0]}")
-        try:
-            frame = pd.read_csv(io.StringIO(text), sep=sep, engine="python", comment="#", skipinitialspace=True,
-                                index_col=False)
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as exc:
-            raise HybridtrackError(f"{path}: cannot read as CSV: {str(exc).splitlines()[0]}") from None
+        options = dict(sep=sep, engine="python", comment="#", skipinitialspace=True, index_col=False)
+        with _as_csv_error(path):  # the header as pandas reads it (quotes, spaces, a '#'), before it renames repeats
+            names = pd.read_csv(io.StringIO(text), header=None, nrows=1, dtype=str, **options).iloc[0] if kept else []
+        _refuse_repeated_names(path, [str(n).strip().lower() for n in names], f"line {kept[0][0]}" if kept else "")
+        _refuse_long_rows(path, kept, sep, len(names))
+        with _as_csv_error(path):
+            frame = pd.read_csv(io.StringIO(text), **options)
     frame.columns = [str(c).strip().lower() for c in frame.columns]
     if frame.empty:
         raise HybridtrackError(f"{path}: the table has no rows")
@@ -225,6 +226,17 @@ def _table_separator(path: Path, kept: list[tuple[int, str]]) -> str:
         return ","
 
 
+@contextlib.contextmanager
+def _as_csv_error(path: Path) -> Iterator[None]:
+    """pandas' and csv's refusals of a table as one `HybridtrackError` naming the file."""
+    try:
+        yield
+    except HybridtrackError:
+        raise
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as exc:
+        raise HybridtrackError(f"{path}: cannot read as CSV: {str(exc).splitlines()[0]}") from None
+
+
 def _refuse_repeated_names(path: Path, names: list[str], where: str) -> None:
     """Refuse a header naming a column twice (column names are read stripped and lowered, so
     ``east`` and ``EAST`` are one name): pandas would keep one and rename or drop the other."""
@@ -236,12 +248,10 @@ def _refuse_repeated_names(path: Path, names: list[str], where: str) -> None:
         seen.add(name)
 
 
-def _refuse_long_rows(path: Path, kept: list[tuple[int, str]], sep: str) -> None:
-    """Refuse a row with more fields than its header names: pandas would take the first column for
-    an index and shift every value one column left (or, told not to, drop the last ones)."""
-    if not kept:
-        return
-    width = len(_split(kept[0][1], sep))
+def _refuse_long_rows(path: Path, kept: list[tuple[int, str]], sep: str, width: int) -> None:
+    """Refuse a row with more fields than its header names (`width`, as pandas reads the header:
+    a ``#`` ends it): pandas would take the first column for an index and shift every value one
+    column left (or, told not to, drop the last ones)."""
     for number, line in kept[1:]:
         fields = _split(line, sep)
         if len(fields) > width and any(f.strip() for f in fields[width:]):
