@@ -90,10 +90,15 @@ def _refuse_no_workers(client, scheduler: str) -> None:
 
 @contextlib.contextmanager
 def _deaf_to_ctrl_c() -> Iterator[None]:
-    """Start worker processes that ignore Ctrl-C. A terminal sends SIGINT to the whole process
-    group: each worker printed distributed's KeyboardInterrupt traceback while this process,
-    which the user interrupted, stopped them anyway (an ignored signal stays ignored in a child).
-    Only the main thread may set a handler; elsewhere the workers start as they would."""
+    """Start worker processes that ignore Ctrl-C.
+
+    A terminal sends SIGINT to the whole process group: each worker printed distributed's
+    KeyboardInterrupt traceback while this process, which the user interrupted, stopped them
+    anyway. An ignored signal stays ignored in a child, so SIGINT is ignored while the workers
+    start, and a Ctrl-C in those seconds is lost: one after them stops the command. (Blocking it
+    instead, to deliver it once they are up, was tried: the workers do not keep a blocked mask,
+    and numpy's BLAS threads take a process's signal and drop it.) Only the main thread may set a
+    handler; elsewhere the workers start as they would."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
