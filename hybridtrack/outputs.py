@@ -321,20 +321,50 @@ class _PipeSafe:
         return getattr(self._stream, name)
 
 
+class _Unheard:
+    """Standard error that may not be written (closed, on a full disk, its reader gone): what
+    fails to go there is dropped, since there is nowhere left to say so, and the run goes on."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except (OSError, ValueError):
+            self._silence()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except (OSError, ValueError):
+            self._silence()
+
+    def _silence(self) -> None:
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())  # nothing fails again at exit
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 @contextlib.contextmanager
 def reader_may_leave() -> Iterator[None]:
     """Within the block, a closed standard output (``| head``) ends the printing, not the work:
     the command goes on and writes its files."""
-    original = sys.stdout
-    # a standard output closed before the start (``>&-``) is None: what is printed goes nowhere, as
-    # after a reader that left
-    sink = open(os.devnull, "w") if original is None else None
-    sys.stdout = _PipeSafe(original if sink is None else sink)
+    original, errors = sys.stdout, sys.stderr
+    # a standard output or error closed before the start (``>&-``, ``2>&-``) is None: what is
+    # printed there goes nowhere, as after a reader that left; a progress bar on a closed or full
+    # standard error had ended a streamed run or a field with an AttributeError or OSError
+    sinks = [open(os.devnull, "w") for stream in (original, errors) if stream is None]
+    sys.stdout = _PipeSafe(original if original is not None else sinks[0])
+    sys.stderr = _Unheard(errors if errors is not None else sinks[-1])
     try:
         yield
     finally:
         with contextlib.suppress(BrokenPipeError):
             sys.stdout.flush()
-        sys.stdout = original
-        if sink is not None:
+        sys.stdout, sys.stderr = original, errors
+        for sink in sinks:
             sink.close()

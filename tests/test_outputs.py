@@ -410,3 +410,24 @@ def test_a_folder_that_takes_no_new_file_still_lets_a_writable_file_be_rewritten
     assert existing.read_text() == "new\n"
     with pytest.raises(HybridtrackError, match=r"new.csv: cannot write \(its folder takes no new file\)"):
         write(tmp_path / "new.csv", lambda path: path.write_text("new\n"))
+
+
+@pytest.mark.parametrize("closed", ["closed", "full"])
+def test_a_closed_or_full_standard_error_loses_no_run_and_keeps_the_status(tmp_path, closed):
+    """A progress bar on a closed (``2>&-``) or full standard error ended a streamed run and a field
+    with an AttributeError or OSError (status 1, nothing written); a refusal ended with status 1."""
+    if closed == "full" and not os.path.exists("/dev/full"):
+        pytest.skip("needs /dev/full, a device that is always full")
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+
+    def run(*args):
+        with open("/dev/full" if closed == "full" else os.devnull, "w") as sink:
+            return subprocess.run([sys.executable, "-m", "hybridtrack", *args], stdout=subprocess.DEVNULL, stderr=sink,
+                                  env=env, preexec_fn=(lambda: os.close(2)) if closed == "closed" else None).returncode
+
+    day = ["--site", "lanzhou", "--date", "2021-06-21", "--freq", "30min"]
+    assert run("simulate", *day, "--stream", "--out", str(tmp_path / "streamed")) == 0
+    assert run("field", "trough", "--count", "2", *day, "--out", str(tmp_path / "field")) == 0
+    assert (tmp_path / "streamed" / "summary.json").stat().st_size > 0
+    assert (tmp_path / "field" / "collectors.csv").stat().st_size > 0
+    assert run("simulate", "--site", "lanzhou", "--date", "2021-02-30") == 2

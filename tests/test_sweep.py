@@ -322,3 +322,17 @@ def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_pat
     assert error.rstrip().endswith(f"the {len(finished)} of 400 runs that had finished are in "
                                    f"{os.path.join('out', 'runs.partial.parquet')}")
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["runs.partial.parquet"]
+
+
+def test_a_forced_sweep_removes_the_partial_runs_of_an_interrupted_one(tmp_path, capsys):
+    """'replaced (--force): out/runs.partial.parquet' was said, and the earlier sweep's partial runs
+    stayed beside the new table (found by helper-2)."""
+    import tomli_w
+
+    out = tmp_path / "out"
+    out.mkdir()
+    pd.DataFrame({"run": [0], "seed": [7]}).to_parquet(out / "runs.partial.parquet")
+    (tmp_path / "s.toml").write_text(tomli_w.dumps({"base": {"freq": "30min"}, "grid": {"seed": [0]}}))
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "--force"]) == 0
+    assert "replaced (--force): " in capsys.readouterr().out
+    assert sorted(p.name for p in out.iterdir()) == ["runs.parquet", "sweep.toml", "tradeoff.png"]

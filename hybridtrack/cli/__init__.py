@@ -93,18 +93,27 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except HybridtrackError as exc:
-        print(f"hybridtrack: error: {exc}", file=sys.stderr)
+        _tell(f"hybridtrack: error: {exc}")
         return EXIT_USAGE
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: one line, no traceback; the shell's status for the signal
         what = str(exc) or ("files already written are left as they are (an unfinished streamed run leaves its "
                             "finished days in log.partial.parquet and events.partial.csv)")
         stopped = "terminated" if isinstance(exc, Terminated) else "interrupted"
-        print(f"\nhybridtrack: {stopped}; {what}", file=sys.stderr)
+        _tell(f"\nhybridtrack: {stopped}; {what}")
         return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
     except OSError as exc:
         name = f" {exc.filename}" if exc.filename else ""
-        print(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}", file=sys.stderr)
+        _tell(f"hybridtrack: error: cannot use{name}: {exc.strerror or exc}")
         return EXIT_USAGE
+
+
+def _tell(line: str) -> None:
+    """The command's last word on standard error, if it can be said: a closed one (``2>&-``) or a
+    full one changes nothing of the exit status."""
+    if sys.stderr is None:
+        return
+    with contextlib.suppress(OSError, ValueError):
+        print(line, file=sys.stderr, flush=True)
 
 
 #: The options that name a file or folder to write.

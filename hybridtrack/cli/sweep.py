@@ -33,6 +33,7 @@ def _sweep(args: argparse.Namespace) -> int:
     except SweepInterrupted as stopped:
         raise KeyboardInterrupt(_keep_finished(stopped, args.out)) from None
     written = save_sweep(table, sweep, args.out)
+    partial_file(args.out).unlink(missing_ok=True)  # an earlier interrupted sweep's, claimed (--force) and replaced
     failed = table[table["error"].notna()]
     keys = [k for k in ("run", *sweep.grid) if k in table]
     front = pareto_front(table, sweep.x, sweep.y)
