@@ -48,7 +48,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         from dask.distributed import Client, LocalCluster
     except ImportError:  # pragma: no cover - a declared dependency
         raise HybridtrackError(f"{what} need dask.distributed: pip install 'dask[distributed]'") from None
-    if scheduler is not None and not isinstance(scheduler, str):
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):  # '' is an unset $VAR
         raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
     if scheduler:
         if workers is not None:

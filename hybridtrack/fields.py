@@ -193,6 +193,14 @@ def _distinct(points: np.ndarray, what: str, unit: str) -> None:
                                "cannot share a place")
 
 
+def _aim_of(aim, aims) -> bool:
+    """Whether `aim` is the mean of `aims`, as a field made before stores it: `dataclasses.replace`
+    hands both back, and that is no second aim point."""
+    one, each = _as_numbers(aim), _as_numbers(aims)
+    return (one is not None and each is not None and one.shape == (3,) and each.ndim == 2 and each.shape[1:] == (3,)
+            and len(each) > 0 and bool(np.allclose(each.mean(axis=0), one, rtol=0.0, atol=1e-9)))
+
+
 def _refuse_overlapping(xyz: np.ndarray) -> None:
     """Refuse heliostats whose centres are closer than `MIN_SPACING`, as `HeliostatField.rings`
     does: their mirrors would overlap (a positions file 0.5 m apart was taken)."""
@@ -202,7 +210,7 @@ def _refuse_overlapping(xyz: np.ndarray) -> None:
     close = pairs[np.linalg.norm(xyz[pairs[:, 0]] - xyz[pairs[:, 1]], axis=1) < MIN_SPACING] if len(pairs) else pairs
     if len(close):
         i, j = sorted(min(close.tolist()))
-        raise HybridtrackError(f"heliostats {i + 1} and {j + 1} are {np.linalg.norm(xyz[i] - xyz[j]):.3g} m apart: "
+        raise HybridtrackError(f"heliostats {i + 1} and {j + 1} are {np.linalg.norm(xyz[i] - xyz[j]):.12g} m apart: "
                                f"closer than {MIN_SPACING:g} m, their mirrors would overlap (heliostats are built from "
                                "about 1 m² up)")
 
@@ -363,7 +371,7 @@ class HeliostatField:
         _distinct(xyz, "heliostats", "m (east, north, up)")
         _refuse_overlapping(xyz)
         object.__setattr__(self, "positions", xyz)
-        if self.aim is not None and self.aims is not None:
+        if self.aim is not None and self.aims is not None and not _aim_of(self.aim, self.aims):
             raise HybridtrackError("heliostat field: give aim (one point for every heliostat) or aims (one each), "
                                    "not both")
         if self.aims is None:
@@ -669,7 +677,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     for name, flag in (("keep_log", keep_log), ("progress", progress)):
         if not isinstance(flag, (bool, np.bool_)) and not (name == "progress" and flag is None):
             raise HybridtrackError(f"{name} must be True or False, got {flag!r:.60}")
-    if scheduler is not None and not isinstance(scheduler, str):  # before the sky is computed
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):  # before the sky
         raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
     site = sites.get(site)
     frame = _check_frame(frame)

@@ -330,11 +330,12 @@ def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.n
     The rule is the records' sun check (`hybridtrack.io.suncheck`: more than 3 steps, and more
     than 2 % of the lit ones, with DNI above `LIGHT_AT_NIGHT`) on the true sun the world has
     computed: down throughout the stamp's tolerance (45 minutes or the step) either side is an
-    altitude below the most the sun climbs in that time, 15° an hour.
+    altitude below the most the sun climbs in that time, 15° an hour. The step is the median one:
+    a frame of days apart (typical days, a gap of a week) has no longer steps for it.
     """
     dni = frame["dni"].to_numpy(float)
     lit = dni > LIGHT_AT_NIGHT
-    step = (frame.index[-1] - frame.index[0]) / (len(frame) - 1)
+    step = pd.Timedelta(int(np.median(np.diff(frame.index.as_unit("ns").asi8))), "ns")  # a gap is not a step
     hours = max(pd.Timedelta(minutes=45), step) / pd.Timedelta(hours=1)
     night = lit & (altitude < -15.0 * hours)
     if night.sum() > max(3, 0.02 * lit.sum()):

@@ -408,8 +408,8 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
                 except Exception as exc:  # noqa: BLE001 - the worker died (killed, out of memory): record it
                     rows.append(_failed(_row(_spec(sweep.base, futures[future])), exc))
                 bar.update()
-    except KeyboardInterrupt:
-        raise SweepInterrupted(_table(rows) if rows else None, len(runs)) from None
+    except KeyboardInterrupt as stop:
+        raise SweepInterrupted(_table(rows) if rows else None, len(runs), stop) from None
     finally:
         close(client, cluster)
     return _table(rows)
@@ -424,11 +424,13 @@ class SweepInterrupted(KeyboardInterrupt):
         The finished runs, one row each as `run_sweep` returns them; None if none had finished.
     planned : int
         The runs the sweep had.
+    stop : KeyboardInterrupt or None
+        What stopped it (Ctrl-C, or the command line's SIGTERM, which is one).
     """
 
-    def __init__(self, table: pd.DataFrame | None, planned: int) -> None:
+    def __init__(self, table: pd.DataFrame | None, planned: int, stop: KeyboardInterrupt | None = None) -> None:
         super().__init__(f"{0 if table is None else len(table)} of {planned} runs had finished")
-        self.table, self.planned = table, planned
+        self.table, self.planned, self.stop = table, planned, stop
 
 
 def _table(rows: list[dict]) -> pd.DataFrame:

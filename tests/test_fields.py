@@ -62,6 +62,10 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     own = HeliostatField(positions=[[0, -100], [80, -60]], aims=[[0, 0, 100], [3, 0, 95]])
     np.testing.assert_array_equal(own.relative_aims, [[0, 100, 100], [-77, 60, 95]])
     assert own.aim == (1.5, 0.0, 97.5)  # their mean, where the map draws the receiver
+    for field in (own, flat, HeliostatField.rings(5)):  # both stored: replace hands them back, no second aim
+        again = dataclasses.replace(field, spread=ImperfectionSpread.none())
+        np.testing.assert_array_equal(again.aims, field.aims)
+        assert again.aim == field.aim
     assert HeliostatField(positions=[[0, -100]]).aim == (0.0, 0.0, 100.0)
 
 

@@ -421,3 +421,8 @@ def test_a_frame_whose_light_comes_while_the_sun_is_down_is_refused():
     assert simulate(local.tz_convert("UTC"), "lanzhou").summary["steps"] == 1440  # the same instants in UTC
     with pytest.raises(HybridtrackError, match="in another time zone"):  # UTC clock readings labelled local
         simulate(local.tz_convert("UTC").tz_localize(None).tz_localize("Asia/Shanghai"), "lanzhou")
+    # two days half a year apart: the mean step (15 h) had made every stamp's tolerance cover the night
+    days = pd.concat([synthetic("lanzhou", day, weather="sunny", freq="10min") for day in ("2021-06-21", "2021-12-21")])
+    assert simulate(days, "lanzhou").summary["energy_capture"] > 0.99
+    with pytest.raises(HybridtrackError, match="while the sun is down at lanzhou"):
+        simulate(days.set_axis(days.index + pd.Timedelta(hours=8)), "lanzhou")

@@ -193,6 +193,7 @@ def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
     ("[grid]\nseed = [0]\n", ["--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
     # distributed's TLS and UCX connectors raise TypeError without their setup: it was a traceback
     ("[grid]\nseed = [0]\n", ["--scheduler", "tls://127.0.0.1:1"], "cannot reach the Dask scheduler at tls://"),
+    ("[grid]\nseed = [0]\n", ["--scheduler", ""], "scheduler must be an address"),  # an unset $VAR: not a local cluster
     ("[grid]\nseed = [0]\n", ["--scheduler", "ucx://127.0.0.1:1"], "cannot reach the Dask scheduler at ucx://"),
     ("[grid\n", [], "not valid TOML"),
     ("[grid]\nwind = [1]\n", [], "grid.wind: unknown key"),
@@ -290,9 +291,11 @@ def test_a_plot_that_cannot_be_written_leaves_no_earlier_sweeps_files_beside_the
     pd.testing.assert_frame_equal(pd.read_parquet(out / "runs.parquet"), table)
 
 
-def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_path):
+@pytest.mark.parametrize("signal_name, status, said", [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated")])
+def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_path, signal_name, status, said):
     """A terminal's Ctrl-C reaches the whole process group: each Dask worker printed distributed's
-    KeyboardInterrupt traceback, and the runs already finished were lost with the folder."""
+    KeyboardInterrupt traceback, and the runs already finished were lost with the folder. A SIGTERM
+    (a batch scheduler's stop) was said as Ctrl-C, status 130."""
     import os
     import signal
     import subprocess
@@ -313,9 +316,9 @@ def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_pat
         if not chunk:
             break
         seen += chunk
-    os.killpg(child.pid, signal.SIGINT)
+    os.killpg(child.pid, getattr(signal, signal_name))
     error = (seen + child.stderr.read()).decode()
-    assert child.wait(timeout=60) == 130
+    assert child.wait(timeout=60) == status and f"hybridtrack: {said}; " in error
     assert "Traceback" not in error and "KeyboardInterrupt" not in error
     finished = pd.read_parquet(tmp_path / "out" / "runs.partial.parquet")
     assert 3 <= len(finished) < 400 and finished["run"].is_unique and finished["error"].isna().all()

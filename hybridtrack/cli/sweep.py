@@ -30,8 +30,8 @@ def _sweep(args: argparse.Namespace) -> int:
     print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
     try:
         table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
-    except SweepInterrupted as stopped:
-        raise KeyboardInterrupt(_keep_finished(stopped, args.out)) from None
+    except SweepInterrupted as stopped:  # said as what stopped it: Ctrl-C (130) or SIGTERM (143)
+        raise type(stopped.stop or KeyboardInterrupt())(_keep_finished(stopped, args.out)) from None
     written = save_sweep(table, sweep, args.out)
     partial_file(args.out).unlink(missing_ok=True)  # an earlier interrupted sweep's, claimed (--force) and replaced
     failed = table[table["error"].notna()]
