@@ -115,8 +115,29 @@ def claim(paths: Iterable) -> list[Path]:
     if replaced is not None:
         replaced.extend(p for p in existing if p not in replaced)
     for folder in dict.fromkeys(path.parent for path in paths):
+        _refuse_held(folder)
         _make_folder(folder)
     return paths
+
+
+def _refuse_held(folder: Path) -> None:
+    """Refuse a folder a streamed run is writing now (`held`): a run with --force had written its
+    files there, and the streamed run then replaced them with its own as it finished."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        return
+    try:
+        descriptor = os.open(folder / LOCK_NAME, os.O_RDONLY | os.O_NOFOLLOW)
+    except OSError:  # no lock there (or none that could be one): nobody holds the folder
+        return
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise HybridtrackError(f"{folder}: another run is writing there now; wait for it to finish, or write "
+                               "elsewhere") from None
+    finally:
+        os.close(descriptor)
 
 
 def output_folder(folder) -> Path:

@@ -521,6 +521,8 @@ def test_a_second_streamed_run_into_the_folder_another_is_writing_is_refused(tmp
         if len(days) == 1:
             with pytest.raises(HybridtrackError, match="another run is writing there now"):
                 stream(_two_days(), tmp_path / "run", on_segment=None)
+            with pytest.raises(HybridtrackError, match="another run is writing there now"):  # any run, not only
+                result.save(tmp_path / "run", plot=False)                                  # a streamed one
 
     first = stream(_two_days(), tmp_path / "run", on_segment=second_run_meanwhile)
     assert len(days) == 2 and len(read_log(first.files["log"])) == sum(len(d.log) for d in days)
