@@ -64,13 +64,18 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
     try:
         # the dashboard on a free port: None still takes 8787, and a second cluster on this machine
         # (another sweep, a test run) warned on stderr that the port was in use
-        with _deaf_to_ctrl_c():
+        with _workers_starting() as held:
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=":0",
                                    silence_logs=50)  # a failed task is reported by its result, not logged
     except RuntimeError as exc:  # distributed's "Nanny failed to start", multiprocessing's bootstrapping error
+        if held:  # the workers were ended by the SIGTERM held meanwhile: end as it asks, not as a failure
+            signal.raise_signal(signal.SIGTERM)
         raise HybridtrackError(f"cannot start {count} local Dask workers for {what} ({' '.join(str(exc).split())[:120]}); "
                                "workers are new processes that import the running script again, so a script "
                                "must start its run under `if __name__ == \"__main__\":`") from None
+    if held:  # a SIGTERM came while the workers started: stop them, then end as it asks
+        cluster.close()
+        signal.raise_signal(signal.SIGTERM)
     return Client(cluster), cluster
 
 
@@ -89,24 +94,31 @@ def _refuse_no_workers(client, scheduler: str) -> None:
 
 
 @contextlib.contextmanager
-def _deaf_to_ctrl_c() -> Iterator[None]:
-    """Start worker processes that ignore Ctrl-C.
+def _workers_starting() -> Iterator[list]:
+    """While worker processes start: ignore Ctrl-C, so that they start deaf to it, and hold a
+    SIGTERM until they are up (the list it yields names the signals held).
 
     A terminal sends SIGINT to the whole process group: each worker printed distributed's
     KeyboardInterrupt traceback while this process, which the user interrupted, stopped them
     anyway. An ignored signal stays ignored in a child, so SIGINT is ignored while the workers
     start, and a Ctrl-C in those seconds is lost: one after them stops the command. (Blocking it
     instead, to deliver it once they are up, was tried: the workers do not keep a blocked mask,
-    and numpy's BLAS threads take a process's signal and drop it.) Only the main thread may set a
-    handler; elsewhere the workers start as they would."""
+    and numpy's BLAS threads take a process's signal and drop it.) A SIGTERM then is held and
+    acted on by the caller once the cluster can be closed: raised amid its start, it left
+    distributed's tracebacks of a half-started cluster. A caught signal is the default again in a
+    child, so the workers still end on SIGTERM, quietly. Only the main thread may set a handler;
+    elsewhere the workers start as they would."""
+    held: list = []
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield held
         return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN), signal.signal(signal.SIGTERM,
+                                                                           lambda signum, frame: held.append(signum))
     try:
-        yield
+        yield held
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.signal(signal.SIGINT, previous[0])
+        signal.signal(signal.SIGTERM, previous[1])
 
 
 def close(client, cluster) -> None:

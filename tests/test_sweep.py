@@ -339,3 +339,38 @@ def test_a_forced_sweep_removes_the_partial_runs_of_an_interrupted_one(tmp_path,
     assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "--force"]) == 0
     assert "replaced (--force): " in capsys.readouterr().out
     assert sorted(p.name for p in out.iterdir()) == ["runs.parquet", "sweep.toml", "tradeoff.png"]
+
+
+def test_a_sigterm_while_the_workers_start_is_held_until_the_cluster_can_be_closed(monkeypatch):
+    """Raised amid distributed's start, it left tracebacks of a half-started cluster (found by helper-2)."""
+    import os
+    import signal
+
+    import dask.distributed
+
+    from hybridtrack import cluster as cluster_module
+
+    closed = []
+
+    class Starting:
+        def __init__(self, **options):
+            os.kill(os.getpid(), signal.SIGTERM)  # while the workers start
+            assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN  # they start deaf to Ctrl-C
+
+        def close(self):
+            closed.append(True)
+
+    class Stopped(Exception):
+        pass
+
+    def stop(signum, frame):
+        raise Stopped
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", Starting)
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        with pytest.raises(Stopped):
+            cluster_module.dask_client(None, 1)
+        assert closed == [True] and signal.getsignal(signal.SIGTERM) is stop
+    finally:
+        signal.signal(signal.SIGTERM, previous)
