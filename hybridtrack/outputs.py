@@ -307,28 +307,35 @@ def strict_json(value, **options) -> str:
 
 
 class _PipeSafe:
-    """A text stream that, once its reader has gone, discards what is written instead of raising;
-    any other failure to write (a full disk) is a `HybridtrackError` naming standard output."""
+    """A text stream that, once its reader has gone, discards what is written instead of raising.
+    Any other failure to write (a full disk) is remembered, and what follows is discarded too, so
+    that the command still writes its files; `reader_may_leave` then ends it as a
+    `HybridtrackError` naming standard output."""
 
     def __init__(self, stream):
         self._stream = stream
+        self.failure: OSError | None = None
 
     def _discard(self) -> None:
         with contextlib.suppress(OSError, ValueError, AttributeError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
 
-    def _failed(self, exc: OSError) -> HybridtrackError:
+    def _failed(self, exc: OSError) -> None:
+        self.failure = self.failure or exc
         self._discard()  # what is left in the buffer would fail again at exit, outside the one line
-        return HybridtrackError(f"standard output: cannot write ({exc.strerror or exc})")
+
+    def error(self) -> HybridtrackError:
+        """The one line for the failure remembered."""
+        return HybridtrackError(f"standard output: cannot write ({self.failure.strerror or self.failure})")
 
     def write(self, text: str) -> int:
         try:
             return self._stream.write(text)
         except BrokenPipeError:
             self._discard()
-            return len(text)
         except OSError as exc:
-            raise self._failed(exc) from None
+            self._failed(exc)
+        return len(text)
 
     def flush(self) -> None:
         try:
@@ -336,7 +343,7 @@ class _PipeSafe:
         except BrokenPipeError:
             self._discard()
         except OSError as exc:
-            raise self._failed(exc) from None
+            self._failed(exc)
 
     def __getattr__(self, name):
         return getattr(self._stream, name)
@@ -373,19 +380,26 @@ class _Unheard:
 @contextlib.contextmanager
 def reader_may_leave() -> Iterator[None]:
     """Within the block, a closed standard output (``| head``) ends the printing, not the work:
-    the command goes on and writes its files."""
+    the command goes on and writes its files. A standard output that cannot be written (a full
+    disk) ends the printing too; the command goes on, and the block then ends in a
+    `HybridtrackError` naming standard output."""
     original, errors = sys.stdout, sys.stderr
     # a standard output or error closed before the start (``>&-``, ``2>&-``) is None: what is
     # printed there goes nowhere, as after a reader that left; a progress bar on a closed or full
     # standard error had ended a streamed run or a field with an AttributeError or OSError
     sinks = [open(os.devnull, "w") for stream in (original, errors) if stream is None]
-    sys.stdout = _PipeSafe(original if original is not None else sinks[0])
+    guarded = sys.stdout = _PipeSafe(original if original is not None else sinks[0])
     sys.stderr = _Unheard(errors if errors is not None else sinks[-1])
     try:
         yield
+        guarded.flush()
+    except SystemExit:  # --help and --version end so, printed or not
+        guarded.flush()
+        if guarded.failure is None:
+            raise
     finally:
-        with contextlib.suppress(BrokenPipeError):
-            sys.stdout.flush()
         sys.stdout, sys.stderr = original, errors
         for sink in sinks:
             sink.close()
+    if guarded.failure is not None:  # the command ran and wrote its files; what it printed was lost
+        raise guarded.error()

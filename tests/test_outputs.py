@@ -274,17 +274,24 @@ class FullDevice:
 
 @pytest.mark.parametrize("args, files", [
     (SHORT, RUN_FILES),
+    # each printed before writing: a full standard output lost their files (found by helper-2)
+    (["replay", RECORD, "--site", "nanjing"], RUN_FILES),
+    (["sky", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "30min", "--plot", "{out}/sky.png"], ("sky.png",)),
+    (["sun", "--site", "lanzhou", "--date", "2021-06-21", "--plot", "{out}/sun.png"], ("sun.png",)),
     (["field", "trough", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min", "--count", "2"],
      ("collectors.csv", "summary.json", "log.nc")),
     (["compare", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min"],
      ("comparison.json", "comparison.png", "hybrid/summary.json")),
-], ids=["simulate", "field", "compare"])
+], ids=["simulate", "replay", "sky", "sun", "field", "compare"])
 def test_a_full_standard_output_is_one_line_but_keeps_the_run_it_computed(tmp_path, monkeypatch, capsys, args,
                                                                            files):
     """The summary was printed before the files were written: a full standard output threw the run away."""
     out = tmp_path / "out"
+    out.mkdir()
     monkeypatch.setattr(sys, "stdout", FullDevice())
-    assert main(args + ["--out", str(out)]) == 2
+    plotted = any("{out}" in arg for arg in args)
+    args = [arg.replace("{out}", str(out)) for arg in args] + ([] if plotted else ["--out", str(out), "--force"])
+    assert main(args) == 2
     error = capsys.readouterr().err.splitlines()[-1]  # after the field's progress bar
     assert error == "hybridtrack: error: standard output: cannot write (No space left on device)"
     for name in files:
