@@ -527,19 +527,38 @@ def read_log(path, *, columns=None, day=None, tz=None) -> pd.DataFrame:
     import pyarrow
     import pyarrow.parquet as pq
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise HybridtrackError(f"read_log: path must be a file's path, got {path!r:.60}")
+    if isinstance(columns, str) or not (columns is None or all(isinstance(c, str) for c in columns)):
+        raise HybridtrackError(f"read_log: columns must be a list of names, got {columns!r:.60}")
     try:
         handle = pq.ParquetFile(path)
     except (OSError, pyarrow.ArrowInvalid) as exc:  # missing, a folder, not Parquet, cut short (no footer)
         raise HybridtrackError(f"{path}: cannot read as a streamed log ({str(exc).splitlines()[0]})") from None
-    unknown = sorted(set(columns or ()) - set(handle.schema_arrow.names))
+    index = set(_with_index(handle, []))
+    names = [name for name in handle.schema_arrow.names if name not in index]
+    unknown = sorted(set(columns or ()) - set(names))
     if unknown:
-        raise HybridtrackError(f"{path}: no column {unknown[0]!r} in the log; it has {', '.join(handle.schema_arrow.names)}")
+        raise HybridtrackError(f"{path}: no column {unknown[0]!r} in the log; it has {', '.join(names)}")
     if day is None:
         return _categorised(handle.read(columns=_with_index(handle, columns)).to_pandas())
+    return _day_of(handle, path, columns, day, tz)
+
+
+def _day_of(handle, path, columns, day, tz) -> pd.DataFrame:
+    """`read_log`'s one local `day` (a date, in the zone `tz` or the log's own)."""
+    from .times import check_tz
+
     try:
-        wanted = pd.Timestamp(day).date()
+        stamp = pd.Timestamp(day)
     except (ValueError, TypeError):
+        stamp = pd.NaT
+    if pd.isna(stamp) or stamp != stamp.normalize():
         raise HybridtrackError(f"read_log: day {day!r} is not a date") from None
+    wanted = stamp.date()
+    if tz is not None and not isinstance(tz, str):
+        raise HybridtrackError(f"read_log: tz must be a time zone's name, got {tz!r:.60}")
+    tz = check_tz(tz, "read_log: ") if tz is not None else None
     for group in range(handle.num_row_groups):
         log = _categorised(handle.read_row_group(group, columns=_with_index(handle, columns)).to_pandas())
         if len(log) and log.index[0].tz_convert(tz or log.index.tz).date() == wanted:

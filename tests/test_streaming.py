@@ -499,6 +499,17 @@ def test_read_log_refuses_what_is_no_streamed_log_by_name(tmp_path, streamed):
         read_log(log, columns=["error", "nope"])
     with pytest.raises(HybridtrackError, match="day 'xx' is not a date"):
         read_log(log, day="xx")
+    # each was a TypeError, a ZoneInfoNotFoundError, letters read as columns or a wrong 'no segment' (helper-2)
+    for arguments, message in [(dict(columns="mode"), "columns must be a list of names"),
+                               (dict(day="2021-03-11", tz="Not/AZone"), "unknown time zone 'Not/AZone'"),
+                               (dict(day="2021-03-11", tz=5), "tz must be a time zone's name"),
+                               (dict(day=""), "day '' is not a date"),
+                               (dict(day="2021-03-11 13:00"), "is not a date")]:
+        with pytest.raises(HybridtrackError, match=message):
+            read_log(log, **arguments)
+    with pytest.raises(HybridtrackError, match="path must be a file's path, got None"):
+        read_log(None)
+    assert read_log(log, day="2021-03-11", tz="Asia/Shanghai").index[0].day == 11
 
 
 @pytest.mark.parametrize("resolution, message", [
