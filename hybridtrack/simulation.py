@@ -412,6 +412,8 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     Result
     """
     config = checked_config(config)
+    if progress is not None and not callable(progress):  # it is called with each count of steps done
+        raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     site = sites.get(site)

@@ -690,6 +690,10 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
         raise HybridtrackError("source must be a DaySource (synthetic_days, recorded_days or frame_days)")
     site = source.site
     config = checked_config(config)
+    if progress is not None and not callable(progress):  # it is called with each count of steps done
+        raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
+    if on_segment is not None and not callable(on_segment):
+        raise HybridtrackError(f"on_segment must be a callable or None, got {on_segment!r:.60}")
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     collector = as_collector(collector)

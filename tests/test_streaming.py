@@ -540,3 +540,12 @@ def test_a_second_streamed_run_into_the_folder_another_is_writing_is_refused(tmp
     assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["events.csv", "log.parquet", "summary.json"]
     again = stream(_two_days(), tmp_path / "run")  # the lock went with the run that held it: replaced, as open would
     assert again.files["summary"].exists() and not (tmp_path / "run" / ".hybridtrack.lock").exists()
+
+
+@pytest.mark.parametrize("arguments, message", [(dict(progress=True), "progress must be a callable"),
+                                                (dict(on_segment=5), "on_segment must be a callable")])
+def test_callbacks_that_are_not_callable_are_refused_before_anything_is_written(tmp_path, arguments, message):
+    """They raised a TypeError after the first day, leaving its partial files (found by helper-2)."""
+    with pytest.raises(HybridtrackError, match=message):
+        stream(_two_days(), tmp_path / "run", **arguments)
+    assert not (tmp_path / "run").exists()
