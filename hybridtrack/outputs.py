@@ -132,12 +132,21 @@ def _refuse_held(folder: Path) -> None:
     except OSError:  # no lock there (or none that could be one): nobody holds the folder
         return
     try:
-        fcntl.flock(descriptor, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        _lock(descriptor, folder, fcntl.LOCK_SH)
+    finally:
+        os.close(descriptor)
+
+
+def _lock(descriptor: int, folder, mode: int) -> None:
+    """Take `folder`'s lock (`held`) in `mode`, shared or exclusive, without waiting; refuse the
+    folder if another run holds it."""
+    import fcntl
+
+    try:
+        fcntl.flock(descriptor, mode | fcntl.LOCK_NB)
     except BlockingIOError:
         raise HybridtrackError(f"{folder}: another run is writing there now; wait for it to finish, or write "
                                "elsewhere") from None
-    finally:
-        os.close(descriptor)
 
 
 def output_folder(folder) -> Path:
@@ -176,11 +185,7 @@ def held(folder) -> Iterator[None]:
     except OSError as exc:
         raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
     try:
-        try:
-            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise HybridtrackError(f"{folder}: another run is writing there now; wait for it to finish, or write "
-                                   "elsewhere") from None
+        _lock(descriptor, folder, fcntl.LOCK_EX)
         try:
             yield
         finally:
