@@ -193,8 +193,8 @@ def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: b
     parser.add_argument("--weather", default="mixed",
                         help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
     parser.add_argument("--freq", default="1min", help="step (default 1min)")
-    parser.add_argument("--seed", type=int, help="random seed of sky and sensor (default: the --config file's seed, "
-                                                 "else 0)")
+    parser.add_argument("--seed", type=int, help="random seed of sky and sensor (default: the --config file's seed "
+                                                 "where the command takes one, else 0)")
     parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
 
 
