@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from . import params
 from .errors import HybridtrackError
 
-__all__ = ["dask_client", "close", "cores", "MAX_WORKERS"]
+__all__ = ["dask_client", "check_where", "close", "cores", "MAX_WORKERS"]
 
 #: The most worker processes a local cluster is asked for.
 MAX_WORKERS = 1024
@@ -30,6 +30,16 @@ def cores() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux
         return os.cpu_count() or 1
+
+
+def check_where(scheduler: str | None, workers: int | None) -> None:
+    """Refuse a `scheduler` that is not an address (an empty one is an unset ``$VAR``, not a local
+    cluster), and a scheduler beside `workers`: the checks of `dask_client`, for callers that make
+    them before their work starts."""
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
+        raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
+    if scheduler and workers is not None:
+        raise HybridtrackError("give either --scheduler or --workers, not both")
 
 
 def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
@@ -48,11 +58,8 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         from dask.distributed import Client, LocalCluster
     except ImportError:  # pragma: no cover - a declared dependency
         raise HybridtrackError(f"{what} need dask.distributed: pip install 'dask[distributed]'") from None
-    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):  # '' is an unset $VAR
-        raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
+    check_where(scheduler, workers)
     if scheduler:
-        if workers is not None:
-            raise HybridtrackError("give either --scheduler or --workers, not both")
         try:
             client = Client(scheduler, timeout="10s")
         # TypeError: distributed's TLS and UCX connectors refuse to start without their setup

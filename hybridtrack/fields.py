@@ -27,7 +27,7 @@ import pandas as pd
 
 from . import params, sites
 from .budget import BYTES_PER_STEP, check_steps
-from .cluster import MAX_WORKERS, cores
+from .cluster import MAX_WORKERS, check_where, cores
 from .collectors import (
     AXIS_AZIMUTH,
     MAX_DISTANCE,
@@ -677,8 +677,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     for name, flag in (("keep_log", keep_log), ("progress", progress)):
         if not isinstance(flag, (bool, np.bool_)) and not (name == "progress" and flag is None):
             raise HybridtrackError(f"{name} must be True or False, got {flag!r:.60}")
-    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):  # before the sky
-        raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
+    check_where(scheduler, workers)  # before the sky is computed
     site = sites.get(site)
     frame = _check_frame(frame)
     config = checked_config(config)

@@ -435,7 +435,8 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         return _controller_side(frame.index, site, told, collector, config, classifier, faults, warm_start)
 
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
-    _refuse_light_at_night(frame, site, world.altitude)
+    # once for a field's collectors under one frame (`hybridtrack.reuse`): a refusal is not kept
+    shared(("light at night", Same(frame), site), lambda: _refuse_light_at_night(frame, site, world.altitude))
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
     compiled = uses_kernel(config, world.n)

@@ -170,11 +170,11 @@ def _format(value) -> str:
 @command("field", "run a tracker for every collector of a Fresnel field, a trough loop or a heliostat field",
          _field_arguments)
 def _field(args: argparse.Namespace) -> int:
+    from ..cluster import check_where
     from ..fields import FieldResult, collector_columns, simulate_field
     from ..outputs import claim
 
-    if args.scheduler is not None and args.workers is not None:  # at the door, not after the weather is made
-        raise HybridtrackError("give either --scheduler or --workers, not both")
+    check_where(args.scheduler, args.workers)  # at the door, not after the weather is made
     if args.threads is not None and (args.scheduler is not None or args.workers is not None):
         raise HybridtrackError("--threads runs the collectors in this process; --workers and --scheduler send them "
                                "to Dask: give one or the other")
