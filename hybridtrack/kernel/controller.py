@@ -703,7 +703,7 @@ def _against_checkpoint(row, theta, p, r, w):
     return ordered_dot(row, theta), math.sqrt(r + w * w * spread)
 
 
-@kernel
+@kernel(inline=True)
 def _disagrees(cfg, state, log, i, miss, spread):
     if state.k[UPDATES] < SETTLE_UPDATES:
         return False
@@ -736,7 +736,7 @@ def _reading_variance(cfg, intensity):
     return cfg.fit_r * ratio * ratio
 
 
-@kernel
+@kernel(inline=True)
 def _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound, intensity):
     t = state.s[PREVIOUS_T]
     if cfg.has_fit and t - state.fitted_at[a] >= FIT_EVERY:
@@ -945,7 +945,7 @@ def _plausibility_bound(cfg, plan, i, a, axes):
     return cfg.plausibility
 
 
-@kernel
+@kernel(inline=True)
 def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes, intensity):
     m0 = plan.model[i, a]
     m1 = plan.model[i - 1, a] if i else math.nan
@@ -978,7 +978,7 @@ def _trusts_sensor(cfg, sky, true_sky):
     return sky == SUNNY
 
 
-@kernel
+@kernel(inline=True)
 def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, sky, valid):
     axes = valid.shape[0]
     valid[:] = False
@@ -1169,7 +1169,7 @@ def _command(cfg, plan, state, awake_plan, i, t, dt, reading, valid, obs_axes, t
         moves[a] = step
 
 
-@kernel
+@kernel(inline=True)
 def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading, targets, valid):
     """Controller.step: take scan `i`'s readings (`obs`: t, wind, valid, intensity, true sky;
     `obs_axes`: encoder, offset, coarse per axis); write the move of each axis into `moves`

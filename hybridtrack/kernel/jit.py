@@ -54,7 +54,7 @@ def _empty_stale_cache(folder: Path = _HERE / "__pycache__") -> None:
         pass
 
 
-def kernel(function=None, *, allocates: bool = False, entry: bool = False):
+def kernel(function=None, *, allocates: bool = False, entry: bool = False, inline: bool = False):
     """Compile `function` with numba (cached on disk), or return it unchanged without numba.
 
     The kernels pass tuples of many arrays from piece to piece. With numba's reference counting
@@ -63,15 +63,23 @@ def kernel(function=None, *, allocates: bool = False, entry: bool = False):
     arrays). The few that make arrays (``allocates=True``: the mount fit's matrix algebra) are
     given only the arrays they need, and the loop (``entry=True``) makes the scratch arrays
     the pieces write into.
+
+    A call between compiled pieces passes every array of every tuple as separate arguments (a
+    tuple of 20 arrays is about 140 machine words), on the stack once registers run out; LLVM
+    does not inline a large piece, so a scan paid for thousands of stores and loads. The large
+    pieces every scan goes through (``inline=True``) are inlined into their caller by numba
+    before LLVM sees them (``inline="always"``): the loop then holds one copy of each tuple
+    (`docs/kernel.md`, "One function a scan"). The same bits: inlining changes no arithmetic.
     """
     if function is None:
-        return lambda f: kernel(f, allocates=allocates, entry=entry)
+        return lambda f: kernel(f, allocates=allocates, entry=entry, inline=inline)
     if numba is None:  # pragma: no cover
         return function
     if not _STAMPED:
         _STAMPED.append(True)
         _empty_stale_cache()
-    return numba.njit(cache=True, error_model="numpy", _nrt=allocates or entry, nogil=entry)(function)
+    return numba.njit(cache=True, error_model="numpy", _nrt=allocates or entry, nogil=entry,
+                      inline="always" if inline else "never")(function)
 
 
 def available() -> bool:

@@ -102,7 +102,7 @@ def _sensor_faults(w, i, reported, obs, obs_axes):
         obs_axes[a, 1] = value
 
 
-@kernel
+@kernel(inline=True)
 def world_observe(w, state, i, obs, obs_axes, offsets, reported):
     """World.observe: fill the observation of scan `i` (`obs`: t, wind, valid, intensity, true sky;
     `obs_axes`: encoder, offset, coarse per axis); `offsets` and `reported` are scratch."""
