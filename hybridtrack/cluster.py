@@ -13,12 +13,14 @@ import contextlib
 import os
 import signal
 import threading
-from collections.abc import Iterator
+import time
+from collections.abc import Iterable, Iterator
 
 from . import params
 from .errors import HybridtrackError
 
-__all__ = ["dask_client", "check_where", "close", "cores", "MAX_WORKERS"]
+__all__ = ["dask_client", "check_where", "close", "cores", "finished", "lost", "WorkersGone", "MAX_WORKERS",
+           "WORKERS_GONE_AFTER"]
 
 #: The most worker processes a local cluster is asked for.
 MAX_WORKERS = 1024
@@ -98,6 +100,75 @@ def _refuse_no_workers(client, scheduler: str) -> None:
         client.close()
         raise HybridtrackError(f"the Dask scheduler at {scheduler} has no workers (waited {WORKER_WAIT:g} s): "
                                f"start some with `dask worker {scheduler}`") from None
+
+
+#: Seconds the runs left wait, mid-run, at a scheduler that has had no worker all that time before
+#: they are given up: distributed queues them for a worker that may never come (a remote worker
+#: killed, its machine gone), and a local cluster's nanny restarts a dead worker within seconds.
+WORKERS_GONE_AFTER = 60.0
+#: Seconds between looks at the futures and the scheduler's workers while none is done.
+_LOOK_EVERY = 0.2
+
+
+class WorkersGone(HybridtrackError):
+    """The scheduler has had no worker for `WORKERS_GONE_AFTER` seconds while runs were left."""
+
+
+def finished(client, futures: Iterable) -> Iterator[tuple]:
+    """``(future, result, error)`` for each of `futures` as it is done: its result, or the
+    exception it raised or was cancelled with (the other None). Raise `WorkersGone` when the
+    scheduler has had no worker for `WORKERS_GONE_AFTER` seconds while some are left.
+
+    distributed's ``as_completed`` alone waits for ever there, and a future it calls done can
+    still hang: its result lives on the worker that made it, and when that worker leaves before
+    it is fetched, ``Future.result`` waits for the task to run again on a worker that may never
+    come. So each result is fetched as the future is done (``with_results``), within the wait.
+    The tasks given must not return a tuple (distributed gives an error as one)."""
+    from dask.distributed import as_completed
+
+    done = as_completed(futures, with_results=True, raise_errors=False)
+    alone_since = None
+    while not done.is_empty():
+        if done.has_ready():
+            for future, result in done.next_batch(block=False):
+                yield future, *_outcome(result)
+            alone_since = None
+            continue
+        if _has_workers(client):
+            alone_since = None
+        elif alone_since is None:
+            alone_since = time.monotonic()
+        elif time.monotonic() - alone_since >= WORKERS_GONE_AFTER:
+            raise WorkersGone(f"the Dask scheduler has had no worker for {WORKERS_GONE_AFTER:g} s, with "
+                              f"{done.count()} tasks left")
+        time.sleep(_LOOK_EVERY)
+
+
+def _outcome(result) -> tuple:
+    """``(result, None)``, or ``(None, error)`` for what ``as_completed(raise_errors=False)`` gives
+    in its place: the cancellation itself, or an error's (type, value, traceback)."""
+    if isinstance(result, BaseException):
+        return None, result
+    if isinstance(result, tuple):
+        return None, result[1].with_traceback(result[2])
+    return result, None
+
+
+def lost(error: BaseException) -> bool:
+    """Whether a task's `error` is its loss on Dask (cancelled, or its worker killed too often),
+    not an error of its own."""
+    from concurrent.futures import CancelledError
+
+    from dask.distributed import KilledWorker
+
+    return isinstance(error, (CancelledError, KilledWorker))
+
+
+def _has_workers(client) -> bool:
+    try:
+        return bool(client.nthreads())
+    except (OSError, TimeoutError):  # the scheduler itself is gone: no worker will take the runs
+        return False
 
 
 @contextlib.contextmanager

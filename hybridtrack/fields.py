@@ -749,9 +749,7 @@ def _blocks(frame: pd.DataFrame, runs: list, job: dict, threads: int, workers: i
     if workers is None and scheduler is None:
         yield from _threaded(frame, runs, job, threads)
         return
-    from dask.distributed import as_completed
-
-    from .cluster import close, dask_client
+    from .cluster import close, dask_client, finished, lost
 
     client, cluster = dask_client(scheduler, workers, what="parallel fields")
     try:
@@ -759,8 +757,13 @@ def _blocks(frame: pd.DataFrame, runs: list, job: dict, threads: int, workers: i
         size = max(1, min(16, len(runs) // (2 * max(len(client.scheduler_info()["workers"]), 1))))
         futures = [client.submit(run_collectors, shared, runs[k:k + size], pure=False, **job)
                    for k in range(0, len(runs), size)]
-        for future in as_completed(futures):
-            yield future.result()
+        for _, done, error in finished(client, futures):
+            if error is not None and lost(error):
+                raise HybridtrackError(f"a block of the field's collectors was lost on Dask ({type(error).__name__}: "
+                                       f"{error}); run the field again") from None
+            if error is not None:
+                raise error
+            yield done
     finally:
         close(client, cluster)
 

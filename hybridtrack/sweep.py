@@ -45,7 +45,7 @@ import numpy as np
 import pandas as pd
 
 from . import params
-from .cluster import close, dask_client
+from .cluster import WorkersGone, close, dask_client, finished
 from .errors import HybridtrackError
 from .outputs import claim, output_folder, together, write
 
@@ -389,7 +389,6 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     progress : bool
         A progress bar over runs on stderr.
     """
-    from dask.distributed import as_completed
     from tqdm import tqdm
 
     if not isinstance(sweep, Sweep):
@@ -402,12 +401,13 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
                                       pure=False), runs))
         with tqdm(total=len(futures), unit="run", file=sys.stderr, disable=not progress, leave=False) as bar:
-            for future in as_completed(futures):
-                try:
-                    rows.append(future.result())
-                except Exception as exc:  # noqa: BLE001 - the worker died (killed, out of memory): record it
-                    rows.append(_failed(_row(_spec(sweep.base, futures[future])), exc))
-                bar.update()
+            try:
+                for future, row, error in finished(client, futures):
+                    run = futures.pop(future)  # an error here is the worker's death (killed, out of memory)
+                    rows.append(row if error is None else _failed(_row(_spec(sweep.base, run)), error))
+                    bar.update()
+            except WorkersGone as gone:  # the runs left are recorded as failed, with why
+                rows.extend(_failed(_row(_spec(sweep.base, run)), gone) for run in futures.values())
     except KeyboardInterrupt as stop:
         raise SweepInterrupted(_table(rows) if rows else None, len(runs), stop) from None
     finally:

@@ -2,6 +2,9 @@
 
 import dataclasses
 import datetime as dt
+import re
+import threading
+import time
 
 import numpy as np
 import pandas as pd
@@ -233,6 +236,54 @@ def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):
     assert table.loc[1, "error"] == "MemoryError: the worker ran out of memory" and pd.isna(table.loc[1, "rms"])
 
 
+_FIRST_DONE, _RELEASED = threading.Event(), threading.Event()
+_RUN_ONE = run_one  # the real one, which the test replaces in its module
+
+
+def _the_first_run_alone(base, spec, source="sweep"):
+    """run_one for the first run to come; the others wait until the test lets them go."""
+    if not _FIRST_DONE.is_set():
+        row = _RUN_ONE(base, spec, source)
+        _FIRST_DONE.set()
+        return row
+    _RELEASED.wait(30)
+    return _RUN_ONE(base, spec, source)
+
+
+def test_runs_left_when_the_schedulers_last_worker_leaves_are_failed_rows_not_a_hang(monkeypatch):
+    """A remote worker killed mid-sweep (its machine gone, no nanny to restart it): the runs left
+    waited for a worker for ever. After WORKERS_GONE_AFTER seconds with none they are rows that
+    say why, and the runs that finished are kept."""
+    from dask.distributed import LocalCluster
+
+    import hybridtrack.cluster as cluster_module
+    import hybridtrack.sweep as sweep_module
+
+    monkeypatch.setattr(cluster_module, "WORKERS_GONE_AFTER", 1.0)
+    monkeypatch.setattr(sweep_module, "run_one", _the_first_run_alone)
+    _FIRST_DONE.clear()
+    _RELEASED.clear()
+    sweep = Sweep.from_dict({"base": {"freq": "30min"}, "grid": {"seed": [0, 1, 2, 3]}})
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        def last_worker_leaves():
+            _FIRST_DONE.wait(60)
+            time.sleep(1.0)  # the client fetches the first result from the worker before it leaves
+            threading.Thread(target=cluster.scale, args=(0,), daemon=True).start()
+            time.sleep(0.5)
+            _RELEASED.set()
+
+        threading.Thread(target=last_worker_leaves, daemon=True).start()
+        started = time.monotonic()
+        table = run_sweep(sweep, scheduler=cluster.scheduler_address, progress=False)
+    assert time.monotonic() - started < 30
+    assert list(table["run"]) == [0, 1, 2, 3]
+    assert table["error"].notna().sum() >= 2 and table["rms"].notna().sum() >= 1  # the first run, at least
+    assert table.loc[table["error"].isna(), "rms"].notna().all()
+    gone = table["error"].dropna()
+    assert gone.str.startswith("WorkersGone: the Dask scheduler has had no worker for 1 s").all()
+    assert table.loc[table["error"].notna(), "rms"].isna().all()
+
+
 def test_a_scheduler_without_workers_is_refused_not_waited_on(monkeypatch):
     """A sweep sat at 0 runs for ever; a field ended in distributed's 'No valid workers found'."""
     from dask.distributed import LocalCluster
@@ -311,8 +362,8 @@ def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_pat
                              start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     seen = b""
     deadline = time.monotonic() + 120
-    while b" 3/400" not in seen and time.monotonic() < deadline:  # the progress bar: three runs done
-        chunk = os.read(child.stderr.fileno(), 4096)
+    while max(map(int, re.findall(rb" (\d+)/400", seen)), default=0) < 3 and time.monotonic() < deadline:
+        chunk = os.read(child.stderr.fileno(), 4096)  # the progress bar, until it counts three runs done
         if not chunk:
             break
         seen += chunk
