@@ -34,14 +34,18 @@ def cores() -> int:
         return os.cpu_count() or 1
 
 
-def check_where(scheduler: str | None, workers: int | None) -> None:
+def check_where(scheduler: str | None, workers: int | None, threads: int | None = None) -> None:
     """Refuse a `scheduler` that is not an address (an empty one is an unset ``$VAR``, not a local
-    cluster), and a scheduler beside `workers`: the checks of `dask_client`, for callers that make
-    them before their work starts."""
+    cluster), a scheduler beside `workers`, and `threads` of this process beside either: the checks
+    of `dask_client` (and of a field's threads), for callers that make them before their work
+    starts."""
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
         raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
     if scheduler and workers is not None:
         raise HybridtrackError("give either --scheduler or --workers, not both")
+    if threads is not None and (scheduler is not None or workers is not None):
+        raise HybridtrackError("threads (--threads) run the collectors in this process; workers or a scheduler "
+                               "(--workers, --scheduler) send them to Dask: give one or the other")
 
 
 def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
@@ -123,7 +127,7 @@ def finished(client, futures: Iterable) -> Iterator[tuple]:
     still hang: its result lives on the worker that made it, and when that worker leaves before
     it is fetched, ``Future.result`` waits for the task to run again on a worker that may never
     come. So each result is fetched as the future is done (``with_results``), within the wait.
-    The tasks given must not return a tuple (distributed gives an error as one)."""
+    A task must not return an exception's (type, value, traceback): distributed gives an error so."""
     from dask.distributed import as_completed
 
     done = as_completed(futures, with_results=True, raise_errors=False)
@@ -149,7 +153,7 @@ def _outcome(result) -> tuple:
     in its place: the cancellation itself, or an error's (type, value, traceback)."""
     if isinstance(result, BaseException):
         return None, result
-    if isinstance(result, tuple):
+    if isinstance(result, tuple) and len(result) == 3 and isinstance(result[1], BaseException):
         return None, result[1].with_traceback(result[2])
     return result, None
 

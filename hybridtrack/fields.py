@@ -677,7 +677,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     for name, flag in (("keep_log", keep_log), ("progress", progress)):
         if not isinstance(flag, (bool, np.bool_)) and not (name == "progress" and flag is None):
             raise HybridtrackError(f"{name} must be True or False, got {flag!r:.60}")
-    check_where(scheduler, workers)  # before the sky is computed
+    check_where(scheduler, workers, threads)  # before the sky is computed
     site = sites.get(site)
     frame = _check_frame(frame)
     config = checked_config(config)
@@ -721,10 +721,7 @@ def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, kee
     takes the most, up to one per core, that fit; one where the runs take the reference loop,
     which holds Python's lock throughout (`compiled` False)."""
     if threads is not None:  # more threads than collectors would have nothing to run, nor hold memory
-        threads = min(params.whole(threads, "threads", 1, MAX_WORKERS), collectors)
-        if dask:
-            raise HybridtrackError("threads runs the collectors in this process; with workers or a scheduler each "
-                                   "worker runs its collectors one at a time: give one or the other")
+        threads = min(params.whole(threads, "threads", 1, MAX_WORKERS), collectors)  # Dask beside it: check_where
     first, last = frame.index[0], frame.index[-1]
     step = (last - first) / (len(frame) - 1)
     log = LOG_BYTES * collectors if keep_log else 0

@@ -174,10 +174,7 @@ def _field(args: argparse.Namespace) -> int:
     from ..fields import FieldResult, collector_columns, simulate_field
     from ..outputs import claim
 
-    check_where(args.scheduler, args.workers)  # at the door, not after the weather is made
-    if args.threads is not None and (args.scheduler is not None or args.workers is not None):
-        raise HybridtrackError("--threads runs the collectors in this process; --workers and --scheduler send them "
-                               "to Dask: give one or the other")
+    check_where(args.scheduler, args.workers, args.threads)  # at the door, not after the weather is made
     site = site_from_arguments(args)
     field = field_from_arguments(args)
     if args.metric not in collector_columns(field):
