@@ -293,6 +293,18 @@ def test_a_command_line_argparse_refuses_is_one_line_too(capsys, argv):
     assert not err.startswith("hybridtrack: error: hybridtrack: ")  # the prefix once, a command named after it
 
 
+@pytest.mark.parametrize("argv, flag", [
+    (["field", "fresnel", "--site", "lanzhou", "--date", "2021-06-21", "--rows=1_0,2"], "--rows"),
+    (["field", "trough", "--site", "lanzhou", "--date", "2021-06-21", "--count", "1_2"], "--count"),
+    (["classify", "--intensity", "2_00", "--variation", "5"], "--intensity"),
+    (["simulate", "--date", "2021-06-21", "--seed", "1_000"], "--seed")])
+def test_a_number_with_underscores_is_refused_not_read_as_another(capsys, argv, flag):
+    """Python's int() and float() read "1_0" as 10: a typo on a command line ran a field of row 10."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and flag in err and "_" in err
+
+
 def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys):
     import hybridtrack.cli.runs as runs
 

@@ -9,7 +9,7 @@ import sys
 from .. import params
 from ..errors import HybridtrackError
 from ..outputs import claim, write
-from .base import add_force_argument, command
+from .base import add_force_argument, command, whole_number
 
 
 def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,12 +20,12 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seasons", nargs="+", default=list(SEASONS), choices=list(SEASONS),
                         help="typical days of these seasons (default all four)")
     parser.add_argument("--weather", nargs="+", default=["mixed"], help="sky of each day (default mixed)")
-    parser.add_argument("--seeds", type=int, default=5, help="seeds per site, season and weather (default 5)")
+    parser.add_argument("--seeds", type=whole_number, default=5, help="seeds per site, season and weather (default 5)")
     parser.add_argument("--collectors", nargs="+", default=["trough-ns", "fresnel"],
                         help="collectors (default trough-ns fresnel)")
     parser.add_argument("--policies", nargs="+", choices=list(STRATEGIES),
                         help="policies (default all; with --tradeoff, the first, default hybrid)")
-    parser.add_argument("--workers", type=int, default=1, help="processes (default 1; the table is the same)")
+    parser.add_argument("--workers", type=whole_number, default=1, help="processes (default 1; the table is the same)")
     parser.add_argument("--config", help="simulation config (TOML) every policy shares")
     parser.add_argument("--out", help="folder for runs.csv, table.csv and ablation.png (tradeoff.png)")
     parser.add_argument("--tradeoff", action="store_true",

@@ -15,6 +15,31 @@ EXIT_INTERRUPTED = 130
 #: The shell's status for a command ended by SIGTERM (128 + 15).
 EXIT_TERMINATED = 143
 
+def _written_plainly(text: str, kind: str) -> str:
+    """`text` unless it groups digits with underscores, which Python's ``int`` and ``float`` read
+    as one number (``1_0`` is 10): on a command line it is a typo, not a number to guess at."""
+    if "_" in text:
+        raise argparse.ArgumentTypeError(f"{text!r} is not {kind} (no underscores: write 10, not 1_0)")
+    return text
+
+
+def whole_number(text: str) -> int:
+    """A flag's whole number, as argparse's ``type``: ``int`` without its underscores."""
+    try:
+        return int(_written_plainly(text, "a whole number"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+
+
+def real_number(text: str) -> float:
+    """A flag's number, as argparse's ``type``: ``float`` without its underscores (NaN and
+    infinities pass, to be refused by the parameter's own check, which names its range)."""
+    try:
+        return float(_written_plainly(text, "a number"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
 _COMMANDS: dict[str, tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = {}
 _HELP: dict[str, str] = {}
 
@@ -39,15 +64,15 @@ def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None =
     """
     group = parser.add_argument_group("site", f"a built-in site ({', '.join(sites.names())}) or coordinates")
     group.add_argument("--site", default=None, help=f"built-in site name{f' (default {default})' if default else ''}")
-    group.add_argument("--lat", type=float, help="latitude, degrees north")
-    group.add_argument("--lon", type=float, help="longitude, degrees east")
+    group.add_argument("--lat", type=real_number, help="latitude, degrees north")
+    group.add_argument("--lon", type=real_number, help="longitude, degrees east")
     if record:
         group.add_argument("--tz", help="IANA time zone of the file's naive stamps (or to convert stamps with "
                                         "offsets to), e.g. UTC; with --lat/--lon also the site's clock")
         group.add_argument("--site-tz", help="with --lat/--lon: the site's clock when it differs from the file's --tz")
     else:
         group.add_argument("--tz", help="IANA time zone of the local clock, e.g. Asia/Shanghai")
-    group.add_argument("--altitude", type=float, help="metres above sea level (with --lat/--lon; default 0)")
+    group.add_argument("--altitude", type=real_number, help="metres above sea level (with --lat/--lon; default 0)")
     parser.set_defaults(_default_site=default, _record_site=record)
 
 
@@ -91,11 +116,11 @@ def add_collector_arguments(parser: argparse.ArgumentParser) -> None:
 
     group = parser.add_argument_group("collector")
     group.add_argument("--collector", choices=KINDS, default="trough-ns", help="collector kind (default trough-ns)")
-    group.add_argument("--axis-azimuth", type=float, help="trough/Fresnel axis azimuth, degrees from north")
-    group.add_argument("--row-distance", type=float, default=5.0,
+    group.add_argument("--axis-azimuth", type=real_number, help="trough/Fresnel axis azimuth, degrees from north")
+    group.add_argument("--row-distance", type=real_number, default=5.0,
                        help="Fresnel: signed row distance from the receiver line, m, east positive (default 5)")
-    group.add_argument("--receiver-height", type=float, default=10.0, help="Fresnel: receiver height, m (default 10)")
-    group.add_argument("--aim", type=float, nargs=3, default=(0.0, 20.0, 100.0), metavar=("E", "N", "U"),
+    group.add_argument("--receiver-height", type=real_number, default=10.0, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--aim", type=real_number, nargs=3, default=(0.0, 20.0, 100.0), metavar=("E", "N", "U"),
                        help="heliostat: aim point from the mirror centre, m (default 0 20 100)")
 
 
@@ -189,13 +214,13 @@ def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: b
     """Site, dates, weather, step, seed and gusts of synthetic days (`record`: a file may be read too)."""
     add_site_arguments(parser, record=record)
     parser.add_argument("--date", required=date_required, help="first local date, YYYY-MM-DD")
-    parser.add_argument("--days", type=int, default=1, help="number of days (default 1)")
+    parser.add_argument("--days", type=whole_number, default=1, help="number of days (default 1)")
     parser.add_argument("--weather", default="mixed",
                         help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
     parser.add_argument("--freq", default="1min", help="step (default 1min)")
-    parser.add_argument("--seed", type=int, help="random seed of sky and sensor (default: the --config file's seed "
+    parser.add_argument("--seed", type=whole_number, help="random seed of sky and sensor (default: the --config file's seed "
                                                  "where the command takes one, else 0)")
-    parser.add_argument("--gusts-per-day", type=float, default=0.0, help="mean gust events a day (default 0)")
+    parser.add_argument("--gusts-per-day", type=real_number, default=0.0, help="mean gust events a day (default 0)")
 
 
 def synthetic_span(args: argparse.Namespace):
@@ -236,5 +261,5 @@ def add_dask_arguments(parser, *, default: str) -> None:
     """``--scheduler`` and ``--workers``: where a command's independent runs go (`hybridtrack.cluster`)."""
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help=f"a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: {default})")
-    parser.add_argument("--workers", type=int, help="worker processes of a local Dask cluster (default: one per core "
+    parser.add_argument("--workers", type=whole_number, help="worker processes of a local Dask cluster (default: one per core "
                                                     "when a cluster is used)")

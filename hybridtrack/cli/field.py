@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import HybridtrackError
 from .base import (
     add_dask_arguments, add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config,
-    site_from_arguments, synthetic_frame,
+    real_number, site_from_arguments, synthetic_frame, whole_number,
 )
 
 
@@ -25,16 +25,16 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--rows", help="Fresnel: row distances from the receiver line, m, comma-separated "
                                       "(default 20 rows, -9.5 to 9.5 every 1 m); write --rows=-4,0,4 when the first is "
                                       "negative")
-    group.add_argument("--receiver-height", type=float, help="Fresnel: receiver height, m (default 10)")
-    group.add_argument("--row-length", type=float, help="Fresnel: row length, m (default 100)")
-    group.add_argument("--count", type=int, help="trough: collectors in the loop (default 12); "
+    group.add_argument("--receiver-height", type=real_number, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--row-length", type=real_number, help="Fresnel: row length, m (default 100)")
+    group.add_argument("--count", type=whole_number, help="trough: collectors in the loop (default 12); "
                                                  "heliostat: mirrors on rings when no --positions (default 12)")
-    group.add_argument("--collector-length", type=float, help="trough: collector length, m (default 150)")
-    group.add_argument("--axis-azimuth", type=float,
+    group.add_argument("--collector-length", type=real_number, help="trough: collector length, m (default 150)")
+    group.add_argument("--axis-azimuth", type=real_number,
                        help="Fresnel/trough: axis azimuth, degrees from north (default 0, north-south)")
     group.add_argument("--positions", help="heliostat: CSV of mirror centres with columns east, north (and up), m; "
                                            "aim_east, aim_north, aim_up give each its own aim point")
-    group.add_argument("--aim", type=float, nargs=3, metavar=("E", "N", "U"),
+    group.add_argument("--aim", type=real_number, nargs=3, metavar=("E", "N", "U"),
                        help="heliostat: the receiver's aim point from the tower foot, m (default 0 0 100)")
     group.add_argument("--spread", action="append", metavar="NAME=SD",
                        help="standard deviation of a per-collector imperfection, e.g. --spread encoder_offset=0.3 "
@@ -48,7 +48,7 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
                                                      "energy_capture, moves, p95, end_loss_share, ...)")
     run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
     run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
-    run.add_argument("--threads", type=int, help="threads of this process the collectors run on (default: one per "
+    run.add_argument("--threads", type=whole_number, help="threads of this process the collectors run on (default: one per "
                                                  "core where the compiled kernel runs them, fewer if memory would not "
                                                  "hold that many runs; otherwise one)")
     add_dask_arguments(run, default="the collectors on threads of this process (--threads); --workers N runs them "
@@ -77,8 +77,8 @@ def _spread(args: argparse.Namespace):
 
 def _numbers(text: str, flag: str) -> list[float]:
     try:
-        return [float(part) for part in text.split(",")]  # an empty item is refused, not skipped
-    except ValueError:
+        return [real_number(part) for part in text.split(",")]  # an empty item is refused, not skipped
+    except argparse.ArgumentTypeError:
         raise HybridtrackError(f"{flag} takes numbers separated by commas, got {text!r}") from None
 
 

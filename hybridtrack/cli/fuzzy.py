@@ -11,7 +11,7 @@ import warnings
 from .. import params
 from ..errors import HybridtrackError
 from ..outputs import claim, strict_json, write
-from .base import add_force_argument, command
+from .base import add_force_argument, command, real_number, whole_number
 
 
 @contextlib.contextmanager
@@ -55,8 +55,8 @@ def check_reading(args: argparse.Namespace) -> None:
 
 def _classify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", nargs="?", help="CSV of readings to classify (instead of --intensity/--variation)")
-    parser.add_argument("--intensity", type=float, help="sensor photocurrent, mA")
-    parser.add_argument("--variation", type=float, help="its variation over the window, mA")
+    parser.add_argument("--intensity", type=real_number, help="sensor photocurrent, mA")
+    parser.add_argument("--variation", type=real_number, help="its variation over the window, mA")
     parser.add_argument("--config",
                         help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by default")
     parser.add_argument("--json", action="store_true", help="print JSON: score, weather and each rule's firing")
@@ -109,11 +109,11 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, help="where to write the tuned config (.toml or .fis)")
     parser.add_argument("--method", choices=("global", "local"), default="global",
                         help="global: population search then Powell (default); local: Powell only")
-    parser.add_argument("--margin", type=float, default=0.5, help="how far inside its band a label's score should sit")
-    parser.add_argument("--seed", type=int, default=0, help="seed for reproducible fits (default 0)")
-    parser.add_argument("--folds", type=int, default=5,
+    parser.add_argument("--margin", type=real_number, default=0.5, help="how far inside its band a label's score should sit")
+    parser.add_argument("--seed", type=whole_number, default=0, help="seed for reproducible fits (default 0)")
+    parser.add_argument("--folds", type=whole_number, default=5,
                         help="k of the k-fold cross-validated accuracy (default 5; 0 skips it)")
-    parser.add_argument("--seeds", type=int, default=3,
+    parser.add_argument("--seeds", type=whole_number, default=3,
                         help="fit from this many seeds and report how far the fits spread (default 3; 1 skips it)")
     parser.add_argument("--report", metavar="DIR",
                         help="also write report.json, surfaces.png (before/after) and confusion.png here")
@@ -162,7 +162,7 @@ def _surface_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", help="classifier config (.toml or .fis); the published one by default")
     parser.add_argument("--out", default="surface.png", help="image to write (default surface.png)")
     add_force_argument(parser)
-    parser.add_argument("--points", type=int, default=121, help="grid points along each input (default 121)")
+    parser.add_argument("--points", type=whole_number, default=121, help="grid points along each input (default 121)")
 
 
 @command("surface", "draw the classifier's decision surface and membership functions", _surface_arguments)

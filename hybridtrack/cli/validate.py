@@ -7,7 +7,7 @@ import argparse
 from ..errors import HybridtrackError
 from ..outputs import claim, strict_json, write
 from .base import (
-    add_force_argument, add_record_arguments, add_site_arguments, command, read_record, site_from_arguments,
+    add_force_argument, add_record_arguments, add_site_arguments, command, read_record, real_number, site_from_arguments,
 )
 
 
@@ -20,7 +20,7 @@ def _validate_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--published", action="store_true",
                        help="the published system: absolute mA, raw samples, the four published rules")
     group.add_argument("--classifier", help="fuzzy config (.toml or .fis) overriding the rule table")
-    group.add_argument("--min-altitude", type=float, default=10.0,
+    group.add_argument("--min-altitude", type=real_number, default=10.0,
                        help="count samples with the sun above this many degrees (default 10)")
     out = parser.add_argument_group("output")
     out.add_argument("--plot", metavar="PNG", help="draw one day: beam ratio, classifier inputs and labels")
