@@ -40,7 +40,7 @@ from .collectors import (
 )
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
-from .outputs import claim, output_folder, strict_json, together, write
+from .outputs import claim, output_folder, removing_empty_folders, strict_json, together, write
 from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -554,6 +554,7 @@ class FieldResult:
                  "summary": folder / "summary.json", "map": folder / "field_map.png"}
         return {**files, "log": folder / "log.nc"} if log else files
 
+    @removing_empty_folders()
     def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
         """Write ``collectors.csv``, ``events.csv``, ``summary.json`` (strict JSON), ``field_map.png``
         and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`."""

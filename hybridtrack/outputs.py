@@ -72,7 +72,9 @@ def replacing(force: bool) -> Iterator[list[Path]]:
 @contextlib.contextmanager
 def removing_empty_folders() -> Iterator[None]:
     """Within the block, the folders `claim` makes are removed again if the block fails while they
-    are still empty: a command refused after claiming its ``--out`` leaves no empty folder behind."""
+    are still empty: a command refused after claiming its ``--out``, or a ``save`` refused after
+    claiming its folder (a plot of a metric there is not), leaves no empty folder behind. Also a
+    decorator, for the API's writers."""
     made: list[Path] = []
     token = _MADE.set(made)
     try:

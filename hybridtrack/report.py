@@ -49,16 +49,17 @@ def save_figure(fig, path) -> Path:
     naming `path`, never a silently empty file."""
     import io
 
-    from .outputs import claim, write
+    from .outputs import claim, removing_empty_folders, write
 
     path = Path(path)
     kind = path.suffix.lstrip(".").lower() or "png"
     if kind not in fig.canvas.get_supported_filetypes():
         raise HybridtrackError(f"{path}: cannot draw a .{kind} image; name a .png, .svg or .pdf file")
-    path, = claim([path])
-    image = io.BytesIO()
-    fig.savefig(image, format=kind, dpi=120, bbox_inches="tight")
-    write(path, lambda target: target.write_bytes(image.getvalue()))
+    with removing_empty_folders():  # a drawing or a write that fails leaves no folder it made
+        path, = claim([path])
+        image = io.BytesIO()
+        fig.savefig(image, format=kind, dpi=120, bbox_inches="tight")
+        write(path, lambda target: target.write_bytes(image.getvalue()))
     return path
 
 

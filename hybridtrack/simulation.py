@@ -32,7 +32,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
-from .outputs import claim, output_folder, strict_json, together, write
+from .outputs import claim, output_folder, removing_empty_folders, strict_json, together, write
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
@@ -228,6 +228,7 @@ class Result:
                  "summary": folder / "summary.json"}
         return {**files, "report": folder / "report.png"} if plot else files
 
+    @removing_empty_folders()
     def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
         """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
         (strict JSON: ``null`` for a missing number) and ``report.png``; see `hybridtrack.outputs`

@@ -56,7 +56,7 @@ from .errors import HybridtrackError
 from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
-from .outputs import claim, held, output_folder, strict_json, write, write_in_place
+from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
 from .times import local_midnight, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
@@ -637,6 +637,7 @@ def partial_files(files: dict) -> dict[str, Path]:
     return {role: files[role].with_name(f"{files[role].stem}.partial{files[role].suffix}") for role in ("log", "events")}
 
 
+@removing_empty_folders()
 def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
            config=None, classifier=None, warm_start: bool = True, progress=None,
            on_segment: Callable | None = None, resolution: float = HISTOGRAM_RESOLUTION) -> StreamResult:

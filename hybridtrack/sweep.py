@@ -47,7 +47,7 @@ import pandas as pd
 from . import params
 from .cluster import WorkersGone, close, dask_client, finished
 from .errors import HybridtrackError
-from .outputs import claim, output_folder, together, write
+from .outputs import claim, output_folder, removing_empty_folders, together, write
 
 __all__ = ["Sweep", "SweepInterrupted", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
            "MAXIMISED"]
@@ -535,6 +535,7 @@ def partial_file(folder) -> Path:
     return Path(folder) / "runs.partial.parquet"
 
 
+@removing_empty_folders()
 def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
     """Write ``runs.parquet``, ``tradeoff.png`` and ``sweep.toml`` (the sweep that made them).
 

@@ -354,6 +354,28 @@ def test_a_run_whose_log_cannot_be_written_leaves_nothing_behind(tmp_path, monke
     assert main(SHORT + ["--out", str(out)]) == 0 and pd.read_parquet(out / "log.parquet").shape[0] == 144
 
 
+
+def test_an_api_save_refused_after_claiming_its_folder_leaves_no_folder(tmp_path, monkeypatch):
+    """`FieldResult.save` with a metric the map cannot draw, and `Result.save` on a full disk, had
+    made the folders they were given and left them empty (the command line removed its own)."""
+    from hybridtrack import simulate, simulate_field
+    from hybridtrack.fields import TroughLoop
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-21", freq="10min", weather="sunny", seed=1)
+    field = simulate_field(frame, "lanzhou", TroughLoop(count=2))
+    with pytest.raises(HybridtrackError, match="no collector metric 'bogus'"):
+        field.save(tmp_path / "field" / "deep", metric="bogus")
+    run = simulate(frame, "lanzhou")
+    monkeypatch.setattr(pd.DataFrame, "to_parquet", lambda self, path, *a, **k: _half_then_full(path))
+    with pytest.raises(HybridtrackError, match="No space left on device"):
+        run.save(tmp_path / "run")
+    assert list(tmp_path.iterdir()) == []  # nor the folder above the one asked for
+    (tmp_path / "mine").mkdir()
+    with pytest.raises(HybridtrackError):
+        run.save(tmp_path / "mine")
+    assert (tmp_path / "mine").is_dir()  # a folder that was there before stays
+
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full, a device that is always full")
 @pytest.mark.parametrize("args", [["--version"], ["--help"], ["sweep", "--help"], ["field", "--help"]])
 def test_help_and_version_to_a_full_standard_output_are_one_line(args):

@@ -47,7 +47,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
-from ..outputs import claim, write
+from ..outputs import claim, removing_empty_folders, write
 from .config import FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
 from .system import MamdaniSystem, SystemRule, format_number, system_of
@@ -119,6 +119,7 @@ def fcl_text(system: MamdaniSystem) -> str:
     return "\n".join(lines) + "\n"
 
 
+@removing_empty_folders()
 def write_fcl(config: FuzzyConfig | MamdaniSystem, path) -> Path:
     """Write a classifier config or a system as an FCL file and return its path."""
     system = system_of(config) if isinstance(config, FuzzyConfig) else config

@@ -27,7 +27,7 @@ import re
 from pathlib import Path
 
 from ..errors import HybridtrackError
-from ..outputs import claim, write
+from ..outputs import claim, removing_empty_folders, write
 from .config import METHOD_CHOICES, FuzzyConfig, Methods, Term, Variable
 from .membership import SHAPES, from_matlab, to_matlab
 from .system import MamdaniSystem, SystemRule, config_from_system, format_number, system_of
@@ -77,6 +77,7 @@ def fis_text(system: MamdaniSystem) -> str:
     return "\n".join(lines) + "\n"
 
 
+@removing_empty_folders()
 def write_fis(config: FuzzyConfig | MamdaniSystem, path) -> Path:
     """Write a classifier config or a system as a MATLAB ``.fis`` file and return its path."""
     system = system_of(config) if isinstance(config, FuzzyConfig) else config

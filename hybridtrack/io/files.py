@@ -139,8 +139,9 @@ def write_toml(data: dict, path) -> Path:
     """Write a dict as TOML, creating folders; `read_toml` reads it back equal."""
     import tomli_w
 
-    from ..outputs import claim, write
+    from ..outputs import claim, removing_empty_folders, write
 
-    path, = claim([path])
-    write(path, lambda target: target.write_text(tomli_w.dumps(data), encoding="utf-8"))
+    with removing_empty_folders():  # a write that fails leaves no folder it made
+        path, = claim([path])
+        write(path, lambda target: target.write_text(tomli_w.dumps(data), encoding="utf-8"))
     return path
