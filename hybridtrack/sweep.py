@@ -55,6 +55,8 @@ __all__ = ["Sweep", "SweepInterrupted", "run_sweep", "run_one", "save_sweep", "p
 #: Keys of a run besides its config, with their defaults.
 RUN_KEYS = {"site": "lanzhou", "collector": "trough-ns", "strategy": "hybrid", "start": "2021-06-21", "days": 1,
             "weather": "mixed", "freq": "1min", "seed": 0, "gusts_per_day": 0.0}
+#: The config key a run's ``strategy`` sets: refused beside it, which would replace it in every run.
+STRATEGY_KEY = "controller.strategy"
 #: The metrics of every run's row (from its summary), in the table's order.
 METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture", "moves", "travel_deg", "mode_switches",
            "stow_events", "faults", "steps")
@@ -151,6 +153,9 @@ def _check_key(key: str, source: str, table: str) -> None:
 
     if key in RUN_KEYS:
         return
+    if key == STRATEGY_KEY:  # the run key would replace it in every run, without a word
+        raise HybridtrackError(f"{source}: {table}.{key}: a run's strategy is the run key strategy; "
+                               f"write strategy = ... in [{table}]")
     head, _, rest = key.partition(".")
     if head == "collector" and rest in {f.name for f in dataclasses.fields(Collector)} - {"kind"}:
         return
@@ -166,11 +171,14 @@ def _check_key(key: str, source: str, table: str) -> None:
 
 def _refuse_given_twice(base: dict, config: dict, source: str) -> None:
     """Refuse a config value the base gives twice, dotted (``drive.deadband``) and in
-    ``[base.config]``, and a ``[base.config]`` seed, which each run's ``seed`` replaces: one of
-    the two would be dropped without a word."""
+    ``[base.config]``, and a ``[base.config]`` seed or strategy, which each run's ``seed`` and
+    ``strategy`` replace: one of the two would be dropped without a word."""
     if "seed" in config:
         raise HybridtrackError(f"{source}: [base.config] seed: each run's seed is the run key seed; set it in [base] "
                                "or [grid]")
+    if isinstance(config.get("controller"), dict) and "strategy" in config["controller"]:
+        raise HybridtrackError(f"{source}: [base.config.controller] strategy: each run's strategy is the run key "
+                               "strategy; set it in [base] or [grid]")
     for key in base:
         if key in RUN_KEYS or key.startswith("collector."):
             continue

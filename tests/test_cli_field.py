@@ -98,6 +98,21 @@ def test_bad_field_flags(capsys, flags, message):
     assert message in capsys.readouterr().err
 
 
+def test_a_config_files_strategy_runs_unless_the_flag_gives_another(tmp_path, capsys):
+    """--strategy's default (hybrid) had replaced the config file's: a sensor-only field was
+    reported, and scored, as hybrid."""
+    config = tmp_path / "run.toml"
+    config.write_text('[controller]\nstrategy = "astronomical"\n')
+    base = ["field", "trough", "--count", "2", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min",
+            "--config", str(config)]
+    for flags, strategy in (([], "astronomical"), (["--strategy", "sensor"], "sensor")):
+        assert main(base + flags) == 0
+        out = capsys.readouterr().out
+        assert out.splitlines()[0].endswith(f"(trough-ns), {strategy}")
+    assert main(["compare", *base[4:], "--strategy", "sensor"]) == 2  # it had been ignored: compare runs them all
+    assert "compare runs every strategy: --strategy is not taken" in capsys.readouterr().err
+
+
 def test_field_help(capsys):
     with pytest.raises(SystemExit) as stop:
         main(["field", "--help"])

@@ -38,6 +38,16 @@ def test_simulate_two_days_with_a_config_and_strategy(tmp_path, capsys):
     assert "2,880" in out
 
 
+def test_simulate_runs_the_config_files_strategy_when_no_flag_gives_one(tmp_path, capsys):
+    """--strategy's default had replaced the file's controller.strategy with hybrid."""
+    config = tmp_path / "run.toml"
+    config.write_text('[controller]\nstrategy = "sensor"\n')
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min", "--config", str(config),
+                 "--out", str(tmp_path / "out")]) == 0
+    assert capsys.readouterr().out.splitlines()[0].endswith("trough-ns, sensor")
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["strategy"] == "sensor"
+
+
 def test_replay_a_shipped_record(tmp_path, capsys):
     out = tmp_path / "replay"
     assert main(["replay", "data/nanjing-2013-cloudy.csv", "--site", "nanjing", "--out", str(out)]) == 0

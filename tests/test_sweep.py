@@ -81,6 +81,12 @@ def test_the_grid_is_every_combination_in_order():
      "s.toml: base.days, base.weather: 2 weathers given for 3 days; give one per day"),
     ({"base": {"freq": ["1min"]}, "grid": {"seed": [0]}}, r"s.toml: base.freq: freq must be a step .* got \['1min'\]"),
     ({"base": {"weather": []}, "grid": {"seed": [0]}}, "s.toml: base.weather: weather is an empty list"),  # IndexError
+    # the run key strategy (hybrid by default) had replaced these in every run, under their names in the table
+    ({"grid": {"controller.strategy": ["sensor", "astronomical"]}},
+     "s.toml: grid.controller.strategy: a run's strategy is the run key strategy; write strategy = ... in .grid."),
+    ({"base": {"controller.strategy": "sensor"}, "grid": {"seed": [0]}}, "s.toml: base.controller.strategy: "),
+    ({"base": {"config": {"controller": {"strategy": "sensor"}}}, "grid": {"seed": [0]}},
+     r"s.toml: \[base.config.controller\] strategy: each run's strategy is the run key strategy"),
 ])
 def test_bad_sweeps_are_refused_before_any_run(data, message):
     with pytest.raises(HybridtrackError, match=message):

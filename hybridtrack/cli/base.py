@@ -182,13 +182,17 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
                         help="replace output files that exist already (default: refuse, naming them)")
 
 
+#: ``--strategy``'s help: without it the ``--config`` file's strategy runs, not a default over it.
+STRATEGY_HELP = "tracking strategy (default: the --config file's controller.strategy, else hybrid)"
+
+
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """Collector, strategy, config and output flags shared by simulate, replay and compare."""
     from ..control import STRATEGIES
 
     add_collector_arguments(parser)
     group = parser.add_argument_group("run")
-    group.add_argument("--strategy", choices=STRATEGIES, default="hybrid", help="tracking strategy (default hybrid)")
+    group.add_argument("--strategy", choices=STRATEGIES, help=STRATEGY_HELP)
     group.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
     group.add_argument("--perfect", action="store_true", help="no imperfections: a perfectly built and set-up field")
     group.add_argument("--out", help="folder for log, events.csv, summary.json and report.png")
@@ -196,12 +200,16 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def simulation_config(args: argparse.Namespace, seed: int | None = None):
+    """The run's config: the ``--config`` file's (or the defaults), with ``--strategy``,
+    ``--perfect`` and `seed` over it where given."""
     import dataclasses
 
     from ..simulation import SimulationConfig
     from ..world import Imperfections
 
     config = SimulationConfig.from_toml(args.config) if args.config else SimulationConfig()
+    if getattr(args, "strategy", None) is not None:  # the flag over the file; the file's where not given
+        config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=args.strategy))
     if args.perfect:
         config = dataclasses.replace(config, imperfections=Imperfections.none())
     if seed is not None:

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import HybridtrackError
 from .base import (
     add_dask_arguments, add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config,
-    real_number, site_from_arguments, synthetic_frame, whole_number,
+    STRATEGY_HELP, real_number, site_from_arguments, synthetic_frame, whole_number,
 )
 
 
@@ -41,7 +41,7 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
                             "(repeatable; see hybridtrack.fields.ImperfectionSpread)")
     group.add_argument("--no-spread", action="store_true", help="every collector gets the config's imperfections")
     run = parser.add_argument_group("run")
-    run.add_argument("--strategy", choices=STRATEGIES, default="hybrid", help="tracking strategy (default hybrid)")
+    run.add_argument("--strategy", choices=STRATEGIES, help=STRATEGY_HELP)
     run.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
     run.add_argument("--perfect", action="store_true", help="no imperfections at the centre of the draws")
     run.add_argument("--metric", default="rms", help="collector metric the field map shows (default rms; "
@@ -188,7 +188,7 @@ def _field(args: argparse.Namespace) -> int:
                             threads=args.threads, workers=args.workers, scheduler=args.scheduler)
     written = result.save(args.out, metric=args.metric) if args.out else None  # first: a failing standard output
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
-          f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {args.strategy}")
+          f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {result.summary['strategy']}")
     print(field_table(result.summary))
     shown = ["east", "north", "rms", "energy_capture", "moves"] + \
         (["end_loss_share"] if "end_loss_share" in result.collectors else [])

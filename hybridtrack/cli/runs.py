@@ -27,13 +27,13 @@ from .base import (
 )
 
 
-def _run(frame, site, args, strategy: str, config, *, label: str = ""):
+def _run(frame, site, args, strategy: str | None, config, *, label: str = ""):
     from tqdm import tqdm
 
     from ..simulation import simulate
 
     days = (frame.index[-1] - frame.index[0]) / pd.Timedelta(days=1)
-    with tqdm(total=len(frame), unit="step", desc=label or strategy, disable=days < 2, leave=False,
+    with tqdm(total=len(frame), unit="step", desc=label or strategy or config.controller.strategy, disable=days < 2, leave=False,
               file=sys.stderr) as bar:
         return simulate(frame, site, collector=collector_from_arguments(args), strategy=strategy, config=config,
                         progress=bar.update)
@@ -126,7 +126,7 @@ def _stream(source, args, config, *, heading: str) -> int:
     if not args.out:
         raise HybridtrackError("--stream writes its log to disk: give --out FOLDER")
     claim(stream_files(args.out).values())  # a bad --out is refused before the bar
-    with progress_bar(source, label=args.strategy) as bar:
+    with progress_bar(source, label=config.controller.strategy) as bar:
         result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
                         config=config, progress=bar.update)
     print(heading + f" (streamed in {result.summary['streamed']['segments']} day-long segments)")
@@ -150,7 +150,7 @@ def _simulate(args: argparse.Namespace) -> int:
     _claim_run_folder(args)
     result = _run(frame, site, args, args.strategy, simulation_config(args, args.seed))
     _finish(result, args, heading=f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, "
-                                  f"{args.weather}), {result.collector.kind}, {args.strategy}")
+                                  f"{args.weather}), {result.collector.kind}, {result.summary['strategy']}")
     return 0
 
 
@@ -163,10 +163,11 @@ def _stream_synthetic(args: argparse.Namespace, site) -> int:
                                "monthly climate), not a per-day list")
     source = synthetic_days(site, first, last, weather=args.weather, freq=args.freq, seed=args.seed,
                             gusts_per_day=args.gusts_per_day)
-    return _stream(source, args, simulation_config(args, args.seed),
+    config = simulation_config(args, args.seed)
+    return _stream(source, args, config,
                    heading=f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}, "
                            f"each day seeded from (seed, date)), {collector_from_arguments(args).kind}, "
-                           f"{args.strategy}")
+                           f"{config.controller.strategy}")
 
 
 def _replay_arguments(parser: argparse.ArgumentParser) -> None:
@@ -217,13 +218,15 @@ def _replay(args: argparse.Namespace) -> int:
                                    "and --format are not taken; convert the record once with read_weather")
         site = site_from_arguments(args)
         source = recorded_days(args.file, site, tz=args.tz)
-        return _stream(source, args, replay_config(args, source.wind_measured),
+        config = replay_config(args, source.wind_measured)
+        return _stream(source, args, config,
                        heading=f"replay of {args.file} at {site.name}, {collector_from_arguments(args).kind}, "
-                               f"{args.strategy}")
+                               f"{config.controller.strategy}")
     site, frame = _replay_frame(args)
     _claim_run_folder(args)
     result = _run(frame, site, args, args.strategy, replay_config(args, _has_wind(frame)))
-    _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, {args.strategy}")
+    _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, "
+                                  f"{result.summary['strategy']}")
     return 0
 
 
@@ -251,6 +254,8 @@ def _compare(args: argparse.Namespace) -> int:
 
     if args.file is None and args.date is None:
         raise HybridtrackError("give a recorded FILE, or --date for synthetic days")
+    if args.strategy is not None:
+        raise HybridtrackError("compare runs every strategy: --strategy is not taken (run simulate or replay for one)")
     if args.file is not None:
         site, frame = _replay_frame(args)
         config = replay_config(args, _has_wind(frame))
