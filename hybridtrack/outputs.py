@@ -119,7 +119,23 @@ def claim(paths: Iterable) -> list[Path]:
     for folder in dict.fromkeys(path.parent for path in paths):
         _refuse_held(folder)
         _make_folder(folder)
+        _refuse_unwritable(folder, [path for path in paths if path.parent == folder])
     return paths
+
+
+def _refuse_unwritable(folder: Path, paths: list[Path]) -> None:
+    """Refuse a folder that takes no new file (read-only, no permission), unless each of `paths`
+    can be written where it is (`write` rewrites such a file in place): found only when the
+    results were written, a sweep's finished runs were lost with the error."""
+    try:
+        descriptor, probe = tempfile.mkstemp(prefix=".hybridtrack-probe-", dir=folder)
+    except OSError as exc:
+        if all(not p.is_file() or os.access(p, os.W_OK) for p in paths) and all(p.exists() for p in paths):
+            return
+        raise HybridtrackError(f"{folder}: cannot write there ({exc.strerror or exc})") from None
+    os.close(descriptor)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
 
 
 def _refuse_held(folder: Path) -> None:

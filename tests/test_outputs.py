@@ -460,3 +460,32 @@ def test_a_closed_or_full_standard_error_loses_no_run_and_keeps_the_status(tmp_p
     assert (tmp_path / "streamed" / "summary.json").stat().st_size > 0
     assert (tmp_path / "field" / "collectors.csv").stat().st_size > 0
     assert run("simulate", "--site", "lanzhou", "--date", "2021-02-30") == 2
+
+
+def _unwritable_folders(tmp_path):
+    """Folders that take no new file here: one without write permission (not for root, whom
+    permissions do not stop) and sysfs's, which refuses new files to root too."""
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    folders = [locked] if os.geteuid() != 0 else []
+    if os.path.isdir("/sys/kernel"):
+        try:
+            Path("/sys/kernel", ".hybridtrack-probe").touch()
+        except OSError:
+            folders.append(Path("/sys/kernel"))
+    return folders
+
+
+def test_a_folder_that_takes_no_new_file_is_refused_before_the_run(tmp_path, capsys):
+    """A read-only --out was found only when the results were written: a sweep lost its runs."""
+    folders = _unwritable_folders(tmp_path)
+    if not folders:
+        pytest.skip("no folder here refuses new files to this user")
+    for folder in folders:
+        with pytest.raises(HybridtrackError, match=rf"^{folder}: cannot write there \("):
+            claim([folder / "summary.json"])
+        assert main(SHORT + ["--out", str(folder)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{folder}: cannot write there" in err
+    (tmp_path / "locked").chmod(0o700)
