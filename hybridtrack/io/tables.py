@@ -280,12 +280,14 @@ def numeric_columns(frame: pd.DataFrame, columns, where: str, *, required=()) ->
     for column in columns:
         if column not in frame.columns:
             continue
-        values = pd.to_numeric(frame[column], errors="coerce")
-        bad = (values.isna() & frame[column].notna()).to_numpy()
+        cells = frame[column]
+        truth = cells.map(lambda v: isinstance(v, (bool, np.bool_))).to_numpy(bool)  # pandas reads True as 1
+        values = pd.to_numeric(cells.mask(truth), errors="coerce")
+        bad = (values.isna() & cells.notna()).to_numpy()
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
-            raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: {frame[column].iloc[row]!r} "
-                                   "is not a number")
+            cell = repr(str(cells.iloc[row])) if truth[row] else repr(cells.iloc[row])  # 'True', as the file has it
+            raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: {cell} is not a number")
         values = values.astype(float)
         refused = np.isinf(values.to_numpy()) | (values.isna().to_numpy() if column in required else False)
         if refused.any():
