@@ -64,6 +64,7 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
     ("east,north\n0,-100\n", ["--metric", "shine"], "--metric: no collector metric 'shine'"),
     ("east,north\n0,-100\n", ["--spread", "encoder_offset=-1"], "encoder_offset must be a finite number >= 0"),
     ("east,north\n0,-100\n", ["--spread", "colour=1"], "--spread: unknown imperfection 'colour'"),
+    ("east,north\n0,-100\n", ["--spread", "encoder_offset=1_0"], "--spread encoder_offset: '1_0' is not a number"),
     ("east,north\n0,-100\n", ["--spread", "encoder_offset=1", "--no-spread"], "not both"),
 ])
 def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, extra, message):

@@ -9,7 +9,7 @@ import sys
 from .. import params
 from ..errors import HybridtrackError
 from ..outputs import claim, write
-from .base import add_force_argument, command, whole_number
+from .base import add_force_argument, command, real_number, whole_number
 
 
 def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
@@ -84,8 +84,8 @@ def _write(files: list, result) -> None:
 
 def _deadbands(text: str) -> tuple[float, ...]:
     try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
+        values = tuple(real_number(v) for v in text.split(","))
+    except argparse.ArgumentTypeError:
         raise HybridtrackError(f"--deadbands {text!r}: give degrees separated by commas, e.g. 0.1,0.2,0.4") from None
     if not all(math.isfinite(v) for v in values):
         raise HybridtrackError(f"--deadbands {text!r}: every deadband must be a finite number")

@@ -69,9 +69,9 @@ def _spread(args: argparse.Namespace):
         if name not in known:
             raise HybridtrackError(f"--spread: unknown imperfection {name!r}; known: {', '.join(sorted(known))}")
         try:
-            changes[name] = float(value)
-        except ValueError:
-            raise HybridtrackError(f"--spread {name}: {value!r} is not a number") from None
+            changes[name] = real_number(value)
+        except argparse.ArgumentTypeError as exc:
+            raise HybridtrackError(f"--spread {name}: {exc}") from None
     return ImperfectionSpread(**changes)
 
 

@@ -41,7 +41,7 @@ def _evaluate(system, args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..fuzzy.engine import CompiledSystem, evaluate, evaluate_skfuzzy
-    from .base import parse_mapping
+    from .base import parse_mapping, real_number
 
     given = parse_mapping(args.values, "NAME=VALUE")
     unknown = sorted(set(given) - set(system.input_names))
@@ -50,8 +50,8 @@ def _evaluate(system, args: argparse.Namespace) -> int:
         problem = f"unknown input {unknown[0]!r}" if unknown else f"no value for input {missing[0]!r}"
         raise HybridtrackError(f"{problem}; the inputs are {', '.join(system.input_names)}")
     try:
-        x = np.array([[float(given[name]) for name in system.input_names]])
-    except ValueError as exc:
+        x = np.array([[real_number(given[name]) for name in system.input_names]])
+    except argparse.ArgumentTypeError as exc:
         raise HybridtrackError(f"input values must be numbers: {exc}") from None
     for name, value in zip(system.input_names, x[0]):
         if not np.isfinite(value):
