@@ -317,6 +317,32 @@ def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys):
     assert err.count("\n") == 0 and err.startswith("hybridtrack: interrupted") and "Traceback" not in err
 
 
+def test_ctrl_c_while_the_command_loads_is_one_line_and_after_it_is_done_is_ignored(monkeypatch, capsys):
+    """A Ctrl-C in the first half second (pandas loading) printed an import's traceback; one while
+    Dask shut down at exit printed a weak reference's, after every file was written."""
+    import signal
+    import sys
+    import types
+
+    from hybridtrack import launch
+
+    class Loading(types.ModuleType):
+        def __getattr__(self, name):
+            raise KeyboardInterrupt
+
+    monkeypatch.setitem(sys.modules, "hybridtrack.cli", Loading("hybridtrack.cli"))
+    assert launch.main() == 130
+    err = capsys.readouterr().err.strip()
+    assert err == "hybridtrack: interrupted while starting; nothing was done"
+    monkeypatch.undo()
+    previous = signal.getsignal(signal.SIGINT)
+    monkeypatch.setattr(sys, "argv", ["hybridtrack", "classify", "--intensity", "200", "--variation", "50"])
+    try:
+        assert launch.main() == 0 and signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def test_without_strict_the_same_problems_are_repaired_and_reported(tmp_path):
     path = tmp_path / "messy.csv"
     path.write_text(HEADER + "2021-06-21 12:01,1,1,1,1\n2021-06-21 12:00,1,1,1,-4\n2021-06-21 12:00,1,1,1,1\n"

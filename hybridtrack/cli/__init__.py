@@ -24,7 +24,8 @@ from .. import __version__
 from ..errors import HybridtrackError
 from ..outputs import reader_may_leave, removing_empty_folders, replacing
 from . import sun, fuzzy, fuzzyfiles, records, runs, ablate, validate, rules, init, field, sweep, faults  # noqa: F401, I001  (each registers its commands, in this order)
-from .base import _COMMANDS, _HELP, EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_USAGE
+from ..launch import EXIT_INTERRUPTED
+from .base import _COMMANDS, _HELP, EXIT_TERMINATED, EXIT_USAGE
 
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
 

@@ -10,10 +10,9 @@ from .. import params, sites
 from ..errors import HybridtrackError
 
 EXIT_USAGE = 2
-#: The shell's status for a run stopped by SIGINT (128 + 2).
-EXIT_INTERRUPTED = 130
 #: The shell's status for a command ended by SIGTERM (128 + 15).
 EXIT_TERMINATED = 143
+
 
 def _written_plainly(text: str, kind: str) -> str:
     """`text` unless it groups digits with underscores, which Python's ``int`` and ``float`` read
