@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import re
 
 import pandas as pd
 
@@ -95,6 +96,12 @@ def check_tz(tz: str, where: str = "") -> str:
 FIRST_DATE, LAST_DATE = dt.date(1678, 1, 1), dt.date(2261, 12, 31)
 
 
+#: A date as the command line and configs write it: ``YYYY-MM-DD``.
+_ISO_DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
+#: A clock time as they write it: ``HH:MM`` or ``HH:MM:SS``.
+_CLOCK = re.compile(r"\d{2}:\d{2}(:\d{2})?")
+
+
 def parse_date(text) -> dt.date:
     """Parse ``YYYY-MM-DD`` (or pass a date through), refusing dates that do not exist or that a
     run cannot cover (`FIRST_DATE` to `LAST_DATE`)."""
@@ -103,10 +110,13 @@ def parse_date(text) -> dt.date:
     elif isinstance(text, dt.date):
         day = text
     else:
-        try:
-            day = dt.date.fromisoformat(str(text).strip())
+        written = str(text).strip()
+        try:  # fromisoformat alone takes 20210621 and 2021W251 too, which the messages never offer
+            day = dt.date.fromisoformat(written) if _ISO_DATE.fullmatch(written) else None
         except ValueError:
-            raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD") from None
+            day = None
+        if day is None:
+            raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD")
     check_dates(day, day, f"date {text!r}" if isinstance(text, str) else f"date {day}")
     return day
 
@@ -123,10 +133,14 @@ def parse_clock(text: str) -> dt.time:
     value = str(text).strip()
     if value in ("24:00", "24:00:00"):
         return dt.time.max
-    try:
-        return dt.time.fromisoformat(value)
+    try:  # fromisoformat alone takes 1200, 12 and 12:00+08:00 (a time in another zone) too
+        return dt.time.fromisoformat(value) if _CLOCK.fullmatch(value) else _refuse_clock(text)
     except ValueError:
-        raise HybridtrackError(f"clock time {text!r} is not HH:MM") from None
+        _refuse_clock(text)
+
+
+def _refuse_clock(text):
+    raise HybridtrackError(f"clock time {text!r} is not HH:MM") from None
 
 
 def parse_freq(text: str) -> pd.Timedelta:

@@ -1,10 +1,15 @@
-"""The clock's fields by integer arithmetic against pandas' own field accessors."""
+"""The clock's fields by integer arithmetic against pandas' own field accessors; dates and clock
+times as they are written."""
+
+import datetime as dt
+import re
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from hybridtrack.times import calendar_days, clock_hours
+from hybridtrack import HybridtrackError
+from hybridtrack.times import calendar_days, clock_hours, parse_clock, parse_date
 
 
 @pytest.mark.parametrize("tz", ["Asia/Shanghai", "America/New_York", "Australia/Lord_Howe", "Etc/GMT+12"])
@@ -46,3 +51,20 @@ def test_plus_seconds_is_pandas_to_timedelta_to_the_nanosecond():
     assert list(whole) == [index[0], index[1] + pd.Timedelta(seconds=20), index[2] - pd.Timedelta(seconds=1.5)]
     with pytest.raises(HybridtrackError, match="beyond"):
         plus_seconds(index[:1], [1e10])
+
+
+@pytest.mark.parametrize("text", ["20210621", "2021W251", "2021-W25-1", "2021-6-21"])
+def test_a_date_not_written_yyyy_mm_dd_is_refused(text):
+    """Python 3.11's fromisoformat read 20210621 and the ISO week date 2021W251 as 21 June, which
+    the messages, the help and the docs never offer."""
+    with pytest.raises(HybridtrackError, match=f"date '{text}' does not exist or is not YYYY-MM-DD"):
+        parse_date(text)
+    assert parse_date(" 2021-06-21 ") == dt.date(2021, 6, 21)
+
+
+@pytest.mark.parametrize("text", ["1200", "12", "12:00+08:00", "7:00"])
+def test_a_clock_time_not_written_hh_mm_is_refused(text):
+    """fromisoformat took 12:00+08:00, a time in another zone than the site's, as noon."""
+    with pytest.raises(HybridtrackError, match=f"clock time '{re.escape(text)}' is not HH:MM"):
+        parse_clock(text)
+    assert parse_clock("05:30") == dt.time(5, 30) and parse_clock("05:30:15") == dt.time(5, 30, 15)
