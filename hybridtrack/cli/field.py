@@ -121,7 +121,10 @@ def field_from_arguments(args: argparse.Namespace):
         if aims is not None and aim is not None:
             raise HybridtrackError(f"--aim gives every mirror one aim point; {args.positions} gives each its own "
                                    "(aim_east, aim_north, aim_up): give one or the other")
-        return HeliostatField(positions=positions, aims=aims, spread=spread, **_given(aim=aim))
+        try:
+            return HeliostatField(positions=positions, aims=aims, spread=spread, **_given(aim=aim))
+        except HybridtrackError as exc:  # heliostat N is the file's N-th mirror
+            raise HybridtrackError(f"{args.positions}: {exc}") from None
     return HeliostatField.rings(**_given(count=args.count, aim=aim), spread=spread)
 
 
