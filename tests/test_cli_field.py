@@ -26,6 +26,18 @@ def test_field_reads_heliostat_positions_and_aims(tmp_path, capsys):
     assert "HeliostatField of 2 (heliostat)" in capsys.readouterr().out
 
 
+def test_a_positions_files_columns_it_does_not_read_are_named(tmp_path, capsys):
+    """An 'elevation' column meant as up had been dropped without a word: the mirrors stood at 0 m."""
+    from hybridtrack.cli.field import read_positions
+
+    path = tmp_path / "mirrors.csv"
+    path.write_text("id,east,north,elevation\n1,0,-100,3\n")
+    positions, _ = read_positions(str(path))
+    assert positions.tolist() == [[0.0, -100.0]]
+    assert capsys.readouterr().out == f"{path}: not read: id, elevation (mirrors are read from east, north, up and " \
+                                      "aim_east, aim_north, aim_up)\n"
+
+
 def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
     from hybridtrack.cli.field import read_positions
 
@@ -86,6 +98,7 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
     (["trough", "--count", "2", "--threads", "2", "--workers", "1"], "give one or the other"),
     (["trough", "--count", "2", "--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler or --workers, not both"),
     (["fresnel", "--rows=1,,2"], "--rows takes numbers separated by commas, got '1,,2'"),  # not two rows
+    (["trough", "--metric", "moves"], "--metric colours the field map, which only --out writes"),  # had been unused
     # a flag that describes another kind of field had been ignored
     (["fresnel", "--positions", "/no/such/file.csv"], "--positions describes a heliostat field, not a fresnel one"),
     (["fresnel", "--count", "99"], "--count describes a trough or heliostat field, not a fresnel one"),

@@ -44,8 +44,8 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
     run.add_argument("--strategy", choices=STRATEGIES, help=STRATEGY_HELP)
     run.add_argument("--config", help="simulation config (TOML: controller, imperfections, sensor, drive, seed)")
     run.add_argument("--perfect", action="store_true", help="no imperfections at the centre of the draws")
-    run.add_argument("--metric", default="rms", help="collector metric the field map shows (default rms; "
-                                                     "energy_capture, moves, p95, end_loss_share, ...)")
+    run.add_argument("--metric", help="collector metric the field map in --out shows (default rms; "
+                                      "energy_capture, moves, p95, end_loss_share, ...)")
     run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
     run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
     run.add_argument("--threads", type=whole_number, help="threads of this process the collectors run on (default: one per "
@@ -97,6 +97,10 @@ def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
     if aim_columns and len(aim_columns) != 3:
         raise HybridtrackError(f"{path}: aim points need all of aim_east, aim_north, aim_up")
     columns = position_columns + aim_columns
+    unread = [c for c in table.columns if c not in columns]
+    if unread:  # an id or a name, or an 'elevation' meant as up: said, not dropped without a word
+        print(f"{path}: not read: {', '.join(map(str, unread))} (mirrors are read from east, north, up and "
+              "aim_east, aim_north, aim_up)")
     table = numeric_columns(table, columns, str(path), required=columns)
     aims = table[aim_columns].to_numpy(float) if aim_columns else None
     return table[position_columns].to_numpy(float), aims
@@ -180,16 +184,18 @@ def _field(args: argparse.Namespace) -> int:
     check_where(args.scheduler, args.workers, args.threads)  # at the door, not after the weather is made
     site = site_from_arguments(args)
     field = field_from_arguments(args)
-    if args.metric not in collector_columns(field):
+    if args.metric is not None and args.metric not in collector_columns(field):
         raise HybridtrackError(f"--metric: no collector metric {args.metric!r}; "
                                f"choose from {', '.join(collector_columns(field))}")
+    if args.metric is not None and not args.out:
+        raise HybridtrackError("--metric colours the field map, which only --out writes: give --out FOLDER")
     frame = synthetic_frame(args, site)
     if args.out:
         claim(FieldResult.files(args.out, log=not args.no_log).values())
     result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
                             seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True,
                             threads=args.threads, workers=args.workers, scheduler=args.scheduler)
-    written = result.save(args.out, metric=args.metric) if args.out else None  # first: a failing standard output
+    written = result.save(args.out, metric=args.metric or "rms") if args.out else None  # first: a failing standard output
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
           f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {result.summary['strategy']}")
     print(field_table(result.summary))
