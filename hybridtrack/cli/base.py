@@ -118,7 +118,8 @@ def add_collector_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--axis-azimuth", type=real_number, help="trough/Fresnel axis azimuth, degrees from north")
     group.add_argument("--row-distance", type=real_number, default=5.0,
                        help="Fresnel: signed row distance from the receiver line, m, east positive (default 5)")
-    group.add_argument("--receiver-height", type=real_number, default=10.0, help="Fresnel: receiver height, m (default 10)")
+    group.add_argument("--receiver-height", type=real_number, default=10.0,
+                       help="Fresnel: receiver height, m (default 10)")
     group.add_argument("--aim", type=real_number, nargs=3, default=(0.0, 20.0, 100.0), metavar=("E", "N", "U"),
                        help="heliostat: aim point from the mirror centre, m (default 0 20 100)")
 
@@ -225,8 +226,9 @@ def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: b
     parser.add_argument("--weather", default="mixed",
                         help="sunny, cloudy, overcast, mixed (default), climate, or one per day: sunny,cloudy,...")
     parser.add_argument("--freq", default="1min", help="step (default 1min)")
-    parser.add_argument("--seed", type=whole_number, help="random seed of sky and sensor (default: the --config file's seed "
-                                                 "where the command takes one, else 0)")
+    parser.add_argument("--seed", type=whole_number,
+                        help="random seed of sky and sensor (default: the --config file's seed where the command "
+                             "takes one, else 0)")
     parser.add_argument("--gusts-per-day", type=real_number, default=0.0, help="mean gust events a day (default 0)")
 
 
@@ -268,5 +270,5 @@ def add_dask_arguments(parser, *, default: str) -> None:
     """``--scheduler`` and ``--workers``: where a command's independent runs go (`hybridtrack.cluster`)."""
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help=f"a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: {default})")
-    parser.add_argument("--workers", type=whole_number, help="worker processes of a local Dask cluster (default: one per core "
-                                                    "when a cluster is used)")
+    parser.add_argument("--workers", type=whole_number,
+                        help="worker processes of a local Dask cluster (default: one per core when a cluster is used)")

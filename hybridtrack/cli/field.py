@@ -27,8 +27,9 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
                                       "negative")
     group.add_argument("--receiver-height", type=real_number, help="Fresnel: receiver height, m (default 10)")
     group.add_argument("--row-length", type=real_number, help="Fresnel: row length, m (default 100)")
-    group.add_argument("--count", type=whole_number, help="trough: collectors in the loop (default 12); "
-                                                 "heliostat: mirrors on rings when no --positions (default 12)")
+    group.add_argument("--count", type=whole_number,
+                       help="trough: collectors in the loop (default 12); heliostat: mirrors on rings when no "
+                            "--positions (default 12)")
     group.add_argument("--collector-length", type=real_number, help="trough: collector length, m (default 150)")
     group.add_argument("--axis-azimuth", type=real_number,
                        help="Fresnel/trough: axis azimuth, degrees from north (default 0, north-south)")
@@ -48,9 +49,9 @@ def _field_arguments(parser: argparse.ArgumentParser) -> None:
                                       "energy_capture, moves, p95, end_loss_share, ...)")
     run.add_argument("--no-log", action="store_true", help="keep only the metrics, not the collector x time log")
     run.add_argument("--out", help="folder for collectors.csv, events.csv, summary.json, field_map.png, log.nc")
-    run.add_argument("--threads", type=whole_number, help="threads of this process the collectors run on (default: one per "
-                                                 "core where the compiled kernel runs them, fewer if memory would not "
-                                                 "hold that many runs; otherwise one)")
+    run.add_argument("--threads", type=whole_number,
+                     help="threads of this process the collectors run on (default: one per core where the compiled "
+                          "kernel runs them, fewer if memory would not hold that many runs; otherwise one)")
     add_dask_arguments(run, default="the collectors on threads of this process (--threads); --workers N runs them "
                                     "on a local cluster of N processes")
     add_force_argument(run)
@@ -195,9 +196,11 @@ def _field(args: argparse.Namespace) -> int:
     result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
                             seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True,
                             threads=args.threads, workers=args.workers, scheduler=args.scheduler)
-    written = result.save(args.out, metric=args.metric or "rms") if args.out else None  # first: a failing standard output
+    # saved first: a standard output that fails to print loses nothing
+    written = result.save(args.out, metric=args.metric or "rms") if args.out else None
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
-          f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), {result.summary['strategy']}")
+          f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), "
+          f"{result.summary['strategy']}")
     print(field_table(result.summary))
     shown = ["east", "north", "rms", "energy_capture", "moves"] + \
         (["end_loss_share"] if "end_loss_share" in result.collectors else [])

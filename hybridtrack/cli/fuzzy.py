@@ -109,7 +109,8 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, help="where to write the tuned config (.toml or .fis)")
     parser.add_argument("--method", choices=("global", "local"), default="global",
                         help="global: population search then Powell (default); local: Powell only")
-    parser.add_argument("--margin", type=real_number, default=0.5, help="how far inside its band a label's score should sit")
+    parser.add_argument("--margin", type=real_number, default=0.5,
+                        help="how far inside its band a label's score should sit")
     parser.add_argument("--seed", type=whole_number, default=0, help="seed for reproducible fits (default 0)")
     parser.add_argument("--folds", type=whole_number, default=5,
                         help="k of the k-fold cross-validated accuracy (default 5; 0 skips it)")

@@ -33,8 +33,8 @@ def _run(frame, site, args, strategy: str | None, config, *, label: str = ""):
     from ..simulation import simulate
 
     days = (frame.index[-1] - frame.index[0]) / pd.Timedelta(days=1)
-    with tqdm(total=len(frame), unit="step", desc=label or strategy or config.controller.strategy, disable=days < 2, leave=False,
-              file=sys.stderr) as bar:
+    with tqdm(total=len(frame), unit="step", desc=label or strategy or config.controller.strategy, disable=days < 2,
+              leave=False, file=sys.stderr) as bar:
         return simulate(frame, site, collector=collector_from_arguments(args), strategy=strategy, config=config,
                         progress=bar.update)
 

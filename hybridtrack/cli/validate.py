@@ -7,7 +7,8 @@ import argparse
 from ..errors import HybridtrackError
 from ..outputs import claim, strict_json, write
 from .base import (
-    add_force_argument, add_record_arguments, add_site_arguments, command, read_record, real_number, site_from_arguments,
+    add_force_argument, add_record_arguments, add_site_arguments, command, read_record, real_number,
+    site_from_arguments,
 )
 
 
