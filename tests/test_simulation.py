@@ -245,6 +245,17 @@ def test_config_round_trips_and_refuses_unknown_keys(tmp_path):
         SimulationConfig.from_toml(tmp_path / "bad4.toml")
 
 
+def test_a_config_saved_with_a_byte_order_mark_reads_as_without_one(tmp_path):
+    """Notepad saves UTF-8 with a byte-order mark: 'not valid TOML: Invalid statement (at line 1,
+    column 1)', where the CSV reader took the same mark."""
+    path = tmp_path / "run.toml"
+    path.write_bytes(b"\xef\xbb\xbf[controller]\r\nstrategy = 'sensor'\r\n")
+    assert SimulationConfig.from_toml(path).controller.strategy == "sensor"
+    path.write_bytes(b"\xef\xbb\xbfseed = 3\n\xff\n")
+    with pytest.raises(HybridtrackError, match=r"run.toml: not UTF-8 text \(invalid start byte at byte 12\)"):
+        SimulationConfig.from_toml(path)
+
+
 def test_result_saves_log_summary_events_and_report(tmp_path, mixed_runs):
     written = mixed_runs[("lanzhou", "hybrid")].save(tmp_path / "run")
     assert json.loads(written["summary"].read_text())["strategy"] == "hybrid"

@@ -125,10 +125,11 @@ def read_toml(path, what: str = "config") -> dict:
     tomllib = _tomllib()
     path = Path(path)
     raw = read_bytes(path, f"{what} file")
+    mark = 3 if raw.startswith(b"\xef\xbb\xbf") else 0  # a byte-order mark, as Windows editors save UTF-8
     try:
-        text = raw.decode("utf-8")
+        text = raw[mark:].decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start + mark})") from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
