@@ -130,7 +130,7 @@ def _refuse_unwritable(folder: Path, paths: list[Path]) -> None:
     try:
         descriptor, probe = tempfile.mkstemp(prefix=".hybridtrack-probe-", dir=folder)
     except OSError as exc:
-        if all(not p.is_file() or os.access(p, os.W_OK) for p in paths) and all(p.exists() for p in paths):
+        if all(p.exists() and (not p.is_file() or os.access(p, os.W_OK)) for p in paths):
             return
         raise HybridtrackError(f"{folder}: cannot write there ({exc.strerror or exc})") from None
     os.close(descriptor)

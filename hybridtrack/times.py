@@ -110,11 +110,7 @@ def parse_date(text) -> dt.date:
     elif isinstance(text, dt.date):
         day = text
     else:
-        written = str(text).strip()
-        try:  # fromisoformat alone takes 20210621 and 2021W251 too, which the messages never offer
-            day = dt.date.fromisoformat(written) if _ISO_DATE.fullmatch(written) else None
-        except ValueError:
-            day = None
+        day = _as_written(str(text).strip(), _ISO_DATE, dt.date.fromisoformat)
         if day is None:
             raise HybridtrackError(f"date {text!r} does not exist or is not YYYY-MM-DD")
     check_dates(day, day, f"date {text!r}" if isinstance(text, str) else f"date {day}")
@@ -133,14 +129,22 @@ def parse_clock(text: str) -> dt.time:
     value = str(text).strip()
     if value in ("24:00", "24:00:00"):
         return dt.time.max
-    try:  # fromisoformat alone takes 1200, 12 and 12:00+08:00 (a time in another zone) too
-        return dt.time.fromisoformat(value) if _CLOCK.fullmatch(value) else _refuse_clock(text)
-    except ValueError:
-        _refuse_clock(text)
+    clock = _as_written(value, _CLOCK, dt.time.fromisoformat)
+    if clock is None:
+        raise HybridtrackError(f"clock time {text!r} is not HH:MM")
+    return clock
 
 
-def _refuse_clock(text):
-    raise HybridtrackError(f"clock time {text!r} is not HH:MM") from None
+def _as_written(value: str, form: re.Pattern, parse):
+    """``parse(value)`` where `value` is in the written `form`, else None: ``fromisoformat`` alone
+    also takes 20210621, the week date 2021W251, 1200 and 12:00+08:00 (a time in another zone),
+    which no message offers."""
+    if not form.fullmatch(value):
+        return None
+    try:
+        return parse(value)
+    except ValueError:  # the form, but no such day or time (2021-02-30, 25:00)
+        return None
 
 
 def parse_freq(text: str) -> pd.Timedelta:
