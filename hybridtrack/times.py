@@ -97,9 +97,9 @@ FIRST_DATE, LAST_DATE = dt.date(1678, 1, 1), dt.date(2261, 12, 31)
 
 
 #: A date as the command line and configs write it: ``YYYY-MM-DD``.
-_ISO_DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
+_ISO_DATE = re.compile(r"\d{4}-\d{2}-\d{2}", re.ASCII)
 #: A clock time as they write it: ``HH:MM`` or ``HH:MM:SS``.
-_CLOCK = re.compile(r"\d{2}:\d{2}(:\d{2})?")
+_CLOCK = re.compile(r"\d{2}:\d{2}(:\d{2})?", re.ASCII)
 
 
 def parse_date(text) -> dt.date:

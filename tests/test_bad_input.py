@@ -305,6 +305,26 @@ def test_a_number_with_underscores_is_refused_not_read_as_another(capsys, argv, 
     assert err.count("\n") == 1 and flag in err and "_" in err
 
 
+@pytest.mark.parametrize("argv, flag", [
+    (["field", "trough", "--site", "lanzhou", "--date", "2021-06-21", "--count", "\uff11\uff12"], "--count"),
+    (["classify", "--intensity", "\u0662\u0660\u0660", "--variation", "5"], "--intensity"),
+    (["simulate", "--date", "2021-06-21", "--seed", "\u0967"], "--seed")])
+def test_a_number_in_other_digits_is_refused(capsys, argv, flag):
+    """int() and float() read full-width "１２", Arabic-Indic "٢٠٠" and Devanagari "१" as 12, 200
+    and 1: a stray input method changed a run without a word."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and flag in err and "ASCII" in err
+
+
+@pytest.mark.parametrize("text", ["\uff12\uff10\uff12\uff11-06-21", "2021-\u0660\u0666-21"])
+def test_a_date_in_other_digits_is_refused(text):
+    from hybridtrack.times import parse_date
+
+    with pytest.raises(HybridtrackError, match="YYYY-MM-DD"):
+        parse_date(text)
+
+
 def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys):
     import hybridtrack.cli.runs as runs
 

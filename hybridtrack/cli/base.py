@@ -15,10 +15,14 @@ EXIT_TERMINATED = 143
 
 
 def _written_plainly(text: str, kind: str) -> str:
-    """`text` unless it groups digits with underscores, which Python's ``int`` and ``float`` read
-    as one number (``1_0`` is 10): on a command line it is a typo, not a number to guess at."""
+    """`text` unless it groups digits with underscores, or writes them in another script, both of
+    which Python's ``int`` and ``float`` read as one number (``1_0`` and the full-width ``１０`` are
+    10): on a command line either is a slip, not a number to guess at, and no file format the
+    project reads takes them."""
     if "_" in text:
         raise argparse.ArgumentTypeError(f"{text!r} is not {kind} (no underscores: write 10, not 1_0)")
+    if not text.isascii():
+        raise argparse.ArgumentTypeError(f"{text!r} is not {kind} (write it in ASCII digits: 0-9)")
     return text
 
 
