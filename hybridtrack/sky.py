@@ -345,8 +345,9 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     site = get(site)
     climate = climate or _climate_for(site)
     index = _period(site, start, end, freq)
-    if len(index) == 0:
-        raise HybridtrackError("the period holds no time steps")
+    if len(index) < 2:  # nothing downstream can take one stamp: a weather frame needs a step
+        raise HybridtrackError(f"step {freq!r} leaves {len(index)} time step{'' if len(index) == 1 else 's'} in the "
+                               f"period: a weather frame needs at least two")
     params.number(gusts_per_day, "gusts_per_day", 0, 200)
     seed = params.seed(seed)
     rng = np.random.default_rng(seed)

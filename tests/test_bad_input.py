@@ -205,6 +205,9 @@ MATRIX = [
      "2021-01-01 to 2021-12-31: 31,536,000 steps of 1s would need about 63.1 GB of memory"),
     ("a sun table at 1 ns", lambda tmp: None, lambda p: local_range("2021-06-21", "UTC", freq="1ns"),
      lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "1ns"], "steps of 1ns would need about"),
+    # a day at 2-day steps is its midnight alone: it had been refused as a frame, naming no step
+    ("a step longer than the period", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq="2d"),
+     lambda p: SIMULATE + ["--freq", "2d"], "step '2d' leaves 1 time step in the period: a weather frame needs"),
     ("an empty step", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq=""),
      lambda p: SIMULATE + ["--freq", ""], "step '' is not a duration"),
     ("reversed working hours", config_file("[controller]\nworking_hours = ['20:00', '05:00']\n"),
