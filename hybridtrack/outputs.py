@@ -180,6 +180,8 @@ def output_folder(folder) -> Path:
 
 #: The hidden file a run that writes a folder over its whole span holds locked (`held`).
 LOCK_NAME = ".hybridtrack.lock"
+#: Times `held` opens the lock file again when the run that held it let it go meanwhile.
+LOCK_ATTEMPTS = 5
 
 
 @contextlib.contextmanager
@@ -198,19 +200,46 @@ def held(folder) -> Iterator[None]:
         yield
         return
     path = Path(folder) / LOCK_NAME
+    descriptor = _locked_file(path, folder)
     try:
-        descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError as exc:
-        raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
-    try:
-        _lock(descriptor, folder, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            with contextlib.suppress(OSError):
-                path.unlink()
+        yield
     finally:
+        with contextlib.suppress(OSError):
+            path.unlink()
         os.close(descriptor)
+
+
+def _locked_file(path: Path, folder) -> int:
+    """An open descriptor of the lock file at `path`, locked for this run alone. A run that ends
+    removes its lock file: one that had opened that file just before then would lock a file no
+    longer in the folder, beside a third run that locks the new one. So the lock taken must be on
+    the file that is at `path` afterwards; if it is not, the folder was just let go: open it again."""
+    import fcntl
+
+    for _ in range(LOCK_ATTEMPTS):
+        try:
+            descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise HybridtrackError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        try:
+            _lock(descriptor, folder, fcntl.LOCK_EX)
+            if _same_file(descriptor, path):
+                return descriptor
+        except BaseException:
+            os.close(descriptor)
+            raise
+        os.close(descriptor)
+    raise HybridtrackError(f"{folder}: other runs keep taking and letting go of the folder; write elsewhere")
+
+
+def _same_file(descriptor: int, path: Path) -> bool:
+    """Whether `descriptor` is the file now at `path`."""
+    try:
+        here = os.stat(path)
+    except OSError:
+        return False
+    mine = os.fstat(descriptor)
+    return (mine.st_dev, mine.st_ino) == (here.st_dev, here.st_ino)
 
 
 def _make_folder(folder: Path) -> None:

@@ -489,3 +489,40 @@ def test_a_folder_that_takes_no_new_file_is_refused_before_the_run(tmp_path, cap
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and f"{folder}: cannot write there" in err
     (tmp_path / "locked").chmod(0o700)
+
+
+def test_a_run_that_opens_the_lock_as_its_holder_lets_go_holds_the_folder_still(tmp_path, monkeypatch):
+    """The holder removes its lock file as it ends: a run that had opened that file just before
+    locked a file no longer in the folder, and a third run then took the folder beside it."""
+    import hybridtrack.outputs as outputs
+
+    lock = tmp_path / outputs.LOCK_NAME
+    take = outputs._lock
+    calls = []
+
+    def holder_ends_first(descriptor, folder, mode):
+        calls.append(mode)
+        if len(calls) == 1:
+            lock.unlink()  # the run that held the folder ended between this run's open and its lock
+        take(descriptor, folder, mode)
+
+    monkeypatch.setattr(outputs, "_lock", holder_ends_first)
+    with outputs.held(tmp_path):
+        assert lock.exists()
+        monkeypatch.setattr(outputs, "_lock", take)
+        with pytest.raises(HybridtrackError, match="another run is writing there now"):
+            with outputs.held(tmp_path):
+                pass
+    assert len(calls) == 2 and not lock.exists()
+
+
+def test_a_folder_whose_lock_is_let_go_at_every_attempt_is_refused_in_one_line(tmp_path, monkeypatch):
+    import hybridtrack.outputs as outputs
+
+    def let_go_each_time(descriptor, folder, mode):
+        (tmp_path / outputs.LOCK_NAME).unlink()
+
+    monkeypatch.setattr(outputs, "_lock", let_go_each_time)
+    with pytest.raises(HybridtrackError, match="other runs keep taking and letting go of the folder"):
+        with outputs.held(tmp_path):
+            pass
