@@ -1,6 +1,9 @@
 """Whole fields: geometry over collectors, seeded imperfections, field runs against per-collector runs."""
 
 import dataclasses
+import threading
+import time
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -9,7 +12,8 @@ from matplotlib.figure import Figure
 
 from hybridtrack import HybridtrackError, simulate, simulate_field
 from hybridtrack.collectors import fresnel_angle, heliostat_normal, trough_angle
-from hybridtrack.fields import FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns
+from hybridtrack.fields import (FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns,
+                                run_collectors)
 from hybridtrack.simulation import SimulationConfig
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import altitude_azimuth, solar_position
@@ -407,3 +411,62 @@ def test_api_arguments_of_the_wrong_kind_are_hybridtrack_errors(day, call, messa
     """Each was a TypeError or AttributeError from deep inside, or wrote where it was not asked to."""
     with pytest.raises(HybridtrackError, match=message):
         call(day)
+
+
+def test_a_block_of_collectors_lost_on_dask_fails_the_field_in_one_line_not_a_hang(day, monkeypatch):
+    """A worker killed too often (out of memory, a signal) loses its block: the field cannot be
+    whole, so it is refused with a message that says what happened and what to do."""
+    from dask.distributed import KilledWorker, LocalCluster
+
+    import hybridtrack.fields as fields_module
+
+    real = fields_module.run_collectors
+
+    def killed(frame, runs, **job):
+        if runs[0][0] == 0:
+            raise KilledWorker("run_collectors", SimpleNamespace(address="tcp://127.0.0.1:1"), 3)
+        return real(frame, runs, **job)
+
+    monkeypatch.setattr(fields_module, "run_collectors", killed)
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        with pytest.raises(HybridtrackError, match="a block of the field's collectors was lost on Dask "
+                                                   r"\(KilledWorker: .*\); run the field again"):
+            simulate_field(day, "lanzhou", TroughLoop(count=3), scheduler=cluster.scheduler_address)
+
+
+_RELEASED = threading.Event()
+_RUN_COLLECTORS = run_collectors  # the real one, which the test replaces in its module
+
+
+def _waits_after_the_first_block(frame, runs, **job):
+    """run_collectors for the first collector's block; the others wait until the test lets them go."""
+    if runs[0][0] > 0:
+        _RELEASED.wait(30)
+    return _RUN_COLLECTORS(frame, runs, **job)
+
+
+def test_a_field_whose_schedulers_last_worker_leaves_is_refused_not_waited_on(day, monkeypatch):
+    """A remote worker gone mid-field (its machine lost, no nanny to restart it): the field waited
+    for ever for the blocks left. After WORKERS_GONE_AFTER seconds with no worker it is refused."""
+    from dask.distributed import LocalCluster
+
+    import hybridtrack.cluster as cluster_module
+    import hybridtrack.fields as fields_module
+
+    monkeypatch.setattr(cluster_module, "WORKERS_GONE_AFTER", 1.0)
+    monkeypatch.setattr(fields_module, "run_collectors", _waits_after_the_first_block)
+    _RELEASED.clear()
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        def last_worker_leaves():
+            time.sleep(2.0)
+            threading.Thread(target=cluster.scale, args=(0,), daemon=True).start()
+            time.sleep(0.5)
+            _RELEASED.set()
+
+        threading.Thread(target=last_worker_leaves, daemon=True).start()
+        started = time.monotonic()
+        # which of the two the client sees first depends on timing: either is one line, and no hang
+        with pytest.raises(HybridtrackError, match="the Dask scheduler has had no worker for 1 s|"
+                                                   "a block of the field's collectors was lost on Dask"):
+            simulate_field(day, "lanzhou", TroughLoop(count=4), scheduler=cluster.scheduler_address)
+    assert time.monotonic() - started < 30
