@@ -58,8 +58,31 @@ def _like(template, values: np.ndarray, name: str | None = None):
     return values
 
 
+def _broadcast(function: str, **arrays) -> None:
+    """Refuse parameters of shapes that do not broadcast together, naming each: numpy's error
+    named no parameter and was no `HybridtrackError`."""
+    shapes = {name: np.shape(value) for name, value in arrays.items()}
+    try:
+        np.broadcast_shapes(*shapes.values())
+    except ValueError:
+        listed = ", ".join(f"{name} {shape}" for name, shape in shapes.items())
+        hint = (" (a sun position of shape (T, 1) against collectors' (N,) gives every collector at every step)"
+                if "altitude" in shapes else "")
+        raise HybridtrackError(f"{function}: the shapes {listed} do not broadcast together{hint}") from None
+
+
+def _vectors(function: str, values, name: str) -> np.ndarray:
+    """`values` as float vectors ``(..., 3)``, refused with their shape unless they are."""
+    vectors = np.atleast_2d(np.asarray(values, float))
+    if vectors.shape[-1] != 3:
+        raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors, shape (..., 3); got shape "
+                               f"{vectors.shape}")
+    return vectors
+
+
 def sun_vector(altitude, azimuth) -> np.ndarray:
     """Unit vectors towards the sun, shape ``(..., 3)`` in (east, north, up)."""
+    _broadcast("sun_vector", altitude=altitude, azimuth=azimuth)
     a = np.radians(np.asarray(altitude, float))
     g = np.radians(np.asarray(azimuth, float))
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
@@ -110,6 +133,7 @@ def trough_angle(altitude, azimuth, axis_azimuth=0.0):
             raise HybridtrackError(f"unknown axis {axis_azimuth!r}; use 'ns', 'ew' or degrees")
         axis_azimuth = AXIS_AZIMUTH[axis_azimuth]
     axis = _finite(axis_azimuth, "axis azimuth")
+    _broadcast("trough_angle", altitude=altitude, azimuth=azimuth, axis_azimuth=axis)
     return _like(altitude, _cross_axis_angle(altitude, azimuth, axis), "trough_angle")
 
 
@@ -166,7 +190,9 @@ def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):
         the zenith; below 90° tilted towards the ``axis_azimuth + 90°`` side). NaN at night.
     """
     receiver = receiver_angle(d, h)
-    sun = _cross_axis_angle(altitude, azimuth, _finite(axis_azimuth, "axis azimuth"))
+    axis = _finite(axis_azimuth, "axis azimuth")
+    _broadcast("fresnel_angle", altitude=altitude, azimuth=azimuth, d=d, h=h, axis_azimuth=axis)
+    sun = _cross_axis_angle(altitude, azimuth, axis)
     return _like(altitude, 0.5 * (sun + receiver), "fresnel_angle")
 
 
@@ -176,6 +202,7 @@ def receiver_angle(d, h):
     A float for scalar `d` and `h`, else an array of their broadcast shape.
     """
     d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
+    _broadcast("receiver_angle", d=d, h=h)
     if not np.all(h > 0):
         raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
     angle = np.degrees(np.arctan2(h, -d))
@@ -214,9 +241,11 @@ def fresnel_end_loss(altitude, azimuth, d, h):
         Metres; positive means the light is lost past the north end, negative the south end.
         NaN while the sun is down.
     """
+    d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
+    _broadcast("fresnel_end_loss", altitude=altitude, azimuth=azimuth, d=d, h=h)
     a = np.radians(np.asarray(altitude, float))
     gs = np.radians(np.asarray(azimuth, float) - 180.0)
-    f = np.hypot(_finite(d, "row distance d"), _finite(h, "receiver height h"))
+    f = np.hypot(d, h)
     with np.errstate(invalid="ignore", divide="ignore"):
         loss = f * np.cos(a) * np.cos(gs) / np.sqrt((np.cos(a) * np.sin(gs)) ** 2 + np.sin(a) ** 2)
     return _like(altitude, np.where(a > 0.0, loss, np.nan), "end_loss")
@@ -253,6 +282,7 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
     alt = np.asarray(altitude, float)
+    _broadcast("heliostat_normal", altitude=alt, azimuth=azimuth, aim_points=target[..., 0])
     s = sun_vector(alt, azimuth) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
@@ -262,7 +292,7 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
 
 def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
     """Azimuth (from north, 0-360) and elevation of unit normals ``(..., 3)``, degrees, shape ``(...)``."""
-    n = np.atleast_2d(np.asarray(normals, float))
+    n = _vectors("normal_angles", normals, "normals")
     azimuth = np.degrees(np.arctan2(n[..., 0], n[..., 1])) % 360.0
     elevation = np.degrees(np.arcsin(np.clip(n[..., 2], -1.0, 1.0)))
     return azimuth, elevation
@@ -287,7 +317,7 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
     ndarray, shape (..., K)
         Jack heights in metres relative to the mirror centre.
     """
-    n = np.atleast_2d(np.asarray(normals, float))
+    n = _vectors("jack_heights", normals, "normals")
     xy = np.asarray(supports, float)
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise HybridtrackError(f"supports must be (x, y) pairs, got shape {xy.shape}")

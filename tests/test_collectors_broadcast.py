@@ -109,6 +109,27 @@ def test_bad_collector_parameters_are_refused_with_their_name(call, message):
         call()
 
 
+THREE_SUNS = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: trough_angle(*THREE_SUNS, [0.0, 90.0]),
+     r"trough_angle: the shapes altitude \(3,\), azimuth \(3,\), axis_azimuth \(2,\) do not broadcast together "
+     r"\(a sun position of shape \(T, 1\) against"),
+    (lambda: fresnel_angle(*THREE_SUNS, [-4.0, 4.0], 8.0), r"fresnel_angle: the shapes .* d \(2,\), h \(\)"),
+    (lambda: fresnel_end_loss(*THREE_SUNS, [-4.0, 4.0], 8.0), r"fresnel_end_loss: the shapes .* d \(2,\)"),
+    (lambda: heliostat_normal(*THREE_SUNS, [[0, 100, 100], [50, 90, 100]]), r"aim_points \(2,\) do not broadcast"),
+    (lambda: receiver_angle([1.0, 2.0], [1.0, 2.0, 3.0]), r"receiver_angle: the shapes d \(2,\), h \(3,\) do not "
+                                                           r"broadcast together$"),
+    (lambda: normal_angles(np.ones((3, 2))), r"normals must be \(east, north, up\) vectors.*got shape \(3, 2\)"),
+    (lambda: jack_heights(np.ones((3, 2))), r"jack_heights: normals must be"),
+])
+def test_collector_parameters_of_shapes_that_do_not_broadcast_are_named(call, message):
+    """numpy's ValueError (or an IndexError) named no parameter and was no HybridtrackError."""
+    with pytest.raises(HybridtrackError, match=message):
+        call()
+
+
 def test_tracking_rates_of_a_field_are_each_columns_own(sun):
     rows = [-6.0, 0.0, 6.0]
     angles = pd.DataFrame(fresnel_angle(sun.altitude.to_numpy()[:, None], sun.azimuth.to_numpy()[:, None], rows, 10.0),
