@@ -384,11 +384,11 @@ class HeliostatField:
             aims = _as_numbers(self.aims)
         if aims is None or aims.shape != xyz.shape:
             raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
-        aim = aims.mean(axis=0)
         far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
         if far.any():
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
                                    f"beyond {MAX_DISTANCE:g} m")
+        aim = aims.mean(axis=0)  # once they are known to be near: a mean of 1e308s overflows
         relative = aims - xyz
         bad = ~np.isfinite(relative).all(axis=1) | (np.linalg.norm(relative, axis=1) == 0)
         if bad.any():

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 
 import pandas as pd
 
@@ -62,10 +63,21 @@ def seed(value, name: str = "seed") -> int:
     return whole(value, name, 0, MAX_SEED)
 
 
+#: A day unit written in lower case (``1d``, ``2 d``): pandas 3.1 warns that it will stop reading it.
+_LOWER_DAY = re.compile(r"(?<=[0-9. ])d(?![A-Za-z])")
+
+
+def timedelta(text) -> pd.Timedelta:
+    """``pd.Timedelta(text)``, reading a day written ``1d`` as ``1D`` (pandas 3.1 deprecates the
+    lower case with a warning that would print beside a command's one line, and pandas 4 will
+    refuse it); raises what ``pd.Timedelta`` raises."""
+    return pd.Timedelta(_LOWER_DAY.sub("D", text) if isinstance(text, str) else text)
+
+
 def duration(text, name: str) -> pd.Timedelta:
     """A positive, finite duration such as ``"20min"``."""
     try:
-        value = pd.Timedelta(text)
+        value = timedelta(text)
     except (TypeError, ValueError):
         value = None
     if value is None or value is pd.NaT or value <= pd.Timedelta(0):

@@ -7,6 +7,7 @@ import re
 
 import pandas as pd
 
+from . import params
 from .budget import check_steps
 from .errors import HybridtrackError
 
@@ -150,7 +151,7 @@ def _as_written(value: str, form: re.Pattern, parse):
 def parse_freq(text: str) -> pd.Timedelta:
     """Parse a positive step such as ``1min``, ``10s`` or ``1h``."""
     try:
-        step = pd.Timedelta(str(text))
+        step = params.timedelta(str(text))
     except ValueError:
         raise HybridtrackError(f"step {text!r} is not a duration such as '1min' or '10s'") from None
     if pd.isna(step):

@@ -470,3 +470,14 @@ def test_a_field_whose_schedulers_last_worker_leaves_is_refused_not_waited_on(da
                                                    "a block of the field's collectors was lost on Dask"):
             simulate_field(day, "lanzhou", TroughLoop(count=4), scheduler=cluster.scheduler_address)
     assert time.monotonic() - started < 30
+
+
+def test_a_far_aim_point_is_refused_before_any_arithmetic_overflows():
+    """The aim points' mean was taken before their distance was checked: 1e308 overflowed with a
+    RuntimeWarning printed beside the refusal."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(HybridtrackError, match="its position or aim point lies beyond 5000 m"):
+            HeliostatField(aim=(0.0, 0.0, 1e308))

@@ -68,3 +68,18 @@ def test_a_clock_time_not_written_hh_mm_is_refused(text):
     with pytest.raises(HybridtrackError, match=f"clock time '{re.escape(text)}' is not HH:MM"):
         parse_clock(text)
     assert parse_clock("05:30") == dt.time(5, 30) and parse_clock("05:30:15") == dt.time(5, 30, 15)
+
+
+@pytest.mark.parametrize("text, days", [("1d", 1.0), ("2 d", 2.0), ("1.5d", 1.5), ("1d12h", 1.5), ("1day", 1.0)])
+def test_a_day_step_in_lower_case_reads_without_pandas_deprecation_warning(text, days):
+    """pandas 3.1 warns that it will stop reading '1d' (a Pandas4Warning printed beside the
+    command's one line); pandas 4 will refuse it. Steps and durations read it as '1D'."""
+    import warnings
+
+    from hybridtrack.params import duration
+    from hybridtrack.times import parse_freq
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert parse_freq(text) == pd.Timedelta(days=days)
+        assert duration(text, "dwell") == pd.Timedelta(days=days)
