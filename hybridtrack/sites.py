@@ -7,7 +7,10 @@ Kunming (linear Fresnel end loss) and a Delingha-type tower site (heliostats).
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
+
+import numpy as np
 
 from .errors import HybridtrackError
 from .times import check_tz
@@ -40,23 +43,34 @@ class Site:
     tz: str = "UTC"
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise HybridtrackError(f"a site's name must be a non-empty text, got {self.name!r:.60}")
         for field in ("latitude", "longitude", "altitude"):
-            value = getattr(self, field)
-            if not isinstance(value, (int, float)) or isinstance(value, bool) or value != value:
-                raise HybridtrackError(f"site {self.name!r}: {field} must be a number, got {value!r}")
+            value = getattr(self, field)  # numpy's scalars are numbers too; True is not a latitude
+            if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)) or value != value:
+                raise HybridtrackError(f"site {self.name!r}: {field} must be a number, got {value!r:.60}")
         if not -90.0 <= self.latitude <= 90.0:
             raise HybridtrackError(
-                f"site {self.name!r}: latitude {self.latitude} is outside [-90, 90] degrees"
+                f"site {self.name!r}: latitude {_brief(self.latitude)} is outside [-90, 90] degrees"
             )
         if not -180.0 <= self.longitude <= 180.0:
             raise HybridtrackError(
-                f"site {self.name!r}: longitude {self.longitude} is outside [-180, 180] degrees"
+                f"site {self.name!r}: longitude {_brief(self.longitude)} is outside [-180, 180] degrees"
             )
         if not -500.0 <= self.altitude <= 9000.0:
             raise HybridtrackError(
-                f"site {self.name!r}: altitude {self.altitude} m is outside [-500, 9000] m"
+                f"site {self.name!r}: altitude {_brief(self.altitude)} m is outside [-500, 9000] m"
             )
-        check_tz(self.tz, f"site {self.name!r}: ")
+        # a zone object (ZoneInfo, pytz) is kept by its name: a Site's zone is written into files
+        object.__setattr__(self, "tz", check_tz(self.tz, f"site {self.name!r}: "))
+        for field in ("latitude", "longitude", "altitude"):  # within range: floats (np.float32 is no JSON)
+            object.__setattr__(self, field, float(getattr(self, field)))
+
+
+def _brief(value) -> str:
+    """`value` as written, cut short (an integer of 400 digits is a latitude too)."""
+    text = repr(value)
+    return text if len(text) <= 24 else f"{text[:20]}… ({len(text)} characters)"
 
 
 BUILTIN: dict[str, Site] = {
@@ -93,4 +107,4 @@ def get(name: str | Site) -> Site:
 
 def custom(latitude: float, longitude: float, tz: str, altitude: float = 0.0, name: str = "custom") -> Site:
     """Return a site given by its coordinates, validated like the built-in ones."""
-    return Site(name, float(latitude), float(longitude), float(altitude), tz)
+    return Site(name, latitude, longitude, altitude, tz)
