@@ -101,14 +101,12 @@ def claim(paths: Iterable) -> list[Path]:
         If a path or its folder is a symbolic link, a path is a folder, or files exist and
         the policy (`replacing`) does not allow replacing them; the message names them all.
     """
-    paths = [Path(p) for p in paths]
+    paths = [output_path(p) for p in paths]
     for path in paths:
-        for candidate in (path.parent, path):
-            if candidate.is_symlink():
-                raise HybridtrackError(f"{candidate} is a symbolic link; results are never written through one "
-                                       "(remove it or write elsewhere)")
-        if path.is_dir():
-            raise HybridtrackError(f"{path} is a folder; a result file would go there")
+        try:
+            _refuse_links_and_folders(path)
+        except OSError as exc:  # a name longer than the file system takes, a folder that cannot be read
+            raise HybridtrackError(f"{path}: cannot write there ({exc.strerror or exc})") from None
     existing = [path for path in paths if path.exists()]
     if existing and not _FORCE.get():
         raise HybridtrackError(f"would replace {len(existing)} existing file{'s' if len(existing) > 1 else ''}: "
@@ -167,15 +165,36 @@ def _lock(descriptor: int, folder, mode: int) -> None:
                                "elsewhere") from None
 
 
+def _refuse_links_and_folders(path: Path) -> None:
+    """Refuse a file to write that is a folder, or that is or lies in a symbolic link."""
+    for candidate in (path.parent, path):
+        if candidate.is_symlink():
+            raise HybridtrackError(f"{candidate} is a symbolic link; results are never written through one "
+                                   "(remove it or write elsewhere)")
+    if path.is_dir():
+        raise HybridtrackError(f"{path} is a folder; a result file would go there")
+
+
 def output_folder(folder) -> Path:
     """`folder` as a Path, refused unless it is a non-empty path: ``save(None)`` raised a
     TypeError, and ``save("")`` wrote into the working folder (the command line refuses an empty
     ``--out`` too)."""
-    if isinstance(folder, bytes):
-        folder = os.fsdecode(folder)
-    if not isinstance(folder, (str, os.PathLike)) or not str(os.fspath(folder)).strip():
-        raise HybridtrackError(f"the output folder must be a path, got {folder!r}")
-    return Path(folder)
+    return output_path(folder, "the output folder")
+
+
+def output_path(value, what: str = "a file to write") -> Path:
+    """`value` as a Path to write, refused unless it is a non-empty path without a NUL (which no
+    file system takes: Python raised a ValueError); a leading ``~`` is the user's home, as the
+    shell and pandas read it (the folder had been made as ``./~``, and pandas then wrote into
+    the home folder's)."""
+    if isinstance(value, bytes):
+        value = os.fsdecode(value)
+    if not isinstance(value, (str, os.PathLike)) or not str(os.fspath(value)).strip():
+        raise HybridtrackError(f"{what} must be a path, got {value!r:.80}")
+    text = os.fspath(value)
+    if "\0" in str(text):
+        raise HybridtrackError(f"{what} must be a path, got {text!r:.80}, which holds a NUL character")
+    return Path(os.path.expanduser(text))
 
 
 #: The hidden file a run that writes a folder over its whole span holds locked (`held`).
@@ -195,7 +214,7 @@ def held(folder) -> Iterator[None]:
     no ``flock`` (Windows) the folder is not held.
     """
     try:
-        import fcntl
+        import fcntl  # noqa: F401 - only POSIX has it; `_locked_file` takes the lock with it
     except ImportError:  # pragma: no cover - not POSIX
         yield
         return
@@ -271,7 +290,7 @@ def write(path, writer: Callable[[Path], object]) -> Path:
     HybridtrackError
         If writing fails with an `OSError` (a full disk, no permission); it names `path`.
     """
-    path = Path(path)
+    path = output_path(path)
     if path.exists() and not path.is_file():
         return write_in_place(path, writer)
     try:
@@ -321,7 +340,7 @@ def together() -> Iterator[None]:
 def write_in_place(path, writer: Callable[[Path], object]) -> Path:
     """Call ``writer(path)`` on `path` itself, for a file that grows as a run goes (a streamed log);
     a failure to write becomes a `HybridtrackError` that names `path`."""
-    path = Path(path)
+    path = output_path(path)
     with _naming(path):
         writer(path)
     return path

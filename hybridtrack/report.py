@@ -49,9 +49,9 @@ def save_figure(fig, path) -> Path:
     naming `path`, never a silently empty file."""
     import io
 
-    from .outputs import claim, removing_empty_folders, write
+    from .outputs import claim, output_path, removing_empty_folders, write
 
-    path = Path(path)
+    path = output_path(path)
     kind = path.suffix.lstrip(".").lower() or "png"
     if kind not in fig.canvas.get_supported_filetypes():
         raise HybridtrackError(f"{path}: cannot draw a .{kind} image; name a .png, .svg or .pdf file")

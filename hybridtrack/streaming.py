@@ -54,6 +54,7 @@ from . import params, sites
 from .collectors import Collector, as_collector
 from .errors import HybridtrackError
 from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
+from .io.files import input_path
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
@@ -238,7 +239,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     DaySource
     """
     site = sites.get(site)
-    path = Path(path)
+    path = input_path(path, "weather file")
     if path.is_dir():
         raise HybridtrackError(f"{path}: is a folder, not a weather file")
     if not path.is_file():

@@ -195,8 +195,9 @@ def load_cases(path) -> list[RuleCase]:
     """
     from .errors import HybridtrackError
     from .io import read_table
+    from .io.files import input_path
 
-    path = Path(path)
+    path = input_path(path, "rule table")
     frame = read_table(path)
     for column in ("intensity", "variation"):
         if column not in frame.columns:

@@ -526,3 +526,29 @@ def test_a_folder_whose_lock_is_let_go_at_every_attempt_is_refused_in_one_line(t
     with pytest.raises(HybridtrackError, match="other runs keep taking and letting go of the folder"):
         with outputs.held(tmp_path):
             pass
+
+
+def test_a_path_from_the_home_folder_is_read_and_written_there(tmp_path, monkeypatch, capsys):
+    """'~/x' was made as a folder named '~' here, while pandas wrote into the home folder's: no
+    save could succeed. The command line gets '--csv=~/x' unexpanded (the shell expands '~' only
+    at a word's start)."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "home").mkdir()
+    SimulationConfig(seed=5).to_toml("~/config.toml")
+    assert SimulationConfig.from_toml("~/config.toml").seed == 5
+    assert main(["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "1h", "--csv=~/sun.csv"]) == 0
+    assert f"wrote 16 rows to {tmp_path / 'home' / 'sun.csv'}" in capsys.readouterr().out
+    assert sorted(p.name for p in (tmp_path / "home").iterdir()) == ["config.toml", "sun.csv"]
+    assert not (tmp_path / "~").exists()
+
+
+@pytest.mark.parametrize("path, message", [
+    ("x\x00y", "holds a NUL character"),  # Python's ValueError: embedded null byte
+    ("a" * 300, r"cannot write there \(File name too long\)"),  # OSError
+])
+def test_a_path_no_file_system_takes_is_refused_in_one_line(tmp_path, path, message):
+    with pytest.raises(HybridtrackError, match=message):
+        SimulationConfig().to_toml(tmp_path / path if "\x00" not in path else str(tmp_path) + "/" + path)
+    with pytest.raises(HybridtrackError, match="config file must be a path|no such config file|cannot be read"):
+        SimulationConfig.from_toml(str(tmp_path) + "/" + path)

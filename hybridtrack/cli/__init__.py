@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import signal
 import sys
 import threading
@@ -118,16 +119,23 @@ def _tell(line: str) -> None:
 
 
 #: The options that name a file or folder to write.
-_OUTPUT_OPTIONS = ("out", "csv", "plot", "report")
+_OUTPUT_OPTIONS = ("out", "csv", "plot", "report", "json")
+#: Every option and argument that names a file or folder, to write or to read.
+_PATH_OPTIONS = (*_OUTPUT_OPTIONS, "target", "dir", "file", "config", "positions", "source", "labels", "classifier")
 
 
 def _refuse_empty_paths(args) -> None:
     """Refuse an output option given an empty path (``--out "$DIR"`` with DIR unset), which would
-    otherwise read as no output at all and write nothing without a word."""
-    for name in _OUTPUT_OPTIONS:
+    otherwise read as no output at all and write nothing without a word; and read a path that
+    begins with ``~`` as the shell would have: ``--out=~/run`` reaches the program unexpanded
+    (the shell expands ``~`` only at a word's start), and the run had made a folder named ``~``."""
+    for name in _PATH_OPTIONS:
         value = getattr(args, name, None)
-        if isinstance(value, str) and not value.strip():
+        if not isinstance(value, str):  # not given, or a flag of the same name (classify --json)
+            continue
+        if name in _OUTPUT_OPTIONS and not value.strip():
             raise HybridtrackError(f"--{name} is empty: give a file or folder to write (an unset shell variable?)")
+        setattr(args, name, os.path.expanduser(value))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -363,8 +363,9 @@ def read_fcl(path, *, resolution=None) -> MamdaniSystem:
         Samples across the input and output universes; (1001, 3001) by default.
     """
     from ..io import read_text
+    from ..io.files import input_path
 
-    path = Path(path)
+    path = input_path(path, "fuzzy system file")
     reader = _Reader(path)
     reader.read(_statements(path, read_text(path)))
     if not reader.inputs or not reader.outputs:

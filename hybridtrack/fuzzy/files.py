@@ -24,7 +24,9 @@ def _suffix(path: Path) -> str:
 
 def read_system(path, *, resolution=None) -> MamdaniSystem:
     """Read a fuzzy system from a ``.fis``, ``.fcl`` or classifier ``.toml`` file."""
-    path = Path(path)
+    from ..io.files import input_path
+
+    path = input_path(path, "fuzzy system file")
     suffix = _suffix(path)
     if suffix == ".fis":
         from .fis import read_fis_system
@@ -42,7 +44,9 @@ def read_system(path, *, resolution=None) -> MamdaniSystem:
 
 def write_system(system: MamdaniSystem, path) -> Path:
     """Write a system as ``.fis``, ``.fcl`` or (two inputs, one output) classifier ``.toml``."""
-    path = Path(path)
+    from ..outputs import output_path
+
+    path = output_path(path)
     suffix = _suffix(path)
     if suffix == ".fis":
         from .fis import write_fis

@@ -249,8 +249,9 @@ def read_fis_system(path, *, resolution=None) -> MamdaniSystem:
         Samples across the input and output universes; (1001, 3001) by default.
     """
     from ..io import read_text
+    from ..io.files import input_path
 
-    path = Path(path)
+    path = input_path(path, "fuzzy system file")
     source = _Source(path, read_text(path))
     if "System" not in source.sections:
         source.fail(None, "no [System] section; is this a MATLAB .fis file?")

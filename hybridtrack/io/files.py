@@ -10,21 +10,33 @@ from __future__ import annotations
 
 import gzip
 import io
+import os
 import zipfile
 from pathlib import Path
 
 from ..errors import HybridtrackError
 
-__all__ = ["read_bytes", "unpack", "decode", "file_text", "read_text", "read_toml", "write_toml", "WEATHER_SUFFIXES"]
+__all__ = ["input_path", "read_bytes", "unpack", "decode", "file_text", "read_text", "read_toml", "write_toml", "WEATHER_SUFFIXES"]
 
 #: In a zip of several files, the one weather file among them is read (EnergyPlus ships .epw with .stat, .ddy).
 WEATHER_SUFFIXES = (".epw", ".csv", ".tm2", ".tmy", ".dat", ".tsv", ".txt")
 
 
+def input_path(value, what: str = "file") -> Path:
+    """`value` as a Path to read: a leading ``~`` is the user's home, as the shell and pandas read
+    it; anything that is no path (None, a number, a name holding a NUL) is refused by name."""
+    if isinstance(value, bytes):
+        value = os.fsdecode(value)
+    if not isinstance(value, (str, os.PathLike)) or not str(os.fspath(value)).strip() or "\0" in str(os.fspath(value)):
+        raise HybridtrackError(f"a {what} must be a path, got {value!r:.80}")
+    return Path(os.path.expanduser(os.fspath(value)))
+
+
 def read_bytes(path: Path, what: str = "file") -> bytes:
     """The raw bytes of `path`, or one clear error: missing, a folder, not readable."""
+    path = input_path(path, what)
     try:
-        return Path(path).read_bytes()
+        return path.read_bytes()
     except FileNotFoundError:
         raise HybridtrackError(f"{path}: no such {what}") from None
     except IsADirectoryError:
@@ -96,7 +108,7 @@ def decode(path: Path, raw: bytes) -> tuple[str, str]:
 
 def file_text(path, what: str = "file") -> tuple[str, str]:
     """The text of a (possibly packed) file and a note of how it was read, e.g. ``'gzip, UTF-16'``."""
-    path = Path(path)
+    path = input_path(path, what)
     raw, packing = unpack(path, read_bytes(path, what))
     text, encoding = decode(path, raw)
     if not text.strip():
@@ -123,7 +135,7 @@ def _tomllib():
 def read_toml(path, what: str = "config") -> dict:
     """A TOML file as a dict, or one clear error naming the file (missing, not UTF-8, bad TOML)."""
     tomllib = _tomllib()
-    path = Path(path)
+    path = input_path(path, f"{what} file")
     raw = read_bytes(path, f"{what} file")
     mark = 3 if raw.startswith(b"\xef\xbb\xbf") else 0  # a byte-order mark, as Windows editors save UTF-8
     try:

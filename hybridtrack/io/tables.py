@@ -178,9 +178,9 @@ def read_table(path) -> pd.DataFrame:
 
     Lines starting with ``#`` in a CSV are comments. Column names are stripped and lowered.
     """
-    from .files import _tomllib
+    from .files import _tomllib, input_path
 
-    path = Path(path)
+    path = input_path(path, "table")
     text = file_text(path)[0]
     if path.suffix.lower() == ".toml":
         tomllib = _tomllib()

@@ -192,8 +192,9 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
     """
     from ..sites import get
     from ..times import check_tz
+    from .files import input_path
 
-    path = Path(path)
+    path = input_path(path, "weather file")
     if tz is not None:
         check_tz(tz)
     check_names(units or {}, "--units")
