@@ -337,8 +337,9 @@ class HeliostatField:
 
     Parameters
     ----------
-    positions : array_like, shape (N, 2) or (N, 3)
-        Mirror centres, metres east, north (and up; 0 when left out) from the tower's foot.
+    positions : array_like, shape (N, 2) or (N, 3), or pandas.DataFrame
+        Mirror centres, metres east, north (and up; 0 when left out) from the tower's foot; a
+        table's columns ``east``, ``north`` (and ``up``) are taken by name.
     aim : tuple of float, optional
         The receiver's aim point, (east, north, up) metres from the tower's foot; (0, 0, 100)
         when neither it nor `aims` is given. With `aims`, it is their mean (where the map draws
@@ -358,7 +359,7 @@ class HeliostatField:
 
     def __post_init__(self) -> None:
         _spread_of(self)
-        xyz = _as_numbers(self.positions)
+        xyz = _as_numbers(_by_name(self.positions))
         if xyz is None or xyz.ndim != 2 or xyz.shape[1] not in (2, 3) or len(xyz) == 0:
             raise HybridtrackError(f"heliostat positions must be numbers, (N, 2) or (N, 3) metres, got {_brief(self.positions)}")
         if xyz.shape[1] == 2:
@@ -446,6 +447,20 @@ class HeliostatField:
     def targets(self, altitude, azimuth) -> np.ndarray:
         """Every mirror's nominal normal azimuth and elevation (T, N, 2), degrees."""
         return np.stack(normal_angles(self.normals(altitude, azimuth)), axis=-1)
+
+
+def _by_name(positions):
+    """A table's ``east``, ``north`` (and ``up``) columns, by name, as a positions file is read; any
+    other positions as they are. A table had been read by its columns' order: an ``id, east,
+    north`` table put the mirrors 100 m underground, and a ``north, east`` one mirrored the field."""
+    if not isinstance(positions, pd.DataFrame):
+        return positions
+    names = {str(column).strip().lower(): column for column in positions.columns}
+    wanted = [axis for axis in ("east", "north", "up") if axis in names]
+    if wanted[:2] != ["east", "north"]:
+        raise HybridtrackError(f"heliostat positions: a table needs columns 'east' and 'north' (and 'up'), m; it has "
+                               f"{', '.join(map(str, positions.columns)) or 'none'}")
+    return positions[[names[axis] for axis in wanted]]
 
 
 def _refuse_unreachable_aims(relative: np.ndarray) -> None:

@@ -481,3 +481,11 @@ def test_a_far_aim_point_is_refused_before_any_arithmetic_overflows():
         warnings.simplefilter("error")
         with pytest.raises(HybridtrackError, match="its position or aim point lies beyond 5000 m"):
             HeliostatField(aim=(0.0, 0.0, 1e308))
+
+
+def test_a_table_of_heliostat_positions_is_read_by_its_columns_names():
+    """It was read by the columns' order: id, east, north put every mirror 100 m underground."""
+    table = pd.DataFrame({"id": [1, 2], "North": [-100.0, -90.0], "east": [0.0, 50.0]})
+    np.testing.assert_array_equal(HeliostatField(positions=table).positions, [[0.0, -100.0, 0.0], [50.0, -90.0, 0.0]])
+    with pytest.raises(HybridtrackError, match="a table needs columns 'east' and 'north' \\(and 'up'\\), m; it has x, y"):
+        HeliostatField(positions=pd.DataFrame({"x": [1.0], "y": [2.0]}))
