@@ -71,6 +71,34 @@ def _broadcast(function: str, **arrays) -> None:
         raise HybridtrackError(f"{function}: the shapes {listed} do not broadcast together{hint}") from None
 
 
+def checked_sun(altitude, azimuth, function: str) -> tuple[np.ndarray, np.ndarray]:
+    """A sun position as float arrays, refused by `function`'s name unless it is numbers: an
+    altitude within [-90, 90] degrees and a finite azimuth, or NaN where there is no sun. Two
+    Series must share their index (numpy pairs them by position, and the answer carried the
+    altitude's labels). Text, None, complex numbers and True had been read, or raised numpy's
+    errors."""
+    if isinstance(altitude, pd.Series) and isinstance(azimuth, pd.Series) and not altitude.index.equals(azimuth.index):
+        raise HybridtrackError(f"{function}: altitude and azimuth are Series on different indexes; align them first "
+                               "(numpy would pair them by position)")
+    alt, az = _degrees(altitude, "altitude", function), _degrees(azimuth, "azimuth", function)
+    with np.errstate(invalid="ignore"):
+        if np.any(np.abs(alt) > 90.0):
+            raise HybridtrackError(f"{function}: altitude must be within [-90, 90] degrees (NaN where there is no "
+                                   f"sun), got {float(alt[np.abs(alt) > 90.0].flat[0]):g}")
+    return alt, az
+
+
+def _degrees(values, name: str, function: str) -> np.ndarray:
+    """`values` as a float array of angles: real numbers (NaN allowed), never infinite."""
+    array = np.asarray(values.to_numpy() if isinstance(values, (pd.Series, pd.DataFrame)) else values)
+    if array.dtype.kind not in "fiu":
+        raise HybridtrackError(f"{function}: {name} must be numbers (degrees), got {values!r:.60}")
+    array = array.astype(float, copy=False)
+    if np.isinf(array).any():
+        raise HybridtrackError(f"{function}: {name} must be finite degrees (NaN where there is no sun), got inf")
+    return array
+
+
 def _vectors(function: str, values, name: str) -> np.ndarray:
     """`values` as float vectors ``(..., 3)``, refused with their shape unless they are."""
     vectors = np.atleast_2d(np.asarray(values, float))
@@ -83,8 +111,7 @@ def _vectors(function: str, values, name: str) -> np.ndarray:
 def sun_vector(altitude, azimuth) -> np.ndarray:
     """Unit vectors towards the sun, shape ``(..., 3)`` in (east, north, up)."""
     _broadcast("sun_vector", altitude=altitude, azimuth=azimuth)
-    a = np.radians(np.asarray(altitude, float))
-    g = np.radians(np.asarray(azimuth, float))
+    a, g = (np.radians(angle) for angle in checked_sun(altitude, azimuth, "sun_vector"))
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
 
@@ -134,7 +161,8 @@ def trough_angle(altitude, azimuth, axis_azimuth=0.0):
         axis_azimuth = AXIS_AZIMUTH[axis_azimuth]
     axis = _finite(axis_azimuth, "axis azimuth")
     _broadcast("trough_angle", altitude=altitude, azimuth=azimuth, axis_azimuth=axis)
-    return _like(altitude, _cross_axis_angle(altitude, azimuth, axis), "trough_angle")
+    alt, az = checked_sun(altitude, azimuth, "trough_angle")
+    return _like(altitude, _cross_axis_angle(alt, az, axis), "trough_angle")
 
 
 def tracking_rate(angle):
@@ -192,7 +220,7 @@ def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):
     receiver = receiver_angle(d, h)
     axis = _finite(axis_azimuth, "axis azimuth")
     _broadcast("fresnel_angle", altitude=altitude, azimuth=azimuth, d=d, h=h, axis_azimuth=axis)
-    sun = _cross_axis_angle(altitude, azimuth, axis)
+    sun = _cross_axis_angle(*checked_sun(altitude, azimuth, "fresnel_angle"), axis)
     return _like(altitude, 0.5 * (sun + receiver), "fresnel_angle")
 
 
@@ -242,9 +270,12 @@ def fresnel_end_loss(altitude, azimuth, d, h):
         NaN while the sun is down.
     """
     d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
+    if not np.all(h > 0):  # the hypotenuse would hide the sign: -10 m gave +10 m's loss
+        raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
     _broadcast("fresnel_end_loss", altitude=altitude, azimuth=azimuth, d=d, h=h)
-    a = np.radians(np.asarray(altitude, float))
-    gs = np.radians(np.asarray(azimuth, float) - 180.0)
+    alt, az = checked_sun(altitude, azimuth, "fresnel_end_loss")
+    a = np.radians(alt)
+    gs = np.radians(az - 180.0)
     f = np.hypot(d, h)
     with np.errstate(invalid="ignore", divide="ignore"):
         loss = f * np.cos(a) * np.cos(gs) / np.sqrt((np.cos(a) * np.sin(gs)) ** 2 + np.sin(a) ** 2)
@@ -281,9 +312,9 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     norm = np.linalg.norm(target, axis=-1, keepdims=True) if target.ndim else np.zeros(1)
     if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
-    alt = np.asarray(altitude, float)
-    _broadcast("heliostat_normal", altitude=alt, azimuth=azimuth, aim_points=target[..., 0])
-    s = sun_vector(alt, azimuth) if sun is None else sun
+    _broadcast("heliostat_normal", altitude=altitude, azimuth=azimuth, aim_points=target[..., 0])
+    alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
+    s = sun_vector(alt, az) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
     n = np.where((alt < 0.0)[..., None], np.nan, n)

@@ -32,6 +32,7 @@ from .collectors import (
     AXIS_AZIMUTH,
     MAX_DISTANCE,
     Collector,
+    checked_sun,
     fresnel_angle,
     fresnel_end_loss,
     heliostat_normal,
@@ -127,8 +128,15 @@ class ImperfectionSpread:
 
 
 def _sun_columns(altitude, azimuth) -> tuple[np.ndarray, np.ndarray]:
-    """Sun path as (T, 1) columns that broadcast against N collectors."""
-    return np.asarray(altitude, float)[:, None], np.asarray(azimuth, float)[:, None]
+    """Sun path as (T, 1) columns that broadcast against N collectors: one position is a path of
+    one step; a path is one value a step, of the same length in both (a length-1 azimuth had been
+    reused against a longer altitude, and a scalar raised numpy's IndexError)."""
+    alt, az = checked_sun(altitude, azimuth, "a field's geometry")
+    alt, az = np.atleast_1d(alt), np.atleast_1d(az)
+    if alt.ndim != 1 or alt.shape != az.shape:
+        raise HybridtrackError(f"a field's geometry takes a sun path: altitude and azimuth of one value a step, the "
+                               f"same length; got shapes {alt.shape} and {az.shape}")
+    return alt[:, None], az[:, None]
 
 
 def _along_axis(offsets: np.ndarray, axis_azimuth: float) -> np.ndarray:
@@ -460,7 +468,10 @@ def _by_name(positions):
     if wanted[:2] != ["east", "north"]:
         raise HybridtrackError(f"heliostat positions: a table needs columns 'east' and 'north' (and 'up'), m; it has "
                                f"{', '.join(map(str, positions.columns)) or 'none'}")
-    return positions[[names[axis] for axis in wanted]]
+    table = positions[[names[axis] for axis in wanted]]
+    if all(pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind) for kind in table.dtypes):
+        return table.to_numpy(dtype=float, na_value=np.nan)  # pandas' nullable numbers too; NA is not finite
+    return table
 
 
 def _refuse_unreachable_aims(relative: np.ndarray) -> None:

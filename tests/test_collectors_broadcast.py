@@ -130,6 +130,33 @@ def test_collector_parameters_of_shapes_that_do_not_broadcast_are_named(call, me
         call()
 
 
+@pytest.mark.parametrize("call, message", [
+    (lambda: trough_angle("abc", 90.0), r"trough_angle: altitude must be numbers \(degrees\), got 'abc'"),
+    (lambda: trough_angle(None, 90.0), "altitude must be numbers"),  # had been NaN, without a word
+    (lambda: trough_angle(True, False), "altitude must be numbers"),  # had been read as 1 and 0
+    (lambda: trough_angle(["10"], ["90"]), "altitude must be numbers"),
+    (lambda: fresnel_angle(10 + 1j, 120.0, 5.0, 10.0), "fresnel_angle: altitude must be numbers"),
+    (lambda: trough_angle(200.0, 90.0), r"altitude must be within \[-90, 90\] degrees .* got 200"),  # gave 200
+    (lambda: fresnel_end_loss(np.inf, 120.0, 5.0, 10.0), "altitude must be finite degrees"),
+    (lambda: heliostat_normal(30.0, "south", [0, 20, 100]), "heliostat_normal: azimuth must be numbers"),
+    (lambda: fresnel_end_loss(30.0, 120.0, 5.0, -10.0), "receiver height h must be positive"),  # gave +10 m's
+    (lambda: trough_angle(pd.Series([10.0, 20.0], index=[0, 1]), pd.Series([90.0, 120.0], index=[1, 0])),
+     "altitude and azimuth are Series on different indexes"),  # paired by position, labelled by altitude's
+])
+def test_a_sun_position_that_is_no_angle_is_refused_by_name(call, message):
+    with pytest.raises(HybridtrackError, match=message):
+        call()
+
+
+def test_a_fields_geometry_takes_one_position_as_a_path_of_one_step_and_refuses_ragged_paths():
+    from hybridtrack.fields import FresnelField, HeliostatField
+
+    assert FresnelField().targets(30.0, 120.0).shape == (1, 20)  # numpy's IndexError before
+    assert HeliostatField().normals(30.0, 120.0).shape == (1, 3, 3)
+    with pytest.raises(HybridtrackError, match=r"the same length; got shapes \(2,\) and \(1,\)"):
+        FresnelField(row_distances=[-2.0, 2.0]).targets([30.0, 40.0], [120.0])  # the azimuth had been reused
+
+
 def test_tracking_rates_of_a_field_are_each_columns_own(sun):
     rows = [-6.0, 0.0, 6.0]
     angles = pd.DataFrame(fresnel_angle(sun.altitude.to_numpy()[:, None], sun.azimuth.to_numpy()[:, None], rows, 10.0),

@@ -116,8 +116,10 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: HeliostatField(positions=[[50, 0], [0, 60]], aim=(True, False, 100)), "aim must be three numbers"),
     (lambda: FresnelField(row_distances=[True, 0.5]), "row distances must be numbers"),
     # a frame's repr had run the message over several lines
-    (lambda: HeliostatField(positions=pd.DataFrame({"e": [1.0, 2.0], "n": [3.0, 4.0]}).astype("Float64")),
-     r"^heliostat positions must be numbers, \(N, 2\) or \(N, 3\) metres, got e n 0 1.0 3.0 1 2.0 4.0$"),
+    (lambda: HeliostatField(positions=pd.DataFrame({"east": [1.0, None], "north": [3.0, 4.0]}).astype("Float64")),
+     r"^heliostat 2: position is not finite$"),
+    (lambda: HeliostatField(positions=pd.DataFrame({"east": ["1", "2"], "north": [3.0, 4.0]})),
+     r"^heliostat positions must be numbers, \(N, 2\) or \(N, 3\) metres, got east north 0 1 3.0 1 2 4.0$"),
     (lambda: HeliostatField(positions=[[1, 2]], aims=[["0", "0", "1"]]), "one \\(x, y, z\\) per heliostat"),
     # a spread of another type had been accepted, to fail at run time with an AttributeError
     (lambda: FresnelField(spread=None), "FresnelField: spread must be an ImperfectionSpread, got NoneType"),
