@@ -101,7 +101,11 @@ def _degrees(values, name: str, function: str) -> np.ndarray:
 
 def _vectors(function: str, values, name: str) -> np.ndarray:
     """`values` as float vectors ``(..., 3)``, refused with their shape unless they are."""
-    vectors = np.atleast_2d(np.asarray(values, float))
+    try:
+        vectors = np.atleast_2d(np.asarray(values, float))
+    except (TypeError, ValueError):  # text, ragged lists
+        raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors of numbers, got "
+                               f"{values!r:.60}") from None
     if vectors.shape[-1] != 3:
         raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors, shape (..., 3); got shape "
                                f"{vectors.shape}")
@@ -123,8 +127,8 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     either horizon stays next to 0 or 180. `axis_azimuth` (degrees) broadcasts against
     ``vectors[..., 0]``.
     """
-    vectors = np.asarray(vectors, float)
-    b = np.radians(np.asarray(axis_azimuth, float))
+    vectors = _vectors("across_angle", vectors, "vectors").reshape(np.shape(vectors))  # its own shape kept
+    b = np.radians(_finite(axis_azimuth, "axis azimuth"))
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     return np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
@@ -186,6 +190,13 @@ def tracking_rate(angle):
         raise HybridtrackError("tracking_rate needs a Series or DataFrame on a DatetimeIndex")
     if len(angle) < 2:
         raise HybridtrackError("tracking_rate needs at least two samples")
+    if angle.index.hasnans or not angle.index.is_monotonic_increasing or not angle.index.is_unique:
+        # a step back or a repeat gave wrong rates or infinities without a word
+        raise HybridtrackError("tracking_rate needs time stamps that increase, without repeats or NaT; sort them "
+                               "and drop the repeats first")
+    columns = angle.to_frame() if isinstance(angle, pd.Series) else angle
+    if not all(kind.kind in "fiu" for kind in columns.dtypes):
+        raise HybridtrackError("tracking_rate needs angles as numbers (degrees)")
     minutes = np.asarray((angle.index - angle.index[0]) / pd.Timedelta(minutes=1), float)
     rate = np.gradient(angle.to_numpy(float), minutes, axis=0)
     if isinstance(angle, pd.DataFrame):
@@ -349,11 +360,25 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
         Jack heights in metres relative to the mirror centre.
     """
     n = _vectors("jack_heights", normals, "normals")
+    with np.errstate(invalid="ignore"):
+        if np.any(n[..., 2] <= 0):  # a mirror facing the horizon or down has no jack heights (inf and nan)
+            raise HybridtrackError("jack_heights: normals must point up (n_z > 0); NaN where there is no sun")
     xy = np.asarray(supports, float)
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise HybridtrackError(f"supports must be (x, y) pairs, got shape {xy.shape}")
     with np.errstate(invalid="ignore", divide="ignore"):
         return -(n[..., :1] * xy[:, 0] + n[..., 1:2] * xy[:, 1]) / n[..., 2:3]
+
+
+def _aim_point(aim) -> tuple[float, float, float]:
+    """A heliostat's aim point as three floats, each checked (None and 5.0 had raised a TypeError)."""
+    try:
+        values = tuple(aim)
+    except TypeError:
+        values = ()
+    if len(values) != 3:
+        raise HybridtrackError(f"collector: aim (m) must be three numbers (east, north, up), got {aim!r:.60}")
+    return tuple(number(value, "collector: aim (m)", -MAX_DISTANCE, MAX_DISTANCE) for value in values)
 
 
 #: The collector kinds the project serves.
@@ -402,8 +427,7 @@ class Collector:
             number(self.axis_azimuth, "collector: axis_azimuth (degrees from north)", -360, 360)
         number(self.row_distance, "collector: row_distance (m)", -MAX_DISTANCE, MAX_DISTANCE)
         number(self.receiver_height, "collector: receiver_height (m)", 0, MAX_DISTANCE, above=True)
-        for value in self.aim:
-            number(value, "collector: aim (m)", -MAX_DISTANCE, MAX_DISTANCE)
+        object.__setattr__(self, "aim", _aim_point(self.aim))  # a tuple: a list or an array made it unhashable
         self._refuse_other_kinds_geometry()
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
@@ -443,6 +467,9 @@ class Collector:
         ``normal_azimuth``, ``normal_elevation`` and the three ``jack_1..3`` heights (m) of the
         published support.
         """
+        if not (isinstance(altitude, pd.Series) and isinstance(azimuth, pd.Series)):
+            raise HybridtrackError("Collector.angles takes the sun path as two Series on its time index (the columns "
+                                   f"of solar_position), got {type(altitude).__name__} and {type(azimuth).__name__}")
         out = pd.DataFrame(index=altitude.index)
         if self.kind == "heliostat":
             normals = heliostat_normal(altitude.to_numpy(float), azimuth.to_numpy(float), self.aim)

@@ -38,9 +38,10 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
+from . import params
 from .errors import HybridtrackError
 from .sites import Site, get
-from .times import DAY_NS, clock_nanoseconds, day_of_year
+from .times import DAY_NS, FIRST_DATE, LAST_DATE, clock_nanoseconds, day_of_year
 
 __all__ = [
     "solar_position",
@@ -197,6 +198,11 @@ def _check_times(times) -> pd.DatetimeIndex:
             "times are naive (no time zone); localise them first, e.g. "
             "index.tz_localize('Asia/Shanghai')"
         )
+    try:  # a year past 2262 (pandas keeps other units than nanoseconds) raised OutOfBoundsDatetime later
+        index.as_unit("ns")
+    except (OverflowError, ValueError):  # pandas' OutOfBoundsDatetime is a ValueError
+        raise HybridtrackError(f"times must lie within {FIRST_DATE} to {LAST_DATE}, got {index.min()} to "
+                               f"{index.max()}") from None
     return index
 
 
@@ -419,6 +425,18 @@ def _remember(key: tuple, frame: pd.DataFrame) -> None:
         del memory[:-capacity]  # keep the newest
 
 
+def _check_plc_options(model: str, declination, equation_of_time) -> None:
+    """Refuse the PLC model's series given by other than their names, or given to another model,
+    which would not use them (a list had raised a TypeError; another model ignored them)."""
+    for name, value, default in (("declination", declination, "wang-liu"),
+                                 ("equation_of_time", equation_of_time, "wang-liu")):
+        if not isinstance(value, str):
+            raise HybridtrackError(f"{name} must be a model's name, got {value!r:.60}")
+        if model != "plc" and value != default:
+            raise HybridtrackError(f"{name} applies to the PLC model (model 'plc') only; model {model!r} would not "
+                                   f"use {value!r}")
+
+
 def solar_position(
     times,
     site: Site | str,
@@ -458,6 +476,10 @@ def solar_position(
 
     site = get(site)
     index = _check_times(times)
+    # the air's extremes on record, -89.2 °C (Vostok, 1983) and 56.7 °C (Death Valley, 1913), within
+    # round bounds: -273.15 °C had given an apparent altitude of -537°, and text pvlib's TypeError
+    temperature = params.number(temperature, "temperature (°C)", -90.0, 60.0)
+    _check_plc_options(model, declination, equation_of_time)
     key = (model, site, temperature) + ((declination, equation_of_time) if model == "plc" else ())
     remembered = _remembered(key, index)
     if remembered is not None:

@@ -168,3 +168,43 @@ def test_tracking_rates_of_a_field_are_each_columns_own(sun):
     # hand case: an angle growing 15° an hour turns at 0.25°/min
     hours = pd.date_range("2021-06-21 08:00", periods=5, freq="1h", tz="UTC")
     np.testing.assert_allclose(tracking_rate(pd.DataFrame({"a": 15.0 * np.arange(5)}, index=hours)), 0.25)
+
+
+def _stamps(count):
+    return pd.date_range("2021-06-21 08:00", periods=count, freq="10min", tz="Asia/Shanghai")
+
+
+@pytest.mark.parametrize("angles, message", [
+    (lambda: pd.Series([0.0, 1.0, 4.0], index=_stamps(3)[[1, 0, 2]]), "time stamps that increase"),  # wrong rates
+    (lambda: pd.Series([1.0, 2.0, 3.0], index=_stamps(3)[[0, 0, 1]]), "without repeats"),  # inf and nan
+    (lambda: pd.Series([1.0, 2.0, 3.0], index=pd.DatetimeIndex([_stamps(1)[0], pd.NaT, _stamps(3)[2]])), "NaT"),
+    (lambda: pd.Series(["a", "b", "c"], index=_stamps(3)), "angles as numbers"),  # numpy's ValueError
+    (lambda: pd.DataFrame({"a": [1.0, 2.0], "b": ["x", "y"]}, index=_stamps(2)), "angles as numbers"),
+])
+def test_tracking_rate_refuses_stamps_out_of_order_and_angles_that_are_no_numbers(angles, message):
+    with pytest.raises(HybridtrackError, match=message):
+        tracking_rate(angles())
+
+
+@pytest.mark.parametrize("aim, message", [(None, "must be three numbers"), (5.0, "must be three numbers"),
+                                          ((0.0, 20.0), "must be three numbers"), ("abc", "must be a finite number")])
+def test_a_heliostats_aim_that_is_no_point_is_refused_and_a_list_or_array_is_kept_as_a_tuple(aim, message):
+    from hybridtrack.collectors import Collector
+
+    with pytest.raises(HybridtrackError, match=f"collector: aim \\(m\\) {message}"):
+        Collector("heliostat", aim=aim)
+    listed = Collector("heliostat", aim=np.array([0.0, 20.0, 100.0]))  # an array made it unhashable
+    assert listed == Collector("heliostat") and hash(listed) == hash(Collector("heliostat"))
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: jack_heights([1.0, 0.0, 0.0]), r"normals must point up \(n_z > 0\)"),  # gave nan, inf, -inf
+    (lambda: jack_heights("abc"), "normals must be \\(east, north, up\\) vectors of numbers"),
+    (lambda: normal_angles([[0, 0, 1], [0, 1]]), "vectors of numbers"),  # ragged
+    (lambda: __import__("hybridtrack.collectors").collectors.across_angle([1.0, 0.0], 0.0), "shape \\(..., 3\\)"),
+    (lambda: __import__("hybridtrack.collectors").collectors.Collector("fresnel").angles(np.ones(2), np.ones(2)),
+     "takes the sun path as two Series"),  # AttributeError: 'numpy.ndarray' object has no attribute 'index'
+])
+def test_vectors_and_paths_that_are_no_such_thing_are_refused_by_name(call, message):
+    with pytest.raises(HybridtrackError, match=message):
+        call()

@@ -142,3 +142,23 @@ def test_a_missing_time_has_no_sun_in_any_model():
     for model in ("plc", "spa"):
         sun = solar_position(index, "lanzhou", model)
         assert sun.iloc[1].isna().all() and sun.iloc[[0, 2]].notna().all().all()
+
+
+@pytest.mark.parametrize("options, message", [
+    (dict(temperature=-273.15), r"temperature \(°C\) = -273.15 is outside \[-90, 60\]"),  # an altitude of -537°
+    (dict(temperature=float("nan")), "must be a finite number"),  # NaN altitudes, without a word
+    (dict(temperature="20"), "must be a finite number"),  # pvlib's TypeError
+    (dict(model="plc", declination=["cooper"]), "declination must be a model's name"),  # TypeError: unhashable
+    (dict(declination="cooper"), "declination applies to the PLC model .* only; model 'spa' would not use"),
+])
+def test_solar_positions_options_are_checked_before_use(options, message):
+    times = pd.date_range("2021-06-21 05:00", periods=3, freq="h", tz="Asia/Shanghai")
+    with pytest.raises(HybridtrackError, match=message):
+        solar_position(times, "lanzhou", **options)
+
+
+def test_times_beyond_pandas_nanoseconds_are_refused_by_their_span():
+    """pandas keeps seconds-resolution stamps of the year 3000: the PLC model raised OutOfBoundsDatetime."""
+    times = pd.DatetimeIndex(np.array(["3000-06-21T06:00"], dtype="datetime64[s]")).tz_localize("UTC")
+    with pytest.raises(HybridtrackError, match="times must lie within 1678-01-01 to 2261-12-31"):
+        solar_position(times, "lanzhou", "plc")
