@@ -305,12 +305,15 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
                                "(read files with hybridtrack.io.read_weather, which sorts and de-duplicates)")
     check_dates(frame.index[0].date(), frame.index[-1].date(), f"the weather frame ({frame.index[0]} to "
                 f"{frame.index[-1]})")
+    if isinstance(frame.columns, pd.MultiIndex):  # pandas gave a frame for each column: an AttributeError
+        raise HybridtrackError("the weather frame's columns must be plain names (dni, dhi, …), not a MultiIndex; "
+                               "flatten them first")
     if "dni" not in frame.columns:
         raise HybridtrackError(f"the weather frame has no 'dni' column; it has {', '.join(map(str, frame.columns))}")
     repeated = frame.columns[frame.columns.duplicated()]
     if len(repeated):  # which of the two would be the weather?
         raise HybridtrackError(f"the weather frame has the column {repeated[0]!r} more than once; keep one")
-    for column in ("dni", "dhi", "wind_speed"):
+    for column in ("dni", "dhi", "wind_speed", "photocurrent"):
         if column in frame.columns:
             _physical_column(frame, column)
     first, last = frame.index[0], frame.index[-1]
@@ -347,19 +350,32 @@ def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.n
                                "zone? (hybridtrack.io.read_weather with the site finds the offset that fits)")
 
 
+#: Light no sky gives, by column: ten times the most there is (the solar constant, 1361 W/m², at
+#: perihelion: 1408 W/m²; a photocurrent of 10 A where the reader's limit is 10,000 mA). A reading
+#: past it is a unit mixed up (kW/m² read as W/m², ×1000) or garbage (1e200 W/m² failed deep in the
+#: mount fit with numpy's LinAlgError); a spike below it is a sensor's fault to survive.
+NOT_LIGHT = {"dni": 14_080.0, "dhi": 14_080.0, "photocurrent": 100_000.0}
+_UNITS = {"dni": "W/m²", "dhi": "W/m²", "photocurrent": "mA"}
+
+
 def _physical_column(frame: pd.DataFrame, column: str) -> None:
-    """Refuse a column that is not numbers, or light that is infinite (no world has it), naming
-    the first such row. A negative or missing reading is a sensor's fault the controller must
-    survive (`hybridtrack.faults`), so it runs; `hybridtrack.io.read_weather` repairs files."""
+    """Refuse a column that is not numbers, or light that is infinite or past `NOT_LIGHT` (no world
+    has it), naming the first such row. A negative or missing reading is a sensor's fault the
+    controller must survive (`hybridtrack.faults`), so it runs; `hybridtrack.io.read_weather`
+    repairs files."""
     values = frame[column]
-    if not pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(values.dtype):
+    if not pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(values.dtype) \
+            or pd.api.types.is_complex_dtype(values.dtype):
         raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
-    array = values.to_numpy(float)
-    bad = np.flatnonzero(np.isinf(array)) if column in ("dni", "dhi") else []
+    if column not in NOT_LIGHT:
+        return
+    array = values.to_numpy(float, na_value=np.nan)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(np.isinf(array) | (array > NOT_LIGHT[column]))
     if len(bad):
-        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} W/m² "
-                               "is not light; read files with hybridtrack.io.read_weather, which flags and counts "
-                               "such values")
+        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} "
+                               f"{_UNITS[column]} is not light (over {NOT_LIGHT[column]:,.0f}: a unit mixed up?); read "
+                               "files with hybridtrack.io.read_weather, which flags and counts such values")
 
 
 def checked_config(config) -> SimulationConfig:
@@ -415,6 +431,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     config = checked_config(config)
     if progress is not None and not callable(progress):  # it is called with each count of steps done
         raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
+    _check_run_options(classifier, bulk_nights, warm_start)
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     site = sites.get(site)
@@ -469,6 +486,18 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     if config.controller.strategy == "astronomical-commissioned":
         memory["commissioned"] = mount
     return Result(log, summary, events, site, collector, config, memory, scoring)
+
+
+def _check_run_options(classifier, bulk_nights, warm_start) -> None:
+    """Refuse `simulate`'s options of another kind: a string classifier raised an AttributeError
+    deep in the sky watch, and warm_start="no" was read as True."""
+    if classifier is not None and not isinstance(classifier, FuzzyWeatherClassifier):
+        raise HybridtrackError(f"classifier must be a FuzzyWeatherClassifier or None, got {classifier!r:.60}")
+    if not isinstance(bulk_nights, (bool, np.bool_)):
+        raise HybridtrackError(f"bulk_nights must be True or False, got {bulk_nights!r:.60}")
+    if not isinstance(warm_start, (bool, np.bool_, dict)):
+        raise HybridtrackError(f"warm_start must be True, False or an earlier run's Result.memory, got "
+                               f"{warm_start!r:.60}")
 
 
 #: Scans from which `simulate` builds the world on a second thread while the controller plans: both
@@ -576,9 +605,44 @@ def _history(site, collector, config, start, classifier, warm_start):
     return None, None
 
 
+#: What an earlier run's memory (`Result.memory`) holds: the mount fit's state, its calibration
+#: offsets, the light level, the clock watch's readings and a commissioned mount.
+MEMORY_KEYS = ("offsets", "theta", "p", "information", "evidence", "frozen", "updates", "light_level", "clock",
+               "commissioned")
+#: The numbers a memory holds, each an array or a number.
+_MEMORY_NUMBERS = ("offsets", "theta", "p", "information", "evidence", "light_level")
+#: The clock watch's readings (`ClockWatch.save`).
+_CLOCK_KEYS = ("start", "counted", "t", "axis", "x", "y", "spell_start", "spell_last", "raised")
+
+
+def _check_memory_form(memory: dict) -> None:
+    """Refuse a `warm_start` dict that is no earlier run's memory by its keys and kinds: a hand-made
+    one raised a ValueError or TypeError deep in the controller."""
+    def refuse(why: str):
+        raise HybridtrackError(f"warm_start: {why}; pass an earlier run's Result.memory (or True or False)")
+
+    unknown = sorted(set(map(str, memory)) - set(MEMORY_KEYS))
+    if unknown:
+        refuse(f"unknown key {unknown[0]!r}; a memory holds {', '.join(MEMORY_KEYS)}")
+    for key in _MEMORY_NUMBERS:
+        if key in memory:
+            try:
+                np.asarray(memory[key], float)
+            except (TypeError, ValueError):
+                refuse(f"{key} must be numbers, got {memory[key]!r:.40}")
+    if "theta" in memory and not {"p", "information", "frozen", "updates"} <= set(memory):
+        refuse("the mount fit's theta comes with its p, information, frozen and updates")
+    clock = memory.get("clock")
+    if clock is not None and (not isinstance(clock, dict) or set(clock) != set(_CLOCK_KEYS)):
+        refuse("clock must be the clock watch's readings, as a run leaves them")
+    if memory.get("commissioned") is not None and not isinstance(memory["commissioned"], MountEstimate):
+        refuse("commissioned must be a commissioned mount (MountEstimate)")
+
+
 def _check_memory(memory: dict, collector: Collector) -> None:
     """Refuse an earlier run's memory that another kind of collector left (its fit and offsets have
     another number of terms)."""
+    _check_memory_form(memory)
     names, axes = parameter_names(collector), 1 if collector.single_axis else 2
     theta, offsets = memory.get("theta"), memory.get("offsets")
     if (theta is not None and len(theta) != len(names)) or (offsets is not None and len(offsets) != axes):

@@ -436,3 +436,43 @@ def test_a_day_that_does_not_exist_to_draw_is_refused(tmp_path, capsys):
     assert main(["validate-sky", "data/nanjing-2013-cloudy.csv", "--site", "nanjing", "--day", "2021-13-01",
                  "--plot", str(tmp_path / "day.png")]) == 2
     assert capsys.readouterr().err == "hybridtrack: error: date '2021-13-01' does not exist or is not YYYY-MM-DD\n"
+
+
+def _small_day():
+    from hybridtrack.sky import synthetic
+
+    return synthetic("lanzhou", "2021-06-21", freq="10min")
+
+
+@pytest.mark.parametrize("frame, message", [
+    (lambda f: f.set_axis(pd.MultiIndex.from_tuples([(c, "x") for c in f.columns]), axis=1),
+     "columns must be plain names"),  # AttributeError: 'DataFrame' object has no attribute 'dtype'
+    (lambda f: f.assign(photocurrent="x"), "column 'photocurrent' must hold numbers"),  # ValueError
+    (lambda f: f.assign(dni=f["dni"] * 1e200), r"W/m² is not light \(over 14,080"),  # LinAlgError in the fit
+    (lambda f: f.assign(dni=f["dni"] * 1000), r"is not light \(over 14,080: a unit mixed up\?\)"),  # ran silently
+    (lambda f: f.assign(dni=f["dni"].astype(complex)), "must hold numbers, got dtype complex128"),  # imaginary dropped
+    (lambda f: f.assign(photocurrent=math.inf), "inf mA is not light"),
+])
+def test_a_weather_frame_of_no_light_or_no_names_is_refused_in_one_line(frame, message):
+    with pytest.raises(HybridtrackError, match=message):
+        simulate(frame(_small_day()), "lanzhou")
+
+
+@pytest.mark.parametrize("options, message", [
+    (dict(classifier="x"), "classifier must be a FuzzyWeatherClassifier or None"),  # AttributeError deep inside
+    (dict(warm_start="no"), "warm_start must be True, False or an earlier run's Result.memory"),  # read as True
+    (dict(bulk_nights="no"), "bulk_nights must be True or False"),
+    (dict(warm_start={"theta": "abc"}), "warm_start: theta must be numbers"),  # ValueError
+    (dict(warm_start={"clock": 5}), "warm_start: clock must be the clock watch's readings"),  # TypeError
+    (dict(warm_start={"x": 1}), "warm_start: unknown key 'x'"),  # ignored
+])
+def test_simulates_options_of_another_kind_are_refused_by_name(options, message):
+    with pytest.raises(HybridtrackError, match=message):
+        simulate(_small_day(), "lanzhou", **options)
+
+
+def test_an_earlier_runs_memory_is_still_taken_whole():
+    day = _small_day()
+    for strategy in ("hybrid", "astronomical-commissioned"):
+        memory = simulate(day, "lanzhou", strategy=strategy).memory
+        assert simulate(day, "lanzhou", strategy=strategy, warm_start=memory).summary["steps"] == len(day)
