@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import contextvars
 import dataclasses
+import math
+import numbers
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -96,13 +98,14 @@ class ImperfectionSpread:
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            number = isinstance(value, (int, float)) and not isinstance(value, bool)
-            if not number or not (np.isfinite(value) and value >= 0):
-                raise HybridtrackError(f"imperfection spread: {f.name} must be a finite number >= 0, got {value!r}")
+            value = getattr(self, f.name)  # numpy's scalars are numbers too (they had been refused)
+            number = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+            if not number or not value >= 0 or value == math.inf:  # NaN is not >= 0; 10**400 is beyond the limit
+                raise HybridtrackError(f"imperfection spread: {f.name} must be a finite number >= 0, got {value!r:.40}")
             if value > IMPERFECTION_LIMITS[f.name]:
-                raise HybridtrackError(f"imperfection spread: {f.name} = {value!r} is beyond the imperfection's own "
-                                       f"limit of {IMPERFECTION_LIMITS[f.name]:g}")
+                raise HybridtrackError(f"imperfection spread: {f.name} = {value!r:.40} is beyond the imperfection's "
+                                       f"own limit of {IMPERFECTION_LIMITS[f.name]:g}")
+            object.__setattr__(self, f.name, float(value))
 
     @classmethod
     def none(cls) -> ImperfectionSpread:
@@ -546,7 +549,7 @@ class FieldResult:
         """
         from matplotlib.figure import Figure
 
-        if metric not in self.collectors.columns:
+        if not isinstance(metric, str) or metric not in self.collectors.columns:  # a list raised a TypeError
             raise HybridtrackError(f"no collector metric {metric!r}; choose from {', '.join(self.collectors.columns)}")
         fig = Figure(figsize=(7, 6), layout="constrained")
         ax = fig.add_subplot()

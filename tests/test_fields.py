@@ -491,3 +491,17 @@ def test_a_table_of_heliostat_positions_is_read_by_its_columns_names():
     np.testing.assert_array_equal(HeliostatField(positions=table).positions, [[0.0, -100.0, 0.0], [50.0, -90.0, 0.0]])
     with pytest.raises(HybridtrackError, match="a table needs columns 'east' and 'north' \\(and 'up'\\), m; it has x, y"):
         HeliostatField(positions=pd.DataFrame({"x": [1.0], "y": [2.0]}))
+
+
+def test_a_spread_takes_numpys_numbers_and_refuses_an_integer_past_any_float():
+    spread = ImperfectionSpread(encoder_offset=np.float32(0.25), axis_tilt_error=np.int64(0))
+    assert spread.encoder_offset == pytest.approx(0.25) and type(spread.axis_tilt_error) is float  # both had been refused
+    with pytest.raises(HybridtrackError, match="is beyond the imperfection's own limit"):
+        ImperfectionSpread(encoder_offset=10**400)  # numpy's TypeError
+
+
+def test_a_field_map_of_a_metric_that_is_no_name_is_refused(day, tmp_path):
+    result = simulate_field(day, "lanzhou", TroughLoop(count=2), keep_log=False)
+    for call in (lambda: result.plot_map(["rms"]), lambda: result.save(tmp_path / "out", metric=["rms"])):
+        with pytest.raises(HybridtrackError, match="no collector metric"):  # a TypeError: unhashable list
+            call()
