@@ -58,11 +58,20 @@ def pack_world(world: World) -> tuple[WorldArrays, WorldState]:
         float(world.imperfections.encoder_offset), np.array([d.resolution for d in world.drives]),
         np.array([d.limits[0] for d in world.drives]), np.array([d.limits[1] for d in world.drives]),
         np.array(world.circular, bool), pointing if pointing is not None else np.zeros((axes, 0)), pointing is not None)
-    # C order throughout: the kernel is compiled (and cached) for C-contiguous arrays only, and a
-    # frame's column can be a strided view
-    arrays = WorldArrays(*(np.ascontiguousarray(v) if isinstance(v, np.ndarray) else v for v in arrays))
+    arrays = WorldArrays(*(_read_only(v) if isinstance(v, np.ndarray) else v for v in arrays))
     state = WorldState(np.array(world.actual, float), np.array(world.last_encoder, float), world.angles)
     return arrays, state
+
+
+def _read_only(values, dtype=None) -> np.ndarray:
+    """`values` as a C-contiguous array marked read-only, as the kernel takes every array it only
+    reads. numba compiles (and caches) the kernel once for each layout and each read-only flag of
+    its arrays: a frame's column can be a strided view, and is read-only under pandas' copy on
+    write while an array computed here is not, so a run with a recorded photocurrent, or a sensor
+    strategy on a heliostat, had compiled the kernel again (one to three minutes each)."""
+    array = np.ascontiguousarray(values, dtype).view()
+    array.flags.writeable = False
+    return array
 
 
 def _settings(controller: Controller) -> kc.ControllerSettings:
@@ -108,12 +117,12 @@ def _plan(controller: Controller) -> kc.ControllerPlanArrays:
     weight = plan.weight if plan.weight is not None else np.zeros((n, axes))
 
     def scans(values):
-        return np.full(n, np.nan) if values is None else np.ascontiguousarray(values, float)
+        return np.full(n, np.nan) if values is None else values
 
     return kc.ControllerPlanArrays(
-        np.ascontiguousarray(plan.model, float), np.ascontiguousarray(plan.awake, bool),
-        np.ascontiguousarray(plan.clock_steps, float), alarm, scans(plan.clear_light),
-        scans(plan.apparent_altitude), np.ascontiguousarray(jacobian, float), np.ascontiguousarray(weight, float))
+        _read_only(plan.model, float), _read_only(plan.awake, bool), _read_only(plan.clock_steps, float),
+        _read_only(alarm), _read_only(scans(plan.clear_light), float), _read_only(scans(plan.apparent_altitude), float),
+        _read_only(jacobian, float), _read_only(weight, float))
 
 
 def _window_capacity(minutes: np.ndarray, windows: list[float]) -> int:
