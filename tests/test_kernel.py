@@ -543,3 +543,19 @@ def test_the_kernels_clock_fit_sums_its_normal_equations_to_the_references_answe
     np.testing.assert_allclose(estimate, expected, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(std, expected_std, rtol=1e-9)
     assert np.isinf(std[-1]) == (days < 1.5)
+
+
+def test_a_recorded_photocurrent_or_a_heliostats_sensor_run_takes_the_kernel_already_compiled(mixed_day):
+    """numba compiles the kernel once for each combination of its arrays' read-only flags: a
+    frame's column is read-only and a computed array is not, so these two runs had compiled the
+    kernel again (one to three minutes each) after a plain one."""
+    from hybridtrack.kernel.loop import run_scans
+
+    compiled = SimulationConfig(engine="compiled")
+    simulate(mixed_day, "lanzhou", config=compiled)
+    before = set(run_scans.signatures)
+    recorded = mixed_day.drop(columns=["wind_speed", "dhi"]).assign(photocurrent=np.linspace(30.0, 330.0, len(mixed_day)))
+    simulate(recorded, "lanzhou", config=dataclasses.replace(compiled, controller=dataclasses.replace(
+        compiled.controller, wind_missing="track")))
+    simulate(mixed_day, "lanzhou", config=compiled, collector="heliostat", strategy="sensor")
+    assert set(run_scans.signatures) == before
