@@ -88,8 +88,16 @@ def removing_empty_folders() -> Iterator[None]:
         _MADE.reset(token)
 
 
-def claim(paths: Iterable) -> list[Path]:
+def claim(paths: Iterable, *, folders: Iterable = ()) -> list[Path]:
     """Check the files about to be written, all before any is, and make their folders.
+
+    Parameters
+    ----------
+    paths : iterable of path
+        Files to write.
+    folders : iterable of path
+        Folders a run writes as one (a streamed run's segments), claimed as a file is: one that
+        exists is replaced only as an existing file would be, and is named once.
 
     Returns
     -------
@@ -107,7 +115,12 @@ def claim(paths: Iterable) -> list[Path]:
             _refuse_links_and_folders(path)
         except OSError as exc:  # a name longer than the file system takes, a folder that cannot be read
             raise HybridtrackError(f"{path}: cannot write there ({exc.strerror or exc})") from None
-    existing = [path for path in paths if path.exists()]
+    folders = [output_path(folder) for folder in folders]
+    for folder in folders:
+        if folder.is_symlink():
+            raise HybridtrackError(f"{folder} is a symbolic link; results are never written through one "
+                                   "(remove it or write elsewhere)")
+    existing = [path for path in (*paths, *folders) if path.exists()]
     if existing and not _FORCE.get():
         raise HybridtrackError(f"would replace {len(existing)} existing file{'s' if len(existing) > 1 else ''}: "
                                f"{', '.join(map(str, existing))}; give --force to replace them, or write elsewhere")

@@ -42,6 +42,7 @@ import contextlib
 import dataclasses
 import datetime as dt
 import os
+import shutil
 import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -533,8 +534,8 @@ def read_log(path, *, columns=None, day=None, tz=None) -> pd.DataFrame:
     if isinstance(columns, str) or not (columns is None or all(isinstance(c, str) for c in columns)):
         raise HybridtrackError(f"read_log: columns must be a list of names, got {columns!r:.60}")
     try:
-        handle = pq.ParquetFile(path)
-    except (OSError, pyarrow.ArrowInvalid) as exc:  # missing, a folder, not Parquet, cut short (no footer)
+        handle = _Segments(Path(path)) if Path(path).is_dir() else pq.ParquetFile(path)
+    except (OSError, pyarrow.ArrowInvalid) as exc:  # missing, not Parquet, cut short (no footer), no segment
         raise HybridtrackError(f"{path}: cannot read as a streamed log ({str(exc).splitlines()[0]})") from None
     index = set(_with_index(handle, []))
     names = [name for name in handle.schema_arrow.names if name not in index]
@@ -544,6 +545,30 @@ def read_log(path, *, columns=None, day=None, tz=None) -> pd.DataFrame:
     if day is None:
         return _categorised(handle.read(columns=_with_index(handle, columns)).to_pandas())
     return _day_of(handle, path, columns, day, tz)
+
+
+class _Segments:
+    """A stopped streamed run's ``log.partial.parquet`` folder, read as its joined log would be:
+    the segments are its row groups (the part of ``pyarrow.parquet.ParquetFile`` `read_log` uses)."""
+
+    def __init__(self, folder: Path):
+        import pyarrow.parquet as pq
+
+        self.parts = _segment_files(folder)
+        if not self.parts:
+            raise OSError(f"{folder} holds no segment of a streamed log")
+        self.schema_arrow = pq.read_schema(self.parts[0])
+        self.num_row_groups = len(self.parts)
+
+    def read_row_group(self, group: int, columns=None):
+        import pyarrow.parquet as pq
+
+        return pq.read_table(self.parts[group], columns=columns)
+
+    def read(self, columns=None):
+        import pyarrow as pa
+
+        return pa.concat_tables([self.read_row_group(group, columns) for group in range(self.num_row_groups)])
 
 
 def _day_of(handle, path, columns, day, tz) -> pd.DataFrame:
@@ -570,60 +595,84 @@ def _day_of(handle, path, columns, day, tz) -> pd.DataFrame:
 class _PartialRun:
     """A streamed run's log and events under partial names (`partial_files`) until it finishes.
 
-    The log is appended to one Parquet file, one row group a segment, one schema; the events to
-    one CSV file. `finish` gives them their names; `abandon` keeps them only if they hold whole
-    segments and no write failed (a failed write may have cut a file mid-segment).
+    Each segment's log is a Parquet file of its own in the folder ``log.partial.parquet``, written
+    whole and then moved into place, so whatever stops the run (an error, Ctrl-C, a full disk,
+    the process killed outright) leaves every finished segment whole and readable (`read_log`
+    reads the folder): one Parquet file appended to lost them all when its footer was never
+    written. The events go to one CSV file, cut back to its last whole segment when a write
+    fails. `finish` joins the segments into ``log.parquet``, one row group a segment.
     """
 
     def __init__(self, files: dict):
         self.files, self.partial = files, partial_files(files)
-        self.writer, self.segments, self.intact = None, 0, True
+        self.schema, self.segments = None, 0
 
-    def _write(self, path: Path, writer) -> None:
-        try:
-            write_in_place(path, writer)
-        except HybridtrackError:
-            self.intact = False
-            raise
+    def _start(self) -> None:
+        """Make the segments' folder (a forced rerun's claim took an earlier stopped run's) and the
+        events' header."""
+        parts = self.partial["log"]
+        if parts.is_dir() and not parts.is_symlink():
+            shutil.rmtree(parts, ignore_errors=True)
+        else:  # a stopped run of an earlier version left one file
+            with contextlib.suppress(OSError):
+                parts.unlink()
+        write_in_place(parts, lambda path: path.mkdir())
+        write_in_place(self.partial["events"], lambda path: path.write_text("time,from,to,reason\n"))
 
     def append(self, result) -> None:
-        """Add one finished segment's log and events."""
+        """Add one finished segment's events and log; a failed write leaves the segments before."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
         table = pa.Table.from_pandas(result.log, preserve_index=True)
-        if self.writer is None:
-            self._write(self.partial["events"], lambda path: path.write_text("time,from,to,reason\n"))
-            self._write(self.partial["log"], lambda path: setattr(self, "writer", pq.ParquetWriter(path, table.schema)))
-        elif not table.schema.equals(self.writer.schema, check_metadata=False):
+        if self.schema is None:
+            self._start()
+            self.schema = table.schema
+        elif not table.schema.equals(self.schema, check_metadata=False):
             raise HybridtrackError(f"{self.files['log']}: a segment's log has other columns or types than the first's")
-        self._write(self.partial["log"], lambda _: self.writer.write_table(table, row_group_size=len(table)))
-        if len(result.events):
-            self._write(self.partial["events"],
-                        lambda path: result.events.to_csv(path, mode="a", header=False, index=False))
+        events = self.partial["events"]
+        whole = events.stat().st_size
+        try:
+            if len(result.events):
+                write_in_place(events, lambda path: result.events.to_csv(path, mode="a", header=False, index=False))
+            write(self.partial["log"] / f"{self.segments:05d}.parquet",
+                  lambda path: pq.write_table(table, path, row_group_size=len(table)))
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.truncate(events, whole)  # the events of the segments whose log is there, no more
+            raise
         self.segments += 1
 
-    def _close(self) -> None:
-        if self.writer is not None:
-            self._write(self.partial["log"], lambda _: self.writer.close())
-
     def finish(self) -> None:
-        """Give the log and the events their names; an earlier run's summary goes first, so that
-        no summary is ever beside a log it does not describe (a finished run writes it last)."""
-        self._close()
+        """Join the segments into the log and give it and the events their names; an earlier run's
+        summary goes first, so that no summary is ever beside a log it does not describe (a
+        finished run writes it last)."""
+        import pyarrow.parquet as pq
+
+        parts = _segment_files(self.partial["log"])
+
+        def join(path: Path) -> None:
+            with pq.ParquetWriter(path, pq.read_schema(parts[0])) as writer:  # as the segments read back
+                for part in parts:  # one segment in memory at a time
+                    table = pq.read_table(part)
+                    writer.write_table(table, row_group_size=max(len(table), 1))
+
         self.files["summary"].unlink(missing_ok=True)
-        for role, path in self.partial.items():
-            write_in_place(self.files[role], lambda target, source=path: os.replace(source, target))
+        write(self.files["log"], join)
+        write_in_place(self.files["events"], lambda target: os.replace(self.partial["events"], target))
+        shutil.rmtree(self.partial["log"], ignore_errors=True)
 
     def abandon(self, keep: bool) -> None:
         """After a failure: if `keep`, keep the segments done (whole, readable with `read_log`)
-        under their partial names; remove the partial files if not, if there are none, or if a
-        write failed."""
-        with contextlib.suppress(HybridtrackError):
-            self._close()
-        if not (keep and self.segments and self.intact):
-            for path in self.partial.values():
-                path.unlink(missing_ok=True)
+        under their partial names; remove them if not, or if there are none."""
+        if not (keep and self.segments):
+            shutil.rmtree(self.partial["log"], ignore_errors=True)
+            self.partial["events"].unlink(missing_ok=True)
+
+
+def _segment_files(folder: Path) -> list[Path]:
+    """A stopped or running streamed run's segment logs, in order."""
+    return sorted(folder.glob("[0-9]" * 5 + ".parquet"))
 
 
 def stream_files(folder) -> dict[str, Path]:
@@ -634,7 +683,8 @@ def stream_files(folder) -> dict[str, Path]:
 
 def partial_files(files: dict) -> dict[str, Path]:
     """Where `stream` writes the log and the events (`stream_files`) until the run finishes:
-    ``log.partial.parquet`` and ``events.partial.csv``."""
+    ``log.partial.parquet``, a folder of one Parquet file a segment (`read_log` reads it), and
+    ``events.partial.csv``."""
     return {role: files[role].with_name(f"{files[role].stem}.partial{files[role].suffix}") for role in ("log", "events")}
 
 
@@ -705,7 +755,8 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                              resolution=resolution)  # checks `resolution` before anything is written
     files = stream_files(out)
-    claim([*files.values(), *partial_files(files).values()])
+    partial = partial_files(files)
+    claim([*files.values(), partial["events"]], folders=[partial["log"]])  # the log's segments: a folder
     with held(files["log"].parent):  # no other run may append to this folder's log while this one does
         return _stream_segments(source, files, site, collector, config, classifier, warm_start, progress,
                                 on_segment, running)

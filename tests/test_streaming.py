@@ -423,13 +423,15 @@ def _two_days():
     return synthetic_days(SITE, "2021-06-21", "2021-06-22", weather="sunny", freq="30min", seed=1)
 
 
-def test_a_write_that_fails_mid_run_leaves_no_log_and_nothing_to_force_past(tmp_path, monkeypatch):
-    """A full disk on the second day cut log.parquet mid-segment and left it under its own name."""
+def test_a_write_that_fails_mid_run_keeps_the_days_before_it_whole(tmp_path, monkeypatch):
+    """A full disk on the second day had cut the one Parquet file mid-segment, and every finished
+    day was removed with it. Each day's log is now a file of its own, written whole: the first
+    day stays readable, and the events file holds that day's events and no more."""
     import errno
 
     import pyarrow.parquet as pq
 
-    real, calls = pq.ParquetWriter.write_table, []
+    real, calls, days = pq.ParquetWriter.write_table, [], []
 
     def full_on_the_second_day(self, table, *args, **kwargs):
         calls.append(1)
@@ -438,11 +440,17 @@ def test_a_write_that_fails_mid_run_leaves_no_log_and_nothing_to_force_past(tmp_
         return real(self, table, *args, **kwargs)
 
     monkeypatch.setattr(pq.ParquetWriter, "write_table", full_on_the_second_day)
-    with pytest.raises(HybridtrackError, match=r"log.partial.parquet: cannot write \(No space left on device\)"):
-        stream(_two_days(), tmp_path / "run")
-    assert not (tmp_path / "run").exists()  # nothing in it, and the folder the run made is gone as well
+    with pytest.raises(HybridtrackError, match=r"log.partial.parquet/00001.parquet: cannot write \(No space left"):
+        stream(_two_days(), tmp_path / "run", on_segment=days.append)
+    run = tmp_path / "run"
+    assert sorted(p.name for p in run.iterdir()) == ["events.partial.csv", "log.partial.parquet"]
+    pd.testing.assert_frame_equal(read_log(run / "log.partial.parquet"), days[0].log, check_freq=False)
+    events = pd.read_csv(run / "events.partial.csv")
+    # each day wakes and stows: the second day's events were written, then cut back off with its log
+    assert len(days[0].events) > 0 and len(events) == len(days[0].events)
     monkeypatch.undo()
-    assert stream(_two_days(), tmp_path / "run").summary["streamed"]["segments"] == 2  # a retry needs no --force
+    assert stream(_two_days(), run).summary["streamed"]["segments"] == 2  # the API replaces, as --force does
+    assert sorted(p.name for p in run.iterdir()) == ["events.csv", "log.parquet", "summary.json"]
 
 
 def test_a_stopped_run_keeps_its_finished_days_under_partial_names_only(tmp_path):
@@ -483,6 +491,29 @@ def test_sigterm_ends_a_streamed_command_as_ctrl_c_does(tmp_path):
     log = read_log(out / "log.partial.parquet")
     assert len(log) % 8640 == 0 and len(log) >= 8640  # whole days of 10-second steps
     assert sorted(p.name for p in out.iterdir()) == ["events.partial.csv", "log.partial.parquet"]
+
+
+def test_a_streamed_run_killed_outright_leaves_its_finished_days_readable(tmp_path):
+    """SIGKILL (the out-of-memory killer, a job's hard time limit) gives the run no last word: the
+    one Parquet file it appended to had no footer, and every finished day was lost with it."""
+    import os
+    import signal
+    import time
+
+    out = tmp_path / "run"
+    child = subprocess.Popen([sys.executable, "-m", "hybridtrack", "simulate", "--site", SITE, "--date", "2021-06-20",
+                              "--days", "30", "--freq", "10s", "--stream", "--out", str(out)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    first = out / "log.partial.parquet" / "00000.parquet"
+    deadline = time.monotonic() + 120
+    while not first.exists() and time.monotonic() < deadline and child.poll() is None:
+        time.sleep(0.05)
+    time.sleep(1.0)  # a later day under way, perhaps mid-write
+    os.kill(child.pid, signal.SIGKILL)
+    assert child.wait(timeout=60) == -signal.SIGKILL
+    log = read_log(out / "log.partial.parquet")
+    assert len(log) % 8640 == 0 and len(log) >= 8640  # whole days of 10-second steps
+    assert log.index.is_monotonic_increasing and log.index.is_unique
 
 
 def test_read_log_refuses_what_is_no_streamed_log_by_name(tmp_path, streamed):
