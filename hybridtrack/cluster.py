@@ -74,20 +74,25 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         _refuse_no_workers(client, scheduler)
         return client, None
     count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else cores()
+    quieted = _quiet_worker_processes()
     try:
         # the dashboard on a free port: None still takes 8787, and a second cluster on this machine
         # (another sweep, a test run) warned on stderr that the port was in use
         with _workers_starting() as held:
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, dashboard_address=":0",
                                    silence_logs=50)  # a failed task is reported by its result, not logged
-    except RuntimeError as exc:  # distributed's "Nanny failed to start", multiprocessing's bootstrapping error
+        cluster.hybridtrack_logging = quieted  # put back when it closes (`close`)
+    except BaseException as exc:
+        _restore_worker_logging(quieted)
+        if not isinstance(exc, RuntimeError):
+            raise
         if held:  # the workers were ended by the SIGTERM held meanwhile: end as it asks, not as a failure
             signal.raise_signal(signal.SIGTERM)
         raise HybridtrackError(f"cannot start {count} local Dask workers for {what} ({' '.join(str(exc).split())[:120]}); "
                                "workers are new processes that import the running script again, so a script "
                                "must start its run under `if __name__ == \"__main__\":`") from None
     if held:  # a SIGTERM came while the workers started: stop them, then end as it asks
-        cluster.close()
+        close_cluster(cluster)
         signal.raise_signal(signal.SIGTERM)
     return Client(cluster), cluster
 
@@ -207,4 +212,38 @@ def close(client, cluster) -> None:
     """Close a client from `dask_client` and its local cluster."""
     client.close()
     if cluster is not None:
-        cluster.close()
+        close_cluster(cluster)
+
+
+def close_cluster(cluster) -> None:
+    """Close a local cluster of `dask_client`'s and put back the logging setting it changed."""
+    cluster.close()
+    _restore_worker_logging(getattr(cluster, "hybridtrack_logging", _UNSET))
+
+
+#: dask's setting, read from the environment as a process imports distributed, of the level of
+#: distributed's own logs (`logging.distributed`).
+_WORKER_LOGGING = "DASK_LOGGING__DISTRIBUTED"
+_UNSET = object()
+
+
+def _quiet_worker_processes():
+    """Start the local workers with distributed's logs at CRITICAL, and return the setting before.
+
+    ``silence_logs`` quiets this process and the nanny's log in a worker, not the rest of the
+    worker's: measured, a worker's ``distributed.batched`` logged at INFO, and at a SIGTERM to the
+    process group a worker printed "Batched Comm Closed" with its traceback as the scheduler went
+    away. A worker process reads this environment variable before it imports distributed (and so
+    does one its nanny restarts while the cluster runs)."""
+    previous = os.environ.get(_WORKER_LOGGING)
+    os.environ[_WORKER_LOGGING] = "critical"
+    return previous
+
+
+def _restore_worker_logging(previous) -> None:
+    if previous is _UNSET:
+        return
+    if previous is None:
+        os.environ.pop(_WORKER_LOGGING, None)
+    else:
+        os.environ[_WORKER_LOGGING] = previous

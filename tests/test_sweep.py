@@ -431,3 +431,27 @@ def test_a_sigterm_while_the_workers_start_is_held_until_the_cluster_can_be_clos
         assert closed == [True] and signal.getsignal(signal.SIGTERM) is stop
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def _distributed_log_level():
+    import logging
+
+    return logging.getLogger("distributed.batched").getEffectiveLevel()
+
+
+def test_local_workers_log_nothing_below_critical_and_the_setting_is_put_back(monkeypatch):
+    """silence_logs quieted this process and the nanny's log in a worker only: a worker's
+    distributed.batched logged at INFO, and at a SIGTERM to the process group one printed
+    "Batched Comm Closed" with a traceback (seen once in the suite under load)."""
+    import logging
+    import os
+
+    from hybridtrack.cluster import close, dask_client
+
+    monkeypatch.delenv("DASK_LOGGING__DISTRIBUTED", raising=False)
+    client, cluster = dask_client(None, 1)
+    try:
+        assert set(client.run(_distributed_log_level).values()) == {logging.CRITICAL}
+    finally:
+        close(client, cluster)
+    assert "DASK_LOGGING__DISTRIBUTED" not in os.environ
