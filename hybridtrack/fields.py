@@ -62,6 +62,11 @@ LOG_BYTES = 80
 #: The closest `HeliostatField.rings` places mirrors, metres: heliostats are built from about 1 m² up
 #: (Pfahl et al. 2017's review; docs/fields.md), so centres closer than 1 m would overlap mirrors.
 MIN_SPACING = 1.0
+#: The closest two Fresnel rows' centres may lie, metres: built primary mirrors are 0.5 m wide and
+#: more (Zhu et al. 2014's review of linear Fresnel collectors, doi:10.1016/j.solener.2013.05.021),
+#: so rows this close would share their mirrors: a typo (rows 0.1 µm apart had been taken). Well
+#: below any built width, so that no real layout is refused.
+MIN_ROW_SPACING = 0.1
 #: The most heliostats a field (one tower) may have, as `HeliostatField.rings` takes: Ivanpah's
 #: 173,500 heliostats serve three towers, some 58,000 each.
 MAX_HELIOSTATS = 100_000
@@ -212,6 +217,17 @@ def _aim_of(aim, aims) -> bool:
             and len(each) > 0 and bool(np.allclose(each.mean(axis=0), one, rtol=0.0, atol=1e-9)))
 
 
+def _refuse_rows_too_close(distances: np.ndarray) -> None:
+    """Refuse Fresnel rows closer than `MIN_ROW_SPACING`, naming the first such pair."""
+    order = np.argsort(distances)
+    gaps = np.diff(distances[order])
+    if len(gaps) and gaps.min() < MIN_ROW_SPACING:
+        k = int(np.argmin(gaps))
+        i, j = sorted((int(order[k]), int(order[k + 1])))
+        raise HybridtrackError(f"rows {i + 1} and {j + 1} are {gaps[k]:.12g} m apart: closer than {MIN_ROW_SPACING:g} "
+                               "m, their mirrors would overlap")
+
+
 def _refuse_overlapping(xyz: np.ndarray) -> None:
     """Refuse heliostats whose centres are closer than `MIN_SPACING`, as `HeliostatField.rings`
     does: their mirrors would overlap (a positions file 0.5 m apart was taken)."""
@@ -261,6 +277,7 @@ class FresnelField:
         _spread_of(self)
         distances = _finite_vector(self.row_distances, "row distances")
         _distinct(distances, "rows", "m from the receiver line")
+        _refuse_rows_too_close(distances)
         object.__setattr__(self, "row_distances", tuple(distances.tolist()))
         for name in ("receiver_height", "row_length"):
             object.__setattr__(self, name, _finite_number(getattr(self, name), name.replace("_", " "), positive=True))

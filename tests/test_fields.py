@@ -115,6 +115,7 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: HeliostatField(positions=[[50, True]]), r"positions must be numbers"),
     (lambda: HeliostatField(positions=[[50, 0], [0, 60]], aim=(True, False, 100)), "aim must be three numbers"),
     (lambda: FresnelField(row_distances=[True, 0.5]), "row distances must be numbers"),
+    (lambda: FresnelField(row_distances=[1.0, 1.0000001]), "rows 1 and 2 are 1.00000000058e-07 m apart: closer than 0.1 m"),
     # a frame's repr had run the message over several lines
     (lambda: HeliostatField(positions=pd.DataFrame({"east": [1.0, None], "north": [3.0, 4.0]}).astype("Float64")),
      r"^heliostat 2: position is not finite$"),
