@@ -46,7 +46,8 @@ _HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "
 
 #: What each repair did, for strict mode's refusal.
 REPAIRS = {
-    "unreadable": "text in a numeric column", "dst_dropped": "a time stamp that does not exist in the time zone",
+    "unreadable": "text in a numeric column", "truncated": "a last line cut short",
+    "dst_dropped": "a time stamp that does not exist in the time zone",
     "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",
     "impossible": "a physically impossible value", "negative_clipped": "a negative irradiance",
     "calm_clipped": "a negative wind reading", "empty_dropped": "an irradiance column without a readable value",
@@ -176,6 +177,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
     judged so only in a file without GHI and DHI, since an overcast day has none. `remedy` ends
     the message (``{name}`` is the column).
     """
+    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
     judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
     for name in judged:
@@ -196,6 +198,28 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             where = f"line {line[0]}, " if line else ""
             raise HybridtrackError(f"{path}: {where}column {header!r}: {name} is {why}; the values look like kW/m² "
                                    f"read as W/m²: {remedy.format(name=name)}")
+
+
+#: W/m² of direct light on the horizontal (GHI - DHI) that only a direct beam of as much again or
+#: more gives: a DNI that stays at 1.5 or less beside it is in kW/m².
+BEAM_SEEN = 100.0
+
+
+def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict, remedy: str) -> None:
+    """Refuse DNI of at most 1.5 while GHI - DHI shows a direct beam of `BEAM_SEEN` W/m² or more:
+    kW/m² beside W/m² columns had been read as W/m², the file called clean, and a clear day
+    replayed as overcast (the magnitude check judges DNI alone only without GHI and DHI)."""
+    if not {"ghi", "dhi", "dni"} <= set(frame.columns):
+        return
+    dni, beam = frame["dni"].to_numpy(float), (frame["ghi"] - frame["dhi"]).to_numpy(float)
+    if not (np.isfinite(dni).any() and np.isfinite(beam).any()):
+        return
+    top, seen = float(np.nanmax(dni)), float(np.nanmax(beam))
+    if 0.0 < top <= 1.5 and seen >= BEAM_SEEN:
+        header = report.get("columns", {}).get("dni", "dni")
+        raise HybridtrackError(f"{path}: column {header!r}: dni is at most {top:g} while ghi - dhi reaches {seen:.0f} "
+                               f"W/m² (a direct beam); the values look like kW/m² read as W/m²: "
+                               f"{remedy.format(name='dni')}")
 
 
 def refuse_repairs(path: Path, report: dict) -> None:

@@ -14,7 +14,7 @@ import pandas as pd
 __all__ = ["validation_report", "ISSUES"]
 
 #: Report keys that make the verdict "usable, with issues" rather than "clean".
-ISSUES = ("unreadable", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
+ISSUES = ("unreadable", "truncated", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
           "impossible", "light_at_night", "wind_missing", "empty_dropped")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
@@ -22,6 +22,7 @@ _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "
 
 _CHANGES = {
     "units_converted": "converted", "unreadable": "set to NaN (unreadable text)",
+    "truncated": "dropped (a last line cut short)",
     "dst_dropped": "dropped (DST: stamps that do not exist)", "unsorted": "sorted (stamps out of order)",
     "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
     "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",

@@ -32,10 +32,17 @@ __all__ = ["parse_stamps", "fixed_zone", "CLOCK_ZONES"]
 CLOCK_ZONES = {"mst": "-07:00", "pst": "-08:00", "cst": "-06:00", "est": "-05:00", "ast": "-04:00", "hst": "-10:00",
                "akst": "-09:00", "utc": "+00:00", "gmt": "+00:00"}
 
-_DMY = re.compile(r"^(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?=$|[ T])(.*)$")
+#: A day-and-month date, its year, and the clock after it (after a space, a T, or a comma, as
+#: ``toLocaleString('en-GB')`` writes ``10/06/2021, 00:00:00``: such stamps had been read by
+#: pandas one at a time, 10-12 June as 6 October, November and December).
+_DMY = re.compile(r"^(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?=$|[ T,])(.*)$")
 _CLOCK_ONLY = re.compile(r"^\d{1,2}:\d{2}(:\d{2}(\.\d+)?)?$")
 _EPOCH = re.compile(r"^\d{9,10}(\.\d+)?$")
-_OFFSET = re.compile(r"\d(?:\s*[+-]\d{2}:?\d{2}|Z)$")
+#: A UTC offset after a clock time: ``+08:00``, ``+0800``, ``Z``, and the hour alone (``+08``, as
+#: PostgreSQL writes a timestamptz), which pandas reads as an offset too (and a traceback followed).
+_OFFSET = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?\s*(?:[+-]\d{2}(?::?\d{2})?|Z)$")
+#: A stamp written ``yyyymmddHH`` (hourly exports): ten digits, like epoch seconds of 2030-2033.
+_COMPACT_HOURS = re.compile(r"^(?:19|20)\d{2}(?:0[1-9]|1[0-2])(?:0[1-9]|[12]\d|3[01])(?:[01]\d|2[0-3])$")
 
 
 def fixed_zone(offset: str) -> dt.timezone:
@@ -99,7 +106,8 @@ def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
     day, month = (parts[0], parts[2]) if is_dayfirst else (parts[2], parts[0])
     years = parts[3].map(_two_digit_year)
     report["date_order"] = why
-    return (years.astype(str) + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + parts[4]).str.strip()
+    clock = parts[4].str.replace(r"^,\s*", " ", regex=True)
+    return (years.astype(str) + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + clock).str.strip()
 
 
 def _parse(column: _Column, text: pd.Series, utc: bool) -> pd.DatetimeIndex:
@@ -139,7 +147,7 @@ def _with_offsets(column: _Column, index: pd.DatetimeIndex, text: pd.Series, has
         column.refuse(int(np.flatnonzero(~has_offset.to_numpy())[0]), "has no UTC offset, but other stamps in "
                                                                        "the column have one")
     endings = pd.Series(text.str.slice(-6).unique())  # a few distinct endings, however long the file
-    offsets = endings.str.extract(r"([+-]\d{2}:?\d{2}|Z)$")[0].str.replace("Z", "+00:00")
+    offsets = endings.str.extract(r"([+-]\d{2}(?::?\d{2})?|Z)$")[0].str.replace("Z", "+00:00")
     if tz is not None:
         report["time"] = f"stamps with UTC offsets, converted to {tz}"
         return index.tz_convert(tz)
@@ -197,9 +205,42 @@ def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *,
         The validation report, which gets ``time`` (and ``date_order``, ``dst_*``).
     """
     column = _Column(path, header, text.astype(str).str.strip(), lines)
+    cut = _cut_short_last(column, report)
+    index, keep = _read_stamps(column, tz, site_tz, clock_zone, dayfirst, report)
+    if cut:
+        keep = keep.copy()
+        keep[-1] = False
+    return index, keep
+
+
+def _cut_short_last(column: _Column, report: dict) -> bool:
+    """Whether the last stamp is cut short (a logger's power lost mid-line): written in another
+    shape than every stamp before it, which all share one. It is then read as the one before it
+    and dropped, and the report says so: ``2021-06-2`` had been read as 2 June, and the replay
+    started 19 days early."""
+    text = column.text
+    if len(text) < 3:
+        return False
+    shapes = text.str.replace(r"\d", "0", regex=True)
+    if shapes.iloc[:-1].nunique() != 1 or shapes.iloc[-1] == shapes.iloc[0] or \
+            len(text.iloc[-1]) >= len(text.iloc[0]):
+        return False
+    report["truncated"] = {"count": 1, "lines": [int(column.lines[-1])],
+                           "why": f"the last line is cut short (its stamp {text.iloc[-1]!r})"}
+    column.text = text.copy()
+    column.text.iloc[-1] = text.iloc[-2]
+    return True
+
+
+def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dict):
+    """`parse_stamps` on a column whose stamps are whole."""
+    path, header, lines = column.path, column.header, column.lines
     empty = np.flatnonzero((column.text == "").to_numpy())
     if len(empty):
         column.refuse(int(empty[0]), "is an empty time stamp")
+    if column.text.str.fullmatch(_COMPACT_HOURS).all():
+        report["date_order"] = "written yyyymmddHH"
+        column.text = column.text.str.replace(r"^(\d{4})(\d{2})(\d{2})(\d{2})$", r"\1-\2-\3 \4:00", regex=True)
     if column.text.str.fullmatch(_EPOCH).all():
         index = _epoch(column, report)
         return (index.tz_convert(tz) if tz else index), np.ones(len(index), bool)

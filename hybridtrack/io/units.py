@@ -16,7 +16,8 @@ import numpy as np
 
 from ..errors import HybridtrackError
 
-__all__ = ["UNITS", "FRAME_UNITS", "normalise_unit", "known_unit", "to_frame_units"]
+__all__ = ["UNITS", "FRAME_UNITS", "normalise_unit", "known_unit", "looks_like_unit", "spellings",
+           "to_frame_units"]
 
 #: Each quantity's unit in a weather frame.
 FRAME_UNITS = {"ghi": "W/m²", "dni": "W/m²", "dhi": "W/m²", "wind_speed": "m/s", "temp_air": "°C",
@@ -27,7 +28,7 @@ UNITS = {
     "irradiance": {"w/m2": (1.0, 0.0), "kw/m2": (1000.0, 0.0), "mw/cm2": (10.0, 0.0)},
     "wind_speed": {"m/s": (1.0, 0.0), "ms-1": (1.0, 0.0), "km/h": (1 / 3.6, 0.0), "kmh": (1 / 3.6, 0.0),
                    "kph": (1 / 3.6, 0.0), "kn": (0.514444, 0.0), "kt": (0.514444, 0.0), "knots": (0.514444, 0.0),
-                   "mph": (0.44704, 0.0)},
+                   "mph": (0.44704, 0.0), "mi/h": (0.44704, 0.0)},
     "temp_air": {"c": (1.0, 0.0), "k": (1.0, -273.15), "f": (5.0 / 9.0, -32.0 * 5.0 / 9.0)},
     "photocurrent": {"ma": (1.0, 0.0), "a": (1000.0, 0.0), "ua": (0.001, 0.0)},
     "angle": {"deg": (1.0, 0.0), "°": (1.0, 0.0), "degrees": (1.0, 0.0), "degree": (1.0, 0.0),
@@ -41,10 +42,12 @@ _QUANTITY = {"ghi": "irradiance", "dni": "irradiance", "dhi": "irradiance", "win
 def normalise_unit(text: str) -> str:
     """``'W m-2'`` -> ``'w/m2'``, ``'Deg C'`` -> ``'c'``, ``'µA'`` -> ``'ua'``."""
     unit = str(text).strip().lower().replace(" ", "").replace("²", "2").replace("^", "").replace("µ", "u")
+    unit = unit.replace("º", "°")  # the ordinal sign Spanish and Portuguese keyboards give for a degree
     unit = unit.replace("·", "").replace("*", "")
     unit = re.sub(r"^(k?w)m-2$", r"\1/m2", unit)
     unit = re.sub(r"^(k?w)/m-2$", r"\1/m2", unit)
     unit = re.sub(r"^(deg(rees?)?|°)_?([cfk])$", r"\3", unit)
+    unit = re.sub(r"^(k?m|mi)h-1$", r"\1/h", unit)  # 'km h-1', as SI writes it
     unit = {"kelvin": "k", "celsius": "c", "m/sec": "m/s", "mps": "m/s",
             "meters/second": "m/s", "metres/second": "m/s", "km/hr": "km/h"}.get(unit, unit)
     return unit
@@ -53,6 +56,27 @@ def normalise_unit(text: str) -> str:
 def known_unit(name: str, text: str) -> bool:
     """Whether `text` is a spelling of a unit of column `name`."""
     return normalise_unit(text) in UNITS[_QUANTITY[name]]
+
+
+#: The pieces units are written with, lower case: a bracket made of these alone is a unit, known
+#: or not (``Wh/m2``, ``km h-1``), never a note (``vent/cor``, ``CMP22``).
+_UNIT_PIECES = {"w", "kw", "mw", "wh", "kwh", "mwh", "j", "kj", "mj", "cal", "ly", "m", "km", "mi", "cm", "mm", "ft",
+                "s", "sec", "min", "h", "hr", "hour", "d", "day", "kt", "kn", "knots", "mph", "kph", "c", "f", "k",
+                "°c", "°f", "°", "deg", "a", "ma", "ua", "v", "mv", "rad", "mrad", "%"}
+
+
+def looks_like_unit(text: str) -> bool:
+    """Whether `text` is written as a unit (of pieces such as W, Wh, m, km, h, °F), whether or not
+    it is one the reader converts: a header's unknown unit must be refused, not kept as a note."""
+    pieces = [re.sub(r"(?<=[a-z])-?[1-4]$", "", piece) for piece in  # an exponent: m2, h-1 (not CM21)
+              re.split(r"[/\s·*.]+", str(text).strip().lower().replace("º", "°").replace("²", "2").replace("^", ""))]
+    pieces = [piece for piece in pieces if piece]
+    return bool(pieces) and all(piece in _UNIT_PIECES for piece in pieces)
+
+
+def spellings(name: str) -> list[str]:
+    """The units (as `normalise_unit` writes them) the reader converts for column `name`."""
+    return sorted(UNITS[_QUANTITY[name]])
 
 
 def any_known_unit(text: str) -> bool:

@@ -24,7 +24,7 @@ from .gapfill import fill_components
 from .resample import resample
 from .stamps import CLOCK_ZONES, parse_stamps
 from .tables import MISSING, Table, locate_table
-from .units import to_frame_units
+from .units import looks_like_unit, spellings, to_frame_units
 
 __all__ = ["read_weather"]
 
@@ -71,6 +71,17 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
                         clock_zone=zone, dayfirst=dayfirst, report=report)
 
 
+def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
+    """Refuse a column whose header gives a unit the reader does not convert: ``GHI (Wh/m2)`` had
+    been read as W/m² (six times too low for 10-minute sums) and ``Wind (km h-1)`` as m/s, with
+    the unit reported as a note and the file called clean."""
+    unit = next((part for part in note.split("; ") if looks_like_unit(part)), None)
+    if unit is not None:
+        raise HybridtrackError(f"{path}: column {header!r}: the unit {unit!r} is not one hybridtrack converts for "
+                               f"{name} (it takes {', '.join(spellings(name))}); convert the column, or "
+                               f"give its unit with --units {name}=UNIT if it is one of those")
+
+
 def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict, report) -> pd.DataFrame:
     table = locate_table(path, text)
     position = {h: i for i, h in enumerate(table.headers)}
@@ -105,6 +116,8 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
         if note:
             notes[header] = note
         unit = (units or {}).get(name) or header_unit or table.units.get(header) or None
+        if unit is None and note:
+            _refuse_unknown_unit(path, header, name, note)
         where = "--units" if (units or {}).get(name) else f"{path}: column {header!r}"
         values, converted = to_frame_units(values, name, unit, where)
         if converted:

@@ -1,0 +1,90 @@
+"""Logger files as engineers have them: stamps and units the reader had misread or crashed on.
+
+Each file is one June day at Lanzhou, 10-minute steps, written by `_day` in the way a logger or
+export tool writes it (found by a helper replaying messy files).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import HybridtrackError
+from hybridtrack.cli import main
+from hybridtrack.io import read_weather
+from hybridtrack.sky import synthetic
+
+
+@pytest.fixture(scope="module")
+def day():
+    return synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=2)[["ghi", "dni", "dhi"]].round(1)
+
+
+def _write(path, stamps, day, *, header="time,ghi,dni,dhi", tail=""):
+    rows = [f"{stamp},{g},{n},{d}" for stamp, (g, n, d) in zip(stamps, day.to_numpy())]
+    path.write_text(header + "\n" + "\n".join(rows) + "\n" + tail)
+    return path
+
+
+def test_hour_only_utc_offsets_are_read_as_offsets(tmp_path, day):
+    """'2021-06-21 00:00:00+08' (PostgreSQL's timestamptz) raised pandas' TypeError: a traceback."""
+    stamps = day.index.strftime("%Y-%m-%d %H:%M:%S") + "+08"
+    frame = read_weather(_write(tmp_path / "pg.csv", stamps, day), site="lanzhou")
+    assert frame.index[0] == pd.Timestamp("2021-06-21 00:00", tz="Asia/Shanghai") and len(frame) == len(day)
+    assert frame.attrs["validation"]["time"].startswith("stamps with UTC offset +08")
+
+
+def test_a_last_line_cut_short_is_dropped_and_reported_not_read_as_another_day(tmp_path, day):
+    """'2021-06-2' (power lost mid-line) had been read as 2 June: the replay started 19 days early."""
+    path = _write(tmp_path / "cut.csv", day.index.strftime("%Y-%m-%d %H:%M"), day, tail="2021-06-2")
+    frame = read_weather(path, site="lanzhou")
+    assert frame.index[0] == day.index[0] and len(frame) == len(day)
+    assert frame.attrs["validation"]["truncated"]["lines"] == [len(day) + 2]
+    with pytest.raises(HybridtrackError, match="a last line cut short \\(strict\\)"):
+        read_weather(path, site="lanzhou", strict=True)
+
+
+def test_ten_digit_hourly_stamps_are_dates_not_epoch_seconds(tmp_path, day):
+    """'2021062112' had been read as epoch seconds: 24 one-second rows in 2034."""
+    hourly = day.iloc[::6]
+    frame = read_weather(_write(tmp_path / "h.csv", hourly.index.strftime("%Y%m%d%H"), hourly), site="lanzhou")
+    assert frame.index[12] == pd.Timestamp("2021-06-21 12:00", tz="Asia/Shanghai") and len(frame) == 24
+
+
+def test_day_first_dates_followed_by_a_comma_are_decided_for_the_whole_column(tmp_path):
+    """'10/06/2021, 00:00:00' (toLocaleString('en-GB')) was parsed one stamp at a time: 10-12 June
+    became 6 October, November and December, and 13-15 June stayed right."""
+    days = synthetic("lanzhou", "2021-06-10", "2021-06-15", weather="sunny", freq="1h", seed=2)
+    stamps = '"' + days.index.strftime("%d/%m/%Y, %H:%M:%S") + '"'
+    frame = read_weather(_write(tmp_path / "gb.csv", stamps, days[["ghi", "dni", "dhi"]].round(1)), tz="Asia/Shanghai")
+    assert frame.index[0] == days.index[0] and frame.index[-1] == days.index[-1] and frame.index.is_monotonic_increasing
+
+
+@pytest.mark.parametrize("header, unit", [("time,GHI (Wh/m2),dni,dhi", "Wh/m2"),
+                                          ("time,ghi,dni,dhi,Wind Speed (km/s)", "km/s")])
+def test_a_unit_in_a_header_the_reader_does_not_convert_is_refused_not_kept_as_a_note(tmp_path, day, header, unit):
+    """'GHI (Wh/m2)' had been read as W/m² and 'Wind (km h-1)' as m/s, the unit reported as a note
+    and the file called clean."""
+    extra = ",3.0" if header.count(",") == 4 else ""
+    rows = [f"{t},{g},{n},{d}{extra}" for t, (g, n, d) in zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+    (tmp_path / "u.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
+    with pytest.raises(HybridtrackError, match=f"the unit '{unit}' is not one hybridtrack converts"):
+        read_weather(tmp_path / "u.csv", site="lanzhou")
+
+
+def test_wind_in_si_and_imperial_spellings_is_converted(tmp_path, day):
+    for header, factor in (("Wind Speed (km h-1)", 1 / 3.6), ("Wind Speed (mi/h)", 0.44704)):
+        rows = [f"{t},{g},{n},{d},10.0" for t, (g, n, d) in zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+        (tmp_path / "w.csv").write_text(f"time,ghi,dni,dhi,{header}\n" + "\n".join(rows) + "\n")
+        assert read_weather(tmp_path / "w.csv", site="lanzhou")["wind_speed"].iloc[0] == pytest.approx(10 * factor)
+
+
+def test_dni_in_kilowatts_beside_ghi_and_dhi_in_watts_is_refused(tmp_path, day, capsys):
+    """It was called clean, and the replay ran a clear day as overcast (sensor mode 0 %)."""
+    kilowatts = day.assign(dni=(day["dni"] / 1000).round(4))
+    path = _write(tmp_path / "kw.csv", day.index.strftime("%Y-%m-%d %H:%M"), kilowatts)
+    assert main(["check", str(path), "--site", "lanzhou"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the values look like kW/m² read as W/m²" in err and "--units dni=kW/m2" in err
+    assert np.isfinite(read_weather(path, site="lanzhou", units={"dni": "kW/m2"})["dni"]).any()
