@@ -88,3 +88,29 @@ def test_dni_in_kilowatts_beside_ghi_and_dhi_in_watts_is_refused(tmp_path, day, 
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "the values look like kW/m² read as W/m²" in err and "--units dni=kW/m2" in err
     assert np.isfinite(read_weather(path, site="lanzhou", units={"dni": "kW/m2"})["dni"]).any()
+
+
+def test_a_spreadsheets_empty_padding_columns_are_skipped_and_said(tmp_path, day, capsys):
+    """Excel pads rows to the sheet's used range ('time;ghi;dni;dhi;;'): the two unnamed columns had
+    been refused as one name given twice."""
+    rows = [f"{t};{g};{n};{d};;" for t, (g, n, d) in zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+    path = tmp_path / "excel.csv"
+    path.write_text("time;ghi;dni;dhi;;\n" + "\n".join(rows) + "\n")
+    frame = read_weather(path, site="lanzhou")
+    assert len(frame) == len(day) and frame.attrs["validation"]["empty_columns"] == 2
+    assert main(["check", str(path), "--site", "lanzhou"]) == 0
+    assert "skipped 2 empty column(s) without a name" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("marker", [-9999, -999, 7999])
+def test_a_loggers_missing_value_marker_is_missing_data_counted_not_a_wrong_unit(tmp_path, day, marker):
+    """A temperature sensor unplugged (-9999 in every row) had refused the whole file as a wrong
+    unit, with a hint (--units temp_air=K) that would have made it worse."""
+    rows = [f"{t},{g},{n},{d},{marker}" for t, (g, n, d) in zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+    path = tmp_path / "marked.csv"
+    path.write_text("time,ghi,dni,dhi,temp_air\n" + "\n".join(rows) + "\n")
+    frame = read_weather(path, site="lanzhou")
+    assert frame["temp_air"].isna().all() and frame["dni"].notna().all()
+    assert frame.attrs["validation"]["missing_markers"]["temp_air"]["count"] == len(day)
+    with pytest.raises(HybridtrackError, match="a logger's missing-value marker \\(strict\\)"):
+        read_weather(path, site="lanzhou", strict=True)

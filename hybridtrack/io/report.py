@@ -14,7 +14,7 @@ import pandas as pd
 __all__ = ["validation_report", "ISSUES"]
 
 #: Report keys that make the verdict "usable, with issues" rather than "clean".
-ISSUES = ("unreadable", "truncated", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
+ISSUES = ("unreadable", "missing_markers", "truncated", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
           "impossible", "light_at_night", "wind_missing", "empty_dropped")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
@@ -23,6 +23,7 @@ _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "
 _CHANGES = {
     "units_converted": "converted", "unreadable": "set to NaN (unreadable text)",
     "truncated": "dropped (a last line cut short)",
+    "missing_markers": "set to NaN (a logger's missing-value marker: -9999, 7999, ...)",
     "dst_dropped": "dropped (DST: stamps that do not exist)", "unsorted": "sorted (stamps out of order)",
     "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
     "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",
@@ -52,6 +53,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
             lines.append(f"  skipped {what}: {len(numbers)} line{'s' if len(numbers) > 1 else ''} "
                          f"({_describe(numbers[:5])}{', ...' if len(numbers) > 5 else ''})")
     lines.append("  columns: " + ", ".join(f"{k} <- {v!r}" for k, v in report.get("columns", {}).items()))
+    if report.get("empty_columns"):
+        lines.append(f"  skipped {report['empty_columns']} empty column(s) without a name (a spreadsheet's padding)")
     if "header_notes" in report:
         lines.append(f"  header notes (not units, ignored): {_describe(report['header_notes'])}")
     lines.append(f"  time: {report.get('time', '?')}" + (f"; dates {report['date_order']}" if "date_order" in report

@@ -8,6 +8,7 @@ missing components (`gapfill`) and the step (`resample`). docs/records.md says w
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -71,6 +72,42 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
                         clock_zone=zone, dayfirst=dayfirst, report=report)
 
 
+def _without_empty_columns(table: Table, report: dict) -> Table:
+    """`table` without its columns that have no name and no value in any row: Excel's "Save as
+    CSV" pads rows to the sheet's used range (``time;ghi;dni;dhi;;``), and the two unnamed columns
+    had been refused as one name twice. They hold nothing, so nothing is changed; the report
+    counts them."""
+    empty = [i for i, header in enumerate(table.headers)
+             if not header.strip() and all(i >= len(row) or not row[i].strip() for row in table.rows)]
+    if not empty or len(empty) == len(table.headers):
+        return table
+    keep = [i for i in range(len(table.headers)) if i not in empty]
+    report["empty_columns"] = len(empty)
+    return dataclasses.replace(table, headers=[table.headers[i] for i in keep],
+                               rows=[[row[i] for i in keep if i < len(row)] for row in table.rows])
+
+
+#: Numbers loggers write for a reading they do not have (Campbell's 7999 and -7999 for over range,
+#: -9999 and -999 in SCADA and BSRN exports): no weather column can hold them, so they are missing.
+MISSING_MARKERS = (-99999.0, -9999.0, -999.0, -7999.0, 7999.0, 9999.0)
+#: The columns markers are read in (a photocurrent or a pointing signal is the user's own record).
+_MARKED = ("ghi", "dni", "dhi", "wind_speed", "temp_air")
+
+
+def _missing_markers(table: Table, name: str, values: np.ndarray, report: dict) -> np.ndarray:
+    """`values` with `MISSING_MARKERS` as NaN, counted: a temperature sensor unplugged (-9999 in
+    every row) had refused the whole file as a wrong unit."""
+    if name not in _MARKED:
+        return values
+    marked = np.isin(values, MISSING_MARKERS)
+    if not marked.any():
+        return values
+    report.setdefault("missing_markers", {})[name] = {
+        "count": int(marked.sum()), "lines": [int(v) for v in table.lines[marked][:5]],
+        "first": float(values[marked][0]), "action": "set to NaN"}
+    return np.where(marked, np.nan, values)
+
+
 def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
     """Refuse a column whose header gives a unit the reader does not convert: ``GHI (Wh/m2)`` had
     been read as W/m² (six times too low for 10-minute sums) and ``Wind (km h-1)`` as m/s, with
@@ -83,7 +120,7 @@ def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
 
 
 def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict, report) -> pd.DataFrame:
-    table = locate_table(path, text)
+    table = _without_empty_columns(locate_table(path, text), report)
     position = {h: i for i, h in enumerate(table.headers)}
     repeated = sorted({h for h in table.headers if table.headers.count(h) > 1})
     if repeated:
@@ -111,7 +148,8 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
         if name not in mapping:
             continue
         header = mapping[name]
-        values = _numbers(path, table, header, cells(header), table.decimal, strict, report, name)
+        values = _missing_markers(table, name, _numbers(path, table, header, cells(header), table.decimal, strict,
+                                                        report, name), report)
         _, header_unit, note = split_header(header)
         if note:
             notes[header] = note
