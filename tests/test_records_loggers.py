@@ -114,3 +114,20 @@ def test_a_loggers_missing_value_marker_is_missing_data_counted_not_a_wrong_unit
     assert frame.attrs["validation"]["missing_markers"]["temp_air"]["count"] == len(day)
     with pytest.raises(HybridtrackError, match="a logger's missing-value marker \\(strict\\)"):
         read_weather(path, site="lanzhou", strict=True)
+
+
+@pytest.mark.parametrize("header", ["time_utc", "UTC", "Time (UTC)"])
+def test_a_time_column_named_utc_is_read_as_utc(tmp_path, day, header):
+    """Its stamps had been read as the site's local time (and refused by the sun check, 8 h off)."""
+    utc = day.index.tz_convert("UTC")
+    path = _write(tmp_path / "utc.csv", utc.strftime("%Y-%m-%d %H:%M"), day, header=f"{header},ghi,dni,dhi")
+    frame = read_weather(path, site="lanzhou")
+    assert frame.index[0] == day.index[0] and "as the time or clock column's name says" in frame.attrs["validation"]["time"]
+
+
+def test_a_units_row_in_brackets_is_read(tmp_path, day):
+    """'[W/m2]' under the header had been refused as an unknown unit; a header's brackets were read."""
+    path = _write(tmp_path / "units.csv", day.index.strftime("%Y-%m-%d %H:%M"), day.assign(dni=day["dni"] / 1000),
+                  header="Timestamp,GHI,DNI,DHI\n[yyyy-mm-dd hh:mm],[W/m2],[kW/m2],[W/m2]")
+    frame = read_weather(path, site="lanzhou")
+    np.testing.assert_allclose(frame["dni"].to_numpy(), day["dni"].to_numpy(), atol=0.06)

@@ -198,7 +198,8 @@ def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *,
     site_tz : str, optional
         The site's zone, taken for naive stamps when nothing else says (and reported so).
     clock_zone : str, optional
-        A UTC offset named by the clock column's header (``'-07:00'`` for ``MST``).
+        A UTC offset named by the time or clock column's header (``'-07:00'`` for ``MST``,
+        ``'+00:00'`` for ``time_utc``).
     dayfirst : bool, optional
         Whether ``a/b/yyyy`` dates are day-first; None decides from the column.
     report : dict
@@ -259,7 +260,7 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
         return _localise(column, index, tz, f"naive stamps localised to {tz}", report)
     if clock_zone is not None:
         zone = fixed_zone(clock_zone)
-        report["time"] = f"naive stamps in UTC{clock_zone}, as the clock column's name says"
+        report["time"] = f"naive stamps in UTC{clock_zone}, as the time or clock column's name says"
         return index.tz_localize(zone), np.ones(len(index), bool)
     if site_tz is not None:
         return _localise(column, index, site_tz, f"naive stamps read as the site's local time ({site_tz}); give "

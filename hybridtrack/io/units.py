@@ -43,6 +43,7 @@ def normalise_unit(text: str) -> str:
     """``'W m-2'`` -> ``'w/m2'``, ``'Deg C'`` -> ``'c'``, ``'µA'`` -> ``'ua'``."""
     unit = str(text).strip().lower().replace(" ", "").replace("²", "2").replace("^", "").replace("µ", "u")
     unit = unit.replace("º", "°")  # the ordinal sign Spanish and Portuguese keyboards give for a degree
+    unit = re.sub(r"^[\[(](.*)[\])]$", r"\1", unit)  # a units row's '[W/m2]', as a header writes it
     unit = unit.replace("·", "").replace("*", "")
     unit = re.sub(r"^(k?w)m-2$", r"\1/m2", unit)
     unit = re.sub(r"^(k?w)/m-2$", r"\1/m2", unit)

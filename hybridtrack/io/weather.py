@@ -9,6 +9,7 @@ missing components (`gapfill`) and the step (`resample`). docs/records.md says w
 from __future__ import annotations
 
 import dataclasses
+import re
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -67,7 +68,8 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
         if dayfirst is None and ("mm/dd" in written or "dd/mm" in written):
             dayfirst = "dd/mm" in written
     else:
-        text, header, zone = pd.Series(cells(mapping["time"])), mapping["time"], None
+        text, header = pd.Series(cells(mapping["time"])), mapping["time"]
+        zone = _zone_in_name(header)
     return parse_stamps(path, header, text, table.lines, tz=tz, site_tz=site.tz if site is not None else None,
                         clock_zone=zone, dayfirst=dayfirst, report=report)
 
@@ -106,6 +108,14 @@ def _missing_markers(table: Table, name: str, values: np.ndarray, report: dict) 
         "count": int(marked.sum()), "lines": [int(v) for v in table.lines[marked][:5]],
         "first": float(values[marked][0]), "action": "set to NaN"}
     return np.where(marked, np.nan, values)
+
+
+def _zone_in_name(header: str) -> str | None:
+    """The UTC offset a time column's name gives (``time_utc``, ``UTC``, ``Time (UTC)``, ``GMT``),
+    as a clock column's does: such stamps had been read as the site's local time."""
+    name, _, note = split_header(header)
+    words = set(re.split(r"[\s_/-]+", name)) | {word.lower() for word in re.split(r"[\s;]+", note or "")}
+    return next((CLOCK_ZONES[word] for word in ("utc", "gmt") if word in words), None)
 
 
 def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
