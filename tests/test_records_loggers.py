@@ -131,3 +131,14 @@ def test_a_units_row_in_brackets_is_read(tmp_path, day):
                   header="Timestamp,GHI,DNI,DHI\n[yyyy-mm-dd hh:mm],[W/m2],[kW/m2],[W/m2]")
     frame = read_weather(path, site="lanzhou")
     np.testing.assert_allclose(frame["dni"].to_numpy(), day["dni"].to_numpy(), atol=0.06)
+
+
+def test_a_header_repeated_mid_file_is_skipped_and_listed(tmp_path, day):
+    """A logger restarted, or daily files joined with cat: the repeated header had been refused as
+    a time stamp ('time' is not a time stamp)."""
+    stamps = day.index.strftime("%Y-%m-%d %H:%M")
+    rows = [f"{t},{g},{n},{d}" for t, (g, n, d) in zip(stamps, day.to_numpy())]
+    rows.insert(80, "time,ghi,dni,dhi")
+    (tmp_path / "joined.csv").write_text("time,ghi,dni,dhi\n" + "\n".join(rows) + "\n")
+    frame = read_weather(tmp_path / "joined.csv", site="lanzhou")
+    assert len(frame) == len(day) and frame.attrs["validation"]["skipped"]["repeated header lines"] == [82]

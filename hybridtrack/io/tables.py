@@ -117,15 +117,31 @@ def _header_after_hint(path: Path, kept: list[tuple[int, str]], sep: str) -> tup
     return 0, sep, f"table with Excel's 'sep={sep}' line"
 
 
-def _rows(path: Path, body: list[tuple[int, str]], sep: str, width: int, header_line: int,
+def _without_repeated_header(rows: list[list[str]], numbers: list[int], headers: list[str],
+                             skipped: dict) -> tuple[list[list[str]], list[int]]:
+    """`rows` without the lines that repeat the header (a logger restarted, daily files joined with
+    ``cat``), which are skipped and listed: such a line had been refused as a time stamp."""
+    again = [i for i, fields in enumerate(rows) if [f.strip() for f in fields] == headers]
+    if not again:
+        return rows, numbers
+    skipped["repeated header lines"] = [numbers[i] for i in again]
+    drop = set(again)
+    keep = [i for i in range(len(rows)) if i not in drop]
+    return [rows[i] for i in keep], [numbers[i] for i in keep]
+
+
+def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str], header_line: int,
           skipped: dict) -> tuple[list[list[str]], list[int]]:
-    """The rows' fields, each `width` long, and their file lines; empty rows skipped, long rows refused."""
+    """The rows' fields, each as long as `headers`, and their file lines; empty rows and repeated
+    headers skipped, long rows refused."""
+    width = len(headers)
     empty = [not line.strip(sep + ' \t"') for _, line in body]  # ';;;;': a row the logger left empty
     if any(empty):
         skipped["empty rows"] = [number for (number, _), blank in zip(body, empty) if blank]
         body = [entry for entry, blank in zip(body, empty) if not blank]
     rows = list(csv.reader([line for _, line in body], delimiter=sep))
     numbers = [number for number, _ in body]
+    rows, numbers = _without_repeated_header(rows, numbers, headers, skipped)
     for i, fields in enumerate(rows):
         if len(fields) == width:
             continue
@@ -167,7 +183,7 @@ def locate_table(path: Path, text: str) -> Table:
         body = body[1:]
     if not body or not rows_with_values(body, sep):
         raise HybridtrackError(f"{path}: the table has a header but no rows")
-    rows, numbers = _rows(path, body, sep, len(headers), kept[position][0], skipped)
+    rows, numbers = _rows(path, body, sep, headers, kept[position][0], skipped)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
     decimal = "," if sep == ";" and any(re.fullmatch(r"[-+]?\d*,\d+", f.strip()) for r in rows for f in r) else "."
     return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind)
