@@ -142,3 +142,18 @@ def test_a_header_repeated_mid_file_is_skipped_and_listed(tmp_path, day):
     (tmp_path / "joined.csv").write_text("time,ghi,dni,dhi\n" + "\n".join(rows) + "\n")
     frame = read_weather(tmp_path / "joined.csv", site="lanzhou")
     assert len(frame) == len(day) and frame.attrs["validation"]["skipped"]["repeated header lines"] == [82]
+
+
+def test_thousands_grouped_by_dots_beside_a_decimal_comma_are_read(tmp_path, day):
+    """'1.073,3' (German Excel) had been unreadable text: every value of 1000 W/m² or more, a clear
+    noon, set to NaN."""
+    def german(value):
+        whole, fraction = f"{value:.1f}".split(".")
+        return (f"{int(whole):,}".replace(",", ".")) + "," + fraction
+
+    rows = [f"{t};{german(g)};{german(n)};{german(d)}" for t, (g, n, d) in
+            zip(day.index.strftime("%d.%m.%Y %H:%M"), day.to_numpy())]
+    (tmp_path / "de.csv").write_text("Datum;GHI;DNI;DHI\n" + "\n".join(rows) + "\n")
+    frame = read_weather(tmp_path / "de.csv", site="lanzhou")
+    np.testing.assert_allclose(frame["ghi"].to_numpy(), day["ghi"].to_numpy(), atol=0.051)
+    assert day["ghi"].max() >= 1000 and "unreadable" not in frame.attrs["validation"]

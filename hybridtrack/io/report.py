@@ -47,8 +47,9 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
         lines.append(f"  format: {report['format'].upper()} (through pvlib), read as {report.get('read_as', '?')}")
     else:
         kind = "" if report.get("table", "table") == "table" else f"{report['table']}, "
+        thousands = f", thousands grouped by {report['thousands']}" if "thousands" in report else ""
         lines.append(f"  table: {kind}{report.get('separator', '?')}-separated, decimal "
-                     f"'{report.get('decimal', '.')}', read as {report.get('read_as', '?')}")
+                     f"'{report.get('decimal', '.')}'{thousands}, read as {report.get('read_as', '?')}")
         for what, numbers in report.get("skipped", {}).items():
             lines.append(f"  skipped {what}: {len(numbers)} line{'s' if len(numbers) > 1 else ''} "
                          f"({_describe(numbers[:5])}{', ...' if len(numbers) > 5 else ''})")

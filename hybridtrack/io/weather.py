@@ -33,6 +33,10 @@ __all__ = ["read_weather"]
 _SEPARATOR_NAMES = {",": "comma", ";": "semicolon", "\t": "tab", "|": "bar"}
 
 
+#: A number whose thousands are grouped with dots beside a decimal comma: ``1.073,3``, ``12.000``.
+_GROUPED = re.compile(r"[-+]?\d{1,3}(\.\d{3})+(,\d*)?")
+
+
 def _numbers(path: Path, table: Table, header: str, column: list[str], decimal: str, strict: bool,
              report: dict, name: str) -> np.ndarray:
     """A column's text as floats; a few unreadable cells become NaN (counted), many are refused."""
@@ -44,6 +48,10 @@ def _numbers(path: Path, table: Table, header: str, column: list[str], decimal: 
     strings = pd.Series(column, dtype=str).str.strip()
     missing = strings.str.lower().isin(MISSING)
     if decimal == ",":
+        grouped = strings.str.fullmatch(_GROUPED)
+        if grouped.any():  # '1.073,3': with a decimal comma, a dot can only group thousands
+            strings = strings.where(~grouped, strings.str.replace(".", "", regex=False))
+            report["thousands"] = "'.' (with the decimal comma)"
         strings = strings.str.replace(",", ".", regex=False)
     values = pd.to_numeric(strings.where(~missing), errors="coerce")
     bad = (values.isna() & ~missing).to_numpy()
