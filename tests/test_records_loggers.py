@@ -157,3 +157,13 @@ def test_thousands_grouped_by_dots_beside_a_decimal_comma_are_read(tmp_path, day
     frame = read_weather(tmp_path / "de.csv", site="lanzhou")
     np.testing.assert_allclose(frame["ghi"].to_numpy(), day["ghi"].to_numpy(), atol=0.051)
     assert day["ghi"].max() >= 1000 and "unreadable" not in frame.attrs["validation"]
+
+
+def test_a_stamp_of_24_00_ends_its_day(tmp_path, day):
+    """'21.06.2021 24:00', as many European hourly files close a day, had been refused as no time stamp."""
+    hourly = day.iloc[6::6]  # 01:00 to 23:00
+    stamps = list(hourly.index.strftime("%d.%m.%Y %H:%M")) + ["21.06.2021 24:00"]
+    rows = [f"{t};{g};{n};{d}" for t, (g, n, d) in zip(stamps, np.vstack([hourly.to_numpy(), [[0.0, 0.0, 0.0]]]))]
+    (tmp_path / "h24.csv").write_text("Datum;GHI;DNI;DHI\n" + "\n".join(rows) + "\n")
+    frame = read_weather(tmp_path / "h24.csv", tz="Asia/Shanghai")
+    assert frame.index[-1] == pd.Timestamp("2021-06-22 00:00", tz="Asia/Shanghai") and len(frame) == 24

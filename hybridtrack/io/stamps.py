@@ -233,6 +233,15 @@ def _cut_short_last(column: _Column, report: dict) -> bool:
     return True
 
 
+def _end_of_day(iso: pd.Series) -> tuple[pd.Series, np.ndarray]:
+    """Stamps of ``24:00`` (the end of a day, as many European hourly files close it) as ``00:00``,
+    and which they were, to be moved to the next day: they had been refused as no time stamp."""
+    midnight = iso.str.contains(r"[ T]24:00(?::00)?$", regex=True).to_numpy()
+    if not midnight.any():
+        return iso, midnight
+    return iso.str.replace(r"([ T])24:00((?::00)?)$", r"\g<1>00:00\g<2>", regex=True), midnight
+
+
 def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dict):
     """`parse_stamps` on a column whose stamps are whole."""
     path, header, lines = column.path, column.header, column.lines
@@ -253,7 +262,10 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
     if iso.str.endswith(("UTC", "GMT")).any():
         iso = iso.str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
     has_offset = iso.str.contains(_OFFSET)
+    iso, midnight = _end_of_day(iso)
     index = _parse(column, iso, utc=bool(has_offset.any()))
+    if midnight.any():
+        index = index + pd.to_timedelta(midnight.astype(int), unit="D")
     if has_offset.any():
         return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)
     if tz is not None:
