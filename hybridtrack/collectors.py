@@ -115,7 +115,12 @@ def _vectors(function: str, values, name: str) -> np.ndarray:
 def sun_vector(altitude, azimuth) -> np.ndarray:
     """Unit vectors towards the sun, shape ``(..., 3)`` in (east, north, up)."""
     _broadcast("sun_vector", altitude=altitude, azimuth=azimuth)
-    a, g = (np.radians(angle) for angle in checked_sun(altitude, azimuth, "sun_vector"))
+    return _unit_vectors(*checked_sun(altitude, azimuth, "sun_vector"))
+
+
+def _unit_vectors(altitude: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
+    """`sun_vector` of a position `checked_sun` has checked already (float arrays, degrees)."""
+    a, g = np.radians(altitude), np.radians(azimuth)
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
 
@@ -136,7 +141,7 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
 
 def _cross_axis_angle(altitude, azimuth, axis_azimuth) -> np.ndarray:
     """Angle of the sun's projection on the plane across a horizontal axis (0-180°)."""
-    angle = across_angle(sun_vector(altitude, azimuth), axis_azimuth)
+    angle = across_angle(_unit_vectors(altitude, azimuth), axis_azimuth)
     return np.where(np.asarray(altitude, float) >= 0.0, angle, np.nan)
 
 
@@ -325,7 +330,7 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
     _broadcast("heliostat_normal", altitude=altitude, azimuth=azimuth, aim_points=target[..., 0])
     alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
-    s = sun_vector(alt, az) if sun is None else sun
+    s = _unit_vectors(alt, az) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
     n = np.where((alt < 0.0)[..., None], np.nan, n)

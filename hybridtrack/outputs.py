@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import params
 from .errors import HybridtrackError
 
 __all__ = ["claim", "held", "output_folder", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
@@ -196,18 +197,8 @@ def output_folder(folder) -> Path:
 
 
 def output_path(value, what: str = "a file to write") -> Path:
-    """`value` as a Path to write, refused unless it is a non-empty path without a NUL (which no
-    file system takes: Python raised a ValueError); a leading ``~`` is the user's home, as the
-    shell and pandas read it (the folder had been made as ``./~``, and pandas then wrote into
-    the home folder's)."""
-    if isinstance(value, bytes):
-        value = os.fsdecode(value)
-    if not isinstance(value, (str, os.PathLike)) or not str(os.fspath(value)).strip():
-        raise HybridtrackError(f"{what} must be a path, got {value!r:.80}")
-    text = os.fspath(value)
-    if "\0" in str(text):
-        raise HybridtrackError(f"{what} must be a path, got {text!r:.80}, which holds a NUL character")
-    return Path(os.path.expanduser(text))
+    """`value` as a Path to write (`params.path`: ``~`` expanded; no NUL, nothing empty)."""
+    return params.path(value, what)
 
 
 #: The hidden file a run that writes a folder over its whole span holds locked (`held`).

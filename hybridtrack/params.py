@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import re
+from pathlib import Path
 
 import pandas as pd
 
@@ -94,3 +96,18 @@ def angle_pair(values, name: str, low: float, high: float) -> tuple[float, float
     if not first < second:
         raise HybridtrackError(f"{name} must be [low, high] with low < high, got {list(pair)!r}")
     return first, second
+
+
+def path(value, what: str) -> Path:
+    """`value` (text, bytes or a path) as a Path, refused with `what` unless it is a non-empty path
+    without a NUL (which no file system takes: Python raised a ValueError). A leading ``~`` is the
+    user's home, as the shell and pandas read it (a folder named ``~`` had been made here, while
+    pandas wrote into the home folder's)."""
+    if isinstance(value, bytes):
+        value = os.fsdecode(value)
+    if not isinstance(value, (str, os.PathLike)) or not str(os.fspath(value)).strip():
+        raise HybridtrackError(f"{what} must be a path, got {value!r:.80}")
+    text = str(os.fspath(value))
+    if "\0" in text:
+        raise HybridtrackError(f"{what} must be a path, got {text!r:.80}, which holds a NUL character")
+    return Path(os.path.expanduser(text))

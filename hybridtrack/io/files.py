@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import gzip
 import io
-import os
 import zipfile
 from pathlib import Path
 
+from .. import params
 from ..errors import HybridtrackError
 
 __all__ = ["input_path", "read_bytes", "unpack", "decode", "file_text", "read_text", "read_toml", "write_toml", "WEATHER_SUFFIXES"]
@@ -23,13 +23,8 @@ WEATHER_SUFFIXES = (".epw", ".csv", ".tm2", ".tmy", ".dat", ".tsv", ".txt")
 
 
 def input_path(value, what: str = "file") -> Path:
-    """`value` as a Path to read: a leading ``~`` is the user's home, as the shell and pandas read
-    it; anything that is no path (None, a number, a name holding a NUL) is refused by name."""
-    if isinstance(value, bytes):
-        value = os.fsdecode(value)
-    if not isinstance(value, (str, os.PathLike)) or not str(os.fspath(value)).strip() or "\0" in str(os.fspath(value)):
-        raise HybridtrackError(f"a {what} must be a path, got {value!r:.80}")
-    return Path(os.path.expanduser(os.fspath(value)))
+    """`value` as a Path to read (`params.path`: ``~`` expanded; no NUL, nothing empty)."""
+    return params.path(value, f"a {what}")
 
 
 def read_bytes(path: Path, what: str = "file") -> bytes:

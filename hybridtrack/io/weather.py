@@ -71,7 +71,7 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
     if "date" in mapping:
         text = pd.Series(cells(mapping["date"])).str.strip() + " " + pd.Series(cells(mapping["clock"])).str.strip()
         header = f"{mapping['date']} + {mapping['clock']}"
-        zone = CLOCK_ZONES.get(split_header(mapping["clock"])[0])
+        zone = _zone_in_name(mapping["clock"])
         written = mapping["date"].lower().replace(" ", "")  # 'DATE (MM/DD/YYYY)' says its order
         if dayfirst is None and ("mm/dd" in written or "dd/mm" in written):
             dayfirst = "dd/mm" in written
@@ -119,11 +119,11 @@ def _missing_markers(table: Table, name: str, values: np.ndarray, report: dict) 
 
 
 def _zone_in_name(header: str) -> str | None:
-    """The UTC offset a time column's name gives (``time_utc``, ``UTC``, ``Time (UTC)``, ``GMT``),
-    as a clock column's does: such stamps had been read as the site's local time."""
+    """The UTC offset a time or clock column's name gives (`CLOCK_ZONES`: MIDC's ``MST``,
+    ``time_utc``, ``Time (UTC)``): a time column so named had been read as the site's local time."""
     name, _, note = split_header(header)
-    words = set(re.split(r"[\s_/-]+", name)) | {word.lower() for word in re.split(r"[\s;]+", note or "")}
-    return next((CLOCK_ZONES[word] for word in ("utc", "gmt") if word in words), None)
+    words = [name, *re.split(r"[\s_/-]+", name), *(word.lower() for word in re.split(r"[\s;]+", note or ""))]
+    return next((CLOCK_ZONES[word] for word in words if word in CLOCK_ZONES), None)
 
 
 def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
