@@ -33,9 +33,10 @@ __all__ = ["commission", "warm_memory", "clear_day"]
 def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy: str, days_before: float,
               classifier=None):
     """The run of `strategy` over a clear day at `site`, `days_before` local days before `start`,
-    with the controller's clock as it was then."""
+    with the controller's clock as it was then, tracked but not scored (`simulation.Tracked`: only
+    its memory is wanted)."""
     from .reuse import apart
-    from .simulation import simulate
+    from .simulation import track
     from .sky import synthetic
 
     day = _day_before(start.tz_convert(site.tz), days_before)
@@ -44,7 +45,7 @@ def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy:
     setup = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy),
                                 imperfections=dataclasses.replace(config.imperfections, commissioned_days_ago=age))
     with apart():  # the day's frame is this run's own: nothing of it is another run's to share
-        return simulate(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
+        return track(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
 
 
 def _day_before(start: pd.Timestamp, days: float) -> dt.date:
@@ -77,11 +78,11 @@ def commission(site, collector: Collector, config, start: pd.Timestamp, *, class
     """
     days = max(config.imperfections.commissioned_days_ago, 1.0)
     run = clear_day(site, collector, config, start, "hybrid-always", days, classifier)
-    return MountEstimate.from_parameters(parameter_names(collector), run.memory["theta"])
+    return MountEstimate.from_parameters(parameter_names(collector), run.memory()["theta"])
 
 
 def warm_memory(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> dict:
     """What the run's own strategy carries out of the clear day before (`Controller.memory`): its
     mount fit and offsets. Not the clock watch's readings: the run's watch starts afresh."""
-    memory = clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier).memory
+    memory = clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier).memory()
     return {key: value for key, value in memory.items() if key != "clock"}

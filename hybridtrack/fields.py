@@ -838,18 +838,24 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
     every run of the block asks for are computed once (`hybridtrack.reuse.reuse_work`)."""
     from .metrics import offered_light
     from .reuse import reuse_work
-    from .simulation import one_thread, simulate
+    from .simulation import _scored, one_thread, track
 
     done = []
     with reuse_work(), one_thread():  # the field spreads its runs over the cores itself
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
-            result = simulate(frame, site, collector=collector, strategy=strategy, config=run_config)
-            offered = offered_light(result.log["dni"], result.scoring["sun_up"], result.scoring["incidence"])
-            row = {**dataclasses.asdict(imperfect), **_metrics(result.summary),
-                   "offered": _energy(offered, frame.index)}
-            done.append((i, row, result.events.assign(collector=name), _kept(result.log) if keep_log else None))
+            run = track(frame, site, collector=collector, strategy=strategy, config=run_config)
+            if keep_log:  # the whole result, for its log
+                result = _scored(run)
+                scores, events, log = result.summary, result.events, _kept(result.log)
+            else:  # the scores alone: no log, no sky as the classifier saw it (`Tracked.scores`)
+                events = run.events()
+                scores, log = run.scores(events), None
+            scoring = run.scoring()
+            offered = offered_light(run.world.frame_dni, scoring["sun_up"], scoring["incidence"])
+            row = {**dataclasses.asdict(imperfect), **_metrics(scores), "offered": _energy(offered, frame.index)}
+            done.append((i, row, events.assign(collector=name), log))
     return done
 
 

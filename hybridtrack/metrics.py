@@ -29,7 +29,7 @@ import pandas as pd
 
 from . import params
 
-__all__ = ["summarize", "RunningSummary", "offered_light", "daily", "shares", "share_counts", "event_counts", "moved_axes",
+__all__ = ["summarize", "score", "RunningSummary", "offered_light", "daily", "shares", "share_counts", "event_counts", "moved_axes",
            "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
 
 TRACKING_MODES = ("sensor", "astronomical", "search")
@@ -176,29 +176,52 @@ def _rounded(value, digits: int = 5):
 def summarize(log: pd.DataFrame, *, site: str, collector: str, strategy: str, moves: int, travel: float,
               events: pd.DataFrame, sun_up: np.ndarray, incidence: np.ndarray) -> dict:
     """The summary of a run (the keys of ``summary.json``); every count and share is defined here."""
+    scored = score(log, collector=collector, moves=moves, travel=travel, events=events, sun_up=sun_up,
+                   incidence=incidence)
+    return _compose(site=site, collector=collector, strategy=strategy, steps=len(log), start=log.index[0],
+                    end=log.index[-1], scores=scored, shares=shares(log, sun_up))
+
+
+def score(log: pd.DataFrame, *, collector: str, moves: int, travel: float, events: pd.DataFrame,
+          sun_up: np.ndarray, incidence: np.ndarray) -> dict:
+    """The summary's scores of a run, without its mode and sky shares: its pointing error
+    (``tracking_error_deg``, ``within_0_5_deg``), ``energy_capture``, ``moves``, ``travel_deg``
+    and its `event_counts`. The log needs only its ``dni``, ``error``, ``mode`` and angle columns
+    (a field's collector that keeps no log is scored from those alone)."""
     steps = _steps(log, collector, sun_up, incidence)
     stats, within = _error_stats(steps)
-    return _compose(site=site, collector=collector, strategy=strategy, steps=len(log), start=log.index[0],
-                    end=log.index[-1], stats=stats, within=within, captured=float(steps["captured"].sum()),
-                    offered=float(steps["offered"].sum()), moves=moves, travel=travel,
-                    shares=shares(log, sun_up), events=event_counts(events))
+    return {**_scores(stats=stats, within=within, captured=float(steps["captured"].sum()),
+                      offered=float(steps["offered"].sum()), moves=moves, travel=travel),
+            **event_counts(events)}
 
 
-def _compose(*, site, collector, strategy, steps, start, end, stats, within, captured, offered, moves, travel,
-             shares, events) -> dict:
-    """The summary's keys, in order, from its parts (`summarize` and `RunningSummary` both)."""
-    mode_share, sky_share = shares
+def _scores(*, stats, within, captured, offered, moves, travel) -> dict:
+    """The error, energy and drive keys of a summary, rounded as it gives them."""
     return {
-        "site": site, "collector": collector, "strategy": strategy, "steps": int(steps),
-        "start": start.isoformat(), "end": end.isoformat(),
         "tracking_error_deg": {k: _rounded(v) for k, v in stats.items()},
         "within_0_5_deg": _rounded(within),
         "energy_capture": round(float(captured / offered), 5) if offered > 0 else None,
         "moves": int(moves), "travel_deg": round(float(travel), 3),
+    }
+
+
+def _compose(*, site, collector, strategy, steps, start, end, scores, shares) -> dict:
+    """The summary's keys, in order, from its parts (`summarize` and `RunningSummary` both): the
+    run's scores (`score`; its event counts last) and its shares."""
+    mode_share, sky_share = shares
+    events = {k: v for k, v in scores.items() if k not in _SCORE_KEYS}
+    return {
+        "site": site, "collector": collector, "strategy": strategy, "steps": int(steps),
+        "start": start.isoformat(), "end": end.isoformat(),
+        **{k: scores[k] for k in _SCORE_KEYS},
         "share_base": "every step of the run; sky 'night' while the true sun is down",
         "mode_share": mode_share, "sky_share": sky_share,
         **events,
     }
+
+
+#: The keys of `_scores`, in the summary's order.
+_SCORE_KEYS = ("tracking_error_deg", "within_0_5_deg", "energy_capture", "moves", "travel_deg")
 
 
 #: Degrees: the width of `RunningSummary`'s error histogram bins (its p95 is within half of it).
@@ -290,10 +313,11 @@ class RunningSummary:
         if self.start is None:
             raise ValueError("no part of the run has been added")
         stats, within = _error_from_sums(self.sums, self.p95())
+        scores = {**_scores(stats=stats, within=within, captured=self.captured, offered=self.offered,
+                            moves=self.moves, travel=self.travel), **self.events}
         return _compose(site=self.site, collector=self.collector, strategy=self.strategy, steps=self.steps,
-                        start=self.start, end=self.end, stats=stats, within=within, captured=self.captured,
-                        offered=self.offered, moves=self.moves, travel=self.travel,
-                        shares=_shares_from_counts(self.modes, self.sky, self.steps), events=self.events)
+                        start=self.start, end=self.end, scores=scores,
+                        shares=_shares_from_counts(self.modes, self.sky, self.steps))
 
 
 def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidence: np.ndarray) -> pd.DataFrame:

@@ -36,7 +36,7 @@ from .outputs import claim, output_folder, removing_empty_folders, strict_json, 
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
-from .metrics import summarize
+from .metrics import score, summarize
 from .mountreport import FIT_PREFIX
 from .sensor import SensorModel
 from .sky import LIGHT_AT_NIGHT
@@ -428,6 +428,88 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     -------
     Result
     """
+    return _scored(track(frame, site, collector=collector, strategy=strategy, config=config, classifier=classifier,
+                         faults=faults, progress=progress, bulk_nights=bulk_nights, warm_start=warm_start))
+
+
+@dataclass
+class Tracked:
+    """A run tracked but not yet scored: what `simulate` builds its `Result` from, and what a
+    caller that needs less than a `Result` takes instead (a field's collector kept without its log:
+    `scores`; a warm start's clear day: `memory`).
+
+    Attributes
+    ----------
+    index : pandas.DatetimeIndex
+        The frame's stamps.
+    site : Site
+    told : Site
+        The site as the installer told the controller.
+    collector : Collector
+    config : SimulationConfig
+        With the run's strategy.
+    world : World
+    controller : Controller
+    out : ControllerOutputs
+    incidence : numpy.ndarray
+        The cosine of incidence on a perfectly tracking aperture, per step.
+    mount : MountEstimate or None
+        The commissioned mount (``astronomical-commissioned``).
+    classifier : FuzzyWeatherClassifier
+    clear : pandas.DataFrame or None
+        The clear sky the controller expects at each scan (None where it expects none).
+    frame : pandas.DataFrame
+    """
+
+    index: pd.DatetimeIndex
+    site: sites.Site
+    told: sites.Site
+    collector: Collector
+    config: SimulationConfig
+    world: World
+    controller: Controller
+    out: object
+    incidence: np.ndarray
+    mount: MountEstimate | None
+    classifier: FuzzyWeatherClassifier
+    clear: pd.DataFrame | None
+    frame: pd.DataFrame = field(repr=False)
+
+    def scoring(self) -> dict:
+        """The summary's inputs that are not in the log (`Result.scoring`)."""
+        return {"sun_up": self.world.altitude > 0, "incidence": self.incidence, "moves": int(self.out.moves.sum()),
+                "travel": float(self.out.travel.sum())}
+
+    def events(self) -> pd.DataFrame:
+        """The controller's events, stamped by their scan's time."""
+        return _events_frame(self.index, self.out.events)
+
+    def memory(self) -> dict:
+        """What the controller carries into a next run (`Result.memory`)."""
+        memory = self.controller.carry(self.index[0])
+        if self.config.controller.strategy == "astronomical-commissioned":
+            memory["commissioned"] = self.mount
+        return memory
+
+    def scores(self, events: pd.DataFrame) -> dict:
+        """The summary's scores (`hybridtrack.metrics.score`) without building the log: from the
+        pointing error, the modes, the DNI and the angles alone."""
+        angle = self.world.angles
+        columns = {"dni": self.world.frame_dni, "error": _pointing_error(self.collector, self.world),
+                   "mode": pd.Categorical.from_codes(self.out.mode, categories=list(MODES)), "angle": angle[-1]}
+        if not self.collector.single_axis:
+            columns["angle_azimuth"] = angle[0] % 360.0
+        log = pd.DataFrame(columns, index=self.index, copy=False)
+        scoring = self.scoring()
+        return score(log, collector=self.collector.kind, events=events, **scoring)
+
+
+def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
+          config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
+          faults: dict | None = None, progress=None, bulk_nights: bool = True,
+          warm_start: bool | dict = True) -> Tracked:
+    """`simulate`'s run without its scoring: the world and the controller stepped over the frame.
+    Takes `simulate`'s arguments; returns a `Tracked`."""
     config = checked_config(config)
     if progress is not None and not callable(progress):  # it is called with each count of steps done
         raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
@@ -471,21 +553,26 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
 
     # the compiled loop lets go of Python's lock, so the scoring's geometry is done beside it
     out, incidence = _side_by_side(run_scans, score_ahead, len(frame) if compiled else 0, cancel=stop.set)
-    index = frame.index
-    log = _log(index, collector, world, out, _sky_seen(out.intensity, index, clf, config, clear, told))
-    events = _events_frame(index, out.events)
-    scoring = {"sun_up": world.altitude > 0, "incidence": incidence, "moves": int(out.moves.sum()),
-               "travel": float(out.travel.sum())}
-    summary = summarize(log, site=site.name, collector=collector.kind, strategy=config.controller.strategy,
+    return Tracked(frame.index, site, told, collector, config, world, controller, out, incidence, mount, clf, clear,
+                   frame)
+
+
+def _scored(run: Tracked) -> Result:
+    """The `Result` of a tracked run: its log, summary and events."""
+    index, out, config, collector, controller = run.index, run.out, run.config, run.collector, run.controller
+    sky = _sky_seen(out.intensity, index, run.classifier, config, run.clear, run.told)
+    log = _log(index, collector, run.world, out, sky)
+    events = run.events()
+    scoring = run.scoring()
+    summary = summarize(log, site=run.site.name, collector=collector.kind, strategy=config.controller.strategy,
                         events=events, **scoring)
-    summary["calibration"] = _calibration_summary(mount, controller.fitted_mount(), out, collector)
+    summary["calibration"] = _calibration_summary(run.mount, controller.fitted_mount(), out, collector)
     summary["clock"] = controller.clock.state() if controller.clock is not None else None
-    summary["wind_data"] = _wind_data(frame)
-    summary["day_cycle"] = _day_cycle(events, site)
-    memory = controller.carry(index[0])
-    if config.controller.strategy == "astronomical-commissioned":
-        memory["commissioned"] = mount
-    return Result(log, summary, events, site, collector, config, memory, scoring)
+    summary["wind_data"] = _wind_data(run.frame)
+    summary["day_cycle"] = _day_cycle(events, run.site)
+    return Result(log, summary, events, run.site, collector, config, run.memory(), scoring)
+
+
 
 
 def _check_run_options(classifier, bulk_nights, warm_start) -> None:
@@ -793,22 +880,28 @@ def _sky_categorical(codes: np.ndarray, names: tuple[str, ...]) -> pd.Categorica
     return pd.Categorical.from_codes(recode[codes], categories=list(SKY_CODES))
 
 
+def _pointing_error(collector: Collector, world: World) -> np.ndarray:
+    """The pointing error at each scan (degrees): a single axis' angle less its true target; a
+    heliostat's angle between its actual and its required mirror normal."""
+    from .collectors import sun_vector
+
+    truth, angle = world.truth, world.angles.T
+    if collector.single_axis:
+        return angle[:, 0] - truth[:, 0]
+    actual = sun_vector(angle[:, 1], angle[:, 0])
+    wanted = sun_vector(truth[:, 1], truth[:, 0])
+    return np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
+
+
 def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> pd.DataFrame:
     """The run's log, one row a scan. Its columns are taken as they are, not copied into one
     block (a heliostat's 26 columns over a year took 0.06 s to copy): every array is the run's
     own, and those read from a frame (which pandas hands out read-only) are copied, so an edit of
     the log works and edits nothing else."""
-    from .collectors import sun_vector
-
     truth = world.truth
     angle = world.angles.T
     main = 0 if collector.single_axis else 1  # a heliostat's main columns are its elevation axis
-    if collector.single_axis:
-        error = angle[:, 0] - truth[:, 0]
-    else:  # the angle between the actual and the required mirror normal
-        actual = sun_vector(angle[:, 1], angle[:, 0])
-        wanted = sun_vector(truth[:, 1], truth[:, 0])
-        error = np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
+    error = _pointing_error(collector, world)
     columns = {
         "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": angle[:, main].copy(),
         "error": error, "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)),

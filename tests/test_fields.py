@@ -173,6 +173,22 @@ def test_a_field_run_is_each_collectors_own_run(day):
     assert len(result.events) > 0 and set(result.events["collector"]) == set(field.names)
 
 
+@pytest.mark.parametrize("field, strategy", [
+    (FresnelField(row_distances=[-4.0, 6.0]), None), (TroughLoop(count=2), "astronomical-commissioned"),
+    (HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0]]), "hybrid"),
+])
+def test_a_field_without_its_log_scores_each_collector_as_its_whole_result_does(day, field, strategy):
+    # keep_log=False scores from the pointing error, modes and angles alone (`Tracked.scores`),
+    # without the log and the sky as the classifier saw it: the reference is the whole `Result`
+    gusty = day.assign(wind_speed=np.where(np.arange(len(day)) % 300 < 20, 25.0, 3.0))  # wind stows too
+    whole = simulate_field(gusty, "lanzhou", field, strategy=strategy, seed=5, keep_log=True)
+    lean = simulate_field(gusty, "lanzhou", field, strategy=strategy, seed=5, keep_log=False)
+    pd.testing.assert_frame_equal(lean.collectors, whole.collectors)
+    pd.testing.assert_frame_equal(lean.events, whole.events)
+    assert lean.summary == whole.summary
+    assert whole.collectors["stow_events"].gt(0).all() and whole.collectors["rms"].gt(0).all()
+
+
 @pytest.mark.parametrize("field, computed", [
     (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (4, 1)),  # pointing (world, plan), incidence, the
     # field's end loss; derivatives
