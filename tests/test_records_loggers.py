@@ -159,6 +159,36 @@ def test_thousands_grouped_by_dots_beside_a_decimal_comma_are_read(tmp_path, day
     assert day["ghi"].max() >= 1000 and "unreadable" not in frame.attrs["validation"]
 
 
+def test_thousands_grouped_by_dots_in_a_whole_numbered_file_are_read(tmp_path, day):
+    """'1.063' beside '998' (German Excel, whole W/m², no decimal comma anywhere) had been read as
+    1.063 W/m²: a clear noon read as night, without a word."""
+    def german(value):
+        return f"{int(round(value)):,}".replace(",", ".")
+
+    rows = [f"{t};{german(g)};{german(n)};{german(d)}" for t, (g, n, d) in
+            zip(day.index.strftime("%d.%m.%Y %H:%M"), day.to_numpy())]
+    (tmp_path / "de.csv").write_text("Datum;GHI;DNI;DHI\n" + "\n".join(rows) + "\n")
+    frame = read_weather(tmp_path / "de.csv", site="lanzhou")
+    np.testing.assert_allclose(frame["ghi"].to_numpy(), day["ghi"].to_numpy(), atol=0.5)
+    grouped = int((day[["ghi", "dni", "dhi"]].round() >= 1000).to_numpy().sum())
+    assert grouped > 0 and sum(frame.attrs["validation"]["thousands_values"].values()) == grouped
+    assert "'.' in" in frame.attrs["validation"]["thousands"]
+
+
+@pytest.mark.parametrize("cells", [
+    ["850.000", "998.000", "1.003"],  # three decimals everywhere: decimals, not groups
+    ["850", "998", "1.5", "1.063"],  # a decimal beside the whole values
+    ["0.850", "1", "1.063"],  # kW/m²: nothing whole is bright
+])
+def test_dots_that_may_be_decimals_stay_decimals(cells):
+    from hybridtrack.io.weather import _thousands_by_dots
+
+    values = np.array(cells, float)
+    report = {}
+    np.testing.assert_array_equal(_thousands_by_dots(cells, values, "dni", report), values)
+    assert report == {}
+
+
 def test_a_stamp_of_24_00_ends_its_day(tmp_path, day):
     """'21.06.2021 24:00', as many European hourly files close a day, had been refused as no time stamp."""
     hourly = day.iloc[6::6]  # 01:00 to 23:00

@@ -40,6 +40,12 @@ _GROUPED = re.compile(r"[-+]?\d{1,3}(\.\d{3})+(,\d*)?")
 def _numbers(path: Path, table: Table, header: str, column: list[str], decimal: str, strict: bool,
              report: dict, name: str) -> np.ndarray:
     """A column's text as floats; a few unreadable cells become NaN (counted), many are refused."""
+    values = _read_numbers(path, table, header, column, decimal, strict, report, name)
+    return _thousands_by_dots(column, values, name, report) if decimal == "." and name in IRRADIANCE else values
+
+
+def _read_numbers(path: Path, table: Table, header: str, column: list[str], decimal: str, strict: bool,
+                  report: dict, name: str) -> np.ndarray:
     if decimal == ".":
         try:  # the common case, fast: every cell a number ('nan', 'inf' and '1e400' included)
             return np.array(column, dtype=float)
@@ -65,6 +71,36 @@ def _numbers(path: Path, table: Table, header: str, column: list[str], decimal: 
                                                      "lines": [int(v) for v in table.lines[bad][:5]],
                                                      "first": str(column[row]), "action": "set to NaN"}
     return values.to_numpy(float)
+
+
+#: Irradiance (W/m²) a logger writes whole that shows the sun well up: a column whose other
+#: values are whole reaches it before its values pass 1000 W/m².
+WHOLE_BRIGHT = 500.0
+#: A cell whose dot groups thousands, a dot-decimal file's reading: ``1.063``, ``1.000``.
+_DOT_GROUPED = re.compile(r"\+?\d{1,3}(\.\d{3})+")
+
+
+def _thousands_by_dots(column: list[str], values: np.ndarray, name: str, report: dict) -> np.ndarray:
+    """An irradiance column written whole with its thousands grouped by dots (German Excel's
+    ``1.063`` beside ``998``), read as the thousands it means; any other column as it is.
+
+    With no decimal comma in the file, such a dot cannot be told from a decimal point by itself;
+    the column tells: values written without a dot reach `WHOLE_BRIGHT` W/m² (the sun well up,
+    so 1,000 W/m² is a noon's reading), and every value written with a dot looks grouped
+    (``d.ddd``). A column of decimals (``850.2``, ``850.000``, kW/m²'s ``0.850``) is left."""
+    dotted = np.fromiter(("." in cell for cell in column), bool, len(column))
+    if not dotted.any() or not (values[~dotted] >= WHOLE_BRIGHT).any():
+        return values
+    rows = np.flatnonzero(dotted)
+    text = [column[i].strip() for i in rows]
+    if not all(_DOT_GROUPED.fullmatch(cell) for cell in text):
+        return values
+    values = values.copy()
+    values[rows] = [float(cell.replace(".", "")) for cell in text]
+    counts = report.setdefault("thousands_values", {})
+    counts[name] = len(rows)
+    report["thousands"] = f"'.' in {sum(counts.values()):,} values of {', '.join(counts)} (every other value whole)"
+    return values
 
 
 def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, report):
