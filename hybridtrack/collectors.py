@@ -338,10 +338,18 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
 
 
 def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
-    """Azimuth (from north, 0-360) and elevation of unit normals ``(..., 3)``, degrees, shape ``(...)``."""
+    """Azimuth (from north, 0-360) and elevation of normals ``(..., 3)``, degrees, shape ``(...)``.
+
+    The normals need not be unit vectors: the elevation is the angle above the horizontal plane
+    (``arctan2(up, horizontal length)``), so a normal of any length gives its direction's angles
+    (the arcsine of ``up`` alone had given 90° for ``(0, 3, 2)``), and a normal near the zenith
+    keeps its precision. A zero vector has no direction and is refused."""
     n = _vectors("normal_angles", normals, "normals")
+    horizontal = np.hypot(n[..., 0], n[..., 1])
+    if np.any((horizontal == 0.0) & (n[..., 2] == 0.0)):
+        raise HybridtrackError("normal_angles: a zero vector has no direction")
     azimuth = np.degrees(np.arctan2(n[..., 0], n[..., 1])) % 360.0
-    elevation = np.degrees(np.arcsin(np.clip(n[..., 2], -1.0, 1.0)))
+    elevation = np.degrees(np.arctan2(n[..., 2], horizontal))
     return azimuth, elevation
 
 

@@ -208,3 +208,13 @@ def test_a_heliostats_aim_that_is_no_point_is_refused_and_a_list_or_array_is_kep
 def test_vectors_and_paths_that_are_no_such_thing_are_refused_by_name(call, message):
     with pytest.raises(HybridtrackError, match=message):
         call()
+
+
+def test_normal_angles_take_a_normal_of_any_length_and_refuse_none():
+    """The arcsine of the up component alone read (0, 3, 2) as 90° elevation; its direction is
+    atan(2/3) = 33.69° above north's horizon (hand-computed), and ten times it is the same."""
+    azimuth, elevation = normal_angles([[0.0, 3.0, 2.0], [0.0, 30.0, 20.0], [-1.0, 0.0, -1.0]])
+    np.testing.assert_allclose(elevation, [33.690067525979785, 33.690067525979785, -45.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(azimuth, [0.0, 0.0, 270.0], atol=1e-12)
+    with pytest.raises(HybridtrackError, match="zero vector"):
+        normal_angles([0.0, 0.0, 0.0])
