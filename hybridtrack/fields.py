@@ -336,6 +336,10 @@ class TroughLoop:
         object.__setattr__(self, "collector_length",
                            _finite_number(self.collector_length, "collector length", positive=True))
         object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
+        if (self.count - 1) * self.collector_length > MAX_DISTANCE:  # each length was bounded, not the line
+            raise HybridtrackError(f"trough loop: {self.count} collectors of {self.collector_length:g} m reach "
+                                   f"{(self.count - 1) * self.collector_length:g} m along the axis, beyond "
+                                   f"{MAX_DISTANCE:g} m")
 
     @property
     def kind(self) -> str:

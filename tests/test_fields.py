@@ -126,6 +126,8 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     (lambda: FresnelField(spread=None), "FresnelField: spread must be an ImperfectionSpread, got NoneType"),
     (lambda: TroughLoop(spread={"encoder_offset": 0.1}), "TroughLoop: spread must be an ImperfectionSpread"),
     (lambda: HeliostatField(spread=0.2), "HeliostatField: spread must be an ImperfectionSpread, got float"),
+    # each length was bounded, the line was not: 100,000 collectors had reached 100,000 km
+    (lambda: TroughLoop(count=100_000, collector_length=1000.0), "reach 9.9999e\\+07 m along the axis, beyond 5000 m"),
 ])
 def test_bad_fields_are_refused_with_what_is_wrong(make, message):
     with pytest.raises(HybridtrackError, match=message):
