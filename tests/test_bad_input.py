@@ -476,3 +476,22 @@ def test_an_earlier_runs_memory_is_still_taken_whole():
     for strategy in ("hybrid", "astronomical-commissioned"):
         memory = simulate(day, "lanzhou", strategy=strategy).memory
         assert simulate(day, "lanzhou", strategy=strategy, warm_start=memory).summary["steps"] == len(day)
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["sun", "--site", "lanzhou", "--date", "2021-06-21", "--site=nanjing"], "--site"),
+    (["simulate", "--site", "lanzhou", "--start", "2021-06-21", "--seed", "1", "--seed", "2"], "--seed"),
+    (["ablate", "--sites", "lanzhou", "--sites", "nanjing"], "--sites"),
+])
+def test_an_option_that_takes_one_value_is_refused_when_given_twice(capsys, argv, option):
+    # argparse keeps the last: the run had gone to Nanjing, or run seed 2, without a word
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and f"{option} is given twice" in err and "give it once" in err
+
+
+def test_options_that_add_up_may_be_repeated(tmp_path):
+    path = tmp_path / "w.csv"
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
+    day[["ghi", "dni", "dhi"]].rename(columns={"ghi": "G", "dni": "B"}).to_csv(path, index_label="time")
+    assert main(["check", str(path), "--site", "lanzhou", "--map", "ghi=G", "--map", "dni=B"]) == 0

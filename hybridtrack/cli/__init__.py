@@ -31,9 +31,28 @@ from .base import _COMMANDS, _HELP, EXIT_TERMINATED, EXIT_USAGE
 __all__ = ["main", "build_parser", "EXIT_USAGE"]
 
 
+class _StoreOnce(argparse._StoreAction):
+    """argparse's store, refusing an option given twice: argparse keeps the last, so ``--site
+    lanzhou ... --site nanjing`` (an edited command line, a script's default then the user's) ran
+    Nanjing without a word. Options that add up (``--map``, ``--spread``) append instead."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = namespace.__dict__.setdefault("_options_given", {})
+        if option_string is not None and self.dest in given:
+            parser.error(f"{option_string} is given twice ({given[self.dest]!r}, then {values!r}); give it once")
+        given[self.dest] = values
+        super().__call__(parser, namespace, values, option_string)
+
+
 class OneLineParser(argparse.ArgumentParser):
     """argparse's parser, whose refusals are one line (``hybridtrack: error: ...``) and status 2,
-    like every other refusal, instead of the usage block and the error."""
+    like every other refusal, instead of the usage block and the error; an option that takes one
+    value is refused when given twice (`_StoreOnce`)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
 
     def error(self, message: str):
         command = f"{self.prog}: " if " " in self.prog else ""  # the top parser's name is the error's prefix already
