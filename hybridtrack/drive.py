@@ -81,11 +81,13 @@ class Drive:
         object.__setattr__(self, "limits", angle_pair(self.limits, "drive: limits (degrees)", *LIMIT_RANGE))
         if self.limits[1] - self.limits[0] > MAX_TRAVEL:
             raise HybridtrackError(f"drive: limits {list(self.limits)} span more than {MAX_TRAVEL:g}° (two turns)")
-        number(self.deadband, "drive: deadband (degrees)", 0, 10)
+        # kept as Python's numbers: numpy's are taken, and TOML cannot write them
+        object.__setattr__(self, "deadband", number(self.deadband, "drive: deadband (degrees)", 0, 10))
         for name in ("speed", "stow_speed"):
-            number(getattr(self, name), f"drive: {name} (degrees per minute)", 0, MAX_SPEED, above=True)
-        number(self.stow, "drive: stow (degrees)", *self.limits)
-        whole(self.encoder_bits, "drive: encoder_bits", 8, 24)
+            object.__setattr__(self, name, number(getattr(self, name), f"drive: {name} (degrees per minute)", 0,
+                                                  MAX_SPEED, above=True))
+        object.__setattr__(self, "stow", number(self.stow, "drive: stow (degrees)", *self.limits))
+        object.__setattr__(self, "encoder_bits", whole(self.encoder_bits, "drive: encoder_bits", 8, 24))
 
     @property
     def resolution(self) -> float:

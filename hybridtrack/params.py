@@ -46,11 +46,21 @@ def number(value, name: str, low: float = -math.inf, high: float = math.inf, *, 
     -------
     float
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-        raise HybridtrackError(f"{name} must be a finite number within {_range(low, high, above)}, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not _finite(value):
+        raise HybridtrackError(f"{name} must be a finite number within {_range(low, high, above)}, got "
+                               f"{value!r:.60}")
     if value < low or value > high or (above and value == low):
         raise HybridtrackError(f"{name} = {value!r} is outside {_range(low, high, above)}")
     return float(value)
+
+
+def _finite(value: numbers.Real) -> bool:
+    """Whether `value` is a finite float: an integer past any float (10**400) is not, where
+    `math.isfinite` raised OverflowError."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 def whole(value, name: str, least: int = 0, most: int = 10_000) -> int:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextvars
 import dataclasses
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -58,6 +58,29 @@ FAULTS = {
 #: The largest size of each numeric fault: a turn of degrees, a year of seconds (a larger clock
 #: offset is no fault a tracker could meet, and beyond it pandas' time arithmetic overflows).
 FAULT_LIMITS = {"sensor": 360.0, "sensor_drift": 360.0, "encoder": 360.0, "clock": 365.0 * 86_400.0}
+
+#: The fields of a run config's parts that a run does not read, with what it reads instead: they
+#: must stay at their defaults (`_refuse_unread`).
+UNREAD = {
+    ("sensor", "bias"): "imperfections.sensor_bias, the installed sensor's bias",
+    ("sensor", "noise"): "imperfections.sensor_noise, the installed sensor's noise",
+    ("sensor", "window"): "sky.window, the controller's variation window",
+    ("heliostat_drive", "limits"): "nothing: a heliostat's azimuth axis turns from -180 to 540 degrees and stows "
+                                   "at 180, its elevation axis from 0 to 90, stowed at 90",
+    ("heliostat_drive", "stow"): "nothing: a heliostat stows its azimuth axis at 180 degrees and its elevation "
+                                 "axis at 90",
+}
+
+
+def _refuse_unread(config) -> None:
+    """Refuse a field of `UNREAD` set to other than its default: a user who set ``[sensor] bias``
+    or ``[heliostat_drive] stow`` (or swept ``sensor.window``) got the default's results without a
+    word. The message says what the run reads instead."""
+    for (part, name), instead in UNREAD.items():
+        value, default = getattr(getattr(config, part), name), getattr(_DEFAULT_PARTS[part](), name)
+        if value != default:
+            raise HybridtrackError(f"config: {part}.{name} = {value!r} is not read by a run; it reads {instead}")
+
 
 LOG_COLUMNS = ("target_true", "target", "angle", "error", "mode", "sky", "sky_score", "sensor_valid",
                "sensor_status", "intensity_ma", "variation_ma", "wind_speed", "dni", "calibration")
@@ -108,11 +131,17 @@ class SimulationConfig:
     engine: str = "auto"
 
     def __post_init__(self) -> None:
+        for part in dataclasses.fields(self):  # a str or a dict had been taken, to fail deep in the run
+            kind = _PART_KINDS.get(part.name)
+            if kind is not None and not isinstance(getattr(self, part.name), kind):
+                raise HybridtrackError(f"config: {part.name} must be a {kind.__name__}, got "
+                                       f"{type(getattr(self, part.name)).__name__}")
         if self.truth not in ("spa-fast", "spa"):
             raise HybridtrackError(f"truth {self.truth!r}: choose 'spa-fast' or 'spa'")
-        params.seed(self.seed, "seed")
+        object.__setattr__(self, "seed", params.seed(self.seed, "seed"))  # numpy's int too; TOML writes int
         if self.engine not in ENGINES:
             raise HybridtrackError(f"engine {self.engine!r}: choose {', '.join(map(repr, ENGINES))}")
+        _refuse_unread(self)
 
     def to_dict(self) -> dict:
         """A plain dict in the TOML layout."""
@@ -128,6 +157,8 @@ class SimulationConfig:
     @classmethod
     def from_dict(cls, data, *, source: str = "config") -> SimulationConfig:
         """Build from the TOML layout; unknown keys and wrong types are refused with their key."""
+        if not isinstance(data, Mapping):
+            raise HybridtrackError(f"{source}: a run config must be a table (a dict), got {type(data).__name__}")
         def build(default, values, where):
             kind = type(default)
             if not isinstance(values, dict):
@@ -184,6 +215,14 @@ class SimulationConfig:
         from .io import write_toml
 
         return write_toml(self.to_dict(), path)
+
+
+#: The kind each part of a `SimulationConfig` must be.
+_PART_KINDS = {"controller": ControllerConfig, "imperfections": Imperfections, "sensor": SensorModel, "drive": Drive,
+               "heliostat_drive": Drive, "sky": SkyInputConfig}
+#: Each part's default, by the part's name.
+_DEFAULT_PARTS = {f.name: f.default_factory for f in dataclasses.fields(SimulationConfig)
+                  if f.default_factory is not dataclasses.MISSING}
 
 
 @dataclass

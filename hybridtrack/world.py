@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -35,6 +36,7 @@ from .control.modes import UNKNOWN, sky_code
 from .control.observation import Observation
 from .drive import Drive, encoder_reading
 from .errors import HybridtrackError
+from .params import _finite
 from .mounting import (geometry_key, heliostat_sun, incidence_cosine, mount_targets, mounting_rotation,
                        pointing_vectors)
 from .reuse import Same, shared
@@ -103,12 +105,13 @@ class Imperfections:
 
     def __post_init__(self) -> None:
         limits = IMPERFECTION_LIMITS
-        for f in fields(self):
+        for f in fields(self):  # numpy's numbers too, kept as floats (a float32 had been refused)
             value = getattr(self, f.name)
-            if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
-                raise HybridtrackError(f"imperfections: {f.name} must be a number, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not _finite(value):
+                raise HybridtrackError(f"imperfections: {f.name} must be a number, got {value!r:.60}")
             if abs(value) > limits[f.name]:
                 raise HybridtrackError(f"imperfections: {f.name} = {value} is beyond ±{limits[f.name]:g}")
+            object.__setattr__(self, f.name, float(value))
         if self.sensor_noise < 0 or self.commissioned_days_ago < 0:
             raise HybridtrackError("imperfections: sensor_noise and commissioned_days_ago must not be negative")
 

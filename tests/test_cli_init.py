@@ -22,6 +22,9 @@ def test_init_writes_a_run_config_a_fuzzy_config_and_a_rule_table_that_load(tmp_
         assert case.config_path == str((folder / "fuzzy.toml").resolve())
         case.check()
     assert read_toml(folder / "run.toml")["controller"]["wind_stow"] == 17.2
+    # the keys a run does not read say so where a user would edit them
+    assert "# Not read by a run (leave it as it is); a run reads imperfections.sensor_bias" in run
+    assert run.count("# Not read by a run") == 5
 
 
 def test_init_refuses_to_overwrite_without_force(tmp_path, capsys):

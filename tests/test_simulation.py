@@ -2,6 +2,7 @@
 
 import dataclasses
 import json
+import re
 
 import numpy as np
 import pandas as pd
@@ -9,7 +10,9 @@ import pytest
 
 from hybridtrack import HybridtrackError, simulate
 from hybridtrack.control import ControllerConfig
+from hybridtrack.drive import Drive
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
+from hybridtrack.sensor import SensorModel
 from hybridtrack.simulation import LOG_COLUMNS, SimulationConfig
 from hybridtrack.skyinputs import SkyInputConfig
 from hybridtrack.sky import synthetic
@@ -243,6 +246,36 @@ def test_config_round_trips_and_refuses_unknown_keys(tmp_path):
     (tmp_path / "bad4.toml").write_text("[controller]\nreacquire = 3.5\n")  # a count of scans
     with pytest.raises(HybridtrackError, match="controller.reacquire: must be a whole number, got 3.5"):
         SimulationConfig.from_toml(tmp_path / "bad4.toml")
+
+
+@pytest.mark.parametrize("make, message", [
+    # set, written, read back, and never read by a run: the default's results without a word
+    (lambda: SimulationConfig(sensor=SensorModel(bias=3.0)), "sensor.bias = 3.0 is not read by a run; it reads "
+                                                             "imperfections.sensor_bias"),
+    (lambda: SimulationConfig(sensor=SensorModel(noise=2.0)), "it reads imperfections.sensor_noise"),
+    (lambda: SimulationConfig(sensor=SensorModel(window="1min")), "it reads sky.window"),
+    (lambda: SimulationConfig(heliostat_drive=Drive(limits=(10.0, 80.0), stow=45.0)), "heliostat_drive.limits"),
+    (lambda: SimulationConfig(heliostat_drive=Drive(stow=45.0)), "heliostat_drive.stow = 45.0 is not read"),
+    # parts of another kind had been taken, to fail deep in the run with an AttributeError
+    (lambda: SimulationConfig(drive="x"), "config: drive must be a Drive, got str"),
+    (lambda: SimulationConfig(controller={"strategy": "sensor"}), "controller must be a ControllerConfig, got dict"),
+    (lambda: SimulationConfig.from_dict(None), "a run config must be a table (a dict), got NoneType"),
+    # an integer past any float raised OverflowError (or numpy's TypeError)
+    (lambda: Drive(deadband=10**400), "drive: deadband (degrees) must be a finite number"),
+    (lambda: Imperfections(clock_error=10**400), "imperfections: clock_error must be a number"),
+])
+def test_a_config_part_a_run_would_not_read_or_could_not_use_is_refused(make, message):
+    with pytest.raises(HybridtrackError, match=re.escape(message)):
+        make()
+
+
+def test_numpys_numbers_in_a_config_are_kept_as_pythons_and_written(tmp_path):
+    """numpy's int64 seed was taken, then to_toml failed ('not TOML serializable'); a float32
+    imperfection was refused as no number."""
+    config = SimulationConfig(seed=np.int64(5), drive=Drive(encoder_bits=np.int64(14), deadband=np.float64(0.3)),
+                              imperfections=Imperfections(encoder_offset=np.float32(0.25)))
+    assert type(config.seed) is int and type(config.drive.encoder_bits) is int
+    assert SimulationConfig.from_toml(config.to_toml(tmp_path / "run.toml")) == config
 
 
 def test_a_config_saved_with_a_byte_order_mark_reads_as_without_one(tmp_path):

@@ -51,7 +51,7 @@ def _wrapped(note: str, width: int = 96) -> list[str]:
 
 def commented_run_config() -> str:
     """`SimulationConfig`'s defaults as TOML, each key under its description."""
-    from ..simulation import SimulationConfig
+    from ..simulation import UNREAD, SimulationConfig
 
     config = SimulationConfig()
     data = config.to_dict()
@@ -66,7 +66,10 @@ def commented_run_config() -> str:
         notes = parameter_notes(type(part))
         lines.append(f"[{section}]")
         for field in dataclasses.fields(part):
-            lines += _wrapped(notes.get(field.name, "")) + [_value(field.name, data[section][field.name])]
+            unread = UNREAD.get((section, field.name))
+            note = f"Not read by a run (leave it as it is); a run reads {unread}." if unread else \
+                notes.get(field.name, "")
+            lines += _wrapped(note) + [_value(field.name, data[section][field.name])]
         lines.append("")
     return "\n".join(lines)
 
