@@ -560,9 +560,8 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
     frame = _check_frame(frame)
     faults = _check_faults(faults or {}, len(frame), 2 if collector.kind == "heliostat" else 1)
     drives = _drives(collector, config)
-    if config.controller.strategy == "hybrid-oracle" and "sky" not in frame.columns:
-        raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
-                               "have one)")
+    if config.controller.strategy == "hybrid-oracle":
+        _check_true_sky(frame)
 
     def build_world():
         return World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults,
@@ -612,6 +611,19 @@ def _scored(run: Tracked) -> Result:
     return Result(log, summary, events, run.site, collector, config, run.memory(), scoring)
 
 
+
+
+def _check_true_sky(frame: pd.DataFrame) -> None:
+    """The hybrid-oracle policy's true sky: a ``sky`` column of `SKY_CODES` labels (or missing). Any
+    other label ('Sunny', 'clear', 1) had been read as not sunny, and the day run open loop."""
+    if "sky" not in frame.columns:
+        raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
+                               "have one)")
+    labels = frame["sky"].dropna()
+    unknown = labels[~labels.isin(SKY_CODES)]
+    if len(unknown):
+        raise HybridtrackError(f"the frame's 'sky' column at {unknown.index[0]}: {unknown.iloc[0]!r} is no sky label; "
+                               f"the hybrid-oracle policy reads {', '.join(map(repr, SKY_CODES))}")
 
 
 def _check_run_options(classifier, bulk_nights, warm_start) -> None:
@@ -925,8 +937,9 @@ def _pointing_error(collector: Collector, world: World) -> np.ndarray:
     from .collectors import sun_vector
 
     truth, angle = world.truth, world.angles.T
-    if collector.single_axis:
-        return angle[:, 0] - truth[:, 0]
+    if collector.single_axis:  # within ±180°: an axis whose limits pass a turn stands a turn off its target
+        error = angle[:, 0] - truth[:, 0]
+        return np.where(np.abs(error) > 180.0, (error + 180.0) % 360.0 - 180.0, error)
     actual = sun_vector(angle[:, 1], angle[:, 0])
     wanted = sun_vector(truth[:, 1], truth[:, 0])
     return np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))

@@ -161,7 +161,9 @@ class Controller:
         self.previous_t = math.nan
         self.resting = False
         self.park = list(park)
-        self.dark_since = math.nan
+        # a run that starts in the dark has been dark long: a sensor-only tracker started at midnight had
+        # taken its first dark scan for dusk, woken and driven off stow for half an hour
+        self.dark_since = -math.inf
         self.was_awake = False
         self.blind_stow: list[float] | None = None  # what is left of a timed stow move, per axis
         self.found_today = False
