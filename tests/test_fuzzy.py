@@ -313,3 +313,20 @@ def test_an_unlabelled_sample_is_named_by_the_files_own_row(tmp_path):
     path.write_text("# labelled by hand\nintensity,variation,weather\n246,27,sunny\n\n200,80,\n")
     with pytest.raises(HybridtrackError, match=r"labels.csv: row 5, column 'weather': empty"):
         read_samples(path)
+
+
+@pytest.mark.parametrize("intensity, variation, message", [
+    ("246", 27.0, "intensity must be numbers"),  # text had been read as 246 mA: sunny
+    (np.inf, 27.0, "intensity must be finite"),  # inf mA had been the brightest sun: sunny
+    (True, 3.0, "intensity must be numbers"),  # True had been 1 mA: overcast
+    (pd.Series([246.0], index=[1]), pd.Series([27.0], index=[2]), "Series on different indexes"),
+])
+def test_the_classifier_refuses_readings_that_are_no_readings(intensity, variation, message):
+    with pytest.raises(HybridtrackError, match=message):
+        FuzzyWeatherClassifier().classify(intensity, variation)
+
+
+def test_the_classifier_reads_pythons_and_numpys_numbers_and_none_as_no_reading():
+    clf = FuzzyWeatherClassifier()
+    assert clf.classify(np.float32(246.0), np.int64(27)) == clf.classify(246, 27) == "sunny"  # the published case
+    assert list(clf.classify([246.0, None], [27.0, 3.0])) == ["sunny", "unknown"]

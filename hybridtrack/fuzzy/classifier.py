@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numbers
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,6 +53,21 @@ class Explanation:
         return "\n".join(lines)
 
 
+def _readings(values, name: str) -> np.ndarray:
+    """`values` as a float array of readings: real numbers, NaN where there is no reading. Text
+    ('246'), True and an infinite reading had been taken (inf mA as the brightest sun)."""
+    array = np.asarray(values.to_numpy() if isinstance(values, pd.Series) else values)
+    if array.dtype.kind == "O" and all(isinstance(v, numbers.Real) and not isinstance(v, bool) or v is None
+                                       for v in array.flat):
+        array = array.astype(float)  # Python's numbers in a list with a None: None is no reading
+    if array.dtype.kind not in "fiu":
+        raise HybridtrackError(f"{name} must be numbers (NaN where there is no reading), got {values!r:.60}")
+    array = array.astype(float, copy=False)
+    if np.isinf(array).any():
+        raise HybridtrackError(f"{name} must be finite (NaN where there is no reading), got inf")
+    return array
+
+
 class FuzzyWeatherClassifier:
     """Mamdani classifier of the sky from a sun sensor's light (docs/fuzzy-engine.md).
 
@@ -83,9 +100,14 @@ class FuzzyWeatherClassifier:
         return np.stack(np.broadcast_arrays(*columns), axis=-1)
 
     def _prepare(self, intensity, variation, raw: bool) -> tuple[np.ndarray, tuple]:
+        if isinstance(intensity, pd.Series) and isinstance(variation, pd.Series) and \
+                not intensity.index.equals(variation.index):
+            raise HybridtrackError("intensity and variation are Series on different indexes; align them first "
+                                   "(numpy would pair them by position)")
+        readings = _readings(intensity, "intensity"), _readings(variation, "variation")
         try:
-            a, b = np.broadcast_arrays(np.asarray(intensity, dtype=float), np.asarray(variation, dtype=float))
-        except (TypeError, ValueError) as exc:
+            a, b = np.broadcast_arrays(*readings)
+        except ValueError as exc:
             raise HybridtrackError(f"intensity and variation must be numbers of matching shape: {exc}") from None
         if raw:
             if self.config.labelled_range is not None:  # a tuned config: say when it extrapolates
