@@ -152,7 +152,13 @@ def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
         """A timestamp on the site's clock, or None for a plain date."""
         if isinstance(value, (pd.Timestamp, dt.datetime)) or (isinstance(value, str) and len(value.strip()) > 10):
             moment = pd.Timestamp(value)
-            return moment.tz_localize(site.tz) if moment.tz is None else moment.tz_convert(site.tz)
+            if moment.tz is not None:
+                return moment.tz_convert(site.tz)
+            try:
+                return moment.tz_localize(site.tz)
+            except ValueError:  # pandas' nonexistent or ambiguous local time
+                raise HybridtrackError(f"{moment} is not one time on {site.tz}'s clock: it is skipped or repeated "
+                                       "where the clocks change; give a time with its UTC offset") from None
         return None
 
     first = stamp(start)
@@ -167,6 +173,22 @@ def _period(site: Site, start, end, freq: str) -> pd.DatetimeIndex:
         raise HybridtrackError(f"the period ends ({last}) before it starts ({first})")
     check_steps(first, last, parse_freq(freq), what=f"{first} to {last}")
     return pd.date_range(first, last, freq=parse_freq(freq))
+
+
+#: m/s: the strongest gust a synthetic frame may draw, above the 113 m/s of the strongest gust on
+#: record (Barrow Island, 1996; WMO's archive of weather extremes).
+STRONGEST_GUST = 120.0
+
+
+def _gust_peak(peak) -> tuple[float, float]:
+    """`synthetic`'s gust peaks: a low and a high within 0 to `STRONGEST_GUST` m/s, low first (a
+    reversed pair raised numpy's ValueError, NaN an OverflowError; 1e9 m/s was drawn)."""
+    if isinstance(peak, (str, bytes)) or not hasattr(peak, "__len__") or len(peak) != 2:
+        raise HybridtrackError(f"gust_peak must be a (low, high) pair of m/s, got {peak!r:.60}")
+    low, high = (params.number(v, "gust_peak (m/s)", 0, STRONGEST_GUST) for v in peak)
+    if low > high:
+        raise HybridtrackError(f"gust_peak ({low:g}, {high:g}): the low peak must not be above the high one")
+    return low, high
 
 
 def check_weather(weather, days: int) -> None:
@@ -349,6 +371,7 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
         raise HybridtrackError(f"step {freq!r} leaves {len(index)} time step{'' if len(index) == 1 else 's'} in the "
                                f"period: a weather frame needs at least two")
     params.number(gusts_per_day, "gusts_per_day", 0, 200)
+    gust_peak = _gust_peak(gust_peak)
     seed = params.seed(seed)
     rng = np.random.default_rng(seed)
     local = index.tz_convert(site.tz)
@@ -389,9 +412,7 @@ def synthetic(site: Site | str, start, end=None, *, weather: str | Sequence[str]
     ghi = dni * np.where(up, cos_z, 0.0) + dhi
 
     hours = clock_hours(local)
-    mean_wind = climate.wind if wind_mean is None else float(wind_mean)
-    if not 0 <= mean_wind <= 40:
-        raise HybridtrackError(f"wind_mean must be within 0-40 m/s, got {wind_mean!r}")
+    mean_wind = climate.wind if wind_mean is None else params.number(wind_mean, "wind_mean (m/s)", 0, 40)
     diurnal = 1.0 + 0.5 * np.sin(2 * np.pi * (hours - 9.0) / 24.0)
     wind = mean_wind * diurnal * np.exp(smooth_noise(index, rng, 20.0, 0.35) - 0.06)
     wind = np.maximum(wind, 0.0) + _gusts(index, rng, gusts_per_day, gust_peak)

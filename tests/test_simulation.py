@@ -501,3 +501,10 @@ def test_the_oracle_refuses_a_sky_label_it_cannot_read(label):
     day = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
     with pytest.raises(HybridtrackError, match="is no sky label; the hybrid-oracle policy reads 'sunny'"):
         simulate(day.assign(sky=label), "lanzhou", strategy="hybrid-oracle")
+
+
+def test_a_sensor_noise_that_underflows_the_mount_fit_is_refused():
+    """1e-200° was within (0, 5]: the fit weighs a reading by its square, which underflowed to 0,
+    and LAPACK's SVD failed mid-run ('SVD did not converge')."""
+    with pytest.raises(HybridtrackError, match=r"controller: sensor_noise = 1e-200 is outside \[0.0001, 5\]"):
+        ControllerConfig(sensor_noise=1e-200)

@@ -151,3 +151,23 @@ def test_the_worlds_clear_sky_is_pvlibs_ineichen_day_and_night():
     for mine, name in zip(clear_sky(index, site, zenith), ("ghi", "dni", "dhi")):
         np.testing.assert_allclose(mine, np.nan_to_num(np.asarray(reference[name], float)), rtol=1e-12, atol=0)
     assert (zenith > 90).any()
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(gust_peak=(24.0, 14.0)), r"gust_peak \(24, 14\): the low peak must not be above the high one"),  # ValueError
+    (dict(gust_peak=(np.nan, 14.0)), "gust_peak .m/s. must be a finite number"),  # OverflowError
+    (dict(gust_peak=(1.0, 2.0, 3.0)), "gust_peak must be a .low, high. pair"),  # TypeError
+    (dict(gust_peak=(14.0, 1e9)), "is outside \\[0, 120\\]"),  # a wind of 6.8e8 m/s had been drawn
+    (dict(wind_mean="5"), "wind_mean .m/s. must be a finite number"),  # text had been read as 5 m/s
+])
+def test_synthetic_weather_refuses_wind_it_cannot_make(kwargs, message):
+    with pytest.raises(HybridtrackError, match=message):
+        synthetic("lanzhou", "2021-06-21", gusts_per_day=2.0, **kwargs)
+
+
+@pytest.mark.parametrize("start, end", [("2021-03-28 02:30", "2021-03-28 12:00"),  # skipped: spring forward
+                                        ("2021-10-31 02:30", "2021-10-31 12:00")])  # repeated: fall back
+def test_a_start_the_clocks_skip_or_repeat_is_refused_in_one_line(start, end):
+    berlin = sites.Site("berlin", 52.52, 13.40, 34.0, "Europe/Berlin")
+    with pytest.raises(HybridtrackError, match="is not one time on Europe/Berlin's clock"):
+        synthetic(berlin, start, end)

@@ -18,10 +18,12 @@ STRATEGIES = ("hybrid", "hybrid-nocal", "astronomical", "astronomical-commission
 
 
 #: (field, low, high, low excluded): m/s, degrees, deg²/min³, standard deviations, degrees per
-#: minute, mA.
+#: minute, mA. A sensor's noise is at least 1e-4° (0.36″, a thousandth of the < 0.1° accuracy of
+#: commercial fine sun sensors): the mount fit weighs a reading by its square, and 1e-200°
+#: underflowed it to zero (LAPACK's SVD then failed mid-run).
 _RANGES = (("wind_stow", 0, 60, True), ("wind_release", 0, 60, True), ("min_altitude", -10, 30, False),
            ("process_noise", 0, 10, True), ("gate", 0, 100, True), ("calibration_max_rate", 0, 100, True),
-           ("sensor_plausibility", 0, 45, True), ("sensor_noise", 0, 5, True), ("dusk_current", 0, 1000, True),
+           ("sensor_plausibility", 0, 45, True), ("sensor_noise", 1e-4, 5, False), ("dusk_current", 0, 1000, True),
            ("disagreement", 0, 45, True), ("pull_gain", 0, 100, False))
 
 
