@@ -28,6 +28,8 @@ import numpy as np
 import pandas as pd
 
 from . import params
+from .errors import HybridtrackError
+from .times import check_tz
 
 __all__ = ["summarize", "score", "RunningSummary", "offered_light", "daily", "shares", "share_counts", "event_counts", "moved_axes",
            "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
@@ -61,6 +63,30 @@ def offered_light(dni, sun_up, incidence) -> np.ndarray:
     return np.where(np.asarray(sun_up, bool) & (dni > 0), dni * np.asarray(incidence, float), 0.0)
 
 
+def _half_angle(collector: str) -> float:
+    """The acceptance half-angle of a kind of collector, refused by name for another kind."""
+    if collector not in ACCEPTANCE_HALF_ANGLE:
+        raise HybridtrackError(f"collector {collector!r}: choose {', '.join(ACCEPTANCE_HALF_ANGLE)}")
+    return ACCEPTANCE_HALF_ANGLE[collector]
+
+
+#: The log columns every metric reads.
+SCORED_COLUMNS = ("dni", "error", "mode")
+
+
+def _check_log(log: pd.DataFrame, sun_up, incidence) -> None:
+    """Refuse a log without the columns the metrics read, or per-step arrays of another length
+    (a KeyError and numpy's broadcast error had come from deep inside)."""
+    missing = [c for c in SCORED_COLUMNS if c not in log.columns]
+    if missing:
+        raise HybridtrackError(f"the log has no {', '.join(map(repr, missing))} column; a run's log has "
+                               f"{', '.join(SCORED_COLUMNS)}")
+    for name, values in (("sun_up", sun_up), ("incidence", incidence)):
+        if np.shape(values) != (len(log),):
+            raise HybridtrackError(f"{name} needs one value per step of the log ({len(log)}), got shape "
+                                   f"{np.shape(values)}")
+
+
 def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.ndarray) -> pd.DataFrame:
     """Per-step terms every metric is built from, so the run summary and the daily table agree.
 
@@ -68,12 +94,14 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
     ``error``, ``offered`` (direct light a perfect tracker would catch), ``captured`` (what this
     one caught through the acceptance model) and ``moved`` (drive axes that moved this step).
     """
+    half_angle = _half_angle(collector)
+    _check_log(log, sun_up, incidence)
     dni = np.nan_to_num(log["dni"].to_numpy(float))
     error = log["error"].to_numpy(float)
     beam = dni * np.asarray(incidence, float)  # direct light on the aperture
     tracking = log["mode"].isin(TRACKING_MODES).to_numpy() & (beam > 0) & np.isfinite(error)
     offered = offered_light(dni, sun_up, incidence)
-    gained = acceptance(np.where(tracking, error, np.inf), ACCEPTANCE_HALF_ANGLE[collector])
+    gained = acceptance(np.where(tracking, error, np.inf), half_angle)
     return pd.DataFrame({"weight": np.where(tracking, beam, 0.0), "error": np.where(tracking, error, np.nan),
                          "offered": offered, "captured": np.where(tracking, offered * gained, 0.0),
                          "moved": moved_axes(log)}, index=log.index)
@@ -260,6 +288,7 @@ class RunningSummary:
                  span: float = HISTOGRAM_SPAN):
         span = params.number(span, "span", 0.0, 180.0, above=True)
         resolution = params.number(resolution, "resolution", span / HISTOGRAM_BINS, min(1.0, span))  # degrees
+        _half_angle(collector)
         self.site, self.collector, self.strategy = site, collector, strategy
         self.resolution, self.span = float(resolution), float(span)
         self.histogram = np.zeros(int(np.ceil(span / resolution)))
@@ -311,7 +340,7 @@ class RunningSummary:
     def summary(self) -> dict:
         """The summary so far, in `summarize`'s keys (its p95 from the histogram)."""
         if self.start is None:
-            raise ValueError("no part of the run has been added")
+            raise HybridtrackError("the running summary has no part of the run yet: add() one first")
         stats, within = _error_from_sums(self.sums, self.p95())
         scores = {**_scores(stats=stats, within=within, captured=self.captured, offered=self.offered,
                             moves=self.moves, travel=self.travel), **self.events}
@@ -329,7 +358,7 @@ def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidenc
     over the day's steps).
     """
     steps = _steps(log, collector, sun_up, incidence)
-    local = log.index.tz_convert(tz)
+    local = log.index.tz_convert(check_tz(tz))
     day = pd.Index(local.date, name="date")
     elapsed = np.asarray((log.index - log.index[0]) / pd.Timedelta(minutes=1), float)  # any index unit
     minutes = np.diff(elapsed, append=elapsed[-1])

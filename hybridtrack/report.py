@@ -8,6 +8,8 @@ and `save_figure` writes it to a file.
 
 from __future__ import annotations
 
+import datetime as dt
+
 from pathlib import Path
 
 import pandas as pd
@@ -527,7 +529,7 @@ def plot_run(result, *, day=None, title: str | None = None):
     log = result.log
     if day is not None:
         local = log.index.tz_convert(result.site.tz)
-        wanted = pd.Timestamp(day).date()
+        wanted = _moment(day, "day", "a date such as '2021-06-21'").date()
         mask = local.date == wanted
         if not mask.any():
             from .errors import HybridtrackError
@@ -1034,12 +1036,25 @@ def plot_rules(classifier, intensity: float, variation: float, *, title: str | N
     return fig
 
 
+def _moment(value, name: str, example: str) -> pd.Timestamp:
+    """`value` (text, a date or a timestamp) as a timestamp, refused by `name` unless it is one: a
+    number had been read as nanoseconds since 1970, None as NaT, and 'junk' raised pandas' error."""
+    if isinstance(value, (str, dt.date)):  # a datetime and a Timestamp are dates too
+        try:
+            stamp = pd.Timestamp(value)
+        except (ValueError, OverflowError):
+            stamp = pd.NaT
+        if stamp is not pd.NaT:
+            return stamp
+    raise HybridtrackError(f"{name} must be {example}, got {value!r:.60}")
+
+
 def explain_step(result, time):
     """Why the controller of `result` was in its mode at `time` (the step at or before it)."""
     from .fuzzy import FuzzyWeatherClassifier
 
     log = result.log
-    stamp = pd.Timestamp(time)
+    stamp = _moment(time, "time", "a time such as '2021-06-21 13:00'")
     if stamp.tz is None:
         stamp = stamp.tz_localize(result.site.tz)
     position = log.index.get_indexer([stamp], method="pad")[0]

@@ -1,5 +1,6 @@
 """Results for people: reprs, the daily table, one definition of counts, pictures that leave pyplot alone."""
 
+import re
 import sys
 
 import matplotlib
@@ -7,7 +8,9 @@ import numpy as np
 import pytest
 
 import hybridtrack
+from hybridtrack import HybridtrackError
 from hybridtrack.cli import main
+from hybridtrack.metrics import RunningSummary, daily, summarize
 from hybridtrack.control import MODES
 from hybridtrack.report import mode_colours, plot_days, save_figure
 from hybridtrack.sky import synthetic
@@ -189,3 +192,32 @@ def test_runs_without_a_fit_have_no_fit_panel():
     result = hybridtrack.simulate(frame, "lanzhou", strategy="astronomical")
     assert not result.log.filter(like="fit_").columns.size
     assert _fit_lines(result.plot()) == ({}, {})
+
+
+@pytest.mark.parametrize("call, message", [
+    # pandas' DateParseError, and a number read as nanoseconds since 1970 ('no step on 1970-01-01')
+    (lambda r: r.plot(day="junk"), "day must be a date such as '2021-06-21', got 'junk'"),
+    (lambda r: r.plot(day=5), "day must be a date such as '2021-06-21', got 5"),
+    (lambda r: r.explain("junk"), "time must be a time such as '2021-06-21 13:00', got 'junk'"),
+    (lambda r: r.explain(None), "time must be a time such as '2021-06-21 13:00', got None"),  # 'NaT is outside'
+])
+def test_a_day_or_time_that_is_none_is_refused_by_its_name(two_days, call, message):
+    with pytest.raises(HybridtrackError, match=re.escape(message)):
+        call(two_days)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda r: summarize(r.log, site="x", collector="dish", strategy="hybrid", events=r.events, **r.scoring),
+     "collector 'dish': choose trough-ns"),  # KeyError: 'dish'
+    (lambda r: summarize(r.log.drop(columns="dni"), site="x", collector="fresnel", strategy="hybrid",
+                         events=r.events, **r.scoring), "the log has no 'dni' column"),  # KeyError
+    (lambda r: summarize(r.log, site="x", collector="trough-ns", strategy="hybrid", events=r.events,
+                         **{**r.scoring, "sun_up": r.scoring["sun_up"][:10]}), "sun_up needs one value per step"),
+    (lambda r: RunningSummary(site="x", collector="dish", strategy="hybrid"), "collector 'dish'"),
+    (lambda r: RunningSummary(site="x", collector="trough-ns", strategy="hybrid").summary(), "add() one first"),
+    (lambda r: daily(r.log, collector="fresnel", tz="Mars/Base", sun_up=r.scoring["sun_up"],
+                     incidence=r.scoring["incidence"]), "unknown time zone 'Mars/Base'"),  # ZoneInfoNotFoundError
+])
+def test_the_metrics_refuse_what_they_cannot_score_by_name(two_days, call, message):
+    with pytest.raises(HybridtrackError, match=re.escape(message)):
+        call(two_days)
