@@ -38,7 +38,7 @@ from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import score, summarize
 from .mountreport import FIT_PREFIX
-from .sensor import SensorModel
+from .sensor import RECORDED_POINTING, SensorModel
 from .sky import LIGHT_AT_NIGHT
 from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
 from .world import Imperfections, World, controller_clock, installed_site, scan_timer
@@ -352,7 +352,7 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     repeated = frame.columns[frame.columns.duplicated()]
     if len(repeated):  # which of the two would be the weather?
         raise HybridtrackError(f"the weather frame has the column {repeated[0]!r} more than once; keep one")
-    for column in ("dni", "dhi", "wind_speed", "photocurrent"):
+    for column in ("dni", "dhi", "wind_speed", "photocurrent", *RECORDED_POINTING):
         if column in frame.columns:
             _physical_column(frame, column)
     first, last = frame.index[0], frame.index[-1]
@@ -406,6 +406,8 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
     if not pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(values.dtype) \
             or pd.api.types.is_complex_dtype(values.dtype):
         raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
+    if column in RECORDED_POINTING:
+        _pointing_column(frame, column)
     if column not in NOT_LIGHT:
         return
     array = values.to_numpy(float, na_value=np.nan)
@@ -415,6 +417,22 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
         raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} "
                                f"{_UNITS[column]} is not light (over {NOT_LIGHT[column]:,.0f}: a unit mixed up?); read "
                                "files with hybridtrack.io.read_weather, which flags and counts such values")
+
+
+#: Degrees: the largest offset a recorded pointing signal can give, the sun at the horizon of a
+#: sensor facing the zenith; the fine cells see ±10° (`SensorModel.field_of_view`).
+POINTING_LIMIT = 90.0
+
+
+def _pointing_column(frame: pd.DataFrame, column: str) -> None:
+    """Refuse a recorded pointing signal (degrees off the sun) that is infinite or past
+    `POINTING_LIMIT`: inf and 500° had been taken as readings."""
+    array = frame[column].to_numpy(float, na_value=np.nan)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(np.isinf(array) | (np.abs(array) > POINTING_LIMIT))
+    if len(bad):
+        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g}° is "
+                               f"no sun sensor's offset (beyond ±{POINTING_LIMIT:g}°: milliradians, or arcminutes?)")
 
 
 def checked_config(config) -> SimulationConfig:

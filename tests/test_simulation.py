@@ -328,6 +328,12 @@ def test_bad_frames_are_refused(frame, message):
     (lambda f, n: dict(frame=f.assign(dni=f["dni"].where(f.index != f.index[100], np.inf))),
      r"column 'dni' at 2021-06-01 16:40:00\+08:00: inf W/m² is not light"),
     (lambda f, n: dict(frame=f.assign(wind_speed="calm")), "column 'wind_speed' must hold numbers"),
+    # a recorded pointing signal of text raised numpy's ValueError; inf and 500° were taken as readings
+    (lambda f, n: dict(frame=f.assign(pointing="0.1")), "column 'pointing' must hold numbers"),
+    (lambda f, n: dict(frame=f.assign(pointing=np.where(np.arange(n) == 100, np.inf, 0.1))),
+     r"column 'pointing' at 2021-06-01 16:40:00\+08:00: inf° is no sun sensor's offset"),
+    (lambda f, n: dict(frame=f.assign(pointing=np.where(np.arange(n) == 100, 500.0, 0.1))),
+     "500° is no sun sensor's offset \\(beyond ±90°"),
 ])
 def test_a_bad_frame_fault_or_config_from_the_api_is_a_hybridtrack_error(change, message):
     """What `simulate` is given as it is (a frame not from read_weather, an injected fault) is
