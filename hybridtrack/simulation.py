@@ -546,6 +546,8 @@ class Tracked:
         memory = self.controller.carry(self.index[0])
         if self.config.controller.strategy == "astronomical-commissioned":
             memory["commissioned"] = self.mount
+        memory["origin"] = {"collector": self.collector.kind, "site": self.site.name,
+                            "latitude": self.site.latitude, "longitude": self.site.longitude, "end": self.index[-1]}
         return memory
 
     def scores(self, events: pd.DataFrame) -> dict:
@@ -747,7 +749,9 @@ def _history(site, collector, config, start, classifier, warm_start):
 
     if isinstance(warm_start, dict):  # an earlier run carried on
         _check_memory(warm_start, collector)
+        _check_origin(warm_start.get("origin"), collector, site, start)
         memory = dict(warm_start)
+        memory.pop("origin", None)
         mount = memory.pop("commissioned", None)
         if config.controller.strategy == "astronomical-commissioned" and mount is None:
             mount = commission(site, collector, config, start, classifier=classifier)
@@ -764,7 +768,10 @@ def _history(site, collector, config, start, classifier, warm_start):
 #: What an earlier run's memory (`Result.memory`) holds: the mount fit's state, its calibration
 #: offsets, the light level, the clock watch's readings and a commissioned mount.
 MEMORY_KEYS = ("offsets", "theta", "p", "information", "evidence", "frozen", "updates", "light_level", "clock",
-               "commissioned")
+               "commissioned", "origin")
+#: Where and when a memory was left (`Tracked.memory`): the kind of collector, the site and the
+#: run's last step.
+_ORIGIN_KEYS = ("collector", "site", "latitude", "longitude", "end")
 #: The numbers a memory holds, each an array or a number.
 _MEMORY_NUMBERS = ("offsets", "theta", "p", "information", "evidence", "light_level")
 #: The clock watch's readings (`ClockWatch.save`).
@@ -793,6 +800,29 @@ def _check_memory_form(memory: dict) -> None:
         refuse("clock must be the clock watch's readings, as a run leaves them")
     if memory.get("commissioned") is not None and not isinstance(memory["commissioned"], MountEstimate):
         refuse("commissioned must be a commissioned mount (MountEstimate)")
+    origin = memory.get("origin")
+    if origin is not None and (not isinstance(origin, dict) or set(origin) != set(_ORIGIN_KEYS)
+                               or not isinstance(origin["end"], pd.Timestamp) or origin["end"].tz is None):
+        refuse("origin must say where and when the memory was left, as a run leaves it")
+
+
+def _check_origin(origin: dict | None, collector: Collector, site: sites.Site, start: pd.Timestamp) -> None:
+    """Refuse a memory left by another kind of collector (a trough-ns fit carried into a trough-ew
+    run, whose mount terms mean something else), at another site, or by a run that ended after
+    this one starts (a June memory in January: the clock watch read -161.5 days). A memory of a
+    release that did not record its origin is taken as it is."""
+    if origin is None:
+        return
+    if origin["collector"] != collector.kind:
+        raise HybridtrackError(f"warm_start: this memory was left by a {origin['collector']} run; this is a "
+                               f"{collector.kind} run, whose mount terms mean something else")
+    if (origin["latitude"], origin["longitude"]) != (site.latitude, site.longitude):
+        raise HybridtrackError(f"warm_start: this memory was left at {origin['site']} ({origin['latitude']:g}, "
+                               f"{origin['longitude']:g}); this run is at {site.name} ({site.latitude:g}, "
+                               f"{site.longitude:g})")
+    if origin["end"] >= start:
+        raise HybridtrackError(f"warm_start: this memory was left by a run that ended at {origin['end']}, not before "
+                               f"this run starts ({start}): carry a memory forward in time")
 
 
 def _check_memory(memory: dict, collector: Collector) -> None:

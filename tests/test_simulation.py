@@ -400,7 +400,23 @@ def test_a_memory_left_by_another_kind_of_collector_is_refused_in_one_line(left_
     memory = simulate(day, "lanzhou", collector=left_by).memory
     with pytest.raises(HybridtrackError, match=f"another kind of collector .* pass the memory of a {used_by} run"):
         simulate(day, "lanzhou", collector=used_by, warm_start=memory)
-    simulate(day, "lanzhou", collector=left_by, warm_start=memory)  # its own kind carries on
+    following = synthetic("lanzhou", "2021-06-22", weather="sunny", freq="5min")
+    simulate(following, "lanzhou", collector=left_by, warm_start=memory)  # its own kind carries on, the next day
+
+
+@pytest.mark.parametrize("frame_day, site, collector, message", [
+    ("2021-01-10", "lanzhou", "trough-ns", "ended at 2021-06-21 23:55:00\\+08:00, not before this run starts"),
+    ("2021-06-21", "lanzhou", "trough-ns", "not before this run starts"),  # the same day again
+    ("2021-06-22", "lanzhou", "trough-ew", "left by a trough-ns run; this is a trough-ew run"),  # same terms
+    ("2021-06-22", "nanjing", "trough-ns", "left at lanzhou .* this run is at nanjing"),
+])
+def test_a_memory_from_later_elsewhere_or_another_axis_is_refused(frame_day, site, collector, message):
+    """Its terms' count was all that was checked: a June memory started a January run (its clock
+    watch read -161.5 days), a trough-ns fit became a trough-ew run's, Lanzhou's Nanjing's."""
+    june = simulate(synthetic("lanzhou", "2021-06-21", weather="sunny", freq="5min"), "lanzhou", collector="trough-ns")
+    with pytest.raises(HybridtrackError, match=message):
+        simulate(synthetic(site, frame_day, weather="sunny", freq="5min"), site, collector=collector,
+                 warm_start=june.memory)
 
 
 def test_a_frame_of_steps_longer_than_an_hour_is_refused_and_night_gaps_are_not():
