@@ -197,3 +197,25 @@ def test_a_stamp_of_24_00_ends_its_day(tmp_path, day):
     (tmp_path / "h24.csv").write_text("Datum;GHI;DNI;DHI\n" + "\n".join(rows) + "\n")
     frame = read_weather(tmp_path / "h24.csv", tz="Asia/Shanghai")
     assert frame.index[-1] == pd.Timestamp("2021-06-22 00:00", tz="Asia/Shanghai") and len(frame) == 24
+
+
+@pytest.mark.parametrize("suffix, shown", [(" UTC+8", "'UTC+8' read as UTC+08:00"), (" GMT+8", "'GMT+8' read as UTC+08:00"),
+                                           (" UTC+08:00", "'UTC+08:00' read as UTC+08:00"),
+                                           (" +0800 (CST)", "'+0800 (CST)': the zone's name ignored")])
+def test_offsets_written_after_utc_or_with_a_zone_name_are_read_with_the_iso_sign(tmp_path, capsys, day, suffix,
+                                                                                  shown):
+    """'... UTC+8' raised pandas' TypeError (a traceback), and pandas reads it as UTC-08:00 (POSIX)."""
+    path = _write(tmp_path / "utc8.csv", day.index.strftime("%Y-%m-%d %H:%M:%S") + suffix, day)
+    frame = read_weather(path, site="lanzhou")
+    assert frame.index[0] == pd.Timestamp("2021-06-20 16:00", tz="UTC") and len(frame) == len(day)
+    assert main(["check", str(path), "--site", "lanzhou"]) == 0
+    assert shown in capsys.readouterr().out
+
+
+def test_a_zone_the_reader_does_not_know_is_refused_naming_the_line(tmp_path, capsys, day):
+    """'CST+8' is a POSIX zone string (UTC-08:00 to pandas, +08:00 to the logger): refused, not guessed."""
+    path = _write(tmp_path / "posix.csv", day.index.strftime("%Y-%m-%d %H:%M:%S") + " CST+8", day)
+    assert main(["check", str(path), "--site", "lanzhou"]) == 2
+    err = capsys.readouterr().err
+    assert "line 2, column 'time'" in err and "ends in a time zone hybridtrack does not read" in err
+    assert len(err.strip().splitlines()) == 1

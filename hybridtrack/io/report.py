@@ -58,8 +58,9 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
         lines.append(f"  skipped {report['empty_columns']} empty column(s) without a name (a spreadsheet's padding)")
     if "header_notes" in report:
         lines.append(f"  header notes (not units, ignored): {_describe(report['header_notes'])}")
-    lines.append(f"  time: {report.get('time', '?')}" + (f"; dates {report['date_order']}" if "date_order" in report
-                                                         else ""))
+    lines.append(f"  time: {report.get('time', '?')}" + "".join(f"; {prefix}{report[key]}" for key, prefix in
+                                                            (("offset_written", ""), ("date_order", "dates "))
+                                                            if key in report))
     if "place" in report:
         lines.append(f"  place: {report['place']}")
     if "sun_check" in report:

@@ -41,6 +41,11 @@ _EPOCH = re.compile(r"^\d{9,10}(\.\d+)?$")
 #: A UTC offset after a clock time: ``+08:00``, ``+0800``, ``Z``, and the hour alone (``+08``, as
 #: PostgreSQL writes a timestamptz), which pandas reads as an offset too (and a traceback followed).
 _OFFSET = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?\s*(?:[+-]\d{2}(?::?\d{2})?|Z)$")
+#: An offset written after ``UTC`` or ``GMT`` (``UTC+8``, ``GMT+8``, ``UTC+08:00``), as loggers write
+#: it: pandas reads ``UTC+8`` with the POSIX sign, 16 h off, and a traceback followed.
+_NAMED_OFFSET = re.compile(r"\s*(?:UTC|GMT)\s*([+-])(\d{1,2})(?::?(\d{2}))?$")
+#: A zone's abbreviation in brackets after a numeric offset (``+0800 (CST)``, as ``date`` writes it).
+_ZONE_NOTE = re.compile(r"([+-]\d{2}:?\d{2})\s*\([A-Za-z]{2,5}\)$")
 #: A stamp written ``yyyymmddHH`` (hourly exports): ten digits, like epoch seconds of 2030-2033.
 _COMPACT_HOURS = re.compile(r"^(?:19|20)\d{2}(?:0[1-9]|1[0-2])(?:0[1-9]|[12]\d|3[01])(?:[01]\d|2[0-3])$")
 
@@ -233,6 +238,30 @@ def _cut_short_last(column: _Column, report: dict) -> bool:
     return True
 
 
+def _iso_offset(match: re.Match) -> str:
+    return f"{match[1]}{int(match[2]):02d}:{match[3] or '00'}"
+
+
+def _written_offsets(iso: pd.Series, report: dict) -> pd.Series:
+    """Offsets written ``UTC``, ``UTC+8``, ``GMT+8``, ``UTC+08:00`` or ``+0800 (CST)`` as ISO
+    offsets (``+00:00``, ``+08:00``, ``+0800``), with the ISO sign: east of Greenwich is plus, as a
+    logger means it. The report says how they were read (``offset_written``)."""
+    tails = [tail for tail in iso.str.slice(-16).unique()  # a few distinct endings, however long the file
+             if ")" in tail or "UTC" in tail or "GMT" in tail]
+    noted = next((_ZONE_NOTE.search(tail) for tail in tails if _ZONE_NOTE.search(tail)), None)
+    if noted is not None:
+        report["offset_written"] = f"{noted[0]!r}: the zone's name ignored, the offset kept"
+        iso = iso.str.replace(_ZONE_NOTE, r"\1", regex=True)
+    if any(tail.endswith(("UTC", "GMT")) for tail in tails):
+        iso = iso.str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
+    named = next((_NAMED_OFFSET.search(tail) for tail in tails if _NAMED_OFFSET.search(tail)), None)
+    if named is not None:
+        report["offset_written"] = (f"{named[0].strip()!r} read as UTC{_iso_offset(named)} (east of Greenwich is "
+                                    "plus, as in ISO 8601; POSIX zone strings invert the sign)")
+        iso = iso.str.replace(_NAMED_OFFSET, _iso_offset, regex=True)
+    return iso
+
+
 def _end_of_day(iso: pd.Series) -> tuple[pd.Series, np.ndarray]:
     """Stamps of ``24:00`` (the end of a day, as many European hourly files close it) as ``00:00``,
     and which they were, to be moved to the next day: they had been refused as no time stamp."""
@@ -258,12 +287,13 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
     if len(clock_only):
         column.refuse(int(clock_only[0]), "has no date; stamps need the date (add a date column, or write "
                                           "'2021-06-21 12:00')")
-    iso = _to_iso(column, dayfirst, report)
-    if iso.str.endswith(("UTC", "GMT")).any():
-        iso = iso.str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
+    iso = _written_offsets(_to_iso(column, dayfirst, report), report)
     has_offset = iso.str.contains(_OFFSET)
     iso, midnight = _end_of_day(iso)
     index = _parse(column, iso, utc=bool(has_offset.any()))
+    if index.tz is not None and not has_offset.any():  # a zone pandas reads and hybridtrack does not
+        column.refuse(0, "ends in a time zone hybridtrack does not read; write its UTC offset (+08:00), or "
+                         "remove it and give the zone (--tz)")
     if midnight.any():
         index = index + pd.to_timedelta(midnight.astype(int), unit="D")
     if has_offset.any():
