@@ -219,3 +219,35 @@ def test_a_zone_the_reader_does_not_know_is_refused_naming_the_line(tmp_path, ca
     err = capsys.readouterr().err
     assert "line 2, column 'time'" in err and "ends in a time zone hybridtrack does not read" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_a_field_over_the_csv_modules_limit_is_read_and_a_long_cell_is_not_a_number(tmp_path, day):
+    """A 140,000-digit cell and a 200,000-character note line stopped the reader with csv's
+    'field larger than field limit' traceback; the cell had then read as infinity."""
+    stamps = day.index.strftime("%Y-%m-%d %H:%M")
+    path = _write(tmp_path / "long.csv", stamps, day)
+    lines = path.read_text().splitlines()
+    lines[3] = lines[3].split(",")[0] + "," + "1" * 140_000 + ",0,0"
+    path.write_text("Station notes: " + "y" * 200_000 + "\n" + "\n".join(lines) + "\n")
+    frame = read_weather(path, site="lanzhou")
+    assert len(frame) == len(day) and np.isnan(frame["ghi"].iloc[2]) and frame["ghi"].iloc[3] == day["ghi"].iloc[3]
+    unreadable = frame.attrs["validation"]["unreadable"]["ghi"]
+    assert unreadable["count"] == 1 and unreadable["lines"] == [5]
+    assert unreadable["first"] == "'11111111111111111111'... (140,000 characters)"
+
+
+def test_a_long_comment_column_in_readings_is_classified(tmp_path, capsys):
+    """'hybridtrack classify FILE' with a 200,000-character quoted note stopped with a traceback."""
+    (tmp_path / "r.csv").write_text('intensity,variation,note\n200,84,"' + "z" * 200_000 + '"\n250,20,ok\n')
+    assert main(["classify", str(tmp_path / "r.csv")]) == 0
+    assert "unknown 0" in capsys.readouterr().out
+
+
+def test_a_quote_never_closed_is_refused_naming_its_line(tmp_path, day):
+    """The csv module reads every line after an open quote into one field: rows and lines part."""
+    path = _write(tmp_path / "q.csv", day.index.strftime("%Y-%m-%d %H:%M"), day)
+    lines = path.read_text().splitlines()
+    lines[4] = lines[4].replace(",", ',"', 1)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(HybridtrackError, match='line 5: a quote \\(\\"\\) opens a field and is never closed'):
+        read_weather(path, site="lanzhou")

@@ -53,6 +53,22 @@ class Table:
     kind: str = "table"
 
 
+#: The longest field the csv module is let read: Python's default, 131,072 characters, had
+#: stopped a file with one long note line or one corrupted cell with a traceback. The text is
+#: in memory already, so no field can be longer than it; 2**31 - 1 fits a C long everywhere.
+_FIELD_LIMIT = 2**31 - 1
+
+
+@contextlib.contextmanager
+def _long_fields() -> Iterator[None]:
+    """Let the csv module read fields of any length while a table is read (then as before)."""
+    previous = csv.field_size_limit(_FIELD_LIMIT)
+    try:
+        yield
+    finally:
+        csv.field_size_limit(previous)
+
+
 def _split(line: str, sep: str) -> list[str]:
     return next(csv.reader([line], delimiter=sep))
 
@@ -141,6 +157,8 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
         body = [entry for entry, blank in zip(body, empty) if not blank]
     rows = list(csv.reader([line for _, line in body], delimiter=sep))
     numbers = [number for number, _ in body]
+    if len(rows) != len(numbers):
+        _refuse_open_quote(path, body)
     rows, numbers = _without_repeated_header(rows, numbers, headers, skipped)
     for i, fields in enumerate(rows):
         if len(fields) == width:
@@ -152,10 +170,20 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
     return rows, numbers
 
 
+def _refuse_open_quote(path: Path, body: list[tuple[int, str]]) -> None:
+    """Refuse the first line whose quote is never closed: the csv module would read every line
+    after it into that one field, and the rows would no longer match their lines."""
+    for number, line in body:
+        if line.count('"') % 2:
+            raise HybridtrackError(f"{path}: line {number}: a quote (\") opens a field and is never closed")
+    raise HybridtrackError(f"{path}: the rows cannot be told apart (a field spans lines)")
+
+
 def rows_with_values(body: list[tuple[int, str]], sep: str) -> bool:
     return any(any(f.strip() for f in _split(line, sep)) for _, line in body)
 
 
+@_long_fields()
 def locate_table(path: Path, text: str) -> Table:
     """The weather table in `text` (see the module's notes)."""
     kept, comments = _kept_lines(text)
@@ -189,6 +217,7 @@ def locate_table(path: Path, text: str) -> Table:
     return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind)
 
 
+@_long_fields()
 def read_table(path) -> pd.DataFrame:
     """A small table from CSV (comma, semicolon or tab) or TOML (``[[case]]`` rows).
 

@@ -44,9 +44,19 @@ def _numbers(path: Path, table: Table, header: str, column: list[str], decimal: 
     return _thousands_by_dots(column, values, name, report) if decimal == "." and name in IRRADIANCE else values
 
 
+#: The longest cell read as a number (a double's digits, a sign, an exponent and room to spare):
+#: a corrupted cell of 140,000 digits had been read as infinity.
+LONGEST_NUMBER = 64
+
+
+def _shown(cell: str) -> str:
+    """A cell as a message quotes it: a long one cut, with its length."""
+    return repr(cell) if len(cell) <= LONGEST_NUMBER else f"{cell[:20]!r}... ({len(cell):,} characters)"
+
+
 def _read_numbers(path: Path, table: Table, header: str, column: list[str], decimal: str, strict: bool,
                   report: dict, name: str) -> np.ndarray:
-    if decimal == ".":
+    if decimal == "." and max(map(len, column), default=0) <= LONGEST_NUMBER:
         try:  # the common case, fast: every cell a number ('nan', 'inf' and '1e400' included)
             return np.array(column, dtype=float)
         except ValueError:
@@ -59,17 +69,17 @@ def _read_numbers(path: Path, table: Table, header: str, column: list[str], deci
             strings = strings.where(~grouped, strings.str.replace(".", "", regex=False))
             report["thousands"] = "'.' (with the decimal comma)"
         strings = strings.str.replace(",", ".", regex=False)
-    values = pd.to_numeric(strings.where(~missing), errors="coerce")
+    values = pd.to_numeric(strings.where(~missing & (strings.str.len() <= LONGEST_NUMBER)), errors="coerce")
     bad = (values.isna() & ~missing).to_numpy()
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
-        where = f"{path}: line {table.lines[row]}, column {header!r}: {column[row]!r} is not a number"
+        where = f"{path}: line {table.lines[row]}, column {header!r}: {_shown(column[row])} is not a number"
         filled = int((~missing).sum())
         if strict or bad.sum() * 2 >= max(filled, 1):
             raise HybridtrackError(where if strict else f"{where} (nor are {bad.sum()} of its {filled} values)")
         report.setdefault("unreadable", {})[name] = {"count": int(bad.sum()),
                                                      "lines": [int(v) for v in table.lines[bad][:5]],
-                                                     "first": str(column[row]), "action": "set to NaN"}
+                                                     "first": _shown(column[row]), "action": "set to NaN"}
     return values.to_numpy(float)
 
 
