@@ -104,6 +104,21 @@ def test_five_minute_data_is_interpolated_to_the_control_step(tmp_path):
     assert ten["ghi"].iloc[0] == pytest.approx(925.0) and ten.attrs["resampling"] == "mean over each 10min step"
 
 
+def test_upsampling_invents_no_value_beside_a_nan_reading(tmp_path):
+    """interpolate(limit=...) filled the first steps of every NaN stretch: an hourly file with GHI
+    NaN from 12:00 to 17:00 got 12:01 = 889.3 W/m², a line from 11:00 to 18:00, though the report
+    said gaps were left empty."""
+    times = pd.date_range("2021-06-21 10:00", "2021-06-21 18:00", freq="1h", tz="Asia/Shanghai")
+    ghi = [800.0, 900.0, *[np.nan] * 6, 420.0]  # 12:00-17:00 missing
+    path = write(tmp_path, "h.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "ghi": ghi,
+                                                  "dni": 700.0, "dhi": 100.0}).to_csv(index=False))
+    frame = read_weather(path, freq="1min")
+    assert frame.loc["2021-06-21 10:30", "ghi"] == pytest.approx(850.0)  # (800 + 900) / 2
+    assert frame.loc["2021-06-21 11:00", "ghi"] == 900.0 and frame.loc["2021-06-21 18:00", "ghi"] == 420.0
+    assert frame.loc["2021-06-21 11:01":"2021-06-21 17:59", "ghi"].isna().all()
+    assert frame.loc["2021-06-21 12:30", "dni"] == 700.0  # a column with its readings is interpolated
+
+
 def test_checks_sort_deduplicate_clip_flag_and_count(tmp_path):
     path = write(tmp_path, "messy.csv", "time,ghi,dni,dhi,wind_speed\n"
                  "2021-06-21 12:00,-3,0,0,2\n2021-06-21 12:02,900,800,100,3\n2021-06-21 12:01,905,5000,100,-4\n"
