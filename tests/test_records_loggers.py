@@ -251,3 +251,26 @@ def test_a_quote_never_closed_is_refused_naming_its_line(tmp_path, day):
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(HybridtrackError, match='line 5: a quote \\(\\"\\) opens a field and is never closed'):
         read_weather(path, site="lanzhou")
+
+
+def test_a_statistics_column_is_never_the_quantity(tmp_path, day):
+    """'WS_ms_Std' and 'GHI_Std' listed before their '_Avg' had been read as the wind and the GHI:
+    a storm of 12-27 m/s replayed without one wind stow."""
+    rows = [f"{t},{g / 50},{g},{n},{d},1.5,{20 + i % 7},{30 + i % 7}"
+            for i, (t, (g, n, d)) in enumerate(zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy()))]
+    path = tmp_path / "stats.csv"
+    path.write_text("TIMESTAMP,GHI_Std,GHI_Avg,DNI_Avg,DHI_Avg,WS_ms_Std,WS_ms_Avg,WS_ms_Max\n" + "\n".join(rows) + "\n")
+    frame = read_weather(path, site="lanzhou")
+    assert frame.attrs["validation"]["columns"]["ghi"] == "GHI_Avg"
+    assert frame.attrs["validation"]["columns"]["wind_speed"] == "WS_ms_Avg"
+    np.testing.assert_array_equal(frame["ghi"], day["ghi"])
+    assert frame["wind_speed"].iloc[8] == 21.0  # 20 + 8 % 7, the mean, not the deviation (1.5)
+
+
+def test_two_columns_that_match_one_quantity_are_refused(tmp_path, capsys, day):
+    """The first of 'GHI' and 'Global' had been taken without a word."""
+    path = _write(tmp_path / "two.csv", day.index.strftime("%Y-%m-%d %H:%M"), day, header="time,GHI,Global,dhi")
+    assert main(["check", str(path), "--site", "lanzhou"]) == 2
+    err = capsys.readouterr().err
+    assert "columns 'GHI' and 'Global' both look like ghi; say which holds it with --map ghi=COLUMN" in err
+    assert main(["check", str(path), "--site", "lanzhou", "--map", "ghi=GHI", "--map", "dni=Global"]) == 0

@@ -3,8 +3,9 @@
 A header is split into its name and a bracketed part (``'GHI [kW/m2]'``); the bracketed part
 is a unit when it spells one (`units.any_known_unit`), else a note (``'(vent/cor)'``) that is
 reported and otherwise ignored. The name is compared, lower-cased, with `ALIASES` after a
-logger's statistics suffix (``_Avg``, ``_Smp``, ``_S_WVT`` ...) is removed, so ``GHI_Avg`` and
-``WS_ms_S_WVT`` are found. The user's mapping (``--map NAME=COLUMN``) comes first and may name
+logger's averaging suffix (``_Avg``, ``_Smp``, ``_S_WVT`` ...) is removed, so ``GHI_Avg`` and
+``WS_ms_S_WVT`` are found; a statistic's (``_Std``, ``_Max`` ...) is not, so ``WS_ms_Std`` is not
+the wind. Two columns that match one quantity are refused. The user's mapping (``--map NAME=COLUMN``) comes first and may name
 any column; it is refused when it names an unknown quantity, a missing column, or one column
 for two quantities. docs/records.md lists the aliases.
 """
@@ -56,8 +57,10 @@ ALIASES = {
     "pointing_2": ("pointing_2", "sensor_offset_2"),
 }
 
-#: Statistics suffixes loggers append to a measurement's name (Campbell: _Avg, _Smp, _S_WVT ...).
-_SUFFIX = re.compile(r"(_(avg|mean|smp|sample|s_wvt|wvt|wvc|std|tot))+$")
+#: Suffixes loggers append to a measurement's name that keep it the quantity (Campbell: _Avg,
+#: _Smp, _S_WVT ...). A statistic of it (_Std, _Tot, _Max, _Min, _Count ...) keeps its suffix, so
+#: it is never taken for the quantity: ``WS_ms_Std`` listed first had been read as the wind.
+_SUFFIX = re.compile(r"(_(avg|mean|smp|sample|s_wvt|wvt|wvc))+$")
 _BRACKETS = re.compile(r"\s*[\[(]([^\])]*)[\])]\s*")
 
 
@@ -117,10 +120,13 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
     for name in ("time", *WEATHER_COLUMNS):
         if name in mapping:
             continue
-        header = next((h for h in unnamed_last if h not in taken and _matches(h, name)), None)
-        if header is not None:
-            mapping[name] = header
-            taken.add(header)
+        found = [h for h in unnamed_last if h not in taken and _matches(h, name)]
+        if len(found) > 1 and name != "time":
+            raise HybridtrackError(f"{where}: columns {found[0]!r} and {found[1]!r} both look like {name}; say "
+                                   f"which holds it with --map {name}=COLUMN (columns={{{name!r}: ...}})")
+        if found:
+            mapping[name] = found[0]
+            taken.add(found[0])
     if "time" not in mapping or split_header(mapping["time"])[0] in ALIASES["clock"] and "time" not in columns:
         _date_and_clock(headers, taken, mapping)
     return mapping
