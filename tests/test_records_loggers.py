@@ -274,3 +274,24 @@ def test_two_columns_that_match_one_quantity_are_refused(tmp_path, capsys, day):
     err = capsys.readouterr().err
     assert "columns 'GHI' and 'Global' both look like ghi; say which holds it with --map ghi=COLUMN" in err
     assert main(["check", str(path), "--site", "lanzhou", "--map", "ghi=GHI", "--map", "dni=Global"]) == 0
+
+
+@pytest.mark.parametrize("header, written, name, expected", [
+    ("Wind Speed (kts)", 10.0, "wind_speed", 10 * 1852 / 3600), ("Wind Speed (knot)", 10.0, "wind_speed", 10 * 1852 / 3600),
+    ("Wind Speed (km/h, 10-min mean)", 36.0, "wind_speed", 10.0), ("Temperature (Fahrenheit)", 50.0, "temp_air", 10.0),
+    ("Sun sensor offset (arcmin)", 30.0, "pointing", 0.5)])
+def test_units_in_brackets_the_reader_had_kept_as_notes_are_converted(tmp_path, day, header, written, name, expected):
+    """'(kts)', '(knot)', '(Fahrenheit)', '(arcmin)' and a bracket with a comma had been notes, the
+    values read in the frame's unit: a 6-13.6 m/s wind read as 12-26 m/s stowed all day."""
+    rows = [f"{t},{g},{n},{d},{written}" for t, (g, n, d) in zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+    (tmp_path / "u.csv").write_text(f'time,ghi,dni,dhi,"{header}"\n' + "\n".join(rows) + "\n")
+    frame = read_weather(tmp_path / "u.csv", site="lanzhou")
+    assert frame[name].iloc[0] == pytest.approx(expected, rel=1e-12)
+    assert name in frame.attrs["validation"]["units_converted"]
+
+
+def test_a_unit_before_a_comma_that_the_reader_does_not_convert_is_refused(tmp_path, day):
+    rows = [f"{t},{g},{n},{d},3" for t, (g, n, d) in zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+    (tmp_path / "u.csv").write_text('time,ghi,dni,dhi,"Wind (ft/s, mean)"\n' + "\n".join(rows) + "\n")
+    with pytest.raises(HybridtrackError, match="the unit 'ft/s' is not one hybridtrack converts for wind_speed"):
+        read_weather(tmp_path / "u.csv", site="lanzhou")

@@ -67,15 +67,20 @@ _BRACKETS = re.compile(r"\s*[\[(]([^\])]*)[\])]\s*")
 def split_header(header: str) -> tuple[str, str | None, str | None]:
     """``'GHI [kW/m2]'`` -> (``'ghi'``, ``'kW/m2'``, None); ``'DNI (vent/cor)'`` -> (``'dni'``, None, ``'vent/cor'``).
 
-    The name is lower-cased, stripped of brackets and of a logger's statistics suffix.
+    The part of a bracket before a comma is its unit when it spells one (``'Wind (km/h, 10-min
+    mean)'`` -> ``'km/h'``, note ``'10-min mean'``). The name is lower-cased, stripped of brackets
+    and of a logger's averaging suffix.
     """
-    unit = note = None
+    unit, notes = None, []
     for match in _BRACKETS.finditer(header):
         inner = match.group(1).strip()
-        if unit is None and any_known_unit(inner):
-            unit = inner
-        elif inner:
-            note = inner if note is None else f"{note}; {inner}"
+        candidate, _, rest = inner.partition(",")  # '(km/h, 10-min mean)': a unit, then a note
+        if unit is None and any_known_unit(candidate):
+            unit = candidate.strip()
+            notes.append(rest.strip())
+        else:
+            notes.append(inner)
+    note = "; ".join(part for part in notes if part) or None
     name = re.sub(r"\s*@.*$", "", _BRACKETS.sub(" ", header)).strip().lower()  # 'Wind Speed @ 6ft'
     name = re.sub(r"\s+", " ", name)
     if name == UNNAMED or name.startswith("unnamed:"):

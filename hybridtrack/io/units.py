@@ -27,12 +27,13 @@ FRAME_UNITS = {"ghi": "W/m²", "dni": "W/m²", "dhi": "W/m²", "wind_speed": "m/
 UNITS = {
     "irradiance": {"w/m2": (1.0, 0.0), "kw/m2": (1000.0, 0.0), "mw/cm2": (10.0, 0.0)},
     "wind_speed": {"m/s": (1.0, 0.0), "ms-1": (1.0, 0.0), "km/h": (1 / 3.6, 0.0), "kmh": (1 / 3.6, 0.0),
-                   "kph": (1 / 3.6, 0.0), "kn": (0.514444, 0.0), "kt": (0.514444, 0.0), "knots": (0.514444, 0.0),
+                   "kph": (1 / 3.6, 0.0), **dict.fromkeys(("kn", "kt", "kts", "knot", "knots"), (1852 / 3600, 0.0)),
                    "mph": (0.44704, 0.0), "mi/h": (0.44704, 0.0)},
     "temp_air": {"c": (1.0, 0.0), "k": (1.0, -273.15), "f": (5.0 / 9.0, -32.0 * 5.0 / 9.0)},
     "photocurrent": {"ma": (1.0, 0.0), "a": (1000.0, 0.0), "ua": (0.001, 0.0)},
     "angle": {"deg": (1.0, 0.0), "°": (1.0, 0.0), "degrees": (1.0, 0.0), "degree": (1.0, 0.0),
-              "mrad": (0.18 / math.pi, 0.0), "rad": (180.0 / math.pi, 0.0)},
+              "mrad": (0.18 / math.pi, 0.0), "rad": (180.0 / math.pi, 0.0), "arcmin": (1 / 60, 0.0),
+              "arcsec": (1 / 3600, 0.0)},
 }
 
 _QUANTITY = {"ghi": "irradiance", "dni": "irradiance", "dhi": "irradiance", "wind_speed": "wind_speed",
@@ -49,7 +50,7 @@ def normalise_unit(text: str) -> str:
     unit = re.sub(r"^(k?w)/m-2$", r"\1/m2", unit)
     unit = re.sub(r"^(deg(rees?)?|°)_?([cfk])$", r"\3", unit)
     unit = re.sub(r"^(k?m|mi)h-1$", r"\1/h", unit)  # 'km h-1', as SI writes it
-    unit = {"kelvin": "k", "celsius": "c", "m/sec": "m/s", "mps": "m/s",
+    unit = {"kelvin": "k", "celsius": "c", "fahrenheit": "f", "m/sec": "m/s", "mps": "m/s",
             "meters/second": "m/s", "metres/second": "m/s", "km/hr": "km/h"}.get(unit, unit)
     return unit
 
@@ -62,8 +63,9 @@ def known_unit(name: str, text: str) -> bool:
 #: The pieces units are written with, lower case: a bracket made of these alone is a unit, known
 #: or not (``Wh/m2``, ``km h-1``), never a note (``vent/cor``, ``CMP22``).
 _UNIT_PIECES = {"w", "kw", "mw", "wh", "kwh", "mwh", "j", "kj", "mj", "cal", "ly", "m", "km", "mi", "cm", "mm", "ft",
-                "s", "sec", "min", "h", "hr", "hour", "d", "day", "kt", "kn", "knots", "mph", "kph", "c", "f", "k",
-                "°c", "°f", "°", "deg", "a", "ma", "ua", "v", "mv", "rad", "mrad", "%"}
+                "s", "sec", "min", "h", "hr", "hour", "d", "day", "kt", "kts", "kn", "knot", "knots", "mph", "kph", "c", "f",
+                "k", "°c", "°f", "°", "deg", "degrees", "celsius", "fahrenheit", "kelvin", "a", "ma", "ua", "v", "mv",
+                "rad", "mrad", "arcmin", "arcsec", "%"}
 
 
 def looks_like_unit(text: str) -> bool:

@@ -176,7 +176,8 @@ def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
     """Refuse a column whose header gives a unit the reader does not convert: ``GHI (Wh/m2)`` had
     been read as W/m² (six times too low for 10-minute sums) and ``Wind (km h-1)`` as m/s, with
     the unit reported as a note and the file called clean."""
-    unit = next((part for part in note.split("; ") if looks_like_unit(part)), None)
+    unit = next((part.partition(",")[0] for part in note.split("; ") if looks_like_unit(part.partition(",")[0])),
+                None)
     if unit is not None:
         raise HybridtrackError(f"{path}: column {header!r}: the unit {unit!r} is not one hybridtrack converts for "
                                f"{name} (it takes {', '.join(spellings(name))}); convert the column, or "
