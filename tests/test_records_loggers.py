@@ -295,3 +295,26 @@ def test_a_unit_before_a_comma_that_the_reader_does_not_convert_is_refused(tmp_p
     (tmp_path / "u.csv").write_text('time,ghi,dni,dhi,"Wind (ft/s, mean)"\n' + "\n".join(rows) + "\n")
     with pytest.raises(HybridtrackError, match="the unit 'ft/s' is not one hybridtrack converts for wind_speed"):
         read_weather(tmp_path / "u.csv", site="lanzhou")
+
+
+def test_thousands_grouped_by_commas_beside_a_decimal_point_are_read(tmp_path, day):
+    """'"1,060.2"' (US Excel) had been unreadable text: every value of 1000 W/m² or more set to NaN."""
+    rows = [f'{t},"{g:,.1f}","{n:,.1f}","{d:,.1f}"' for t, (g, n, d) in
+            zip(day.index.strftime("%Y-%m-%d %H:%M"), day.to_numpy())]
+    (tmp_path / "us.csv").write_text("time,GHI,DNI,DHI\n" + "\n".join(rows) + "\n")
+    frame = read_weather(tmp_path / "us.csv", site="lanzhou")
+    np.testing.assert_array_equal(frame["ghi"].to_numpy(), day["ghi"].to_numpy())
+    grouped = int((day[["ghi", "dni", "dhi"]] >= 1000).to_numpy().sum())
+    report = frame.attrs["validation"]
+    assert grouped > 0 and sum(report["thousands_values"].values()) == grouped and "unreadable" not in report
+    assert report["thousands"].startswith(f"',' in {grouped} values")
+
+
+def test_a_decimal_comma_in_a_dot_decimal_column_is_not_taken_for_thousands(tmp_path, day):
+    """Beside '0,5' (a decimal comma), '1,060' may be 1.06: both stay unreadable text, counted."""
+    path = _write(tmp_path / "mixed.csv", day.index.strftime("%Y-%m-%d %H:%M"), day)
+    lines = path.read_text().splitlines()
+    lines[60], lines[61] = (line.split(",", 1)[0] + f',"{cell}",0,0' for line, cell in zip(lines[60:62], ("0,5", "1,060")))
+    path.write_text("\n".join(lines) + "\n")
+    report = read_weather(path, site="lanzhou").attrs["validation"]
+    assert report["unreadable"]["ghi"]["lines"] == [61, 62] and "thousands" not in report

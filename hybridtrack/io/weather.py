@@ -63,6 +63,8 @@ def _read_numbers(path: Path, table: Table, header: str, column: list[str], deci
             pass
     strings = pd.Series(column, dtype=str).str.strip()
     missing = strings.str.lower().isin(MISSING)
+    if decimal == ".":
+        strings = _thousands_by_commas(strings, name, report)
     if decimal == ",":
         grouped = strings.str.fullmatch(_GROUPED)
         if grouped.any():  # '1.073,3': with a decimal comma, a dot can only group thousands
@@ -81,6 +83,26 @@ def _read_numbers(path: Path, table: Table, header: str, column: list[str], deci
                                                      "lines": [int(v) for v in table.lines[bad][:5]],
                                                      "first": _shown(column[row]), "action": "set to NaN"}
     return values.to_numpy(float)
+
+
+#: A number whose thousands are grouped with commas beside a decimal point: ``1,060.2``, ``12,000``.
+_COMMA_GROUPED = re.compile(r"[-+]?\d{1,3}(,\d{3})+(\.\d*)?")
+
+
+def _thousands_by_commas(strings: pd.Series, name: str, report: dict) -> pd.Series:
+    """A dot-decimal column's cells with thousands grouped by commas (US Excel's quoted
+    ``"1,060.2"``) without their commas, counted: every value of 1000 or more had been unreadable
+    text, a clear noon set to NaN. A column with any other comma (``0,5``) is left as it is."""
+    commas = strings.str.contains(",", regex=False)
+    if not commas.any():
+        return strings
+    grouped = strings.str.fullmatch(_COMMA_GROUPED)
+    if not grouped[commas].all():
+        return strings
+    counts = report.setdefault("thousands_values", {})
+    counts[name] = int(grouped.sum())
+    report["thousands"] = f"',' in {sum(counts.values()):,} values of {', '.join(counts)} (with the decimal point)"
+    return strings.str.replace(",", "", regex=False)
 
 
 #: Irradiance (W/m²) a logger writes whole that shows the sun well up: a column whose other
