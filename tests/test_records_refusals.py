@@ -50,6 +50,10 @@ REFUSALS = [
      ["column 'GHI_Avg'", "unknown unit 'furlongs' for ghi"]),
     ("a zip of two files", zipped({"a.csv": PLAIN, "b.csv": PLAIN}), {"tz": "UTC"}, ["--tz", "UTC"],
      ["a zip archive must hold exactly one file; it holds a.csv, b.csv"]),
+    ("an Excel workbook (a zip of XML parts)", zipped({"[Content_Types].xml": "<Types/>", "_rels/.rels": "<r/>",
+                                                       "xl/workbook.xml": "<workbook/>",
+                                                       "xl/worksheets/sheet1.xml": "<worksheet/>"}),
+     {"tz": "UTC"}, ["--tz", "UTC"], ["an Excel workbook: save it as CSV (File > Save As > CSV)"]),
     ("a damaged gzip file", gzip.compress(PLAIN.encode())[:30], {"tz": "UTC"}, ["--tz", "UTC"],
      ["a damaged gzip file"]),
     ("light at midnight", PLAIN + "".join(

@@ -53,6 +53,7 @@ def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
         try:
             with zipfile.ZipFile(io.BytesIO(raw)) as archive:
                 members = [m for m in archive.infolist() if not m.is_dir() and not m.filename.startswith("__MACOSX")]
+                _refuse_office(path, [m.filename for m in members])
                 weather = [m for m in members if m.filename.lower().endswith(WEATHER_SUFFIXES)]
                 if len(members) > 1 and len(weather) == 1:  # EnergyPlus zips: .epw with .stat and .ddy
                     members = weather
@@ -63,6 +64,15 @@ def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
         except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, NotImplementedError) as exc:
             raise HybridtrackError(f"{path}: a damaged or unsupported zip file ({exc})") from None
     return raw, None
+
+
+def _refuse_office(path: Path, names: list[str]) -> None:
+    """Refuse an Office file (a zip with ``[Content_Types].xml``): an Excel workbook had been told
+    that a zip archive must hold one file, naming its XML parts."""
+    if "[Content_Types].xml" in names:
+        kind = ("an Excel workbook: save it as CSV (File > Save As > CSV)" if "xl/workbook.xml" in names
+                else "an Office document, not a table")
+        raise HybridtrackError(f"{path}: {kind}")
 
 
 def _looks_utf16(raw: bytes) -> str | None:
