@@ -88,3 +88,22 @@ def test_a_utc_logger_replays_at_a_built_in_site_with_tz_utc(tmp_path, capsys):
     capsys.readouterr()
     again = json.loads((by_coordinates / "summary.json").read_text())
     assert again["energy_capture"] == pytest.approx(summary["energy_capture"], abs=1e-3)
+
+
+def test_check_writes_parquet_for_a_parquet_name_and_a_streamed_replay_reads_it(tmp_path, capsys):
+    """'--out x.parquet' had written CSV text under that name: a streamed replay then failed with
+    'Parquet magic bytes not found'."""
+    out = tmp_path / "clean.parquet"
+    assert main(["check", "data/lanzhou-2021-sunny.csv", "--out", str(out)]) == 0
+    frame = pd.read_parquet(out)
+    assert frame.index.tz is not None and frame.index.name == "time" and len(frame) > 1000
+    assert main(["replay", str(out), "--site", "lanzhou", "--stream", "--out", str(tmp_path / "run")]) == 0
+    assert main(["check", str(out)]) == 2  # not a text table, said so
+    assert "a Parquet file, not a text table: replay it with --stream" in capsys.readouterr().err
+
+
+def test_check_refuses_an_output_name_it_cannot_write_before_reading(tmp_path, capsys):
+    assert main(["check", "data/lanzhou-2021-sunny.csv", "--out", str(tmp_path / "clean.xlsx")]) == 2
+    captured = capsys.readouterr()
+    assert "--out writes CSV or Parquet; name the file .csv or .parquet" in captured.err
+    assert "rows read" not in captured.out  # refused before the file was read

@@ -24,7 +24,8 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
     add_site_arguments(parser, record=True)
     add_record_arguments(parser)
     parser.add_argument("--freq", help="resample to this step, e.g. 1min")
-    parser.add_argument("--out", metavar="FILE", help="write the checked (cleaned) frame as CSV")
+    parser.add_argument("--out", metavar="FILE", help="write the checked (cleaned) frame: Parquet for a .parquet "
+                                                      "name, else CSV")
     add_force_argument(parser)
 
 
@@ -34,6 +35,8 @@ def _check(args: argparse.Namespace) -> int:
     from ..io import validation_report
 
     site = site_from_arguments(args, clock_required=False)
+    if args.out:
+        _refuse_other_formats(args.out)  # before the file is read, not after its report
     frame = read_record(args, args.file, site=site, freq=args.freq)
     print(validation_report(frame))
     if args.out:
@@ -42,8 +45,23 @@ def _check(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Names of files `write_frame` cannot write: it writes Parquet or CSV text, and had written CSV
+#: under a .parquet name (which a streamed replay then could not open).
+_NOT_CSV = (".xlsx", ".xls", ".json", ".nc", ".feather", ".h5", ".pkl")
+
+
+def _refuse_other_formats(path: str) -> None:
+    from pathlib import Path
+
+    from ..errors import HybridtrackError
+
+    if Path(path).suffix.lower() in _NOT_CSV:
+        raise HybridtrackError(f"{path}: --out writes CSV or Parquet; name the file .csv or .parquet")
+
+
 def write_frame(frame: pd.DataFrame, path: str) -> None:
-    """A weather frame as CSV: ISO stamps with their UTC offset, which `read_weather` reads back."""
+    """A weather frame as Parquet (a ``.parquet`` name, its tz-aware index kept: what a streamed
+    replay reads fastest) or CSV (ISO stamps with their UTC offset, which `read_weather` reads back)."""
     from pathlib import Path
 
     from ..errors import HybridtrackError
@@ -51,7 +69,11 @@ def write_frame(frame: pd.DataFrame, path: str) -> None:
     target = Path(path)
     if target.is_dir():
         raise HybridtrackError(f"{path}: is a folder; --out takes a file name")
+    _refuse_other_formats(path)
     claim([target])
+    if target.suffix.lower() == ".parquet":
+        write(target, lambda file: frame.rename_axis("time").to_parquet(file))
+        return
     out = frame.copy()
     out.index = out.index.strftime("%Y-%m-%dT%H:%M:%S%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2", regex=True)
     write(target, lambda file: out.to_csv(file, index_label="time", float_format="%.6g"))

@@ -99,6 +99,9 @@ def decode(path: Path, raw: bytes) -> tuple[str, str]:
             return raw.decode(encoding).lstrip("\ufeff"), encoding.upper()
         except UnicodeDecodeError as exc:
             raise HybridtrackError(f"{path}: not valid UTF-16 text (byte {exc.start})") from None
+    if raw[:4] == b"PAR1":  # a frame written already (hybridtrack check --out x.parquet)
+        raise HybridtrackError(f"{path}: a Parquet file, not a text table: replay it with --stream, or read it "
+                               "with pandas.read_parquet")
     if b"\x00" in raw[:4096]:
         raise HybridtrackError(f"{path}: looks binary, not a text table")
     try:
