@@ -93,10 +93,14 @@ def test_a_utc_logger_replays_at_a_built_in_site_with_tz_utc(tmp_path, capsys):
 def test_check_writes_parquet_for_a_parquet_name_and_a_streamed_replay_reads_it(tmp_path, capsys):
     """'--out x.parquet' had written CSV text under that name: a streamed replay then failed with
     'Parquet magic bytes not found'."""
+    from hybridtrack.sky import synthetic
+
+    day = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=2)[["ghi", "dni", "dhi", "wind_speed"]]
+    day.to_csv(tmp_path / "day.csv", index_label="time")  # a whole local day: a streamed run's least
     out = tmp_path / "clean.parquet"
-    assert main(["check", "data/lanzhou-2021-sunny.csv", "--out", str(out)]) == 0
+    assert main(["check", str(tmp_path / "day.csv"), "--out", str(out)]) == 0
     frame = pd.read_parquet(out)
-    assert frame.index.tz is not None and frame.index.name == "time" and len(frame) > 1000
+    assert frame.index.tz is not None and frame.index.name == "time" and len(frame) == 1440
     assert main(["replay", str(out), "--site", "lanzhou", "--stream", "--out", str(tmp_path / "run")]) == 0
     assert main(["check", str(out)]) == 2  # not a text table, said so
     assert "a Parquet file, not a text table: replay it with --stream" in capsys.readouterr().err
