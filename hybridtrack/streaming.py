@@ -181,7 +181,7 @@ def _cut_days(pieces: Iterator[pd.DataFrame], site: sites.Site, where: str) -> I
         if not len(piece):  # a file of a header alone
             continue
         if not isinstance(piece.index, pd.DatetimeIndex) or piece.index.tz is None:
-            raise HybridtrackError(f"{where}: the time stamps must be tz-aware (or give tz=)")
+            raise HybridtrackError(f"{where}: the time stamps have no UTC offset; give their zone (--tz; tz= from Python)")
         if last is not None and piece.index[0] <= last:
             raise HybridtrackError(f"{where}: time goes back or repeats at {piece.index[0]}; a streamed file must be "
                                    "sorted without repeats (write it from hybridtrack.io.read_weather)")
@@ -218,7 +218,7 @@ def frame_days(frame: pd.DataFrame, site) -> DaySource:
     covered = (frame.index[-1] - frame.index[0]) + (frame.index[1] - frame.index[0]) if len(frame) > 1 else None
     if covered is not None and covered < pd.Timedelta(hours=23):
         raise HybridtrackError(f"the frame spans {local[0]} to {local[-1]}: a streamed run needs at least one whole "
-                               "local day (run a shorter span in memory with hybridtrack.simulate)")
+                               "local day (run a shorter span without --stream; hybridtrack.simulate from Python)")
     return DaySource(site, "a weather frame", len(frame), days, lambda: _by_day(iter([frame]), site, "the frame"))
 
 
@@ -303,8 +303,8 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 #: The separators a streamed CSV may use: the one its header line holds most of is used.
 SEPARATORS = (",", ";", "\t")
 #: What a streamed file's stamp trouble is refused with: the way to a file that streams.
-CONVERT_ONCE = ("a streamed file is read as written: convert a record once with "
-                "hybridtrack.io.read_weather(...).to_parquet(...)")
+CONVERT_ONCE = ("a streamed file is read as written: convert a record once with hybridtrack check FILE --out "
+                "clean.parquet (hybridtrack.io.read_weather(...).to_parquet(...) from Python)")
 
 
 def csv_separator(path: Path) -> str:
@@ -415,12 +415,12 @@ def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
             raise HybridtrackError(
                 f"{path}: row {first_row + int(bad[0])}, column {column!r}: {values[bad[0]]:g} is outside "
                 f"{floor:g}..{high:g} {FRAME_UNITS[column]} (a streamed file is read as written, without the "
-                f"reader's repairs: convert it once with hybridtrack.io.read_weather(...).to_parquet(...))")
+                f"reader's repairs: convert it once with hybridtrack check FILE --out clean.parquet)")
     if len(piece) < 2:  # no span to judge a magnitude over
         return
     lines = piece.assign(_line=np.arange(first_row, first_row + len(piece), dtype=float))
-    check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack.io.read_weather(..., "
-                                                  "units={{'{name}': 'kW/m2'}}).to_parquet(...)")
+    check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack check FILE --units "
+                                                  "{name}=kW/m2 --out clean.parquet")
 
 
 # -- the run -------------------------------------------------------------------------------------
@@ -797,7 +797,7 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
         if run.segments == 0 or not whole:
             raise HybridtrackError(f"{source.describe}: holds no time steps" if run.segments == 0 else
                                    f"a streamed run needs at least one whole local day at {site.name}; this span has "
-                                   "none (run it in memory with hybridtrack.simulate)")
+                                   "none (run it without --stream; hybridtrack.simulate from Python)")
     except BaseException:
         run.abandon(keep=whole)  # a span refused for holding no whole day keeps nothing
         raise
