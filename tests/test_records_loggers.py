@@ -318,3 +318,12 @@ def test_a_decimal_comma_in_a_dot_decimal_column_is_not_taken_for_thousands(tmp_
     path.write_text("\n".join(lines) + "\n")
     report = read_weather(path, site="lanzhou").attrs["validation"]
     assert report["unreadable"]["ghi"]["lines"] == [61, 62] and "thousands" not in report
+
+
+def test_a_time_column_wins_over_a_written_out_index(tmp_path, day):
+    """A reset_index() export ('index,time,ghi,...') had its counter 0, 1, 2 taken for the time:
+    'line 2, column 'index': '0' is not a time stamp'."""
+    frame = day.rename_axis("time").reset_index().reset_index()
+    frame.to_csv(tmp_path / "idx.csv", index=False)
+    read = read_weather(tmp_path / "idx.csv", site="lanzhou")
+    assert read.index[0] == day.index[0] and len(read) == len(day)

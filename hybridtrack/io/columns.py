@@ -121,7 +121,9 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
                                    "one column holds one quantity")
         mapping[name] = found
     taken = set(mapping.values())
-    unnamed_last = sorted(headers, key=lambda h: h.strip().lower() in (UNNAMED, "unnamed: 0"))
+    # pandas' index written out ('', 'Unnamed: 0', 'index' after reset_index) is the time only when
+    # no column is named for it: a counter 0, 1, 2 had been taken over a 'time' column beside it
+    unnamed_last = sorted(headers, key=lambda h: h.strip().lower() in (UNNAMED, "unnamed: 0", "index"))
     for name in ("time", *WEATHER_COLUMNS):
         if name in mapping:
             continue
