@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
+from ..sky import LIGHT_AT_NIGHT
 from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
@@ -40,6 +41,14 @@ CLIPPED_AT_ZERO = (*IRRADIANCE, "wind_speed")
 
 #: m/s: negative wind down to this is an anemometer's zero offset in calm air, read as 0.
 CALM_OFFSET = -0.5
+
+#: W/m² of clear-sky GHI (pvlib's Haurwitz) with the sun well up, about 35° above the horizon.
+SUN_WELL_UP = 600.0
+#: Clock hours with the clear sky at `SUN_WELL_UP` or more before a file's darkness is judged.
+HOURS_WELL_UP = 2
+#: W/m²: the largest value no sky keeps below for `HOURS_WELL_UP` hours of a high sun (see
+#: `_refuse_too_dark`); it is also the light the sun check counts (`hybridtrack.sky.LIGHT_AT_NIGHT`).
+DARKEST = LIGHT_AT_NIGHT
 
 _HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "temp_air": "K", "photocurrent": "A",
          "pointing": "rad", "pointing_2": "rad"}
@@ -111,11 +120,7 @@ def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
         values = frame[name].to_numpy(float)
         present = ~np.isnan(values)
         bad = present & ~((values >= low) & (values <= high))  # inf and 1e400 included
-        if present.sum() and bad.sum() > 0.5 * present.sum():
-            raise HybridtrackError(
-                f"{path}: column {report.get('columns', {}).get(name, name)!r}: {bad.sum() / present.sum():.0%} of "
-                f"values are outside {low:g}..{high:g} ({FRAME_UNITS[name]}); wrong unit? give it, e.g. "
-                f"--units {name}={_HINT[name]}")
+        _refuse_mostly_impossible(path, report, name, values, bad)
         if bad.any():
             first = values[bad][0]
             impossible[name] = {"count": int(bad.sum()), "lines": first_lines(frame, bad),
@@ -131,6 +136,28 @@ def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
     for key, entry in (("negative_clipped", clipped), ("calm_clipped", calm), ("impossible", impossible)):
         if entry:
             report[key] = entry
+
+
+def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.ndarray, bad: np.ndarray) -> None:
+    """Refuse a column most of whose values are outside `LIMITS`: a unit mistake, not spikes.
+
+    An irradiance column is judged on its finite daylight values too (above `DARKEST` W/m², or
+    beyond the limits): hourly kJ/m² sums (3.6 times W/m²) pass 1500 at every bright hour, but
+    the nights' zeros had kept the share under half, so the noons were set to NaN and the rest
+    kept 3.6 times too high. A non-finite cell (``inf``) is damage, not a unit: not judged there.
+    """
+    judged, what = ~np.isnan(values), "values"
+    if name in IRRADIANCE and bad.sum() <= 0.5 * judged.sum():
+        judged, what = np.isfinite(values) & (bad | (values > DARKEST)), "daylight values"
+        bad = bad & judged
+    if not judged.sum() or bad.sum() <= 0.5 * judged.sum():
+        return
+    low, high = LIMITS[name]
+    hint = (f"give it, e.g. --units {name}={_HINT[name]}" if name not in IRRADIANCE or not (values[bad] > high).all()
+            else "kJ/m² or J/m² sums? convert the column to W/m²")
+    header = report.get("columns", {}).get(name, name)
+    raise HybridtrackError(f"{path}: column {header!r}: {bad.sum() / judged.sum():.0%} of {what} are outside "
+                           f"{low:g}..{high:g} ({FRAME_UNITS[name]}); wrong unit? {hint}")
 
 
 def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
@@ -169,14 +196,15 @@ def _drop_empty(frame: pd.DataFrame, report: dict) -> pd.DataFrame:
 
 def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
                     remedy: str = "give the unit (--units {name}=kW/m2)") -> None:
-    """Refuse irradiance a thousand times too small: kW/m² read as W/m².
+    """Refuse irradiance a thousand times too small (kW/m² read as W/m²), or darker than any sky.
 
     In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
     tens of W/m² while the sun is well up. So GHI (or DHI) whose largest value is above 0 and at
     most 1.5 is refused when the site's clear sky (`clear_ghi`, W/m², on the frame's stamps)
     reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
-    judged so only in a file without GHI and DHI, since an overcast day has none. `remedy` ends
-    the message (``{name}`` is the column).
+    judged so only in a file without GHI and DHI, since an overcast day has none. With a site,
+    GHI or DHI that stays darker than any sky while the sun is high is refused too
+    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column).
     """
     _refuse_dni_in_kw_beside_beam(path, frame, report, remedy)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
@@ -193,12 +221,34 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
         else:
             suspicious = hours >= 6.0 and 0.0 < top <= 1.5
             why = f"at most {top:g} over {hours:.0f} hours"
+        header = report.get("columns", {}).get(name, name)
+        line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
+        where = f"{path}: line {line[0]}, column {header!r}" if line else f"{path}: column {header!r}"
         if suspicious:
-            header = report.get("columns", {}).get(name, name)
-            line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
-            where = f"line {line[0]}, " if line else ""
-            raise HybridtrackError(f"{path}: {where}column {header!r}: {name} is {why}; the values look like kW/m² "
-                                   f"read as W/m²: {remedy.format(name=name)}")
+            raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
+                                   f"{remedy.format(name=name)}")
+        if clear_ghi is not None:
+            _refuse_too_dark(where, frame, name, top, clear_ghi)
+
+
+def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, clear_ghi: np.ndarray) -> None:
+    """Refuse GHI or DHI whose largest value is at most `DARKEST` W/m² through `HOURS_WELL_UP` clock
+    hours of a clear sky of `SUN_WELL_UP` W/m² or more: no sky is so dark.
+
+    The thickest clouds (optical depth about 100) still pass some 8 % of the light, by the
+    two-stream transmittance of a thick scattering cloud, 1 / (1 + 0.75 (1 - g) tau) with g = 0.85:
+    about 50 W/m² under a 600 W/m² clear sky; 20 W/m² would need an optical depth of some 260.
+    Such a column is in another unit: a pyranometer's raw millivolts (5-20 µV per W/m²) or sums
+    of energy (hourly MJ/m², one-minute Wh/m²). It had been read as a day without light, the sun
+    check skipped and the file called clean.
+    """
+    well_up = frame.index[np.asarray(clear_ghi) >= SUN_WELL_UP].floor("h").nunique()
+    if well_up < HOURS_WELL_UP or top > DARKEST:
+        return
+    raise HybridtrackError(f"{where}: {name} is at most {top:g} W/m² through {well_up} hours in which the clear sky "
+                           f"is above {SUN_WELL_UP:g} W/m²; no sky is that dark with the sun so high (the thickest "
+                           "cloud still gives tens of W/m²): a wrong unit? raw mV, MJ/m² or Wh/m² sums? convert the "
+                           "column to W/m²")
 
 
 #: W/m² of direct light on the horizontal (GHI - DHI) that only a direct beam of as much again or

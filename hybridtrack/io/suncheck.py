@@ -135,6 +135,17 @@ def _mismatch(path: Path, frame: pd.DataFrame, site, name: str, header: str, nig
             f"time zone (--tz) or the right site{ask}")
 
 
+def _no_light(frame: pd.DataFrame, site) -> str:
+    """The sun check's word on a file without light: a warning (so the file is not called clean)
+    when the site's sun is up at any of its stamps, since daylight gives light under any sky."""
+    altitude = _sun_up(site, frame.index)
+    if not (altitude > 0.0).any():
+        return "not done (no light in the file, whose stamps are all at night)"
+    return (f"WARNING: not done: no light above {LIGHT:g} W/m² in the file, while the sun at {site.name} is up in "
+            f"{int((altitude > 0.0).sum())} rows (up to {np.nanmax(altitude):.0f}°); is the light in another unit, "
+            "or the sensor dead?")
+
+
 def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: bool = False) -> None:
     """Refuse (or, `lenient`, warn about) light that does not follow the site's sun.
 
@@ -142,7 +153,7 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
     """
     lit_in = [c for c in ("dni", "ghi", "dhi") if c in frame and (frame[c].to_numpy(float) > LIGHT).any()]
     if not lit_in:
-        report["sun_check"] = "not done (no light in the file)"
+        report["sun_check"] = _no_light(frame, site)
         return
     name = lit_in[0]  # direct light where there is some: it is the surest sign of the sun
     curve = "ghi" if "ghi" in lit_in else name  # global light has the day's edges under any sky
