@@ -88,3 +88,45 @@ def test_a_file_without_light_while_the_sun_is_up_is_never_called_clean(tmp_path
                                                                                freq="10min")))
     report = read_weather(night, site="lanzhou").attrs["validation"]
     assert report["sun_check"] == "not done (no light in the file, whose stamps are all at night)"
+
+
+def write_ghi_dni(path, ghi: pd.Series, dni: pd.Series):
+    pd.DataFrame({"GHI": ghi, "DNI": dni}).rename_axis("time").to_csv(path)
+    return path
+
+
+@pytest.mark.parametrize("dni_factor, parts", [
+    (1e-3, ["dni is at most 1.0", "ghi, at 80% of the clear sky, reaches", "kW/m² read as W/m²",
+            "--units dni=kW/m2"]),
+    (0.0, ["dni is at most 0 while ghi", "is the pyrheliometer dead or off the sun?"])])
+def test_dni_in_kilowatts_or_dead_beside_ghi_alone_is_refused(tmp_path, capsys, dni_factor, parts):
+    """Both were called clean, DHI derived as GHI itself (up to 1100 W/m²), a clear day replayed overcast."""
+    sky = clear_sky("2021-06-21 05:00", "2021-06-21 21:00", "1min")
+    path = write_ghi_dni(tmp_path / "gd.csv", sky["ghi"].round(1), (dni_factor * sky["dni"]).round(4))
+    refused(path, capsys, "column 'DNI'", *parts)
+
+
+def test_dni_in_kilowatts_given_its_unit_derives_the_clear_skys_diffuse(tmp_path):
+    sky = clear_sky("2021-06-21 05:00", "2021-06-21 21:00", "1min")
+    path = write_ghi_dni(tmp_path / "gd.csv", sky["ghi"].round(1), (sky["dni"] / 1000).round(4))
+    dhi = read_weather(path, site="lanzhou", units={"dni": "kW/m2"})["dhi"]
+    assert dhi.max() == pytest.approx(sky["dhi"].max(), abs=15.0)  # Ineichen's DHI = GHI - DNI cos z
+
+
+def test_a_derived_component_beyond_the_limits_is_counted_and_most_of_it_refused(tmp_path):
+    """DHI = GHI - DNI cos z from a pyrheliometer reading a twentieth of the beam passes 1000 W/m²
+    near noon: those rows are impossible, set to NaN and counted, as a measured value's are."""
+    sky = clear_sky("2021-06-21 05:00", "2021-06-21 21:00", "1min")
+    path = write_ghi_dni(tmp_path / "gd.csv", sky["ghi"].round(1), (0.05 * sky["dni"]).round(1))
+    frame = read_weather(path, site="lanzhou")
+    entry = frame.attrs["validation"]["impossible"]["dhi"]
+    assert entry["count"] > 0 and entry["first"] > 1000.0 and entry["action"] == "set to NaN (derived)"
+    assert frame["dhi"].max() <= 1000.0
+
+    from hybridtrack.io.checks import check_derived
+
+    bright = pd.DataFrame({"dhi": [1100.0, 1200.0, 900.0], "_line": [2.0, 3.0, 4.0]},
+                          index=pd.date_range("2021-06-21 12:00", periods=3, freq="1min", tz=SITE.tz))
+    with pytest.raises(HybridtrackError, match=r"^x\.csv: line 2, dhi derived from the other components is outside "
+                                               r"-50\.\.1000 W/m² in 2 of 3 daylight rows, first 1100"):
+        check_derived("x.csv", bright, "dhi", {})

@@ -29,7 +29,8 @@ from ..sky import LIGHT_AT_NIGHT
 from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
-__all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude", "refuse_repairs"]
+__all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude",
+           "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
 LIMITS = {"ghi": (-50.0, 1500.0), "dni": (-50.0, 1400.0), "dhi": (-50.0, 1000.0), "wind_speed": (-0.5, 75.0),
@@ -206,7 +207,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
     GHI or DHI that stays darker than any sky while the sun is high is refused too
     (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column).
     """
-    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy)
+    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
     judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
     for name in judged:
@@ -254,23 +255,66 @@ def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, cle
 #: W/m² of direct light on the horizontal (GHI - DHI) that only a direct beam of as much again or
 #: more gives: a DNI that stays at 1.5 or less beside it is in kW/m².
 BEAM_SEEN = 100.0
+#: Share of the clear sky (Haurwitz) that GHI reaches only with the sun out: at such a clearness
+#: two thirds or more of GHI is beam (Erbs, Klein & Duffie 1982, doi:10.1016/0038-092X(82)90302-4).
+SUN_OUT = 0.8
 
 
-def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict, remedy: str) -> None:
-    """Refuse DNI of at most 1.5 while GHI - DHI shows a direct beam of `BEAM_SEEN` W/m² or more:
-    kW/m² beside W/m² columns had been read as W/m², the file called clean, and a clear day
-    replayed as overcast (the magnitude check judges DNI alone only without GHI and DHI)."""
-    if not {"ghi", "dhi", "dni"} <= set(frame.columns):
+def _horizontal_beam(frame: pd.DataFrame, clear_ghi: np.ndarray | None) -> tuple[np.ndarray, str] | None:
+    """Direct light on the horizontal the file shows, and how it was seen: GHI - DHI, or, without
+    DHI but with the site's clear sky, GHI where it reaches `SUN_OUT` of the clear sky."""
+    if "dhi" in frame:
+        return (frame["ghi"] - frame["dhi"]).to_numpy(float), "ghi - dhi reaches"
+    if clear_ghi is None:
+        return None
+    ghi = frame["ghi"].to_numpy(float)
+    seen = np.where(ghi >= SUN_OUT * np.asarray(clear_ghi), ghi, np.nan)
+    return seen, f"ghi, at {SUN_OUT:.0%} of the clear sky, reaches"
+
+
+def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict, remedy: str,
+                                  clear_ghi: np.ndarray | None) -> None:
+    """Refuse DNI of at most 1.5 while GHI shows a direct beam of `BEAM_SEEN` W/m² or more
+    (`_horizontal_beam`): kW/m² beside W/m² columns had been read as W/m², the file called clean,
+    and a clear day replayed as overcast (the magnitude check judges DNI alone only without GHI
+    and DHI). Without DHI a DNI of 0 all day is refused too (a dead pyrheliometer): DHI derived
+    from it is GHI itself, and no closure check can see it."""
+    if not {"ghi", "dni"} <= set(frame.columns):
         return
-    dni, beam = frame["dni"].to_numpy(float), (frame["ghi"] - frame["dhi"]).to_numpy(float)
-    if not (np.isfinite(dni).any() and np.isfinite(beam).any()):
+    beam = _horizontal_beam(frame, clear_ghi)
+    dni = frame["dni"].to_numpy(float)
+    if beam is None or not (np.isfinite(dni).any() and np.isfinite(beam[0]).any()):
         return
-    top, seen = float(np.nanmax(dni)), float(np.nanmax(beam))
-    if 0.0 < top <= 1.5 and seen >= BEAM_SEEN:
+    top, seen = float(np.nanmax(dni)), float(np.nanmax(beam[0]))
+    lowest = 0.0 if "dhi" in frame else -np.inf
+    if lowest < top <= 1.5 and seen >= BEAM_SEEN:
         header = report.get("columns", {}).get("dni", "dni")
-        raise HybridtrackError(f"{path}: column {header!r}: dni is at most {top:g} while ghi - dhi reaches {seen:.0f} "
-                               f"W/m² (a direct beam); the values look like kW/m² read as W/m²: "
-                               f"{remedy.format(name='dni')}")
+        why = ("is the pyrheliometer dead or off the sun? remove the column from the file to derive DNI from GHI"
+               if top <= 0.0 else f"the values look like kW/m² read as W/m²: {remedy.format(name='dni')}")
+        raise HybridtrackError(f"{path}: column {header!r}: dni is at most {top:g} while {beam[1]} {seen:.0f} "
+                               f"W/m² (a direct beam); {why}")
+
+
+def check_derived(path: Path, frame: pd.DataFrame, name: str, report: dict) -> None:
+    """Judge a component derived from the others (`hybridtrack.io.gapfill`) by `LIMITS` as a
+    measured one is: most of its daylight values beyond them refuse the file, a few are set to NaN
+    and counted as impossible. DHI derived from kW/m² DNI beside GHI had reached 1100 W/m²."""
+    low, high = LIMITS[name]
+    values = frame[name].to_numpy(float)
+    bad = np.isfinite(values) & ((values < low) | (values > high))
+    if not bad.any():
+        return
+    lit = int((bad | (values > DARKEST)).sum())
+    line = first_lines(frame, bad)
+    where = f"line {line[0]}, " if line else ""
+    if bad.sum() > 0.5 * lit:
+        raise HybridtrackError(f"{path}: {where}{name} derived from the other components is outside "
+                               f"{low:g}..{high:g} W/m² in {bad.sum()} of {lit} daylight rows, first "
+                               f"{values[bad][0]:.0f}; is a measured column in a wrong unit (kW/m²?) or its sensor "
+                               "dead?")
+    report.setdefault("impossible", {})[name] = {"count": int(bad.sum()), "lines": line,
+                                                 "first": float(values[bad][0]), "action": "set to NaN (derived)"}
+    frame[name] = np.where(bad, np.nan, values)
 
 
 def refuse_repairs(path: Path, report: dict) -> None:

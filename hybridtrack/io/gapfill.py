@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
+from .checks import check_derived
 from .columns import IRRADIANCE
 
 __all__ = ["DECOMPOSITIONS", "fill_components"]
@@ -59,13 +60,15 @@ def _decompose(ghi: pd.Series, zenith: pd.Series, method: str) -> tuple[pd.Serie
     return dni, ghi - dni.fillna(0.0) * cos_z
 
 
-def _store(frame: pd.DataFrame, name: str, values: pd.Series, source: str, attrs: dict, report: dict) -> None:
+def _store(path: Path, frame: pd.DataFrame, name: str, values: pd.Series, source: str, attrs: dict,
+           report: dict) -> None:
     values = pd.Series(np.asarray(values, float), index=frame.index)
     empty = values.isna() & frame[[c for c in IRRADIANCE if c in frame]].notna().all(axis=1)
     frame[name] = values.where(~empty, 0.0).clip(lower=0.0)
     attrs[f"{name}_source"] = source
     report.setdefault("filled", {})[name] = {"count": int(len(frame)), "how": source,
                                              "zero_where_undefined": int(empty.sum())}
+    check_derived(path, frame, name, report)
 
 
 def fill_components(path: Path, frame: pd.DataFrame, site, decomposition: str, attrs: dict,
@@ -115,11 +118,11 @@ def fill_components(path: Path, frame: pd.DataFrame, site, decomposition: str, a
     zenith = solar_position(frame.index, site)["zenith"]  # true zenith, as pvlib documents for each
     frame = frame.copy()
     if len(present) == 2:
-        _store(frame, missing[0], _closure(frame, zenith, missing[0]), f"closure with {' and '.join(present)} "
+        _store(path, frame, missing[0], _closure(frame, zenith, missing[0]), f"closure with {' and '.join(present)} "
                "(pvlib.irradiance.complete_irradiance, true zenith)", attrs, report)
         return frame
     dni, dhi = _decompose(frame["ghi"], zenith, decomposition)
     how = f"{decomposition} decomposition of GHI (pvlib.irradiance.{decomposition}, true zenith)"
-    _store(frame, "dni", dni, how, attrs, report)
-    _store(frame, "dhi", dhi, how, attrs, report)
+    _store(path, frame, "dni", dni, how, attrs, report)
+    _store(path, frame, "dhi", dhi, how, attrs, report)
     return frame
