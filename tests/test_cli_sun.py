@@ -58,3 +58,18 @@ def test_a_closed_pipe_is_not_an_error(tmp_path):
     run = subprocess.run(f'"{sys.executable}" -c "{script}" sun --date 2013-06-21 --freq 1min | head -n 2',
                          shell=True, capture_output=True, text=True)
     assert run.stdout.count("\n") == 2 and "error" not in run.stderr
+
+
+def test_one_step_with_the_sun_up_has_no_rate_and_no_warning(capsys):
+    """05:00 and 05:50 are before sunrise at Lanzhou on 21 June, 06:40 after: one step with the sun
+    up gives no rate; 'nan °/min' and numpy's All-NaN RuntimeWarning had been printed."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["sun", "--site", "lanzhou", "--date", "2021-06-21", "--start", "05:00", "--end", "06:40",
+                     "--freq", "50min"]) == 0
+    captured = capsys.readouterr()
+    assert "sun up in range 06:40-06:40" in captured.out
+    assert "  fastest target rate: needs two steps with the sun up\n" in captured.out
+    assert "nan" not in captured.out and captured.err == ""

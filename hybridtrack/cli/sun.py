@@ -35,6 +35,15 @@ def _sun_arguments(parser: argparse.ArgumentParser) -> None:
     add_force_argument(parser)
 
 
+def _fastest_rate(rate: pd.Series) -> str:
+    """The summary's rate line: the fastest target rate, or why there is none (a rate needs two
+    steps in a row with the sun up; nan and numpy's All-NaN warning had been printed)."""
+    rates = np.abs(rate.to_numpy(float))
+    if not np.isfinite(rates).any():
+        return "fastest target rate: needs two steps with the sun up"
+    return f"fastest target rate {np.nanmax(rates):.3f} °/min"
+
+
 @command("sun", "sun position and collector target angles over a day", _sun_arguments)
 def _sun(args: argparse.Namespace) -> int:
     from ..collectors import Collector
@@ -63,7 +72,7 @@ def _sun(args: argparse.Namespace) -> int:
         print(f"  sun up in range {up.index[up.to_numpy()][0]:%H:%M}-{up.index[up.to_numpy()][-1]:%H:%M}; "
               f"highest {position['altitude'].max():.3f}° at {peak:%H:%M:%S}")
         if "rate" in angles:
-            print(f"  fastest target rate {np.nanmax(np.abs(angles['rate'])):.3f} °/min")
+            print(f"  {_fastest_rate(angles['rate'])}")
     else:
         print("  the sun stays below the horizon in this range")
     if args.plot:
