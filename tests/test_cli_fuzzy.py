@@ -150,3 +150,26 @@ def test_tune_refuses_an_empty_score_cell(tmp_path, capsys):
     assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
                  "--seeds", "1"]) == 2
     assert f"{labels}: row 3, column 'score': empty" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", ["classify", "rules"])
+@pytest.mark.parametrize("intensity, variation, message", [
+    ("-500", "20", "--intensity must be 0 or more (a photocurrent in mA is never below zero), got -500"),
+    ("100", "-20", "--variation must be 0 or more (a variation is a range, max - min, never below zero), got -20"),
+])
+def test_a_negative_reading_is_refused_in_one_line(capsys, command, intensity, variation, message):
+    # 'classify --intensity -500 --variation -20' had printed 'score 5.007 -> overcast', status 0
+    assert main([command, f"--intensity={intensity}", f"--variation={variation}"]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
+
+
+@pytest.mark.parametrize("command", ["classify", "tune"])
+def test_a_negative_cell_is_refused_by_row_and_column(tmp_path, capsys, command):
+    # negative labels had been fitted, and negative cells classified
+    src = tmp_path / "labels.csv"
+    src.write_text("intensity,variation,weather\n246,27,sunny\n60,-3,overcast\n")
+    extra = ["--out", str(tmp_path / "t.toml"), "--folds", "0", "--seeds", "1"] if command == "tune" else []
+    assert main([command, str(src), *extra]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {src}: row 3, column 'variation': -3 is no reading; "
+                                       "a variation is a range, max - min, never below zero\n")
+    assert not (tmp_path / "t.toml").exists()

@@ -46,11 +46,16 @@ def load_fuzzy_config(path):
 
 def check_reading(args: argparse.Namespace) -> None:
     """Refuse an ``--intensity`` or ``--variation`` that is not a finite number (NaN fires no
-    rule; an infinite one would be clipped to the end of its range)."""
+    rule; an infinite one would be clipped to the end of its range) or is below zero (no reading:
+    ``--intensity -500 --variation -20`` had been classified overcast)."""
+    from ..fuzzy.classifier import NEVER_NEGATIVE
+
     for name in ("intensity", "variation"):
         value = getattr(args, name)
         if value is not None and not math.isfinite(value):
             raise HybridtrackError(f"--{name} must be a finite number, got {value}")
+        if value is not None and value < 0.0:
+            raise HybridtrackError(f"--{name} must be 0 or more ({NEVER_NEGATIVE[name]}), got {value:g}")
 
 
 def _classify_arguments(parser: argparse.ArgumentParser) -> None:
@@ -76,6 +81,7 @@ def _classify(args: argparse.Namespace) -> int:
 
 def _classify_readings(args: argparse.Namespace) -> int:
     from ..fuzzy import FuzzyWeatherClassifier
+    from ..fuzzy.classifier import refuse_negative_readings
 
     clf = FuzzyWeatherClassifier(load_fuzzy_config(args.config))
     if args.file is None:
@@ -93,6 +99,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
         if column not in table.columns:
             raise HybridtrackError(f"{args.file}: no column {column!r}; columns are {', '.join(table.columns)}")
     readings = numeric_columns(table[wanted], wanted, str(args.file))
+    refuse_negative_readings(readings, wanted, str(args.file))
     table["sky_score"] = clf.score(readings[wanted[0]].to_numpy(), readings[wanted[1]].to_numpy(), engine=args.engine)
     table["sky"] = clf.label(table["sky_score"].to_numpy())
     if args.out:

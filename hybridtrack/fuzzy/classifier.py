@@ -13,7 +13,8 @@ from ..errors import HybridtrackError
 from .config import FuzzyConfig
 from .engine import CompiledSystem, evaluate_fast, evaluate_skfuzzy
 
-__all__ = ["FuzzyWeatherClassifier", "Explanation", "UNKNOWN", "ENGINES"]
+__all__ = ["FuzzyWeatherClassifier", "Explanation", "UNKNOWN", "ENGINES", "NEVER_NEGATIVE",
+           "refuse_negative_readings"]
 
 #: The label given when no rule fires or an input is missing.
 UNKNOWN = "unknown"
@@ -53,9 +54,37 @@ class Explanation:
         return "\n".join(lines)
 
 
-def _readings(values, name: str) -> np.ndarray:
+#: Why a raw reading is never below zero, by input.
+NEVER_NEGATIVE = {"intensity": "a photocurrent in mA is never below zero",
+                  "variation": "a variation is a range, max - min, never below zero"}
+
+
+def refuse_negative_readings(frame: pd.DataFrame, columns, where: str) -> None:
+    """Refuse a table's first raw reading below zero in `columns`, by its row and column.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Readings as numbers (`hybridtrack.io.numeric_columns`).
+    columns : iterable of str
+        The intensity and variation columns, in that order.
+    where : str
+        The file, for the message.
+    """
+    from ..io import table_row
+
+    for column, name in zip(columns, NEVER_NEGATIVE):
+        negative = frame[column].to_numpy(float) < 0.0
+        if negative.any():
+            row = int(np.flatnonzero(negative)[0])
+            raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: "
+                                   f"{frame[column].iloc[row]:g} is no reading; {NEVER_NEGATIVE[name]}")
+
+
+def _readings(values, name: str, raw: bool) -> np.ndarray:
     """`values` as a float array of readings: real numbers, NaN where there is no reading. Text
-    ('246'), True and an infinite reading had been taken (inf mA as the brightest sun)."""
+    ('246'), True and an infinite reading had been taken (inf mA as the brightest sun), and a
+    raw reading below zero (`NEVER_NEGATIVE`) as the darkest sky."""
     array = np.asarray(values.to_numpy() if isinstance(values, pd.Series) else values)
     if array.dtype.kind == "O" and all(isinstance(v, numbers.Real) and not isinstance(v, bool) or v is None
                                        for v in array.flat):
@@ -65,6 +94,9 @@ def _readings(values, name: str) -> np.ndarray:
     array = array.astype(float, copy=False)
     if np.isinf(array).any():
         raise HybridtrackError(f"{name} must be finite (NaN where there is no reading), got inf")
+    if raw and (array < 0.0).any():
+        raise HybridtrackError(f"{name} must be 0 or more as a raw reading ({NEVER_NEGATIVE[name]}), got "
+                               f"{array[array < 0.0].flat[0]:g}")
     return array
 
 
@@ -104,7 +136,7 @@ class FuzzyWeatherClassifier:
                 not intensity.index.equals(variation.index):
             raise HybridtrackError("intensity and variation are Series on different indexes; align them first "
                                    "(numpy would pair them by position)")
-        readings = _readings(intensity, "intensity"), _readings(variation, "variation")
+        readings = _readings(intensity, "intensity", raw), _readings(variation, "variation", raw)
         try:
             a, b = np.broadcast_arrays(*readings)
         except ValueError as exc:

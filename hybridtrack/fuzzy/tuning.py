@@ -40,7 +40,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from ..params import number
-from .classifier import FuzzyWeatherClassifier
+from .classifier import FuzzyWeatherClassifier, refuse_negative_readings
 from .config import FuzzyConfig, Term
 
 __all__ = ["tune", "check_margin", "TuningReport", "read_samples", "evaluate", "cross_validate",
@@ -131,7 +131,7 @@ def read_samples(source) -> pd.DataFrame:
 
     Columns: ``intensity``, ``variation`` (raw mA), and ``weather`` and/or ``score``;
     optional ``tolerance`` (used by rule-table tests). Every reading, label and score must be
-    given: an empty or infinite cell is refused by its row and column.
+    given: an empty or infinite cell, or a reading below zero, is refused by its row and column.
     """
     if isinstance(source, pd.DataFrame):
         frame, where = source.copy(), "samples"
@@ -153,8 +153,10 @@ def read_samples(source) -> pd.DataFrame:
         raise HybridtrackError(f"{where}: row {table_row(frame, int(np.flatnonzero(frame['weather'].isna())[0]))}, "
                                "column 'weather': empty")
 
-    return numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where,
-                           required=("intensity", "variation", "score"))
+    frame = numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where,
+                            required=("intensity", "variation", "score"))
+    refuse_negative_readings(frame, ("intensity", "variation"), where)
+    return frame
 
 
 def evaluate(config: FuzzyConfig, samples: pd.DataFrame, margin: float = 0.5) -> dict:
