@@ -81,10 +81,12 @@ def refuse_negative_readings(frame: pd.DataFrame, columns, where: str) -> None:
                                    f"{frame[column].iloc[row]:g} is no reading; {NEVER_NEGATIVE[name]}")
 
 
-def _readings(values, name: str, raw: bool) -> np.ndarray:
+def _readings(values, name: str) -> np.ndarray:
     """`values` as a float array of readings: real numbers, NaN where there is no reading. Text
-    ('246'), True and an infinite reading had been taken (inf mA as the brightest sun), and a
-    raw reading below zero (`NEVER_NEGATIVE`) as the darkest sky."""
+    ('246'), True and an infinite reading had been taken (inf mA as the brightest sun). A reading
+    below zero is clipped onto the input's range, as any reading past it: a recorded photocurrent
+    below zero is a logger's offset a run survives (`hybridtrack.faults`); the command line, where
+    a person types or files readings, refuses it (`refuse_negative_readings`)."""
     array = np.asarray(values.to_numpy() if isinstance(values, pd.Series) else values)
     if array.dtype.kind == "O" and all(isinstance(v, numbers.Real) and not isinstance(v, bool) or v is None
                                        for v in array.flat):
@@ -94,9 +96,6 @@ def _readings(values, name: str, raw: bool) -> np.ndarray:
     array = array.astype(float, copy=False)
     if np.isinf(array).any():
         raise HybridtrackError(f"{name} must be finite (NaN where there is no reading), got inf")
-    if raw and (array < 0.0).any():
-        raise HybridtrackError(f"{name} must be 0 or more as a raw reading ({NEVER_NEGATIVE[name]}), got "
-                               f"{array[array < 0.0].flat[0]:g}")
     return array
 
 
@@ -136,7 +135,7 @@ class FuzzyWeatherClassifier:
                 not intensity.index.equals(variation.index):
             raise HybridtrackError("intensity and variation are Series on different indexes; align them first "
                                    "(numpy would pair them by position)")
-        readings = _readings(intensity, "intensity", raw), _readings(variation, "variation", raw)
+        readings = _readings(intensity, "intensity"), _readings(variation, "variation")
         try:
             a, b = np.broadcast_arrays(*readings)
         except ValueError as exc:
