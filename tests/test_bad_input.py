@@ -473,9 +473,10 @@ def test_simulates_options_of_another_kind_are_refused_by_name(options, message)
 
 def test_an_earlier_runs_memory_is_still_taken_whole():
     day = _small_day()
+    following = day.set_axis(day.index + pd.Timedelta(days=1))  # a memory carries forward in time
     for strategy in ("hybrid", "astronomical-commissioned"):
         memory = simulate(day, "lanzhou", strategy=strategy).memory
-        assert simulate(day, "lanzhou", strategy=strategy, warm_start=memory).summary["steps"] == len(day)
+        assert simulate(following, "lanzhou", strategy=strategy, warm_start=memory).summary["steps"] == len(day)
 
 
 @pytest.mark.parametrize("argv, option", [
