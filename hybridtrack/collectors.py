@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
-from .params import number
+from .params import finite_array, number
 
 __all__ = [
     "Collector",
@@ -90,13 +90,8 @@ def checked_sun(altitude, azimuth, function: str) -> tuple[np.ndarray, np.ndarra
 
 def _degrees(values, name: str, function: str) -> np.ndarray:
     """`values` as a float array of angles: real numbers (NaN allowed), never infinite."""
-    array = np.asarray(values.to_numpy() if isinstance(values, (pd.Series, pd.DataFrame)) else values)
-    if array.dtype.kind not in "fiu":
-        raise HybridtrackError(f"{function}: {name} must be numbers (degrees), got {values!r:.60}")
-    array = array.astype(float, copy=False)
-    if np.isinf(array).any():
-        raise HybridtrackError(f"{function}: {name} must be finite degrees (NaN where there is no sun), got inf")
-    return array
+    return finite_array(values, not_numbers=f"{function}: {name} must be numbers (degrees)",
+                        infinite=f"{function}: {name} must be finite degrees (NaN where there is no sun)")
 
 
 def _vectors(function: str, values, name: str) -> np.ndarray:
@@ -115,11 +110,15 @@ def _vectors(function: str, values, name: str) -> np.ndarray:
 def sun_vector(altitude, azimuth) -> np.ndarray:
     """Unit vectors towards the sun, shape ``(..., 3)`` in (east, north, up)."""
     _broadcast("sun_vector", altitude=altitude, azimuth=azimuth)
-    return _unit_vectors(*checked_sun(altitude, azimuth, "sun_vector"))
+    return direction_vectors(*checked_sun(altitude, azimuth, "sun_vector"))
 
 
-def _unit_vectors(altitude: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
-    """`sun_vector` of a position `checked_sun` has checked already (float arrays, degrees)."""
+def direction_vectors(altitude: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
+    """Unit vectors ``(..., 3)`` in (east, north, up) at `altitude` above the horizon and `azimuth`
+    from north (float arrays, degrees), without `sun_vector`'s checks: for a sun position checked
+    already, or an axis's angles, which may stand past the zenith (a heliostat's elevation axis
+    parked at 90° with its encoder's offset stood at 90.01°, and a 1,000-mirror field's scoring
+    had refused it as no sun)."""
     a, g = np.radians(altitude), np.radians(azimuth)
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
@@ -141,7 +140,7 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
 
 def _cross_axis_angle(altitude, azimuth, axis_azimuth) -> np.ndarray:
     """Angle of the sun's projection on the plane across a horizontal axis (0-180°)."""
-    angle = across_angle(_unit_vectors(altitude, azimuth), axis_azimuth)
+    angle = across_angle(direction_vectors(altitude, azimuth), axis_azimuth)
     return np.where(np.asarray(altitude, float) >= 0.0, angle, np.nan)
 
 
@@ -330,7 +329,7 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
     _broadcast("heliostat_normal", altitude=altitude, azimuth=azimuth, aim_points=target[..., 0])
     alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
-    s = _unit_vectors(alt, az) if sun is None else sun
+    s = direction_vectors(alt, az) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
     n = np.where((alt < 0.0)[..., None], np.nan, n)

@@ -14,6 +14,7 @@ import os
 import re
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from .errors import HybridtrackError
@@ -121,3 +122,25 @@ def path(value, what: str) -> Path:
     if "\0" in text:
         raise HybridtrackError(f"{what} must be a path, got {text!r:.80}, which holds a NUL character")
     return Path(os.path.expanduser(text))
+
+
+def _real(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def finite_array(values, *, not_numbers: str, infinite: str) -> np.ndarray:
+    """`values` (a Series, frame, array, list or number) as a float array of real numbers, NaN
+    where a value is missing (a None among numbers in a list too); refused with ``"<not_numbers>, got ..."``
+    unless numbers (text, True and complex numbers are not) and ``"<infinite>, got inf"`` where
+    one is infinite."""
+    array = np.asarray(values.to_numpy() if isinstance(values, (pd.Series, pd.DataFrame)) else values)
+    cells = list(array.flat) if array.dtype.kind == "O" else []
+    if any(_real(v) for v in cells) and all(_real(v) or v is None for v in cells):
+        array = array.astype(float)  # Python's numbers in a list with a None: None is missing (None alone is not)
+    if array.dtype.kind not in "fiu":
+        raise HybridtrackError(f"{not_numbers}, got {values!r:.60}")
+    array = array.astype(float, copy=False)
+    if np.isinf(array).any():
+        raise HybridtrackError(f"{infinite}, got inf")
+    return array
+

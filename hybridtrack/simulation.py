@@ -431,8 +431,8 @@ def _pointing_column(frame: pd.DataFrame, column: str) -> None:
     with np.errstate(invalid="ignore"):
         bad = np.flatnonzero(np.isinf(array) | (np.abs(array) > POINTING_LIMIT))
     if len(bad):
-        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g}° is "
-                               f"no sun sensor's offset (beyond ±{POINTING_LIMIT:g}°: milliradians, or arcminutes?)")
+        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g}° "
+                               f"is no sun sensor's offset (beyond ±{POINTING_LIMIT:g}°: milliradians, or arcminutes?)")
 
 
 def checked_config(config) -> SimulationConfig:
@@ -982,14 +982,14 @@ def _sky_categorical(codes: np.ndarray, names: tuple[str, ...]) -> pd.Categorica
 def _pointing_error(collector: Collector, world: World) -> np.ndarray:
     """The pointing error at each scan (degrees): a single axis' angle less its true target; a
     heliostat's angle between its actual and its required mirror normal."""
-    from .collectors import sun_vector
+    from .collectors import direction_vectors
 
     truth, angle = world.truth, world.angles.T
     if collector.single_axis:  # within ±180°: an axis whose limits pass a turn stands a turn off its target
         error = angle[:, 0] - truth[:, 0]
         return np.where(np.abs(error) > 180.0, (error + 180.0) % 360.0 - 180.0, error)
-    actual = sun_vector(angle[:, 1], angle[:, 0])
-    wanted = sun_vector(truth[:, 1], truth[:, 0])
+    actual = direction_vectors(angle[:, 1], angle[:, 0])  # the axes may stand past the zenith
+    wanted = direction_vectors(truth[:, 1], truth[:, 0])
     return np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
 
 

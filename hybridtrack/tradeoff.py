@@ -109,7 +109,7 @@ def _day(day: dict, plan: TradeoffPlan, config) -> list[dict]:
 def held_error(result) -> tuple[float, float]:
     """DNI-weighted RMS and p95 of the pointing error between scans, degrees: from each scan to the
     next the collector holds its angle while the true target moves on (see the module's notes)."""
-    from .collectors import sun_vector
+    from .collectors import direction_vectors
     from .metrics import TRACKING_MODES, weighted_quantile
     from .mounting import incidence_cosine
     from .sun import solar_position
@@ -132,8 +132,8 @@ def held_error(result) -> tuple[float, float]:
     if single:
         error = np.abs(held[0][:, None] - wanted[0])
     else:  # the angle between the held and the wanted mirror normal
-        actual = sun_vector(np.repeat(held[0], SUBSTEPS), np.repeat(held[1], SUBSTEPS))
-        target = sun_vector(wanted[0].ravel(), wanted[1].ravel())
+        actual = direction_vectors(np.repeat(held[0], SUBSTEPS), np.repeat(held[1], SUBSTEPS))  # past the zenith too
+        target = direction_vectors(wanted[0].ravel(), wanted[1].ravel())
         error = np.degrees(np.arccos(np.clip(np.sum(actual * target, axis=1), -1.0, 1.0))).reshape(-1, SUBSTEPS)
     scored = (log["mode"].isin(TRACKING_MODES).to_numpy()[:-1] & (beam[:-1] > 0)
               & np.isfinite(error).all(axis=1))

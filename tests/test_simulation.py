@@ -530,3 +530,13 @@ def test_a_sensor_noise_that_underflows_the_mount_fit_is_refused():
     and LAPACK's SVD failed mid-run ('SVD did not converge')."""
     with pytest.raises(HybridtrackError, match=r"controller: sensor_noise = 1e-200 is outside \[0.0001, 5\]"):
         ControllerConfig(sensor_noise=1e-200)
+
+
+def test_a_heliostat_whose_elevation_axis_stands_past_the_zenith_is_scored():
+    """Parked at 90° with an encoder offset of -0.05°, the elevation axis stands at 90.05°: the
+    scoring refused it as no sun position ('altitude must be within [-90, 90]'), and a
+    1,000-mirror field-year failed on the mirrors drawn so."""
+    day = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=1)
+    config = SimulationConfig(imperfections=Imperfections(encoder_offset=-0.05))
+    result = simulate(day, "lanzhou", collector="heliostat", config=config)
+    assert result.log["angle"].max() > 90.0 and 0 < result.summary["tracking_error_deg"]["rms"] < 0.5

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import numbers
-
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
+from ..params import finite_array
 from .config import FuzzyConfig
 from .engine import CompiledSystem, evaluate_fast, evaluate_skfuzzy
 
@@ -87,16 +86,8 @@ def _readings(values, name: str) -> np.ndarray:
     below zero is clipped onto the input's range, as any reading past it: a recorded photocurrent
     below zero is a logger's offset a run survives (`hybridtrack.faults`); the command line, where
     a person types or files readings, refuses it (`refuse_negative_readings`)."""
-    array = np.asarray(values.to_numpy() if isinstance(values, pd.Series) else values)
-    if array.dtype.kind == "O" and all(isinstance(v, numbers.Real) and not isinstance(v, bool) or v is None
-                                       for v in array.flat):
-        array = array.astype(float)  # Python's numbers in a list with a None: None is no reading
-    if array.dtype.kind not in "fiu":
-        raise HybridtrackError(f"{name} must be numbers (NaN where there is no reading), got {values!r:.60}")
-    array = array.astype(float, copy=False)
-    if np.isinf(array).any():
-        raise HybridtrackError(f"{name} must be finite (NaN where there is no reading), got inf")
-    return array
+    return finite_array(values, not_numbers=f"{name} must be numbers (NaN where there is no reading)",
+                        infinite=f"{name} must be finite (NaN where there is no reading)")
 
 
 class FuzzyWeatherClassifier:
