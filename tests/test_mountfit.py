@@ -123,8 +123,8 @@ def test_a_fit_readings_variance_grows_as_the_worlds_sensor_noise_does_with_less
     from hybridtrack.simulation import _drives
 
     frame = synthetic("nanjing", "2013-06-21 08:00", "2013-06-21 08:10", weather="sunny", seed=1)
-    model = SensorModel(noise=0.05)
-    config = SimulationConfig(sensor=model)
+    model = SensorModel(noise=0.05)  # the sensor read here; a run's world takes imperfections.sensor_noise
+    config = SimulationConfig()
     collector = Collector("trough-ns")
     plan = make_plan(frame.index, np.arange(len(frame), dtype=float), sites.get("nanjing"), collector,
                      config.controller)
