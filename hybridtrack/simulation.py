@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextvars
 import dataclasses
+import functools
 import threading
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
@@ -77,8 +78,8 @@ def _refuse_unread(config) -> None:
     or ``[heliostat_drive] stow`` (or swept ``sensor.window``) got the default's results without a
     word. The message says what the run reads instead."""
     for (part, name), instead in UNREAD.items():
-        value, default = getattr(getattr(config, part), name), getattr(_DEFAULT_PARTS[part](), name)
-        if value != default:
+        value = getattr(getattr(config, part), name)
+        if value != _unread_default(part, name):
             raise HybridtrackError(f"config: {part}.{name} = {value!r} is not read by a run; it reads {instead}")
 
 
@@ -223,6 +224,13 @@ _PART_KINDS = {"controller": ControllerConfig, "imperfections": Imperfections, "
 #: Each part's default, by the part's name.
 _DEFAULT_PARTS = {f.name: f.default_factory for f in dataclasses.fields(SimulationConfig)
                   if f.default_factory is not dataclasses.MISSING}
+
+
+@functools.cache
+def _unread_default(part: str, name: str):
+    """The default of an `UNREAD` field, made once (a config is made for every collector of a field
+    and every day of a stream)."""
+    return getattr(_DEFAULT_PARTS[part](), name)
 
 
 @dataclass
@@ -553,14 +561,8 @@ class Tracked:
     def scores(self, events: pd.DataFrame) -> dict:
         """The summary's scores (`hybridtrack.metrics.score`) without building the log: from the
         pointing error, the modes, the DNI and the angles alone."""
-        angle = self.world.angles
-        columns = {"dni": self.world.frame_dni, "error": _pointing_error(self.collector, self.world),
-                   "mode": pd.Categorical.from_codes(self.out.mode, categories=list(MODES)), "angle": angle[-1]}
-        if not self.collector.single_axis:
-            columns["angle_azimuth"] = angle[0] % 360.0
-        log = pd.DataFrame(columns, index=self.index, copy=False)
-        scoring = self.scoring()
-        return score(log, collector=self.collector.kind, events=events, **scoring)
+        log = pd.DataFrame(_scored_columns(self.collector, self.world, self.out), index=self.index, copy=False)
+        return score(log, collector=self.collector.kind, events=events, **self.scoring())
 
 
 def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
@@ -993,23 +995,34 @@ def _pointing_error(collector: Collector, world: World) -> np.ndarray:
     return np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
 
 
+def _scored_columns(collector: Collector, world: World, out) -> dict:
+    """The log columns the metrics read (`hybridtrack.metrics.score`): ``dni``, ``error``,
+    ``mode``, ``angle`` (a heliostat's elevation) and a heliostat's ``angle_azimuth`` (within a
+    turn), each the run's own array; `_log` and `Tracked.scores` both take them from here."""
+    angle = world.angles
+    columns = {"angle": angle[-1].copy(), "error": _pointing_error(collector, world),
+               "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)), "dni": world.frame_dni.copy()}
+    if not collector.single_axis:
+        columns["angle_azimuth"] = angle[0] % 360.0  # the axis may have wound past a turn
+    return columns
+
+
 def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> pd.DataFrame:
     """The run's log, one row a scan. Its columns are taken as they are, not copied into one
     block (a heliostat's 26 columns over a year took 0.06 s to copy): every array is the run's
     own, and those read from a frame (which pandas hands out read-only) are copied, so an edit of
     the log works and edits nothing else."""
     truth = world.truth
-    angle = world.angles.T
     main = 0 if collector.single_axis else 1  # a heliostat's main columns are its elevation axis
-    error = _pointing_error(collector, world)
+    scored = _scored_columns(collector, world, out)
     columns = {
-        "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": angle[:, main].copy(),
-        "error": error, "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)),
+        "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": scored["angle"],
+        "error": scored["error"], "mode": scored["mode"],
         "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(copy=True),
         "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical.from_codes(out.sensor_status, categories=list(SENSOR_STATUS)),
         "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(copy=True),
-        "wind_speed": world.wind.copy(), "dni": world.frame_dni.copy(), "calibration": out.calibration[:, main],
+        "wind_speed": world.wind.copy(), "dni": scored["dni"], "calibration": out.calibration[:, main],
         "sensor_sun": out.sun[:, main],
     }
     for k, name in enumerate(parameter_names(collector)[:out.fit.shape[1]]):
@@ -1019,6 +1032,6 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
         columns.update({
             "target_true_azimuth": truth[:, 0].copy(),
             "target_azimuth": out.target[:, 0] % 360.0,  # the axis may have wound past a turn
-            "angle_azimuth": angle[:, 0] % 360.0, "calibration_azimuth": out.calibration[:, 0],
+            "angle_azimuth": scored["angle_azimuth"], "calibration_azimuth": out.calibration[:, 0],
             "sensor_sun_azimuth": out.sun[:, 0]})
     return pd.DataFrame(columns, index=index, copy=False)

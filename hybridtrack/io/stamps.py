@@ -248,13 +248,13 @@ def _written_offsets(iso: pd.Series, report: dict) -> pd.Series:
     logger means it. The report says how they were read (``offset_written``)."""
     tails = [tail for tail in iso.str.slice(-16).unique()  # a few distinct endings, however long the file
              if ")" in tail or "UTC" in tail or "GMT" in tail]
-    noted = next((_ZONE_NOTE.search(tail) for tail in tails if _ZONE_NOTE.search(tail)), None)
+    noted = next(filter(None, map(_ZONE_NOTE.search, tails)), None)
     if noted is not None:
         report["offset_written"] = f"{noted[0]!r}: the zone's name ignored, the offset kept"
         iso = iso.str.replace(_ZONE_NOTE, r"\1", regex=True)
     if any(tail.endswith(("UTC", "GMT")) for tail in tails):
         iso = iso.str.replace(r"\s*(UTC|GMT)$", "+00:00", regex=True)
-    named = next((_NAMED_OFFSET.search(tail) for tail in tails if _NAMED_OFFSET.search(tail)), None)
+    named = next(filter(None, map(_NAMED_OFFSET.search, tails)), None)
     if named is not None:
         report["offset_written"] = (f"{named[0].strip()!r} read as UTC{_iso_offset(named)} (east of Greenwich is "
                                     "plus, as in ISO 8601; POSIX zone strings invert the sign)")

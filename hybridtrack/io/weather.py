@@ -99,9 +99,7 @@ def _thousands_by_commas(strings: pd.Series, name: str, report: dict) -> pd.Seri
     grouped = strings.str.fullmatch(_COMMA_GROUPED)
     if not grouped[commas].all():
         return strings
-    counts = report.setdefault("thousands_values", {})
-    counts[name] = int(grouped.sum())
-    report["thousands"] = f"',' in {sum(counts.values()):,} values of {', '.join(counts)} (with the decimal point)"
+    _count_thousands(report, name, int(grouped.sum()), "','", "with the decimal point")
     return strings.str.replace(",", "", regex=False)
 
 
@@ -129,10 +127,16 @@ def _thousands_by_dots(column: list[str], values: np.ndarray, name: str, report:
         return values
     values = values.copy()
     values[rows] = [float(cell.replace(".", "")) for cell in text]
-    counts = report.setdefault("thousands_values", {})
-    counts[name] = len(rows)
-    report["thousands"] = f"'.' in {sum(counts.values()):,} values of {', '.join(counts)} (every other value whole)"
+    _count_thousands(report, name, len(rows), "'.'", "every other value whole")
     return values
+
+
+def _count_thousands(report: dict, name: str, count: int, separator: str, why: str) -> None:
+    """Count `name`'s values read with their thousands grouped (``thousands_values``), and say how
+    in the table line (``thousands``)."""
+    counts = report.setdefault("thousands_values", {})
+    counts[name] = count
+    report["thousands"] = f"{separator} in {sum(counts.values()):,} values of {', '.join(counts)} ({why})"
 
 
 def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, report):
