@@ -123,6 +123,18 @@ def direction_vectors(altitude: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
 
+def within_turn(angle: np.ndarray) -> np.ndarray:
+    """`angle` % 360 (degrees, a float array), bit for bit, without numpy's float remainder on
+    every element: that takes ~45 ns an angle below zero and ~110 ns a NaN (0.06 s for a
+    year's azimuths with its nights), against ~10 ns for the add below. Angles within a turn of
+    zero (-360 to 360) add 360 where negative, as the remainder itself does; the rest take it."""
+    within = np.where(angle < 0.0, angle + 360.0, angle + 0.0)  # + 0.0: -0.0 % 360 is 0.0
+    beyond = (angle < -360.0) | (angle >= 360.0)
+    if beyond.any():
+        within[beyond] = angle[beyond] % 360.0
+    return within
+
+
 def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     """Angle (degrees) of vectors ``(..., 3)`` projected on the plane across a horizontal axis.
 
@@ -347,7 +359,7 @@ def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
     horizontal = np.hypot(n[..., 0], n[..., 1])
     if np.any((horizontal == 0.0) & (n[..., 2] == 0.0)):
         raise HybridtrackError("normal_angles: a zero vector has no direction")
-    azimuth = np.degrees(np.arctan2(n[..., 0], n[..., 1])) % 360.0
+    azimuth = within_turn(np.degrees(np.arctan2(n[..., 0], n[..., 1])))
     elevation = np.degrees(np.arctan2(n[..., 2], horizontal))
     return azimuth, elevation
 

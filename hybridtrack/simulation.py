@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from . import params, sites
-from .collectors import Collector, as_collector
+from .collectors import Collector, as_collector, within_turn
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
 from .control.clockwatch import ClockWatch
@@ -989,7 +989,9 @@ def _pointing_error(collector: Collector, world: World) -> np.ndarray:
     truth, angle = world.truth, world.angles.T
     if collector.single_axis:  # within ±180°: an axis whose limits pass a turn stands a turn off its target
         error = angle[:, 0] - truth[:, 0]
-        return np.where(np.abs(error) > 180.0, (error + 180.0) % 360.0 - 180.0, error)
+        wound = np.abs(error) > 180.0  # rare: the remainder on the whole year took 0.07 s (its NaN nights)
+        error[wound] = (error[wound] + 180.0) % 360.0 - 180.0
+        return error
     actual = direction_vectors(angle[:, 1], angle[:, 0])  # the axes may stand past the zenith
     wanted = direction_vectors(truth[:, 1], truth[:, 0])
     return np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
@@ -1003,7 +1005,7 @@ def _scored_columns(collector: Collector, world: World, out) -> dict:
     columns = {"angle": angle[-1].copy(), "error": _pointing_error(collector, world),
                "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)), "dni": world.frame_dni.copy()}
     if not collector.single_axis:
-        columns["angle_azimuth"] = angle[0] % 360.0  # the axis may have wound past a turn
+        columns["angle_azimuth"] = within_turn(angle[0])  # the axis may have wound past a turn
     return columns
 
 
@@ -1031,7 +1033,7 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
     if not collector.single_axis:
         columns.update({
             "target_true_azimuth": truth[:, 0].copy(),
-            "target_azimuth": out.target[:, 0] % 360.0,  # the axis may have wound past a turn
+            "target_azimuth": within_turn(out.target[:, 0]),  # the axis may have wound past a turn
             "angle_azimuth": scored["angle_azimuth"], "calibration_azimuth": out.calibration[:, 0],
             "sensor_sun_azimuth": out.sun[:, 0]})
     return pd.DataFrame(columns, index=index, copy=False)

@@ -185,3 +185,19 @@ def test_geometry_of_another_kind_is_refused_not_ignored(kind, geometry, message
     with pytest.raises(HybridtrackError, match=message):
         Collector(kind, **geometry)
     assert Collector(kind, row_distance=5.0, aim=[0, 20, 100]).kind == kind  # the defaults, however spelled
+
+
+def test_within_turn_is_numpys_remainder_bit_for_bit():
+    """The cheap turn (`within_turn`) gives numpy's own ``% 360`` on every kind of angle: inside a
+    turn either side of zero, far outside it, at the edges, signed zeros, NaN and infinities."""
+    from hybridtrack.collectors import within_turn
+
+    rng = np.random.default_rng(7)
+    edges = [-0.0, 0.0, -1e-20, -5e-324, -360.0, 360.0, -720.0, 720.0, 359.99999999999994, -359.99999999999994,
+             180.0, -180.0, 1e300, -1e300, np.nan, np.inf, -np.inf]
+    angles = np.concatenate([edges, rng.uniform(-360, 360, 10_000), rng.uniform(-1e4, 1e4, 10_000)])
+    with np.errstate(invalid="ignore"):
+        expected = angles % 360.0
+    got = within_turn(angles)
+    assert np.array_equal(got, expected, equal_nan=True)
+    assert np.array_equal(np.signbit(got), np.signbit(expected))
