@@ -41,20 +41,28 @@ def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_az
 
 
 def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,
-                 night: bool = False, vectors: np.ndarray | None = None) -> np.ndarray:
+                  night: bool = False, vectors: np.ndarray | None = None, sun: np.ndarray | None = None) -> np.ndarray:
     """Target angles of a collector on a mount turned by `rotation` (`mounting_rotation`), degrees.
 
     Returns shape (N, 1) for single-axis collectors (trough convention) and (N, 2) for a
     heliostat (normal azimuth and elevation). NaN while the sun is down, unless `night`:
     then the geometry is followed below the horizon too (to pre-position before sunrise).
-    `vectors` are this sun's `pointing_vectors` (with the same `night`) when the caller has them.
+    `vectors` are this sun's `pointing_vectors` (with the same `night`) when the caller has them,
+    `sun` its unit vectors (a heliostat's, `heliostat_sun`) otherwise.
     """
-    alt = np.asarray(altitude, float)
+    alt, az = np.asarray(altitude, float), np.asarray(azimuth, float)
+    if night:
+        return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
+                               else vectors, collector, rotation)
+    # only where the sun is up: half a year's scans are nights, where a heliostat's NaN normals cost
+    # numpy's slow path (a mirror's targets for a year took 0.13 s, against 0.05 s up only)
+    up = ~(alt < 0)
     if vectors is None:
-        vectors = pointing_vectors(alt, azimuth, collector, night=night)
-    out = angles_on_mount(vectors, collector, rotation)
-    if not night:
-        out[alt < 0] = np.nan
+        vectors = pointing_vectors(alt[up], az[up], collector, sun=None if sun is None else sun[up])
+    else:
+        vectors = vectors[up]
+    out = np.full((len(alt), 1 if collector.single_axis else 2), np.nan)
+    out[up] = angles_on_mount(vectors, collector, rotation)
     return out
 
 

@@ -992,9 +992,12 @@ def _pointing_error(collector: Collector, world: World) -> np.ndarray:
         wound = np.abs(error) > 180.0  # rare: the remainder on the whole year took 0.07 s (its NaN nights)
         error[wound] = (error[wound] + 180.0) % 360.0 - 180.0
         return error
-    actual = direction_vectors(angle[:, 1], angle[:, 0])  # the axes may stand past the zenith
-    wanted = direction_vectors(truth[:, 1], truth[:, 0])
-    return np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
+    error = np.full(len(truth), np.nan)  # no target while the sun is down
+    up = ~np.isnan(truth).any(axis=1)  # only there: a year's NaN nights took numpy's slow path
+    actual = direction_vectors(angle[up, 1], angle[up, 0])  # the axes may stand past the zenith
+    wanted = direction_vectors(truth[up, 1], truth[up, 0])
+    error[up] = np.degrees(np.arccos(np.clip(np.sum(actual * wanted, axis=1), -1.0, 1.0)))
+    return error
 
 
 def _scored_columns(collector: Collector, world: World, out) -> dict:

@@ -203,9 +203,10 @@ class World:
         self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
                                      imperfections.axis_roll_error)
-        vectors = shared(geometry_key(self._sun_key, "pointing", collector),
-                         lambda: pointing_vectors(self.altitude, self.azimuth, collector, sun=self._heliostat_sun()))
-        self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation, vectors=vectors)
+        key = geometry_key(self._sun_key, "pointing", collector)  # None: a heliostat's are its own
+        vectors = None if key is None else shared(key, lambda: pointing_vectors(self.altitude, self.azimuth, collector))
+        self.truth = mount_targets(self.altitude, self.azimuth, collector, rotation, vectors=vectors,
+                                   sun=self._heliostat_sun())
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
         light = shared(("scene light", Same(frame), *self._sun_key, self.sensor.view_share),
                        lambda: self._scene_light(weather, position))
