@@ -90,12 +90,24 @@ def _sensor_value(value, start="11:00", end="14:00", noise=0.0):
     return build
 
 
+def _ramp(frame, per_hour, start):
+    """Degrees growing by `per_hour` from the local clock time `start`, 0 before it."""
+    hours = np.asarray((frame.index - frame.index[0]) / pd.Timedelta(hours=1))
+    begin = float(start[:2]) + float(start[3:]) / 60.0
+    return np.clip((hours - begin) * per_hour, 0.0, None)
+
+
 def _sensor_drift(per_hour, start="10:00"):
     def build(site):
         frame = _day(site)
-        hours = np.asarray((frame.index - frame.index[0]) / pd.Timedelta(hours=1))
-        begin = float(start[:2]) + float(start[3:]) / 60.0
-        return frame, {"sensor_drift": np.clip((hours - begin) * per_hour, 0.0, None)}, {}, start
+        return frame, {"sensor_drift": _ramp(frame, per_hour, start)}, {}, start
+    return build
+
+
+def _encoder_creep(per_hour, start="11:00"):
+    def build(site):
+        frame = _day(site)
+        return frame, {"encoder": _ramp(frame, per_hour, start)}, {}, start
     return build
 
 
@@ -227,6 +239,8 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
              r"encoder glitch"),
     Scenario("encoder-step", "the encoder reads 1.4° more from 11:00 on (slipped coupling)",
              _encoder_step(1.40625), r"held for|encoder glitch"),
+    Scenario("encoder-creep", "the encoder reads 1° an hour more from 11:00 (a coupling slipping)",
+             _encoder_creep(1.0), r"held beyond the plausibility bound"),
     Scenario("encoder-frozen", "the encoder freezes 12:00-18:00", _mask("encoder_frozen", "12:00", "18:00"),
              r"encoder frozen"),
     Scenario("encoder-frozen-gust", "frozen encoder, then 29 m/s at 14:00", _frozen_and_gust, r"encoder frozen"),

@@ -332,3 +332,33 @@ def test_whom_to_trust_on_a_disagreement_is_a_policy_and_each_wins_where_it_shou
 def test_an_unknown_trust_policy_is_refused():
     with pytest.raises(HybridtrackError, match="on_disagreement 'both'; choose 'model' or 'sensor'"):
         ControllerConfig(on_disagreement="both")
+
+
+@pytest.mark.parametrize("policy", ["model", "sensor"])
+def test_a_creeping_encoder_that_leaves_the_sensor_beyond_the_bound_raises_an_alarm_naming_both_suspects(policy):
+    """A coupling slipping 1° an hour from 11:00: the sensor (which is right) ends beyond the
+    plausibility bound of the calibrated model and is no longer used. Held there an hour with no
+    plausible reading, the controller says so once, naming how far off the sensor reads: by hand,
+    the slip then is (alarm time - 11:00) x 1°/h, less what the calibration took up before the
+    readings went beyond the bound (under 2°, the bound itself)."""
+    from hybridtrack.faults import SCENARIOS
+
+    case = SCENARIOS["encoder-creep"]
+    frame, faults, _, onset = case.build(case.site)
+    config = SimulationConfig(controller=ControllerConfig(on_disagreement=policy))
+    result = simulate(frame, case.site, config=config, faults=faults)
+    events = result.events[result.events["reason"].str.contains("held beyond the plausibility bound")]
+    assert len(events) == 1
+    reason, when = events["reason"].iloc[0], events["time"].iloc[0]
+    assert "slipping coupling" in reason and "faulty sensor" in reason
+    slip = (when - when.normalize() - pd.Timedelta(onset + ":00")) / pd.Timedelta(hours=1)
+    miss = float(reason.split("°")[0].split()[-1])
+    assert slip - 2.0 <= miss <= slip + 0.3, (slip, miss)
+    status = result.log["sensor_status"]
+    held = status.index[(status == "implausible") & (status.index < when)]
+    assert when - held[0] >= pd.Timedelta(minutes=60)  # not before an hour beyond the bound
+
+
+def test_a_healthy_sensor_on_a_sunny_day_raises_no_held_off_alarm():
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
+    assert not simulate(frame, "lanzhou").events["reason"].str.contains("held beyond").any()

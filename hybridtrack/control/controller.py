@@ -42,6 +42,12 @@ DUSK_MINUTES = 30.0
 FIT_EVERY = 5.0
 #: Fit readings (an hour at one every five minutes) before the sensor is judged against the fit.
 SETTLE_UPDATES = 12
+#: Minutes a sensor may read beyond the plausibility bound of the calibrated model, with no
+#: plausible reading between, before it is an alarm (`Controller._held_off`): the sun turns 15° in
+#: an hour, so a reading that stays off that long is no cloud's passing pull (which the gate's
+#: reacquire rides out in minutes) but a faulty sensor or a collector that is not where its
+#: encoder says (a coupling slipping by degrees an hour, a mount that moved).
+HELD_OFF_MINUTES = 60.0
 #: W/m² of light in view at which the sensor's datasheet noise (`ControllerConfig.sensor_noise`) is stated.
 REFERENCE_LIGHT = 1000.0
 #: The policies that decide on the fuzzy classifier's sky.
@@ -148,6 +154,8 @@ class Controller:
         self.disagreement = DisagreementMonitor()
         self.checkpoint: dict | None = None
         self.distrusted_until = -math.inf  # the sensor disagreed with the calibrated model: not trusted till then
+        self.held_off_since, self.held_off_raised = math.nan, False  # `_held_off`'s spell
+        self.held_miss = math.nan  # this scan's implausible reading furthest from the model
         if memory:
             self._recall(memory)
             if self.fit is not None:  # the clear sky's level is the sky's, not the fit's: no checkpoint restores it
@@ -392,6 +400,7 @@ class Controller:
             return NOT_READ, valid
         status = OK
         trusted = config.calibrates and self._trusts_sensor(sky, obs)
+        self.held_miss = math.nan
         for a, gate in enumerate(self.gates):
             verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a],
                                  self._turn(a, self._expected_sun(i, a, t) - reading[a]))
@@ -407,6 +416,7 @@ class Controller:
         for a, gate in enumerate(self.gates):
             if not valid[a]:
                 gate.coast(dt)
+        self._held_off(i, t, all(valid))
         if all(valid):
             self.invalid_since = math.nan
             if config.sensor_only and not self.found_today:
@@ -415,6 +425,27 @@ class Controller:
         elif math.isnan(self.invalid_since):
             self.invalid_since = t
         return status, valid
+
+    def _held_off(self, i: int, t: float, plausible: bool) -> None:
+        """Watch for a sensor held beyond the plausibility bound: a spell starts at a reading the
+        gate finds implausible against the calibrated model (`held_miss`) and ends at a scan whose
+        readings are all taken; scans between (clouds, the night, a distrusted sensor) neither end
+        nor extend it. After `HELD_OFF_MINUTES` an alarm, once a spell: the sensor is no longer
+        used, and if the collector is what slipped, the computed target it now follows is off too
+        (a coupling creeping by a degree an hour had left a trough 8° off by evening with no word
+        after the first "sensor lost")."""
+        if plausible:
+            self.held_off_since, self.held_off_raised = math.nan, False
+            return
+        if math.isnan(self.held_miss):
+            return
+        if math.isnan(self.held_off_since):
+            self.held_off_since = t
+        if not self.held_off_raised and t - self.held_off_since >= HELD_OFF_MINUTES:
+            self.held_off_raised = True
+            self._alarm(i, f"sensor {self.held_miss:+.2f}° from the calibrated model, held beyond the plausibility "
+                           f"bound for {t - self.held_off_since:.0f} min: a faulty sensor, or a collector off its "
+                           "encoder (a slipping coupling, a moved mount); the computed target is followed")
 
     def _expected_sun(self, i: int, a: int, t: float) -> float:
         """Where the sun should be on axis `a` for the stuck check: the computed sun, or for the
@@ -457,6 +488,8 @@ class Controller:
         else:  # no computed sun: the filter's own rate, once it has one
             rate = gate.filter.rate if gate.ready else 0.0
         verdict = gate.take(z, dt, miss, bound, rate)
+        if verdict == IMPLAUSIBLE and not abs(miss) <= abs(self.held_miss):  # the first, or further off
+            self.held_miss = miss
         if verdict == OK and trusted and has_model:
             self._learn(i, a, dt, z, m0, m1, bound)
         return verdict

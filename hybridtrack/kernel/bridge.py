@@ -148,12 +148,14 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
     s[[kc.CALM_SINCE, kc.FLAT_VALUE, kc.FLAT_SINCE]] = [c.wind.calm_since, c.wind.flat_value, c.wind.flat_since]
     s[kc.CONDITION] = c.fit.condition if c.fit else math.inf
     s[kc.LIGHT_LEVEL] = c.fit.level if c.fit else math.nan
+    s[[kc.HELD_OFF_SINCE, kc.HELD_MISS]] = [c.held_off_since, c.held_miss]
     clock = c.clock
     s[[kc.SPELL_START, kc.SPELL_LAST]] = [clock.spell_start, clock.spell_last] if clock else [math.nan, math.nan]
     k = np.zeros(kc.INT_SLOTS, np.int64)
     k[[kc.MODE, kc.RESTING, kc.WAS_AWAKE, kc.FOUND_TODAY, kc.WIND_STUCK]] = \
         [c.mode, c.resting, c.was_awake, c.found_today, c.wind.stuck]
     k[kc.BLIND_STOW] = c.blind_stow is not None
+    k[kc.HELD_OFF_RAISED] = c.held_off_raised
     k[[kc.MOUNT_AT_SCAN, kc.MOUNT_AT_UPDATES]] = -1
     fit = c.fit
     p = 2 + axes if fit else 0

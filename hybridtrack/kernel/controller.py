@@ -35,7 +35,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..control.clockwatch import ALARM_SIGMAS, CLOCK_TOLERANCE, DRIFT_DAYS, DRIFT_TOLERANCE, SPELL, SPELL_GAP
-from ..control.controller import DUSK_MINUTES, FIT_EVERY, REFERENCE_LIGHT, SETTLE_UPDATES
+from ..control.controller import DUSK_MINUTES, FIT_EVERY, HELD_OFF_MINUTES, REFERENCE_LIGHT, SETTLE_UPDATES
 from ..control.disagreement import ALLOWANCE, MIN_RUN, THRESHOLD
 from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGHT, NOT_READ, OK, OUT_OF_VIEW,
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
@@ -78,13 +78,14 @@ EventLog = namedtuple("EventLog", ["scan", "before", "after", "code", "value"])
 
 # slots of ControllerState.s
 (MODE_SINCE, INVALID_SINCE, PREVIOUS_T, DARK_SINCE, DISTRUSTED_UNTIL, FIT_SINCE, CALM_SINCE, FLAT_VALUE, FLAT_SINCE,
- MEAN_TOTAL, CONDITION, CUSUM_HIGH, CUSUM_LOW, CUSUM_SUM, SPELL_START, SPELL_LAST, LIGHT_LEVEL) = range(17)
-FLOAT_SLOTS = 17
+ MEAN_TOTAL, CONDITION, CUSUM_HIGH, CUSUM_LOW, CUSUM_SUM, SPELL_START, SPELL_LAST, LIGHT_LEVEL, HELD_OFF_SINCE,
+ HELD_MISS) = range(19)
+FLOAT_SLOTS = 19
 # slots of ControllerState.k
 (MODE, RESTING, WAS_AWAKE, FOUND_TODAY, BLIND_STOW, WIND_STUCK, EVENTS, HAS_CHECKPOINT, UPDATES, FROZEN,
  CHECKPOINT_UPDATES, CHECKPOINT_FROZEN, CUSUM_RUN, MOUNT_AT_SCAN, MOUNT_AT_UPDATES, CLOCK_ROWS, CLOCK_PENDING,
- CLOCK_RAISED, DRIFT_RAISED) = range(19)
-INT_SLOTS = 19
+ CLOCK_RAISED, DRIFT_RAISED, HELD_OFF_RAISED) = range(20)
+INT_SLOTS = 20
 # the clock watch's running sums over its counted readings: rows of clock_moments (n x n each), of
 # clock_sums (n each) and, after the n columns, its scalars; x a reading's row with its drift
 # column, y its residual; a reading linked to the one before it on its axis (`_correlation_factor`)
@@ -957,6 +958,8 @@ def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes, intensity):
     else:  # no computed sun: the filter's own rate, once it has one
         rate = state.kf[a, X1] if state.gate[a, READY] else 0.0
     verdict = gate_take(cfg, state, a, z, dt, miss, bound, rate)
+    if verdict == IMPLAUSIBLE and not abs(miss) <= abs(state.s[HELD_MISS]):  # the first, or further off
+        state.s[HELD_MISS] = miss
     if verdict == OK and trusted and has_model:
         _learn(cfg, plan, state, log, i, a, dt, z, m0, m1, bound, intensity)
     return verdict
@@ -987,6 +990,7 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
         return NOT_READ
     status = OK
     trusted = cfg.calibrates and _trusts_sensor(cfg, sky, obs[4])
+    state.s[HELD_MISS] = math.nan
     for a in range(axes):
         offset = obs_axes[a, 1]
         verdict = gate_judge(cfg, state, a, offset, obs[2] != 0.0, obs_axes[a, 2],
@@ -1003,6 +1007,7 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
     for a in range(axes):
         if not valid[a]:
             gate_coast(cfg, state, a, dt)
+    _held_off(state, log, i, t, valid.all())
     if valid.all():
         state.s[INVALID_SINCE] = math.nan
         if cfg.sensor_only and not state.k[FOUND_TODAY]:
@@ -1012,6 +1017,22 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
     elif math.isnan(state.s[INVALID_SINCE]):
         state.s[INVALID_SINCE] = t
     return status
+
+
+@kernel
+def _held_off(state, log, i, t, plausible):
+    """Controller._held_off."""
+    if plausible:
+        state.s[HELD_OFF_SINCE] = math.nan
+        state.k[HELD_OFF_RAISED] = 0
+        return
+    if math.isnan(state.s[HELD_MISS]):
+        return
+    if math.isnan(state.s[HELD_OFF_SINCE]):
+        state.s[HELD_OFF_SINCE] = t
+    if not state.k[HELD_OFF_RAISED] and t - state.s[HELD_OFF_SINCE] >= HELD_OFF_MINUTES:
+        state.k[HELD_OFF_RAISED] = 1
+        _alarm(i, ev.HELD_OFF, state.s[HELD_MISS], t - state.s[HELD_OFF_SINCE], state, log)
 
 
 @kernel

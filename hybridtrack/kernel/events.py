@@ -15,7 +15,7 @@ __all__ = ["wording"]
 (PLAN_ALARM, CLOCK_STEPPED, ENCODER_FROZEN, ENCODER_BELIEVED, ENCODER_GLITCH, ANEMOMETER_MOVING, ANEMOMETER_STUCK,
  WIND_MISSING, WIND_HIGH, WIND_RELEASED, WIND_RELEASED_FROZEN, NEW_DAY_PROBE, NIGHT, WAKE, SENSOR_LOST, SKY_NOT_SUNNY,
  TRUE_SKY_NOT_SUNNY, SENSOR_TRUSTED, SKY_SUNNY, SUN_BACK, OUT_OF_FINE_VIEW, DISAGREEMENT, CLOCK_OFF,
- CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED) = range(1, 26)
+ CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED, HELD_OFF) = range(1, 27)
 #: A flag added to the wind codes when the stow is a timed move from the last trusted reading.
 BLIND = 100
 
@@ -59,6 +59,10 @@ def wording(config, plan_alarms: dict):
         DISAGREEMENT_FOLLOWED: lambda value, other, scan, third: (
             f"sensor and calibrated model disagree: mean residual {value:+.3f}° over {int(other)} readings; "
             "sensor trusted, calibration follows it (on_disagreement = 'sensor')"),
+        HELD_OFF: lambda value, other, scan, third: (
+            f"sensor {value:+.2f}° from the calibrated model, held beyond the plausibility bound for {other:.0f} min: "
+            "a faulty sensor, or a collector off its encoder (a slipping coupling, a moved mount); the computed "
+            "target is followed"),
         CLOCK_OFF: lambda value, other, scan, third: (
             f"controller clock off by {value:+.0f} s (±{other:.0f} s) against the sun the sensor shows, "
             f"over {int(third)} readings"),
