@@ -327,3 +327,51 @@ def test_a_time_column_wins_over_a_written_out_index(tmp_path, day):
     frame.to_csv(tmp_path / "idx.csv", index=False)
     read = read_weather(tmp_path / "idx.csv", site="lanzhou")
     assert read.index[0] == day.index[0] and len(read) == len(day)
+
+
+@pytest.fixture(scope="module")
+def two_days():
+    """15 and 16 June 2021 at Lanzhou, hourly: every number of a yy-mm-dd stamp is 31 or less."""
+    days = synthetic("lanzhou", "2021-06-15", "2021-06-16", weather="sunny", freq="1h", seed=2)
+    return days[["ghi", "dni", "dhi"]].round(1)
+
+
+def test_year_first_two_digit_dates_are_told_by_their_days_running(tmp_path, two_days):
+    """'21-06-15 12:00' (yy-mm-dd) had been read as 21 June 2015, day-first, and the report said
+    so as if the column had told it: read day-first, the dates jump a year at midnight."""
+    path = _write(tmp_path / "ymd.csv", two_days.index.strftime("%y-%m-%d %H:%M"), two_days)
+    frame = read_weather(path, tz="Asia/Shanghai")
+    assert frame.index[0] == pd.Timestamp("2021-06-15 00:00", tz="Asia/Shanghai")
+    assert frame.index[-1] == pd.Timestamp("2021-06-16 23:00", tz="Asia/Shanghai") and len(frame) == 48
+    assert frame.attrs["validation"]["date_order"] == "year-first (line 2 is no date month-first; read day-first, " \
+                                                      "line 26 moves a month or more)"
+
+
+def test_day_first_two_digit_dates_are_still_day_first(tmp_path, two_days):
+    """'15-06-21' could be yy-mm-dd too (2015-06-21): read so, the dates would jump a year a day."""
+    path = _write(tmp_path / "dmy.csv", two_days.index.strftime("%d-%m-%y %H:%M"), two_days)
+    frame = read_weather(path, tz="Asia/Shanghai")
+    assert frame.index[0] == pd.Timestamp("2021-06-15 00:00", tz="Asia/Shanghai") and len(frame) == 48
+    assert frame.attrs["validation"]["date_order"].startswith("day-first")
+
+
+def test_two_digit_dates_no_row_of_which_tells_the_order_are_refused(tmp_path, capsys, day):
+    """A day of '21-06-21 HH:MM' is 21 June 2021 either way, but '21-06-15' on one day is 2021-06-15
+    or 2015-06-21 and nothing in the file tells: refused with both readings, not guessed."""
+    path = _write(tmp_path / "one.csv", day.index.strftime("21-06-15 %H:%M"), day)
+    with pytest.raises(HybridtrackError) as refused:
+        read_weather(path, tz="Asia/Shanghai")
+    message = str(refused.value)
+    assert message.startswith(f"{path}: line 2, column 'time': '21-06-15 00:00' could be day-first or year-first "
+                              "(2015-06-21 or 2021-06-15), and no date in the column tells")
+    assert main(["check", str(path), "--tz", "Asia/Shanghai"]) == 2
+    err = capsys.readouterr().err
+    assert err == f"hybridtrack: error: {message}\n"
+    assert read_weather(path, tz="Asia/Shanghai", dayfirst=True).index[0] == pd.Timestamp("2015-06-21 00:00",
+                                                                                          tz="Asia/Shanghai")
+
+
+def test_two_digit_dates_that_read_the_same_every_way_are_read(tmp_path, day):
+    """'21-06-21' is 21 June 2021 read day-first or year-first: nothing to decide, nothing refused."""
+    frame = read_weather(_write(tmp_path / "same.csv", day.index.strftime("%d-%m-%y %H:%M"), day), tz="Asia/Shanghai")
+    assert frame.index[0] == pd.Timestamp("2021-06-21 00:00", tz="Asia/Shanghai") and len(frame) == len(day)

@@ -2,11 +2,14 @@
 
 Decided for the whole column, never cell by cell:
 
-* **Day or month first.** ``dd/mm/yyyy`` and ``mm/dd/yyyy`` are told apart by a first number
-  above 12 (then the day comes first) or a second one above 12 (the month first). A column
-  with both is refused; a column with neither is refused and the user asked
-  (``dayfirst=True``/``False``, ``--dayfirst``/``--monthfirst``), except dotted dates
-  (``05.06.2021``), which are day-first wherever they are written.
+* **Day, month or year first.** ``dd/mm/yyyy`` and ``mm/dd/yyyy`` (and, with two-digit years,
+  ``yy/mm/dd``: ``21-06-15`` is 2021-06-15 or 2015-06-21) are told apart first by the rows that
+  are a date in only some readings (a first number above 12 is no month, above 31 no day), then
+  by how the dates run: read in the right order, neighbouring rows' dates move by days; read in
+  a wrong one, a day's change moves a month or a year, or back. A column that no reading makes
+  all dates is refused; so is one that more than one reading makes dates running as days do, and
+  the user asked (``dayfirst=True``/``False``, ``--dayfirst``/``--monthfirst``, or four-digit
+  years). Dotted dates (``05.06.2021``) are never month-first.
 * **Epoch seconds**: a column of 9- or 10-digit numbers is seconds since 1970-01-01 UTC.
 * **Stamps without a date** (``12:00``) are refused: the date cannot be guessed.
 * **The file's zone**: stamps with UTC offsets (``+08:00``, ``Z``, `` UTC``) keep them, or are
@@ -71,33 +74,105 @@ class _Column:
                                f"{self.text.iloc[row]!r} {problem}")
 
 
+#: The readings of an ``a/b/c`` date: which of its numbers (groups 0, 2 and 3 of `_DMY`) is the
+#: day, the month and the year. Year-first is a reading only where every last number has two digits.
+_READINGS = {"day-first": (0, 2, 3), "month-first": (2, 0, 3), "year-first": (3, 2, 0)}
+#: Read in a wrong order, a date that moves on by one day moves by a month or a year (or back):
+#: dates that run as days do move by less between neighbouring rows.
+_WRONG_ORDER_MOVE = np.timedelta64(28, "D")
+
+
 def _two_digit_year(year: str) -> int:
     value = int(year)
     return value if len(year) == 4 else value + (2000 if value < 70 else 1900)
 
 
-def _day_month_order(column: _Column, parts: pd.DataFrame, dayfirst: bool | None) -> tuple[bool, str]:
-    """Whether the column's dates are day-first, and why (see the module's notes)."""
-    first, second = parts[0].astype(int).to_numpy(), parts[2].astype(int).to_numpy()
-    if dayfirst is not None:
-        return dayfirst, ("day-first" if dayfirst else "month-first") + " as given (a flag or the column's name)"
-    day_first, month_first = np.flatnonzero(first > 12), np.flatnonzero(second > 12)
-    if len(day_first) and len(month_first):
-        column.refuse(int(month_first[0]), f"reads month-first, but line {int(column.lines[day_first[0]])} reads "
-                                           "day-first; the column mixes both")
-    if len(day_first):
-        return True, f"day-first (a first number above 12 on line {int(column.lines[day_first[0]])})"
-    if len(month_first):
-        return False, f"month-first (a second number above 12 on line {int(column.lines[month_first[0]])})"
-    if (parts[1] == ".").all():
-        return True, "day-first (dotted dates)"
-    column.refuse(0, "could be day-first or month-first, and no date in the column tells; give --dayfirst or "
-                     "--monthfirst (dayfirst=True/False)")
-    raise AssertionError  # unreachable: refuse raises
+def _either(words) -> str:
+    """``'a'``, ``'a or b'``, ``'a, b or c'``."""
+    words = list(words)
+    return " or ".join(words) if len(words) < 3 else ", ".join(words[:-1]) + " or " + words[-1]
+
+
+def _possible_readings(parts: pd.DataFrame, dayfirst: bool | None) -> list[str]:
+    """The readings the written years and `dayfirst` leave (month-first and year-first both put
+    the month before the day)."""
+    readings = list(_READINGS) if (parts[3].str.len() <= 2).all() else ["day-first", "month-first"]
+    if dayfirst is None:
+        return readings
+    return ["day-first"] if dayfirst else [reading for reading in readings if reading != "day-first"]
+
+
+def _dates_read(parts: pd.DataFrame, readings: list[str]) -> dict[str, np.ndarray]:
+    """Each row's date in each of `readings`, NaT where it is none (computed once per distinct date)."""
+    codes, _ = pd.factorize(parts[0] + "/" + parts[2] + "/" + parts[3])
+    distinct = parts.iloc[np.unique(codes, return_index=True)[1]]
+    dates = {}
+    for reading in readings:
+        day, month, year = (distinct[i] for i in _READINGS[reading])
+        fields = pd.DataFrame({"year": year.map(_two_digit_year), "month": month.astype(int), "day": day.astype(int)})
+        dates[reading] = pd.to_datetime(fields, errors="coerce").to_numpy()[codes]
+    return dates
+
+
+def _first_jump(dates: np.ndarray) -> int | None:
+    """The first row whose date moves a month or more from the row before it; None if none does."""
+    jumps = np.flatnonzero(np.abs(np.diff(dates)) >= _WRONG_ORDER_MOVE)
+    return int(jumps[0]) + 1 if len(jumps) else None
+
+
+def _refuse_mixed(column: _Column, valid: dict[str, np.ndarray], flagged: bool):
+    """Refuse a column in which no reading makes every row a date, at the row where the last fails."""
+    names = np.array(list(valid))
+    allowed = np.stack(list(valid.values()), axis=1)  # rows x readings
+    row = int(np.flatnonzero(~np.logical_and.accumulate(allowed, axis=0).any(axis=1))[0])
+    if not allowed[row].any():
+        column.refuse(row, f"is no date read {_either(names)}" + (" (as a flag or the column's name says)"
+                                                                  if flagged else ""))
+    disjoint = np.flatnonzero(~(allowed[:row] & allowed[row]).any(axis=1))
+    other = (f"line {int(column.lines[disjoint[0]])} reads {_either(names[allowed[disjoint[0]]])}" if len(disjoint)
+             else "no reading fits it and every line before it")
+    column.refuse(row, f"reads {_either(names[allowed[row]])}, but {other}; the column mixes both")
+
+
+def _refuse_undecided(column: _Column, fitting: list[str], dates: dict[str, np.ndarray]):
+    """Refuse a column that two or more readings make dates running as days do."""
+    if "year-first" not in fitting:
+        ask = "give --dayfirst or --monthfirst (dayfirst=True/False)"
+    else:
+        ask = "write the years with four digits" + (", or give --dayfirst (dayfirst=True) if they are day-first"
+                                                    if "day-first" in fitting else "")
+    column.refuse(0, f"could be {_either(fitting)} ({_either(str(dates[r][0])[:10] for r in fitting)}), and no date "
+                     f"in the column tells; {ask}")
+
+
+def _date_reading(column: _Column, parts: pd.DataFrame, dayfirst: bool | None) -> tuple[str, str]:
+    """The reading of the column's ``a/b/c`` dates (a key of `_READINGS`), and why (see the module's notes)."""
+    readings = _possible_readings(parts, dayfirst)
+    dates = _dates_read(parts, readings)
+    valid = {reading: ~np.isnat(values) for reading, values in dates.items()}
+    fitting = [reading for reading in readings if valid[reading].all()]
+    if not fitting:
+        _refuse_mixed(column, valid, dayfirst is not None)
+    why = ["as a flag or the column's name says"] if dayfirst is not None else []
+    why += [f"line {int(column.lines[np.argmin(valid[r])])} is no date {r}" for r in readings if r not in fitting]
+    same = [r for i, r in enumerate(fitting) if any(np.array_equal(dates[r], dates[o]) for o in fitting[:i])]
+    fitting = [reading for reading in fitting if reading not in same]
+    why += [f"{reading} reads the same dates" for reading in same]
+    if len(fitting) > 1 and "month-first" in fitting and (parts[1] == ".").all():
+        fitting.remove("month-first")
+        why.append("dotted dates")
+    jumps = {reading: _first_jump(dates[reading]) for reading in fitting} if len(fitting) > 1 else {}
+    if sum(jump is None for jump in jumps.values()) == 1:
+        why += [f"read {r}, line {int(column.lines[jump])} moves a month or more" for r, jump in jumps.items()
+                if jump is not None]
+        fitting = [reading for reading, jump in jumps.items() if jump is None]
+    if len(fitting) > 1:
+        _refuse_undecided(column, fitting, dates)
+    return fitting[0], f"{fitting[0]} ({'; '.join(why)})"
 
 
 def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
-    """Dates in ``d/m/y`` or ``m/d/y`` form rewritten as ``yyyy-mm-dd``, decided for the whole column."""
+    """Dates in ``d/m/y``, ``m/d/y`` or ``yy/m/d`` form rewritten as ``yyyy-mm-dd``, decided for the whole column."""
     if not column.text.str.contains(r"^\d{1,2}[./-]\d{1,2}[./-]\d", regex=True).any():
         return column.text  # year first (ISO) or another form the parser reads whole
     parts = column.text.str.extract(_DMY)
@@ -107,12 +182,10 @@ def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
     if not matched.all():
         column.refuse(int(np.flatnonzero(~matched)[0]), f"is not written like the column's other dates "
                                                         f"({column.text.iloc[int(np.flatnonzero(matched)[0])]!r})")
-    is_dayfirst, why = _day_month_order(column, parts, dayfirst)
-    day, month = (parts[0], parts[2]) if is_dayfirst else (parts[2], parts[0])
-    years = parts[3].map(_two_digit_year)
-    report["date_order"] = why
+    reading, report["date_order"] = _date_reading(column, parts, dayfirst)
+    day, month, year = (parts[i] for i in _READINGS[reading])
     clock = parts[4].str.replace(r"^,\s*", " ", regex=True)
-    return (years.astype(str) + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + clock).str.strip()
+    return (year.map(_two_digit_year).astype(str) + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + clock).str.strip()
 
 
 def _parse(column: _Column, text: pd.Series, utc: bool) -> pd.DatetimeIndex:
