@@ -173,3 +173,30 @@ def test_a_negative_cell_is_refused_by_row_and_column(tmp_path, capsys, command)
     assert capsys.readouterr().err == (f"hybridtrack: error: {src}: row 3, column 'variation': -3 is no reading; "
                                        "a variation is a range, max - min, never below zero\n")
     assert not (tmp_path / "t.toml").exists()
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--margin", "100"], "--margin (score units) = 100.0 is outside [0, 30]"),
+    (["--folds", "9"], "--folds must be 0 (none) or between 2 and the number of samples (3), got 9"),
+    (["--folds", "-1"], "--folds must be 0 (none) or between 2 and the number of samples (3), got -1"),
+    (["--seeds", "0"], "--seeds must be between 1 and 20, got 0"),
+    (["--seeds", "50"], "--seeds must be between 1 and 20, got 50"),
+])
+def test_tune_names_the_flag_at_fault_in_one_line(tmp_path, capsys, flags, message):
+    # 'margin (score units) = 100.0 ...', 'folds must be ...', 'seeds must be ...': no flag named, and the
+    # last two after a progress bar had been drawn on the same standard error
+    labels = tmp_path / "labels.csv"
+    labels.write_text("intensity,variation,weather\n246,27,sunny\n200,85,cloudy\n60,3,overcast\n")
+    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", *flags]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
+    assert not (tmp_path / "t.toml").exists()
+
+
+def test_tune_names_the_file_row_and_column_of_an_unknown_label(tmp_path, capsys):
+    # 'samples: unknown weather label 'foggy'; ...': neither the file nor the row
+    labels = tmp_path / "labels.csv"
+    labels.write_text("# field notes\nintensity,variation,weather\n246,27,sunny\n150,40,Foggy\n60,3,overcast\n")
+    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
+                 "--seeds", "1"]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {labels}: row 4, column 'weather': unknown weather label "
+                                       "'Foggy'; the bands are overcast, cloudy, sunny\n")

@@ -132,14 +132,14 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
 def _tune(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..fuzzy.tuning import check_margin, read_samples, tune
+    from ..fuzzy.tuning import check_folds, check_margin, check_seeds, read_samples, tune
 
-    if args.folds == 1 or args.folds < 0:
-        raise HybridtrackError(f"--folds must be 0 (none) or at least 2, got {args.folds}")
     params.seed(args.seed, "--seed")
+    check_seeds(args.seeds, "--seeds")  # these checks before the progress bar
     start = load_fuzzy_config(args.config)
-    check_margin(args.margin, start)  # before the progress bar
-    samples = read_samples(args.labels)
+    check_margin(args.margin, start, "--margin")
+    samples = read_samples(args.labels, start)
+    check_folds(args.folds, len(samples), "--folds")
     report_files = [Path(args.report) / name for name in ("report.json", "surfaces.png", "confusion.png")] \
         if args.report else []
     claim([args.out, *report_files])  # before the fit, not after it

@@ -43,9 +43,9 @@ from ..params import number
 from .classifier import FuzzyWeatherClassifier, refuse_negative_readings
 from .config import FuzzyConfig, Term
 
-__all__ = ["tune", "check_margin", "TuningReport", "read_samples", "evaluate", "cross_validate",
-           "constraint_violations", "labelled_range", "outside_labels", "warn_outside_labels", "OutsideLabelsWarning",
-           "MONOTONE_TOLERANCE"]
+__all__ = ["tune", "check_margin", "check_folds", "check_seeds", "TuningReport", "read_samples", "evaluate",
+           "cross_validate", "constraint_violations", "labelled_range", "outside_labels", "warn_outside_labels",
+           "OutsideLabelsWarning", "MONOTONE_TOLERANCE"]
 
 #: How far (score units) the score may dip below its running maximum as intensity rises at
 #: constant variation: the discretised centroid of the published system wobbles by 0.26 on this grid.
@@ -126,12 +126,25 @@ class TuningReport:
         return "\n".join(lines)
 
 
-def read_samples(source) -> pd.DataFrame:
+def read_samples(source, config: FuzzyConfig | None = None) -> pd.DataFrame:
     """Labelled readings from a CSV path or a DataFrame, checked.
 
     Columns: ``intensity``, ``variation`` (raw mA), and ``weather`` and/or ``score``;
     optional ``tolerance`` (used by rule-table tests). Every reading, label and score must be
-    given: an empty or infinite cell, or a reading below zero, is refused by its row and column.
+    given: an empty or infinite cell, a reading below zero, or a label that none of `config`'s
+    bands names (when a config is given) is refused by its row and column.
+
+    Parameters
+    ----------
+    source : str, Path or pandas.DataFrame
+        The table (a CSV or TOML ``[[case]]`` file), or the readings themselves.
+    config : FuzzyConfig, optional
+        The config the labels are for: its bands name the weather labels allowed.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The readings, with ``intensity``, ``variation``, ``score`` and ``tolerance`` as floats.
     """
     if isinstance(source, pd.DataFrame):
         frame, where = source.copy(), "samples"
@@ -156,11 +169,31 @@ def read_samples(source) -> pd.DataFrame:
     frame = numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where,
                             required=("intensity", "variation", "score"))
     refuse_negative_readings(frame, ("intensity", "variation"), where)
+    if config is not None and "weather" in frame.columns:
+        _refuse_unknown_labels(frame, config, where)
     return frame
 
 
+def _labels(samples: pd.DataFrame) -> np.ndarray:
+    """The samples' weather labels as the bands name them: stripped, in lower case."""
+    return samples["weather"].astype(str).str.strip().str.lower().to_numpy()
+
+
+def _refuse_unknown_labels(frame: pd.DataFrame, config: FuzzyConfig, where: str) -> None:
+    """Refuse the first weather label that none of `config`'s bands names, by its row."""
+    from ..io import table_row
+
+    bands = [name for name, _, _ in config.bands]
+    unknown = np.flatnonzero(~np.isin(_labels(frame), bands))
+    if len(unknown):
+        row = int(unknown[0])
+        raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column 'weather': unknown weather label "
+                               f"{frame['weather'].iloc[row]!r}; the bands are {', '.join(bands)}")
+
+
 def evaluate(config: FuzzyConfig, samples: pd.DataFrame, margin: float = 0.5) -> dict:
-    """Loss, label accuracy and score RMSE of `config` on checked `samples`."""
+    """Loss, label accuracy and score RMSE of `config` on `samples` (checked by `read_samples`)."""
+    samples = read_samples(samples, config)
     clf = FuzzyWeatherClassifier(config)
     scores = clf.score(samples["intensity"].to_numpy(), samples["variation"].to_numpy())
     return _metrics(clf, config, scores, samples, margin)
@@ -178,10 +211,7 @@ def _metrics(clf, config, scores, samples, margin) -> dict:
         out["rmse"] = float(np.sqrt(np.mean(err**2)))
     if "weather" in samples.columns:
         bands = {name: (lo, hi) for name, lo, hi in config.bands}
-        labels = samples["weather"].astype(str).str.strip().str.lower().to_numpy()
-        unknown = sorted(set(labels) - set(bands))
-        if unknown:
-            raise HybridtrackError(f"samples: unknown weather label {unknown[0]!r}; the bands are {', '.join(bands)}")
+        labels = _labels(samples)
         lo = np.array([bands[label][0] for label in labels]) + margin
         hi = np.array([bands[label][1] for label in labels]) - margin
         outside = np.maximum(lo - scores, 0.0) + np.maximum(scores - hi, 0.0)
@@ -380,7 +410,7 @@ def _folds(samples: pd.DataFrame, folds: int, seed: int) -> np.ndarray:
     """A fold number per reading, stratified by label when there are labels."""
     rng = np.random.default_rng(seed)
     fold = np.empty(len(samples), int)
-    groups = samples.groupby(samples["weather"].astype(str).str.strip().str.lower()).indices \
+    groups = samples.groupby(_labels(samples)).indices \
         if "weather" in samples.columns else {"all": np.arange(len(samples))}
     offset = 0
     for _, members in sorted(groups.items()):
@@ -405,10 +435,9 @@ def cross_validate(config: FuzzyConfig | None, samples, *, folds: int = 5, seed:
         scores), ``accuracy_folds`` per fold, ``folds``.
     """
     config = config if config is not None else FuzzyConfig.default()
-    samples = read_samples(samples)
+    samples = read_samples(samples, config)
     opts = _Options(**options)
-    if not 2 <= folds <= len(samples):
-        raise HybridtrackError(f"folds must be between 2 and the number of samples ({len(samples)}), got {folds}")
+    check_folds(folds, len(samples), none=False)
     assignment = _folds(samples, folds, seed)
     scores = np.full(len(samples), np.nan)
     per_fold = []
@@ -434,10 +463,67 @@ def _centre_spread(fits: list[FuzzyConfig]) -> dict[str, float]:
     return spread
 
 
-def check_margin(margin, config: FuzzyConfig) -> float:
-    """`margin` as a float, refused unless finite and within the width of the output universe."""
+def check_margin(margin, config: FuzzyConfig, name: str = "margin") -> float:
+    """`margin` as a float, refused unless finite and within the width of the output universe.
+
+    Parameters
+    ----------
+    margin : float
+        How far inside its band a label's score should sit (score units).
+    config : FuzzyConfig
+        The config whose output universe bounds it.
+    name : str
+        What the message calls it (``"--margin"`` on the command line).
+
+    Returns
+    -------
+    float
+    """
     low, high = config.output.universe
-    return number(margin, "margin (score units)", 0, high - low)
+    return number(margin, f"{name} (score units)", 0, high - low)
+
+
+def check_folds(folds: int, samples: int, name: str = "folds", *, none: bool = True) -> int:
+    """`folds`, refused unless between 2 and the number of samples, or 0 where `none` allows it.
+
+    Parameters
+    ----------
+    folds : int
+        k of the k-fold cross-validation; 0 for none.
+    samples : int
+        How many labelled readings there are.
+    name : str
+        What the message calls it (``"--folds"`` on the command line).
+    none : bool
+        Whether 0 (no cross-validation) is allowed.
+
+    Returns
+    -------
+    int
+    """
+    if not ((none and folds == 0) or 2 <= folds <= samples):
+        raise HybridtrackError(f"{name} must be {'0 (none) or ' if none else ''}between 2 and the number of samples "
+                               f"({samples}), got {folds}")
+    return folds
+
+
+def check_seeds(seeds: int, name: str = "seeds") -> int:
+    """`seeds`, refused unless between 1 and 20.
+
+    Parameters
+    ----------
+    seeds : int
+        How many seeds to fit from.
+    name : str
+        What the message calls it (``"--seeds"`` on the command line).
+
+    Returns
+    -------
+    int
+    """
+    if not 1 <= seeds <= 20:
+        raise HybridtrackError(f"{name} must be between 1 and 20, got {seeds}")
+    return seeds
 
 
 def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin: float = 0.5,
@@ -491,12 +577,12 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
        (DOI not verified here, so none is given; through `scipy.optimize.minimize`.)
     """
     config = config if config is not None else FuzzyConfig.default()
-    samples = read_samples(samples)
+    samples = read_samples(samples, config)
     check_margin(margin, config)
     if method not in ("global", "local"):
         raise HybridtrackError(f"unknown tuning method {method!r}; choose 'global' or 'local'")
-    if not 1 <= seeds <= 20:
-        raise HybridtrackError(f"seeds must be between 1 and 20, got {seeds}")
+    check_seeds(seeds)
+    check_folds(folds, len(samples))
     options = _Options(method, margin, maxiter, popsize, restarts)
     cv = cross_validate(config, samples, folds=folds, seed=seed, progress=progress, **options.__dict__) if folds \
         else {}
