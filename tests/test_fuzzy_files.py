@@ -238,6 +238,26 @@ def test_cli_evaluates_a_system_file(capsys):
     assert capsys.readouterr().out.strip() == "tip = 15"
 
 
+@pytest.mark.parametrize("raw, normalised", [
+    (("intensity=165", "variation=90"), ("intensity=5", "variation=5")),  # 10 (165 - 30) / 270, 10 (90 - 0) / 180
+    (("intensity=246", "variation=27"), ("intensity=8", "variation=1.5")),  # 10 * 216 / 270, 10 * 27 / 180
+    (("intensity=400", "variation=0"), ("intensity=10", "variation=0")),  # above 300 mA: clipped to the top
+])
+def test_cli_evaluates_a_classifier_toml_at_raw_readings_through_its_raw_range(tmp_path, capsys, raw, normalised):
+    # the raw mA had been taken as universe values and clipped: intensity=246 variation=27 gave
+    # weather = 15.0067 (cloudy) where the classifier from the same file gives 24.906 (sunny)
+    config = FuzzyConfig()  # raw_range 30-300 mA and 0-180 mA onto universes 0-10
+    toml, fis = config.to_toml(tmp_path / "c.toml"), config.to_fis(tmp_path / "c.fis")  # a .fis has no raw range
+    assert main(["fuzzy", "eval", str(fis), *normalised]) == 0
+    reference = capsys.readouterr().out
+    assert main(["fuzzy", "eval", str(toml), *raw]) == 0
+    printed = capsys.readouterr().out
+    assert printed == reference
+    intensity, variation = (float(value.split("=")[1]) for value in raw)
+    classifier = FuzzyWeatherClassifier(FuzzyConfig.from_toml(toml))
+    assert printed == f"weather = {classifier.score(intensity, variation):.6g}\n"
+
+
 @pytest.mark.parametrize("args, message", [
     (["convert", "tipper.fis", "out.xml"], "unknown fuzzy system format '.xml'"),
     (["convert", "missing.fis", "out.fcl"], "missing.fis"),

@@ -17,7 +17,9 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
     convert.add_argument("target", metavar="OUT", help="file to write (.fis, .fcl or .toml)")
     add_force_argument(convert)
     evaluate = actions.add_parser("eval", help="evaluate a system file at some inputs",
-                                  description="Evaluate a Mamdani system file (.fis, .fcl or .toml) at one reading.")
+                                  description="Evaluate a Mamdani system file (.fis, .fcl or .toml) at one reading. "
+                                              "A classifier .toml takes raw readings (mA), mapped through its inputs' "
+                                              "raw_range as the classifier maps them.")
     evaluate.add_argument("source", metavar="FILE", help="system to read (.fis, .fcl or .toml)")
     evaluate.add_argument("values", metavar="NAME=VALUE", nargs="+", help="one value per input, e.g. service=2")
     evaluate.add_argument("--engine", choices=("auto", "numba", "numpy", "skfuzzy"), default="auto",
@@ -56,6 +58,7 @@ def _evaluate(system, args: argparse.Namespace) -> int:
     for name, value in zip(system.input_names, x[0]):
         if not np.isfinite(value):
             raise HybridtrackError(f"input {name!r} must be a finite number, got {value}")
+    x = np.array([[var.to_universe(value) for var, value in zip(system.inputs, x[0])]])  # a .toml's raw_range
     if args.engine == "skfuzzy":
         values = [evaluate_skfuzzy(system, x, output=o)[0] for o in range(len(system.outputs))]
     else:

@@ -113,12 +113,7 @@ class FuzzyWeatherClassifier:
 
     def normalise(self, intensity, variation) -> np.ndarray:
         """Raw readings (mA) onto the input universes, clipped: ``10 (P - Pmin)/(Pmax - Pmin)``."""
-        columns = []
-        for var, values in zip(self.config.inputs, (intensity, variation)):
-            lo, hi = var.raw_range
-            u0, u1 = var.universe
-            raw = np.clip(np.asarray(values, float), lo, hi)  # first, so 1e308 mA cannot overflow the scaling
-            columns.append(np.clip(u0 + (u1 - u0) * (raw - lo) / (hi - lo), u0, u1))
+        columns = [var.to_universe(values) for var, values in zip(self.config.inputs, (intensity, variation))]
         return np.stack(np.broadcast_arrays(*columns), axis=-1)
 
     def _prepare(self, intensity, variation, raw: bool) -> tuple[np.ndarray, tuple]:

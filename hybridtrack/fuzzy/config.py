@@ -21,6 +21,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import HybridtrackError
 from .membership import SHAPES, centre, check_params
 
@@ -129,6 +131,27 @@ class Variable:
     def term_names(self) -> tuple[str, ...]:
         """The names of the terms, in order."""
         return tuple(term.name for term in self.terms)
+
+    def to_universe(self, readings) -> np.ndarray:
+        """Raw readings (in `unit`) mapped linearly onto the universe, clipped: ``u0 + (u1 - u0)
+        (P - Pmin)/(Pmax - Pmin)`` with (Pmin, Pmax) the `raw_range`; without one, the readings
+        are on the universe already and are returned as they are.
+
+        Parameters
+        ----------
+        readings : float or array_like
+
+        Returns
+        -------
+        numpy.ndarray
+        """
+        values = np.asarray(readings, float)
+        if self.raw_range is None:
+            return values
+        lo, hi = self.raw_range
+        u0, u1 = self.universe
+        raw = np.clip(values, lo, hi)  # first, so 1e308 mA cannot overflow the scaling
+        return np.clip(u0 + (u1 - u0) * (raw - lo) / (hi - lo), u0, u1)
 
     def check(self, where: str) -> None:
         """Raise `HybridtrackError` if the variable is not usable."""
