@@ -58,7 +58,10 @@ def test_the_report_gives_the_dates_and_every_change_with_where(capsys):
     assert "sorted (stamps out of order): count 1, lines 33" in out
     assert "dropped (repeated stamps, the first kept): count 1, lines 82" in out
     assert "clipped to 0 (negative irradiance): ghi count 1, lines 3, lowest -2.5" in out
-    assert "resampled: linear in time from 10min to 5min" in out and "(rows 193, interpolated 96, empty 0)" in out
+    # DNI is NaN at 15:00 (line 62): 14:55, 15:00 and 15:05 are left empty (the count had been of rows empty in
+    # every column: 0)
+    assert "resampled: linear in time from 10min to 5min" in out
+    assert "(rows 193, interpolated 96, empty 3: dni 3)" in out
     assert "NaN kept: dni 1" in out
 
 

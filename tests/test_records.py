@@ -10,6 +10,7 @@ import pytest
 
 from hybridtrack import HybridtrackError
 from hybridtrack.io import read_weather, validation_report
+from hybridtrack.io.resample import resample
 
 ROOT = Path(__file__).resolve().parents[1]
 PVLIB_DATA = Path(os.path.dirname(pvlib.__file__)) / "data"
@@ -117,6 +118,28 @@ def test_upsampling_invents_no_value_beside_a_nan_reading(tmp_path):
     assert frame.loc["2021-06-21 11:00", "ghi"] == 900.0 and frame.loc["2021-06-21 18:00", "ghi"] == 420.0
     assert frame.loc["2021-06-21 11:01":"2021-06-21 17:59", "ghi"].isna().all()
     assert frame.loc["2021-06-21 12:30", "dni"] == 700.0  # a column with its readings is interpolated
+
+
+def test_upsampling_counts_every_value_left_empty_by_column():
+    """The count was of steps empty in every column: GHI missing all afternoon beside measured DNI
+    and DHI read 'empty 0', though the docs count every step a NaN reading leaves empty."""
+    times = pd.date_range("2021-06-21 10:00", "2021-06-21 18:00", freq="1h", tz="Asia/Shanghai")
+    dni = [700.0] * 9
+    dni[5] = np.nan  # 15:00
+    frame = pd.DataFrame({"ghi": [800.0, 900.0, *[np.nan] * 6, 420.0], "dni": dni, "dhi": 100.0}, index=times)
+    report = {}
+    resample(frame, "1min", report, {})
+    # ghi: 11:01 to 17:59 (7 h less a minute); dni: 14:01 to 15:59 (2 h less a minute)
+    assert report["resampled"]["empty"] == 419 + 119
+    assert report["resampled"]["empty_by_column"] == {"ghi": 419, "dni": 119}
+
+
+def test_the_report_says_the_values_left_empty_by_column(tmp_path):
+    times = pd.date_range("2021-06-21 10:00", "2021-06-21 18:00", freq="1h", tz="Asia/Shanghai")
+    ghi = [800.0, 900.0, *[np.nan] * 6, 420.0]
+    path = write(tmp_path, "h.csv", pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "ghi": ghi,
+                                                  "dni": 700.0, "dhi": 100.0}).to_csv(index=False))
+    assert "empty 419: ghi 419)" in validation_report(read_weather(path, freq="1min"))
 
 
 def test_checks_sort_deduplicate_clip_flag_and_count(tmp_path):

@@ -80,8 +80,9 @@ def _changes(report: dict) -> list[str]:
             lines.append(f"    {label}: {_describe(report[key])}")
     if "resampled" in report:
         entry = report["resampled"]
-        counts = ", ".join(f"{k} {v}" for k, v in entry.items() if k != "method")
-        lines.append(f"    resampled: {entry['method']} ({counts})")
+        counts = ", ".join(f"{k} {v}" for k, v in entry.items() if k not in ("method", "empty_by_column"))
+        by_column = f": {_describe(entry['empty_by_column'])}" if entry.get("empty_by_column") else ""
+        lines.append(f"    resampled: {entry['method']} ({counts}{by_column})")
     return lines
 
 

@@ -10,7 +10,9 @@ gap longer than three native steps is resampled on its own, so a gap stays a gap
   readings that both have a value, never across a gap or beside a NaN reading; a stamp the
   data has keeps its value, NaN included (a flagged value is never filled).
 
-The report counts the rows made, the values interpolated and those left empty.
+The report counts the rows made, the new rows given a value (``interpolated``) or the steps with
+a reading (``averaged``), and the values left empty (``empty``, a step empty in two columns
+counting twice, and ``empty_by_column``).
 """
 
 from __future__ import annotations
@@ -64,6 +66,13 @@ def _interpolated(series: pd.Series, grid: pd.DatetimeIndex, longest: pd.Timedel
     return out
 
 
+def _left_empty(out: pd.DataFrame) -> dict:
+    """The values the resampled columns were left without: ``empty`` in all, and
+    ``empty_by_column`` for each column that has any."""
+    by_column = {column: int(count) for column, count in out.isna().sum().items() if count}
+    return {"empty": sum(by_column.values()), "empty_by_column": by_column}
+
+
 def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -> pd.DataFrame:
     """`frame` on a regular grid of step `freq` (its own median step if None); see the module's notes."""
     from ..times import parse_freq
@@ -94,10 +103,9 @@ def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -
         counts = {"rows": int(len(out)), "interpolated": int((new & out[columns].notna().any(axis=1)).sum())}
     if not regular:
         method = f"irregular stamps (median step {span(native)}): " + method
-    empty = out[columns].isna().all(axis=1)
-    if empty.all():
+    if out[columns].isna().all(axis=None):
         raise HybridtrackError(f"resampling to {span(target)} left no values; check the step (--freq/--step)")
-    counts["empty"] = int(empty.sum())
+    counts.update(_left_empty(out[columns]))
     if LABEL_COLUMN in frame.columns:
         out[LABEL_COLUMN] = frame[LABEL_COLUMN].reindex(out.index, method="ffill")
     attrs["resampling"] = method
