@@ -9,6 +9,7 @@ import pvlib
 import pytest
 
 from hybridtrack import HybridtrackError
+from hybridtrack.cli import main
 from hybridtrack.io import read_weather, validation_report
 from hybridtrack.io.resample import resample
 
@@ -172,14 +173,49 @@ EPW_HEADER = ("LOCATION,Nanjing,JS,CHN,SYN,582380,31.93,118.90,8.0,7.1\nDESIGN C
               "DATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n")
 
 
-def _epw_row(hour, ghi, dni, dhi, temp):
-    fields = [2013, 6, 21, hour, 0, "?", temp, 15.0, 60, 101000, 0, 0, 350, ghi, dni, dhi, 0, 0, 0, 0, 180, 3.0, 5, 5,
+def _epw_row(hour, ghi, dni, dhi, temp, date=(2013, 6, 21)):
+    fields = [*date, hour, 0, "?", temp, 15.0, 60, 101000, 0, 0, 350, ghi, dni, dhi, 0, 0, 0, 0, 180, 3.0, 5, 5,
               20.0, 77777, 9, 999999999, 0, 0.1, 0, 88, 0.2, 0, 1]
     return ",".join(map(str, fields))
 
 
 EPW = EPW_HEADER + "\n".join(_epw_row(h, g, d, f, t) for h, g, d, f, t in
                              ((11, 700, 600, 120, 21.0), (12, 720, 612, 125, 21.5), (13, 690, 590, 118, 21.9))) + "\n"
+
+
+def _epw_days(dates) -> str:
+    """An EPW of whole days at Nanjing: 500/400/100 W/m² from 09:00 to 15:00, dark otherwise (hour h
+    of a day is the hour that starts at h - 1)."""
+    rows = [_epw_row(hour, *((500, 400, 100) if 10 <= hour <= 16 else (0, 0, 0)), 10.0, date=date)
+            for date in dates for hour in range(1, 25)]
+    return EPW_HEADER + "\n".join(rows) + "\n"
+
+
+def test_a_leap_year_of_real_data_in_an_epw_keeps_its_29_february(tmp_path, capsys):
+    """An AMY file of 2020 was refused with pvlib's cut message ('day is out of range for month.
+    You might want to try:'): every EPW was coerced into 2019, which has no 29 February."""
+    path = write(tmp_path, "amy2020.epw", _epw_days([(2020, 2, 28), (2020, 2, 29), (2020, 3, 1)]))
+    frame = read_weather(path)
+    assert frame.index[0] == pd.Timestamp("2020-02-28 00:00", tz="Etc/GMT-8") and len(frame) == 72
+    assert frame.loc["2020-02-29 09:00", "ghi"] == 500.0 and frame.loc["2020-02-29 16:00", "ghi"] == 0.0
+    assert "the file's own years" in frame.attrs["validation"]["time"]
+    assert main(["check", str(path)]) == 0
+
+
+def test_29_february_in_a_typical_year_epw_is_refused_naming_the_line(tmp_path, capsys):
+    """A typical year's months come from different years (here a 2012 February after a 2005
+    January): it is read in 2019, which has no 29 February."""
+    typical = read_weather(write(tmp_path, "tmy-ok.epw", _epw_days([(2005, 1, 31), (2012, 2, 28)])))
+    assert typical.index[0] == pd.Timestamp("2019-01-31 00:00", tz="Etc/GMT-8")
+    assert typical.index[-1] == pd.Timestamp("2019-02-28 23:00", tz="Etc/GMT-8")
+    path = write(tmp_path, "tmy.epw", _epw_days([(2005, 1, 31), (2012, 2, 29)]))
+    message = (f"{path}: line 33: 29 February in a typical-year file (its stamps do not run in steady steps, as "
+               "real years' do), which is read in 2019, a year without one; remove that day")
+    with pytest.raises(HybridtrackError) as refused:
+        read_weather(path)
+    assert str(refused.value) == message
+    assert main(["check", str(path)]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
 
 
 def test_the_shipped_records_read_back_with_their_labels():

@@ -11,7 +11,9 @@ Whatever pvlib returns, its columns are mapped to the frame's through the same a
 a CSV's (`columns.ALIASES`), plus pvlib's own names per format, with the format's units (TMY2
 gives tenths of °C and m/s); a file from which no irradiance column can be mapped is refused,
 so "clean" always means readable. Typical-year files (EPW, TMY3, TMY2) take one year, 2019,
-since their months come from different years.
+since their months come from different years; an EPW whose stamps run in steady steps holds real
+years (an AMY file, or part of one) and keeps them, 29 February included. A typical-year EPW or
+TMY2 file with a 29 February is refused naming its line: 2019 has none.
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ PVLIB_FORMATS = {"epw": "read_epw", "tmy3": "read_tmy3", "tmy2": "read_tmy2", "m
 #: Typical-year formats: their months come from different years, so one year is coerced.
 TYPICAL_YEAR_FORMATS = ("epw", "tmy3", "tmy2")
 TYPICAL_YEAR = 2019  # any year that is not a leap year
+#: The file line of the first data row, for messages: an EPW has eight header lines, a TMY2 one.
+_FIRST_DATA_LINE = {"epw": 9, "tmy2": 2}
 
 #: pvlib's names in each format that the alias table does not already know, and their scale.
 PVLIB_NAMES = {
@@ -71,7 +75,7 @@ def _call(path: Path, fmt: str, shown: Path | None = None):
     import pvlib
 
     reader = getattr(pvlib.iotools, PVLIB_FORMATS[fmt])
-    options = {"coerce_year": TYPICAL_YEAR} if fmt in ("epw", "tmy3") else {}
+    options = {"coerce_year": TYPICAL_YEAR} if fmt == "tmy3" else {}
     try:
         result = reader(str(path), **options)
     except Exception as exc:  # pvlib raises many kinds; the user needs one line
@@ -82,9 +86,21 @@ def _call(path: Path, fmt: str, shown: Path | None = None):
     return data, dict(meta) if isinstance(meta, Mapping) else {}
 
 
-def _coerce_year(index: pd.DatetimeIndex) -> pd.DatetimeIndex:
-    """TMY2 stamps in one year, as pvlib does for EPW and TMY3."""
+def _real_years(index: pd.DatetimeIndex) -> bool:
+    """Whether the stamps run in one steady step, as real-year (AMY) data do: a typical year's
+    months come from different years, so its stamps jump between months."""
+    steps = np.diff(index.as_unit("ns").asi8)
+    return len(steps) > 0 and steps[0] > 0 and bool((steps == steps[0]).all())
+
+
+def _coerce_year(path: Path, fmt: str, index: pd.DatetimeIndex) -> pd.DatetimeIndex:
+    """Typical-year stamps in one year, as pvlib does for TMY3; a 29 February is refused by its line."""
     naive = index.tz_localize(None)
+    leap = np.flatnonzero((naive.month == 2) & (naive.day == 29))
+    if len(leap):
+        why = " (its stamps do not run in steady steps, as real years' do)" if fmt == "epw" else ""
+        raise HybridtrackError(f"{path}: line {_FIRST_DATA_LINE[fmt] + int(leap[0])}: 29 February in a typical-year "
+                               f"file{why}, which is read in {TYPICAL_YEAR}, a year without one; remove that day")
     moved = pd.to_datetime({"year": TYPICAL_YEAR, "month": naive.month, "day": naive.day, "hour": naive.hour,
                             "minute": naive.minute})
     return pd.DatetimeIndex(moved).tz_localize(index.tz)
@@ -151,15 +167,17 @@ def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict, text: str | N
     if len(data) == 0:
         raise HybridtrackError(f"{path}: pvlib read it as {fmt.upper()}, but it holds no rows")
     frame = _map(path, fmt, data, report)
-    if fmt == "tmy2":
-        frame.index = _coerce_year(frame.index)
+    years = f", one year ({TYPICAL_YEAR}) for a typical-year file" if fmt in TYPICAL_YEAR_FORMATS else ""
+    if fmt == "epw" and _real_years(frame.index):
+        years = ", the file's own years (its stamps run in steady steps: real-year data)"
+    elif fmt in _FIRST_DATA_LINE:
+        frame.index = _coerce_year(path, fmt, frame.index)
     if frame.index.tz is None:
         if tz is None:
             raise HybridtrackError(f"{path}: the {fmt.upper()} stamps carry no time zone; give one (tz=..., --tz)")
         frame.index = frame.index.tz_localize(tz, ambiguous="infer", nonexistent="shift_forward")
     elif tz is not None:
         frame.index = frame.index.tz_convert(tz)
-    typical = f", one year ({TYPICAL_YEAR}) for a typical-year file" if fmt in TYPICAL_YEAR_FORMATS else ""
-    report.update(format=fmt, time=f"from the {fmt.upper()} file ({frame.index.tz}){typical}")
+    report.update(format=fmt, time=f"from the {fmt.upper()} file ({frame.index.tz}){years}")
     frame["_line"] = np.arange(1, len(frame) + 1, dtype=float)
     return frame, meta
