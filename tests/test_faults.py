@@ -362,3 +362,13 @@ def test_a_creeping_encoder_that_leaves_the_sensor_beyond_the_bound_raises_an_al
 def test_a_healthy_sensor_on_a_sunny_day_raises_no_held_off_alarm():
     frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
     assert not simulate(frame, "lanzhou").events["reason"].str.contains("held beyond").any()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("site", ["lanzhou", "nanjing"])
+def test_a_healthy_year_under_clouds_raises_no_held_off_alarm(site):
+    """A sensor trusted under every sky (hybrid-always), pulled by cloud light a whole climate year,
+    is never beyond the bound an hour without a plausible reading between."""
+    frame = synthetic(site, "2021-01-01", "2021-12-31", weather="climate", seed=2)
+    result = simulate(frame, site, strategy="hybrid-always")
+    assert not result.events["reason"].str.contains("held beyond").any()
