@@ -128,28 +128,31 @@ def test_classify_refuses_an_infinite_cell_by_row_and_column(tmp_path, capsys):
     assert not (tmp_path / "out.csv").exists()
 
 
+def _tune_refused(tmp_path, capsys, text: str, *flags: str) -> tuple:
+    """Run ``tune`` on a labels file of `text` (no folds and one seed unless `flags` say); check it
+    exits 2 and writes nothing; return the labels path and its standard error."""
+    labels = tmp_path / "labels.csv"
+    labels.write_text(text)
+    flags = flags or ("--folds", "0", "--seeds", "1")
+    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", *flags]) == 2
+    assert not (tmp_path / "t.toml").exists()
+    return labels, capsys.readouterr().err
+
+
 @pytest.mark.parametrize("cells, row, column", [
     ("246,27,sunny\n,3,overcast\n", 3, "intensity"),  # was fitted as a wrongly labelled reading
     ("246,27,sunny\n60,inf,overcast\n", 3, "variation"),  # was 'labelled_range needs a finite ...'
     ("246,27,sunny\n60,3,\n", 3, "weather"),  # was 'samples: unknown weather label 'nan'', no file or row
 ])
 def test_tune_refuses_a_reading_without_a_number_by_row_and_column(tmp_path, capsys, cells, row, column):
-    labels = tmp_path / "labels.csv"
-    labels.write_text("intensity,variation,weather\n" + cells)
-    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
-                 "--seeds", "1"]) == 2
-    err = capsys.readouterr().err
+    labels, err = _tune_refused(tmp_path, capsys, "intensity,variation,weather\n" + cells)
     assert err.count("\n") == 1 and f"{labels}: row {row}, column {column!r}: " in err
-    assert not (tmp_path / "t.toml").exists()
 
 
 def test_tune_refuses_an_empty_score_cell(tmp_path, capsys):
     # an empty score made every loss NaN and the fit was written anyway ('loss nan -> nan')
-    labels = tmp_path / "labels.csv"
-    labels.write_text("intensity,variation,score\n246,27,25\n60,3,\n150,100,15\n")
-    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
-                 "--seeds", "1"]) == 2
-    assert f"{labels}: row 3, column 'score': empty" in capsys.readouterr().err
+    labels, err = _tune_refused(tmp_path, capsys, "intensity,variation,score\n246,27,25\n60,3,\n150,100,15\n")
+    assert f"{labels}: row 3, column 'score': empty" in err
 
 
 @pytest.mark.parametrize("command", ["classify", "rules"])
@@ -185,18 +188,14 @@ def test_a_negative_cell_is_refused_by_row_and_column(tmp_path, capsys, command)
 def test_tune_names_the_flag_at_fault_in_one_line(tmp_path, capsys, flags, message):
     # 'margin (score units) = 100.0 ...', 'folds must be ...', 'seeds must be ...': no flag named, and the
     # last two after a progress bar had been drawn on the same standard error
-    labels = tmp_path / "labels.csv"
-    labels.write_text("intensity,variation,weather\n246,27,sunny\n200,85,cloudy\n60,3,overcast\n")
-    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", *flags]) == 2
-    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
-    assert not (tmp_path / "t.toml").exists()
+    _, err = _tune_refused(tmp_path, capsys, "intensity,variation,weather\n246,27,sunny\n200,85,cloudy\n60,3,overcast\n",
+                           *flags)
+    assert err == f"hybridtrack: error: {message}\n"
 
 
 def test_tune_names_the_file_row_and_column_of_an_unknown_label(tmp_path, capsys):
     # 'samples: unknown weather label 'foggy'; ...': neither the file nor the row
-    labels = tmp_path / "labels.csv"
-    labels.write_text("# field notes\nintensity,variation,weather\n246,27,sunny\n150,40,Foggy\n60,3,overcast\n")
-    assert main(["tune", str(labels), "--out", str(tmp_path / "t.toml"), "--method", "local", "--folds", "0",
-                 "--seeds", "1"]) == 2
-    assert capsys.readouterr().err == (f"hybridtrack: error: {labels}: row 4, column 'weather': unknown weather label "
+    labels, err = _tune_refused(tmp_path, capsys,
+                                "# field notes\nintensity,variation,weather\n246,27,sunny\n150,40,Foggy\n60,3,overcast\n")
+    assert err == (f"hybridtrack: error: {labels}: row 4, column 'weather': unknown weather label "
                                        "'Foggy'; the bands are overcast, cloudy, sunny\n")
