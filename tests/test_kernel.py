@@ -112,7 +112,7 @@ def scenario_runs(name):
     return both(frame, scenario.site, collector=scenario.collector, config=config, faults=faults or None)
 
 
-@pytest.mark.parametrize("name", ["sensor-drift", "encoder-frozen-gust", "clock-creep", "wind-stuck",
+@pytest.mark.parametrize("name", ["sensor-drift", "encoder-creep", "encoder-frozen-gust", "clock-creep", "wind-stuck",
                                   "heliostat-wrap"])
 def test_fault_scenarios_run_the_same_compiled(name):
     assert_same_run(*scenario_runs(name))
