@@ -375,3 +375,17 @@ def test_two_digit_dates_that_read_the_same_every_way_are_read(tmp_path, day):
     """'21-06-21' is 21 June 2021 read day-first or year-first: nothing to decide, nothing refused."""
     frame = read_weather(_write(tmp_path / "same.csv", day.index.strftime("%d-%m-%y %H:%M"), day), tz="Asia/Shanghai")
     assert frame.index[0] == pd.Timestamp("2021-06-21 00:00", tz="Asia/Shanghai") and len(frame) == len(day)
+
+
+@pytest.mark.parametrize("written", ["%d/%m/%y %H:%M", "%d/%m/%Y %H:%M"])
+def test_a_gap_of_weeks_in_the_record_does_not_hide_its_date_order(tmp_path, written):
+    """A logger off for seven weeks: read day-first the dates move a month once, at the gap; read
+    year- or month-first they do at every midnight. Such files were refused as if no date told."""
+    hours = pd.date_range("2021-05-01", "2021-05-10 23:00", freq="1h").append(
+        pd.date_range("2021-07-01", "2021-07-10 23:00", freq="1h"))
+    days = pd.DataFrame({"ghi": 0.0, "dni": 0.0, "dhi": 0.0}, index=hours)
+    frame = read_weather(_write(tmp_path / "gap.csv", hours.strftime(written), days), tz="Asia/Shanghai")
+    assert frame.index[0] == pd.Timestamp("2021-05-01 00:00", tz="Asia/Shanghai")
+    assert frame.index[-1] == pd.Timestamp("2021-07-10 23:00", tz="Asia/Shanghai") and len(frame) == 480
+    assert frame.attrs["validation"]["date_order"].startswith("day-first (")
+    assert "read day-first, only 1 line moves a month or more: a gap" in frame.attrs["validation"]["date_order"]

@@ -5,8 +5,9 @@ Decided for the whole column, never cell by cell:
 * **Day, month or year first.** ``dd/mm/yyyy`` and ``mm/dd/yyyy`` (and, with two-digit years,
   ``yy/mm/dd``: ``21-06-15`` is 2021-06-15 or 2015-06-21) are told apart first by the rows that
   are a date in only some readings (a first number above 12 is no month, above 31 no day), then
-  by how the dates run: read in the right order, neighbouring rows' dates move by days; read in
-  a wrong one, a day's change moves a month or a year, or back. A column that no reading makes
+  by how the dates run: read in the right order, neighbouring rows' dates move by days (or by
+  more only at a gap in the record); read in a wrong one, a day's change moves a month or a year,
+  or back. The reading whose dates move a month or more least often is taken. A column that no reading makes
   all dates is refused; so is one that more than one reading makes dates running as days do, and
   the user asked (``dayfirst=True``/``False``, ``--dayfirst``/``--monthfirst``, or four-digit
   years). Dotted dates (``05.06.2021``) are never month-first.
@@ -114,10 +115,9 @@ def _dates_read(parts: pd.DataFrame, readings: list[str]) -> dict[str, np.ndarra
     return dates
 
 
-def _first_jump(dates: np.ndarray) -> int | None:
-    """The first row whose date moves a month or more from the row before it; None if none does."""
-    jumps = np.flatnonzero(np.abs(np.diff(dates)) >= _WRONG_ORDER_MOVE)
-    return int(jumps[0]) + 1 if len(jumps) else None
+def _jumps(dates: np.ndarray) -> np.ndarray:
+    """The rows whose date moves a month or more from the row before it."""
+    return np.flatnonzero(np.abs(np.diff(dates)) >= _WRONG_ORDER_MOVE) + 1
 
 
 def _refuse_mixed(column: _Column, valid: dict[str, np.ndarray], flagged: bool):
@@ -161,11 +161,15 @@ def _date_reading(column: _Column, parts: pd.DataFrame, dayfirst: bool | None) -
     if len(fitting) > 1 and "month-first" in fitting and (parts[1] == ".").all():
         fitting.remove("month-first")
         why.append("dotted dates")
-    jumps = {reading: _first_jump(dates[reading]) for reading in fitting} if len(fitting) > 1 else {}
-    if sum(jump is None for jump in jumps.values()) == 1:
-        why += [f"read {r}, line {int(column.lines[jump])} moves a month or more" for r, jump in jumps.items()
-                if jump is not None]
-        fitting = [reading for reading, jump in jumps.items() if jump is None]
+    jumps = {reading: _jumps(dates[reading]) for reading in fitting} if len(fitting) > 1 else {}
+    fewest = min(map(len, jumps.values()), default=0)
+    if sum(len(rows) == fewest for rows in jumps.values()) == 1:  # a gap in the record moves the right one too
+        why += [f"read {r}, line {int(column.lines[rows[0]])} moves a month or more" for r, rows in jumps.items()
+                if len(rows) > fewest]
+        fitting = [reading for reading, rows in jumps.items() if len(rows) == fewest]
+        if fewest:
+            why.append(f"read {fitting[0]}, only {fewest} line{'s' * (fewest > 1)} move{'s' * (fewest == 1)} a month "
+                       "or more: a gap")
     if len(fitting) > 1:
         _refuse_undecided(column, fitting, dates)
     return fitting[0], f"{fitting[0]} ({'; '.join(why)})"
