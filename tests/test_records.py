@@ -202,6 +202,19 @@ def test_a_leap_year_of_real_data_in_an_epw_keeps_its_29_february(tmp_path, caps
     assert main(["check", str(path)]) == 0
 
 
+@pytest.mark.parametrize("dates", [[(2020, 2, 28), (2020, 2, 29), (2020, 3, 1)], [(2020, 12, 31), (2021, 1, 1)]])
+def test_an_epw_of_real_years_with_a_missing_hour_keeps_its_years(tmp_path, dates):
+    """One hour missing from an AMY file (line 20 here) made its steps unsteady: it was taken for a
+    typical year, so a 2020 with 29 February was refused, and 31 December 2020 was put after
+    1 January in 2019, a year apart."""
+    lines = _epw_days(dates).splitlines()
+    path = write(tmp_path, "amy-gap.epw", "\n".join(lines[:19] + lines[20:]) + "\n")
+    frame = read_weather(path)
+    assert frame.index[0] == pd.Timestamp(*dates[0], tz="Etc/GMT-8") and len(frame) == 24 * len(dates) - 1
+    assert frame.index[-1] == pd.Timestamp(*dates[-1], 23, tz="Etc/GMT-8")
+    assert "the file's own years" in frame.attrs["validation"]["time"]
+
+
 def test_29_february_in_a_typical_year_epw_is_refused_naming_the_line(tmp_path, capsys):
     """A typical year's months come from different years (here a 2012 February after a 2005
     January): it is read in 2019, which has no 29 February."""
@@ -209,8 +222,8 @@ def test_29_february_in_a_typical_year_epw_is_refused_naming_the_line(tmp_path, 
     assert typical.index[0] == pd.Timestamp("2019-01-31 00:00", tz="Etc/GMT-8")
     assert typical.index[-1] == pd.Timestamp("2019-02-28 23:00", tz="Etc/GMT-8")
     path = write(tmp_path, "tmy.epw", _epw_days([(2005, 1, 31), (2012, 2, 29)]))
-    message = (f"{path}: line 33: 29 February in a typical-year file (its stamps do not run in steady steps, as "
-               "real years' do), which is read in 2019, a year without one; remove that day")
+    message = (f"{path}: line 33: 29 February in a typical-year file (its stamps do not run forward through "
+               "real years), which is read in 2019, a year without one; remove that day")
     with pytest.raises(HybridtrackError) as refused:
         read_weather(path)
     assert str(refused.value) == message

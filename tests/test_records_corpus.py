@@ -187,7 +187,7 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
 
 
 def check_pvlib(frame: pd.DataFrame, path: Path, fmt: str) -> None:
-    reader = {"epw": pvlib.iotools.read_epw,  # two days in steady steps: real-year data, in its own year (2021)
+    reader = {"epw": pvlib.iotools.read_epw,  # two days running forward in one year: real-year data, in its own year (2021)
               "surfrad": pvlib.iotools.read_surfrad, "srml": pvlib.iotools.read_srml,
               "bsrn": pvlib.iotools.read_bsrn}[fmt]
     data = reader(str(path))

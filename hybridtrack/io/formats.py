@@ -11,8 +11,9 @@ Whatever pvlib returns, its columns are mapped to the frame's through the same a
 a CSV's (`columns.ALIASES`), plus pvlib's own names per format, with the format's units (TMY2
 gives tenths of °C and m/s); a file from which no irradiance column can be mapped is refused,
 so "clean" always means readable. Typical-year files (EPW, TMY3, TMY2) take one year, 2019,
-since their months come from different years; an EPW whose stamps run in steady steps holds real
-years (an AMY file, or part of one) and keeps them, 29 February included. A typical-year EPW or
+since their months come from different years; an EPW whose stamps run forward through real years
+(the year changing only at New Year, no 29 February skipped) is AMY data, or part of it, an hour
+missing or not, and keeps its years, 29 February included. A typical-year EPW or
 TMY2 file with a 29 February is refused naming its line: 2019 has none.
 """
 
@@ -87,10 +88,19 @@ def _call(path: Path, fmt: str, shown: Path | None = None):
 
 
 def _real_years(index: pd.DatetimeIndex) -> bool:
-    """Whether the stamps run in one steady step, as real-year (AMY) data do: a typical year's
-    months come from different years, so its stamps jump between months."""
-    steps = np.diff(index.as_unit("ns").asi8)
-    return len(steps) > 0 and steps[0] > 0 and bool((steps == steps[0]).all())
+    """Whether the stamps are real years (AMY data, or part of them, an hour missing or not): they
+    run forward, their year changes only from a December to the next January, and no 29 February
+    of their span is missing. A typical year's months come from different years, so its year
+    changes between other months or goes back; one written in a single leap year lacks 29 February."""
+    naive = index.tz_localize(None)
+    if len(naive) < 2 or not (np.diff(naive.as_unit("ns").asi8) > 0).all():
+        return False
+    years, months = naive.year.to_numpy(), naive.month.to_numpy()
+    new = np.flatnonzero(np.diff(years) != 0)
+    if not ((years[new + 1] == years[new] + 1) & (months[new] == 12) & (months[new + 1] == 1)).all():
+        return False
+    days = pd.date_range(naive[0].normalize(), naive[-1], freq="D")
+    return bool(days[(days.month == 2) & (days.day == 29)].isin(naive.normalize()).all())
 
 
 def _coerce_year(path: Path, fmt: str, index: pd.DatetimeIndex) -> pd.DatetimeIndex:
@@ -98,7 +108,7 @@ def _coerce_year(path: Path, fmt: str, index: pd.DatetimeIndex) -> pd.DatetimeIn
     naive = index.tz_localize(None)
     leap = np.flatnonzero((naive.month == 2) & (naive.day == 29))
     if len(leap):
-        why = " (its stamps do not run in steady steps, as real years' do)" if fmt == "epw" else ""
+        why = " (its stamps do not run forward through real years)" if fmt == "epw" else ""
         raise HybridtrackError(f"{path}: line {_FIRST_DATA_LINE[fmt] + int(leap[0])}: 29 February in a typical-year "
                                f"file{why}, which is read in {TYPICAL_YEAR}, a year without one; remove that day")
     moved = pd.to_datetime({"year": TYPICAL_YEAR, "month": naive.month, "day": naive.day, "hour": naive.hour,
@@ -169,7 +179,7 @@ def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict, text: str | N
     frame = _map(path, fmt, data, report)
     years = f", one year ({TYPICAL_YEAR}) for a typical-year file" if fmt in TYPICAL_YEAR_FORMATS else ""
     if fmt == "epw" and _real_years(frame.index):
-        years = ", the file's own years (its stamps run in steady steps: real-year data)"
+        years = ", the file's own years (its stamps run forward in real years: AMY data)"
     elif fmt in _FIRST_DATA_LINE:
         frame.index = _coerce_year(path, fmt, frame.index)
     if frame.index.tz is None:
