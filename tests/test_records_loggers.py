@@ -389,3 +389,12 @@ def test_a_gap_of_weeks_in_the_record_does_not_hide_its_date_order(tmp_path, wri
     assert frame.index[-1] == pd.Timestamp("2021-07-10 23:00", tz="Asia/Shanghai") and len(frame) == 480
     assert frame.attrs["validation"]["date_order"].startswith("day-first (")
     assert "read day-first, only 1 line moves a month or more: a gap" in frame.attrs["validation"]["date_order"]
+
+
+def test_monthfirst_reads_a_one_day_two_digit_year_file_month_first(tmp_path, capsys, day):
+    """'06/12/21' on one day is 12 June 2021 month-first or 21 December 2006 year-first; given
+    --monthfirst it had still been refused as either, and the only way out offered was to edit the file."""
+    path = _write(tmp_path / "us.csv", day.index.strftime("06/12/21 %H:%M"), day)
+    frame = read_weather(path, tz="Asia/Shanghai", dayfirst=False)
+    assert frame.index[0] == pd.Timestamp("2021-06-12 00:00", tz="Asia/Shanghai") and len(frame) == len(day)
+    assert main(["check", str(path), "--tz", "Asia/Shanghai", "--monthfirst"]) == 0

@@ -95,12 +95,12 @@ def _either(words) -> str:
 
 
 def _possible_readings(parts: pd.DataFrame, dayfirst: bool | None) -> list[str]:
-    """The readings the written years and `dayfirst` leave (month-first and year-first both put
-    the month before the day)."""
-    readings = list(_READINGS) if (parts[3].str.len() <= 2).all() else ["day-first", "month-first"]
-    if dayfirst is None:
-        return readings
-    return ["day-first"] if dayfirst else [reading for reading in readings if reading != "day-first"]
+    """The readings the written years and `dayfirst` leave: all the years allow, or the one a flag
+    or the column's name gives (``--monthfirst`` is month-first, not year-first too: a one-day
+    ``06/12/21`` file so flagged had still been refused as either)."""
+    if dayfirst is not None:
+        return ["day-first" if dayfirst else "month-first"]
+    return list(_READINGS) if (parts[3].str.len() <= 2).all() else ["day-first", "month-first"]
 
 
 def _dates_read(parts: pd.DataFrame, readings: list[str]) -> dict[str, np.ndarray]:

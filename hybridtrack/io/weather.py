@@ -145,8 +145,8 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
         header = f"{mapping['date']} + {mapping['clock']}"
         zone = _zone_in_name(mapping["clock"])
         written = mapping["date"].lower().replace(" ", "")  # 'DATE (MM/DD/YYYY)' says its order
-        if dayfirst is None and ("mm/dd" in written or "dd/mm" in written):
-            dayfirst = "dd/mm" in written
+        if dayfirst is None and ("mm/dd/y" in written or "dd/mm/y" in written):  # not 'yy/mm/dd'
+            dayfirst = "dd/mm/y" in written
     else:
         text, header = pd.Series(cells(mapping["time"])), mapping["time"]
         zone = _zone_in_name(header)
