@@ -182,8 +182,9 @@ def test_a_negative_cell_is_refused_by_row_and_column(tmp_path, capsys, command)
     (["--margin", "100"], "--margin (score units) = 100.0 is outside [0, 30]"),
     (["--folds", "9"], "--folds must be 0 (none) or between 2 and the number of samples (3), got 9"),
     (["--folds", "-1"], "--folds must be 0 (none) or between 2 and the number of samples (3), got -1"),
-    (["--seeds", "0"], "--seeds must be between 1 and 20, got 0"),
-    (["--seeds", "50"], "--seeds must be between 1 and 20, got 50"),
+    (["--seeds", "0"], "--seeds must be a whole number within [1, 20], got 0"),
+    (["--seeds", "50"], "--seeds must be a whole number within [1, 20], got 50"),
+    (["--seed", "5000000000"], "--seed must be a whole number within [0, 4,294,967,276], got 5000000000"),
 ])
 def test_tune_names_the_flag_at_fault_in_one_line(tmp_path, capsys, flags, message):
     # 'margin (score units) = 100.0 ...', 'folds must be ...', 'seeds must be ...': no flag named, and the

@@ -306,6 +306,22 @@ def test_bad_tuning_tables_are_refused(table, message):
         tune(None, table, method="local")
 
 
+@pytest.mark.parametrize("options, message", [
+    ({"seeds": "3"}, r"seeds must be a whole number within \[1, 20\], got '3'"),  # TypeError: '<=' not supported
+    ({"seeds": 2.0}, r"seeds must be a whole number within \[1, 20\], got 2.0"),  # TypeError in range()
+    ({"folds": 2.5}, r"folds must be 0 \(none\) or between 2 .* got 2.5"),  # TypeError in range()
+    ({"maxiter": 0}, r"maxiter must be a whole number within \[1, 100,000\], got 0"),  # a fit of no iterations
+    ({"popsize": -1}, r"popsize must be a whole number within \[1, 1,000\], got -1"),  # had been accepted
+    ({"restarts": float("nan")}, r"restarts must be a whole number within \[0, 1,000\], got nan"),
+    ({"seed": -1}, r"seed must be a whole number within \[0, 4,294,967,276\], got -1"),  # numpy's ValueError
+    ({"seed": 2**40}, r"seed must be a whole number within \[0, 4,294,967,276\]"),  # scipy's: below 2\*\*32
+])
+def test_tunings_counts_and_seed_are_refused_in_one_message(options, message):
+    table = target_table(12)[["intensity", "variation", "weather"]]
+    with pytest.raises(HybridtrackError, match=message):
+        tune(None, table, method="local", **options)
+
+
 def test_an_unlabelled_sample_is_named_by_the_files_own_row(tmp_path):
     from hybridtrack.fuzzy.tuning import read_samples
 

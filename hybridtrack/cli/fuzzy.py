@@ -8,7 +8,6 @@ import math
 import sys
 import warnings
 
-from .. import params
 from ..errors import HybridtrackError
 from ..outputs import claim, strict_json, write
 from .base import add_force_argument, command, real_number, whole_number
@@ -132,9 +131,9 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
 def _tune(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..fuzzy.tuning import check_folds, check_margin, check_seeds, read_samples, tune
+    from ..fuzzy.tuning import check_folds, check_margin, check_seed, check_seeds, read_samples, tune
 
-    params.seed(args.seed, "--seed")
+    check_seed(args.seed, "--seed")
     check_seeds(args.seeds, "--seeds")  # these checks before the progress bar
     start = load_fuzzy_config(args.config)
     check_margin(args.margin, start, "--margin")

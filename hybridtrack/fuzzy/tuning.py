@@ -32,6 +32,7 @@ the raw range its labels covered (``labelled_range``) and a classifier built on 
 
 from __future__ import annotations
 
+import numbers
 import warnings
 from dataclasses import dataclass, field
 
@@ -39,11 +40,11 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
-from ..params import number
+from ..params import number, whole
 from .classifier import FuzzyWeatherClassifier, refuse_negative_readings
 from .config import FuzzyConfig, Term
 
-__all__ = ["tune", "check_margin", "check_folds", "check_seeds", "TuningReport", "read_samples", "evaluate",
+__all__ = ["tune", "check_margin", "check_folds", "check_seeds", "check_seed", "TuningReport", "read_samples", "evaluate",
            "cross_validate", "constraint_violations", "labelled_range", "outside_labels", "warn_outside_labels",
            "OutsideLabelsWarning", "MONOTONE_TOLERANCE"]
 
@@ -354,6 +355,11 @@ def warn_outside_labels(config: FuzzyConfig, intensity, variation, *, stacklevel
     return count
 
 
+#: The largest seed a fit takes: scipy's population search takes seeds below 2**32, and each of up
+#: to 20 seeds (`check_seeds`) adds one.
+MAX_TUNE_SEED = 2**32 - 1 - 19
+
+
 @dataclass(frozen=True)
 class _Options:
     method: str = "global"
@@ -361,6 +367,13 @@ class _Options:
     maxiter: int = 60
     popsize: int = 8
     restarts: int = 8
+
+    def __post_init__(self) -> None:
+        """Refuse counts that are no whole numbers or out of range (a raw TypeError deep in
+        scipy, or a fit of no iterations, before)."""
+        whole(self.maxiter, "maxiter", 1, 100_000)
+        whole(self.popsize, "popsize", 1, 1_000)
+        whole(self.restarts, "restarts", 0, 1_000)
 
 
 def _fit(config: FuzzyConfig, samples: pd.DataFrame, options: _Options, seed: int) -> tuple[FuzzyConfig, int]:
@@ -438,6 +451,7 @@ def cross_validate(config: FuzzyConfig | None, samples, *, folds: int = 5, seed:
     samples = read_samples(samples, config)
     opts = _Options(**options)
     check_folds(folds, len(samples), none=False)
+    check_seed(seed)
     assignment = _folds(samples, folds, seed)
     scores = np.full(len(samples), np.nan)
     per_fold = []
@@ -501,9 +515,10 @@ def check_folds(folds: int, samples: int, name: str = "folds", *, none: bool = T
     -------
     int
     """
-    if not ((none and folds == 0) or 2 <= folds <= samples):
+    if isinstance(folds, bool) or not isinstance(folds, numbers.Integral) \
+            or not ((none and folds == 0) or 2 <= folds <= samples):
         raise HybridtrackError(f"{name} must be {'0 (none) or ' if none else ''}between 2 and the number of samples "
-                               f"({samples}), got {folds}")
+                               f"({samples}), got {folds!r}")
     return folds
 
 
@@ -521,9 +536,24 @@ def check_seeds(seeds: int, name: str = "seeds") -> int:
     -------
     int
     """
-    if not 1 <= seeds <= 20:
-        raise HybridtrackError(f"{name} must be between 1 and 20, got {seeds}")
-    return seeds
+    return whole(seeds, name, 1, 20)
+
+
+def check_seed(seed: int, name: str = "seed") -> int:
+    """`seed`, refused unless a whole number from 0 to `MAX_TUNE_SEED`.
+
+    Parameters
+    ----------
+    seed : int
+        The fit's seed.
+    name : str
+        What the message calls it (``"--seed"`` on the command line).
+
+    Returns
+    -------
+    int
+    """
+    return whole(seed, name, 0, MAX_TUNE_SEED)
 
 
 def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin: float = 0.5,
@@ -582,6 +612,7 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     if method not in ("global", "local"):
         raise HybridtrackError(f"unknown tuning method {method!r}; choose 'global' or 'local'")
     check_seeds(seeds)
+    check_seed(seed)
     check_folds(folds, len(samples))
     options = _Options(method, margin, maxiter, popsize, restarts)
     cv = cross_validate(config, samples, folds=folds, seed=seed, progress=progress, **options.__dict__) if folds \
