@@ -1066,19 +1066,23 @@ def explain_step(result, time):
     events = result.events[result.events["time"] <= log.index[position]]
     event = events.iloc[-1].to_dict() if len(events) else None
     classifier = getattr(result, "classifier", None) or FuzzyWeatherClassifier()  # the run's, once it keeps one
+    scale = "mA" if result.config.sky.mode == "absolute" else "the clear-sky ratio and its range on its mA scale"
     return StepExplanation(log.index[position].tz_convert(result.site.tz), str(row["mode"]), str(row["sky"]),
                            float(row["sky_score"]), str(row["sensor_status"]), float(row["wind_speed"]),
-                           float(row["dni"]), event, classifier.explain(row["intensity_ma"], row["variation_ma"]),
-                           classifier)
+                           float(row["dni"]), event, classifier.explain(row["intensity_input"], row["variation_input"]),
+                           classifier, reading=(float(row["intensity_ma"]), float(row["variation_ma"]), scale))
 
 
 class StepExplanation:
     """One step of a run taken apart: mode, sky, sensor, the last event, and the fuzzy rules."""
 
-    def __init__(self, time, mode, sky, sky_score, sensor_status, wind_speed, dni, event, fuzzy, classifier):
+    def __init__(self, time, mode, sky, sky_score, sensor_status, wind_speed, dni, event, fuzzy, classifier, *,
+                 reading):
         self.time, self.mode, self.sky, self.sky_score = time, mode, sky, sky_score
         self.sensor_status, self.wind_speed, self.dni = sensor_status, wind_speed, dni
         self.event, self.fuzzy, self._classifier = event, fuzzy, classifier
+        #: the photocurrent read and its trailing range (mA), and the scale of the classifier's inputs
+        self.photocurrent, self.photocurrent_range, self.input_scale = reading
 
     def __str__(self) -> str:
         since = (f"since {self.event['time'].tz_convert(self.time.tz):%Y-%m-%d %H:%M}: {self.event['from']} -> "
@@ -1087,8 +1091,9 @@ class StepExplanation:
             f"{self.time:%Y-%m-%d %H:%M:%S} mode {self.mode} ({since})",
             f"  sky {self.sky} (score {self.sky_score:.2f}), sensor {self.sensor_status}, DNI {self.dni:.0f} W/m², "
             f"wind {self.wind_speed:.1f} m/s",
-            f"  the classifier's rules for intensity {self.fuzzy.intensity:.1f} mA, "
-            f"variation {self.fuzzy.variation:.1f} mA:",
+            f"  photocurrent {self.photocurrent:.1f} mA, its range over the window {self.photocurrent_range:.1f} mA",
+            f"  the classifier's rules for its inputs ({self.input_scale}): intensity {self.fuzzy.intensity:.1f}, "
+            f"variation {self.fuzzy.variation:.1f}:",
             *("  " + line for line in str(self.fuzzy).splitlines()),
         ])
 

@@ -41,7 +41,8 @@ from .metrics import score, summarize
 from .mountreport import FIT_PREFIX
 from .sensor import RECORDED_POINTING, SensorModel
 from .sky import LIGHT_AT_NIGHT
-from .skyinputs import SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, sky_inputs
+from .skyinputs import (SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy_config, photocurrent_range,
+                        sky_inputs)
 from .world import Imperfections, World, controller_clock, installed_site, scan_timer
 from .times import check_dates
 
@@ -83,8 +84,13 @@ def _refuse_unread(config) -> None:
             raise HybridtrackError(f"config: {part}.{name} = {value!r} is not read by a run; it reads {instead}")
 
 
+#: ``intensity_ma`` and ``variation_ma`` are the photocurrent read and its trailing range, mA;
+#: ``intensity_input`` and ``variation_input`` are what the classifier scored (``sky_score``), on the
+#: mA scale of its config: the same in absolute mode, the clear-sky ratio and its range put on that
+#: scale in relative mode (`hybridtrack.skyinputs.sky_inputs`).
 LOG_COLUMNS = ("target_true", "target", "angle", "error", "mode", "sky", "sky_score", "sensor_valid",
-               "sensor_status", "intensity_ma", "variation_ma", "wind_speed", "dni", "calibration")
+               "sensor_status", "intensity_ma", "variation_ma", "intensity_input", "variation_input", "wind_speed",
+               "dni", "calibration")
 
 
 @dataclass(frozen=True)
@@ -962,16 +968,19 @@ def _expected_clear_sky(index: pd.DatetimeIndex, site: sites.Site, config: Simul
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,
               clear: pd.DataFrame | None, site: sites.Site) -> pd.DataFrame:
     """The sky as the exact classifier calls the controller's own readings (the log's ``sky``): the
-    photocurrent read (NaN while asleep), the classifier's two inputs from it (`sky_inputs`, the
-    reference of the controller's scan-by-scan sky watch), the score and the label."""
+    photocurrent read (NaN while asleep) and its trailing range, the classifier's two inputs from it
+    (`sky_inputs`, the reference of the controller's scan-by-scan sky watch), the score and the
+    label. The ranges and inputs are NaN where nothing was read."""
     reading = pd.Series(intensity, index=index, name="intensity_ma")
     inputs = config.sky if clear is not None else dataclasses.replace(config.sky, mode="absolute")
     level, variation = sky_inputs(pd.DataFrame(index=index), site, config.sensor, inputs, intensity=reading,
                                   clear=clear)
-    variation = variation.to_numpy(copy=True)
-    variation[np.isnan(intensity)] = np.nan
-    score = np.asarray(classifier.score(level.to_numpy(), variation), float)
-    return pd.DataFrame({"intensity_ma": intensity, "variation_ma": variation, "sky_score": score,
+    asleep = np.isnan(intensity)
+    level, variation, swing = (np.where(asleep, np.nan, values.to_numpy())
+                               for values in (level, variation, photocurrent_range(reading, inputs)[1]))
+    score = np.asarray(classifier.score(level, variation), float)
+    return pd.DataFrame({"intensity_ma": intensity, "variation_ma": swing, "intensity_input": level,
+                         "variation_input": variation, "sky_score": score,
                          "sky": _sky_categorical(*classifier.label_codes(score))}, index=index)
 
 
@@ -1026,7 +1035,8 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
         "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(copy=True),
         "sensor_valid": out.sensor_status == 0,
         "sensor_status": pd.Categorical.from_codes(out.sensor_status, categories=list(SENSOR_STATUS)),
-        "intensity_ma": out.intensity, "variation_ma": sky["variation_ma"].to_numpy(copy=True),
+        **{name: sky[name].to_numpy(copy=True) for name in ("variation_ma", "intensity_input", "variation_input")},
+        "intensity_ma": out.intensity,
         "wind_speed": world.wind.copy(), "dni": scored["dni"], "calibration": out.calibration[:, main],
         "sensor_sun": out.sun[:, main],
     }

@@ -61,7 +61,7 @@ from .sites import Site, get
 from .sky import clear_sky as ineichen_clear_sky
 
 __all__ = ["SkyInputConfig", "MODES", "RULES", "LOW_SUN", "clear_sky", "clear_sky_photocurrent", "sky_inputs",
-           "classify_sky", "fuzzy_config"]
+           "photocurrent_range", "classify_sky", "fuzzy_config"]
 
 MODES = ("relative", "absolute")
 RULES = ("complete", "published")
@@ -231,6 +231,28 @@ def _smoothed(values: pd.Series, smoothing: str | None) -> pd.Series:
     return values.rolling(pd.Timedelta(smoothing), min_periods=1).mean()
 
 
+def photocurrent_range(current: pd.Series, config: SkyInputConfig | None = None) -> tuple[pd.Series, pd.Series]:
+    """The photocurrent as the sky watch reads it and its trailing range, both in mA.
+
+    Parameters
+    ----------
+    current : pandas.Series
+        The sensor's photocurrent (mA) on a time index.
+    config : SkyInputConfig, optional
+        Its ``smoothing`` (the trailing mean taken first, if any) and ``window`` (the range's
+        span); the default when omitted.
+
+    Returns
+    -------
+    (pandas.Series, pandas.Series)
+        The smoothed photocurrent and its range (max - min) over the trailing ``window``: the
+        classifier's inputs in absolute mode, and what relative mode divides by the clear sky.
+    """
+    config = config or SkyInputConfig()
+    absolute = _smoothed(current.astype(float), config.smoothing)
+    return absolute, trailing_range(absolute, config.window)
+
+
 def sky_inputs(frame: pd.DataFrame, site: Site | str, sensor: SensorModel | None = None,
                config: SkyInputConfig | None = None, *, intensity: pd.Series | None = None,
                clear: pd.DataFrame | None = None) -> tuple[pd.Series, pd.Series]:
@@ -266,9 +288,8 @@ def sky_inputs(frame: pd.DataFrame, site: Site | str, sensor: SensorModel | None
     config = config or SkyInputConfig()
     if not isinstance(frame.index, pd.DatetimeIndex) or frame.index.tz is None:
         raise HybridtrackError("the sky inputs need a weather frame on a time-zone-aware DatetimeIndex")
-    current = sensor.photocurrent(frame) if intensity is None else intensity.astype(float)
-    absolute = _smoothed(current, config.smoothing)
-    absolute_variation = trailing_range(absolute, config.window)
+    current = sensor.photocurrent(frame) if intensity is None else intensity
+    absolute, absolute_variation = photocurrent_range(current, config)
     if config.mode == "absolute":
         return absolute.rename("intensity_input"), absolute_variation.rename("variation_input")
     fuzzy = fuzzy_config(config)

@@ -362,6 +362,31 @@ def test_the_logs_sky_is_the_classifiers_label_and_a_band_named_otherwise_is_mis
     assert clear.any() and log["sky"][clear].isna().all() and log["sky"][~clear].notna().all()
 
 
+@pytest.mark.parametrize("mode", ["relative", "absolute"])
+def test_the_log_keeps_the_photocurrents_range_in_ma_apart_from_what_the_classifier_scored(mode):
+    """``variation_ma`` is the photocurrent's 20-minute range in mA whatever the sky mode; the
+    classifier's inputs are ``intensity_input`` and ``variation_input``, whose score is the log's.
+    In relative mode (the default) ``variation_ma`` had held the clear-sky ratio's range put on the
+    classifier's scale (463 "mA" beside a reading of 86 mA), and `explain` had scored the raw
+    reading with it: 14.976 where the run logged 14.200."""
+    frame = synthetic("nanjing", "2021-06-21", weather="cloudy", seed=2)
+    result = simulate(frame, "nanjing", config=SimulationConfig(sky=SkyInputConfig(mode=mode, smoothing=None)))
+    log = result.log
+    read = log["intensity_ma"]
+    by_hand = (read.rolling("20min").max() - read.rolling("20min").min()).where(read.notna())  # (t - 20 min, t]
+    np.testing.assert_allclose(log["variation_ma"], by_hand, rtol=0, atol=1e-9)
+    if mode == "absolute":  # the classifier reads the photocurrent itself
+        np.testing.assert_array_equal(log["intensity_input"], read)
+        np.testing.assert_array_equal(log["variation_input"], log["variation_ma"])
+    clf = FuzzyWeatherClassifier()  # the published table, both modes' default rules
+    scored = clf.score(log["intensity_input"].to_numpy(), log["variation_input"].to_numpy())
+    np.testing.assert_allclose(scored, log["sky_score"], rtol=0, atol=1e-9)
+    for time in ("2021-06-21 09:00", "2021-06-21 12:00", "2021-06-21 17:30"):
+        step = result.explain(time)
+        assert step.fuzzy.score == pytest.approx(log.loc[time, "sky_score"], abs=1e-9)
+        assert f"photocurrent {log.loc[time, 'intensity_ma']:.1f} mA" in str(step)
+
+
 @pytest.mark.parametrize("engine", ["reference", "compiled"])
 @pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
 def test_a_run_built_side_by_side_is_the_run_built_in_turn(monkeypatch, collector, engine):
