@@ -67,6 +67,11 @@ MIN_SPACING = 1.0
 #: so rows this close would share their mirrors: a typo (rows 0.1 µm apart had been taken). Well
 #: below any built width, so that no real layout is refused.
 MIN_ROW_SPACING = 0.1
+#: Metres two collectors may fall short of the least spacing and still be taken: positions written
+#: as decimals differ in binary floating point by a little less than they read (-7.2 - -8.2 is
+#: 0.9999999999999991), and "1 m apart: closer than 1 m" had refused layouts exactly at the limit.
+#: A nanometre lies far below any survey.
+SPACING_TOLERANCE = 1e-9
 #: The most heliostats a field (one tower) may have, as `HeliostatField.rings` takes: Ivanpah's
 #: 173,500 heliostats serve three towers, some 58,000 each.
 MAX_HELIOSTATS = 100_000
@@ -221,7 +226,7 @@ def _refuse_rows_too_close(distances: np.ndarray) -> None:
     """Refuse Fresnel rows closer than `MIN_ROW_SPACING`, naming the first such pair."""
     order = np.argsort(distances)
     gaps = np.diff(distances[order])
-    if len(gaps) and gaps.min() < MIN_ROW_SPACING:
+    if len(gaps) and gaps.min() < MIN_ROW_SPACING - SPACING_TOLERANCE:
         k = int(np.argmin(gaps))
         i, j = sorted((int(order[k]), int(order[k + 1])))
         raise HybridtrackError(f"rows {i + 1} and {j + 1} are {gaps[k]:.12g} m apart: closer than {MIN_ROW_SPACING:g} "
@@ -234,7 +239,8 @@ def _refuse_overlapping(xyz: np.ndarray) -> None:
     from scipy.spatial import cKDTree
 
     pairs = cKDTree(xyz).query_pairs(MIN_SPACING, output_type="ndarray")
-    close = pairs[np.linalg.norm(xyz[pairs[:, 0]] - xyz[pairs[:, 1]], axis=1) < MIN_SPACING] if len(pairs) else pairs
+    apart = np.linalg.norm(xyz[pairs[:, 0]] - xyz[pairs[:, 1]], axis=1) if len(pairs) else np.empty(0)
+    close = pairs[apart < MIN_SPACING - SPACING_TOLERANCE]
     if len(close):
         i, j = sorted(min(close.tolist()))
         raise HybridtrackError(f"heliostats {i + 1} and {j + 1} are {np.linalg.norm(xyz[i] - xyz[j]):.12g} m apart: "

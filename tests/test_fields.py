@@ -134,6 +134,17 @@ def test_bad_fields_are_refused_with_what_is_wrong(make, message):
         make()
 
 
+@pytest.mark.parametrize("make", [
+    lambda: HeliostatField(positions=[[-8.2, -60.0], [-7.2, -60.0]]),  # 1 m apart as written
+    lambda: HeliostatField.rings(6, first_radius=1.0, spacing=1.0),  # a hexagon of 1 m sides: 2 sin(30°) = 1
+    lambda: FresnelField(row_distances=[0.2, 0.3]),  # 0.1 m apart as written
+])
+def test_collectors_exactly_the_least_spacing_apart_are_taken(make):
+    """Decimals exactly at the limit had been refused as "1 m apart: closer than 1 m": -7.2 - -8.2
+    is 0.9999999999999991 in binary floating point."""
+    make()
+
+
 def test_imperfection_draws_are_seeded_per_collector_and_spread_as_asked():
     spread = ImperfectionSpread(axis_azimuth_error=0.2, sensor_noise=0.05)
     mean = Imperfections()
