@@ -683,8 +683,8 @@ def _end_loss_columns(field: FresnelField, dni, altitude, azimuth) -> dict[str, 
     return {"end_loss_m": np.sum(beam * loss, axis=0) / total, "end_loss_share": np.sum(beam * share, axis=0) / total}
 
 
-def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None, seed: int = 0,
-                   keep_log: bool = True, progress: bool | None = None, threads: int | None = None,
+def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None,
+                   seed: int | None = None, keep_log: bool = True, progress: bool | None = None, threads: int | None = None,
                    workers: int | None = None, scheduler: str | None = None) -> FieldResult:
     """Run the tracker for every collector of a field on the same weather.
 
@@ -698,9 +698,10 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         As for `hybridtrack.simulate`.
     config : SimulationConfig, optional
         The run config; its imperfections are the centre of every collector's draw.
-    seed : int
+    seed : int, optional
         Seeds the imperfection draws and each collector's sensor noise: collector ``i``'s
-        draws depend only on `seed` and ``i``.
+        draws depend only on `seed` and ``i``. By default the config's seed, as the command
+        line's ``--seed`` defaults to the ``--config`` file's.
     keep_log : bool
         Keep every collector's log in `FieldResult.dataset` (about 50 bytes per collector
         and step, 80 for a heliostat); False keeps only the metrics.
@@ -730,14 +731,14 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
                                f"got {type(field).__name__}")
-    seed = params.seed(seed)
+    config = checked_config(config)
+    seed = params.seed(config.seed if seed is None else seed)
     for name, flag in (("keep_log", keep_log), ("progress", progress)):
         if not isinstance(flag, (bool, np.bool_)) and not (name == "progress" and flag is None):
             raise HybridtrackError(f"{name} must be True or False, got {flag!r:.60}")
     check_where(scheduler, workers, threads)  # before the sky is computed
     site = sites.get(site)
     frame = _check_frame(frame)
-    config = checked_config(config)
     if workers is not None:
         params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()

@@ -73,6 +73,18 @@ def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
     assert HeliostatField(positions=[[0, -100]]).aim == (0.0, 0.0, 100.0)
 
 
+def test_replace_moves_a_shared_aim_point_or_the_mirrors():
+    field = HeliostatField(positions=[[0, -100], [80, -60]], aim=(0, 0, 100))
+    lower = dataclasses.replace(field, aim=(0.0, 0.0, 80.0))  # had been refused as a second aim point
+    assert lower.aim == (0.0, 0.0, 80.0)
+    np.testing.assert_array_equal(lower.relative_aims, [[0, 100, 80], [-80, 60, 80]])
+    more = dataclasses.replace(field, positions=[[0, -100], [80, -60], [-80, -60]])  # had kept two aim points
+    np.testing.assert_array_equal(more.relative_aims, [[0, 100, 100], [-80, 60, 100], [80, 60, 100]])
+    own = HeliostatField(positions=[[0, -100], [80, -60]], aims=[[0, 0, 100], [3, 0, 95]])
+    with pytest.raises(HybridtrackError, match="not both"):  # which of the two would be used?
+        dataclasses.replace(own, aim=(0.0, 0.0, 80.0))
+
+
 @pytest.mark.parametrize("make, message", [
     (lambda: HeliostatField(positions=[[0.0, np.nan]]), "heliostat 1: position is not finite"),
     (lambda: HeliostatField(positions=[[0, 0, 0, 0]]), r"\(N, 2\) or \(N, 3\)"),
@@ -184,6 +196,18 @@ def test_a_field_run_is_each_collectors_own_run(day):
         meanings = result.dataset["mode"].attrs["flag_meanings"].split()
         assert list(np.asarray(meanings)[codes]) == list(alone.log["mode"].astype(str))
     assert len(result.events) > 0 and set(result.events["collector"]) == set(field.names)
+
+
+def test_a_configs_seed_seeds_the_field_unless_seed_is_given():
+    """A config's seed had been dropped without a word for seed=0 (the command line's --seed
+    defaults to the --config file's seed, the API did not)."""
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=3, freq="20min")
+    field, config = FresnelField(row_distances=[-4.0, 6.0]), SimulationConfig(seed=7)
+    for seed, expected in ((None, 7), (0, 0)):
+        result = simulate_field(frame, "lanzhou", field, config=config, keep_log=False,
+                                **({} if seed is None else {"seed": seed}))
+        drawn = field.spread.draw(config.imperfections, 2, expected)
+        assert list(result.collectors["encoder_offset"]) == [d.encoder_offset for d in drawn]
 
 
 @pytest.mark.parametrize("field, strategy", [
