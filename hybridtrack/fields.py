@@ -384,7 +384,8 @@ class HeliostatField:
         the receiver).
     aims : array_like, shape (N, 3), optional
         One aim point per heliostat (aim-point strategies spread the flux on the receiver);
-        refused beside `aim`, which one of the two would not be used.
+        refused beside `aim`, which one of the two would not be used. None (kept so) when every
+        heliostat aims at `aim`.
     spread : ImperfectionSpread
     """
 
@@ -427,7 +428,7 @@ class HeliostatField:
         if far.any():
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
                                    f"beyond {MAX_DISTANCE:g} m")
-        aim = aims.mean(axis=0)  # once they are known to be near: a mean of 1e308s overflows
+        aim = aims[0] if self.aims is None else aims.mean(axis=0)  # once near: a mean of 1e308s overflows
         relative = aims - xyz
         bad = ~np.isfinite(relative).all(axis=1) | (np.linalg.norm(relative, axis=1) == 0)
         if bad.any():
@@ -435,7 +436,8 @@ class HeliostatField:
                                    "the mirror itself")
         _refuse_unreachable_aims(relative)
         object.__setattr__(self, "aim", tuple(aim.tolist()))
-        object.__setattr__(self, "aims", aims)
+        # one shared point stays one: `dataclasses.replace` then moves it, or the mirrors, alone
+        object.__setattr__(self, "aims", None if self.aims is None else aims)
 
     @classmethod
     def rings(cls, count: int = 12, *, first_radius: float = 60.0, spacing: float = 12.0,
@@ -468,7 +470,7 @@ class HeliostatField:
     @property
     def relative_aims(self) -> np.ndarray:
         """Each aim point from its mirror's centre (N, 3), metres."""
-        return self.aims - self.positions
+        return (np.asarray(self.aim) if self.aims is None else self.aims) - self.positions
 
     def collectors(self) -> list[Collector]:
         return [Collector("heliostat", aim=tuple(a)) for a in self.relative_aims.tolist()]
