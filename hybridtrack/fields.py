@@ -686,8 +686,8 @@ def _end_loss_columns(field: FresnelField, dni, altitude, azimuth) -> dict[str, 
 
 
 def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None,
-                   seed: int | None = None, keep_log: bool = True, progress: bool | None = None, threads: int | None = None,
-                   workers: int | None = None, scheduler: str | None = None) -> FieldResult:
+                   seed: int | None = None, keep_log: bool = True, progress: bool | None = None,
+                   threads: int | None = None, workers: int | None = None, scheduler: str | None = None) -> FieldResult:
     """Run the tracker for every collector of a field on the same weather.
 
     Parameters
