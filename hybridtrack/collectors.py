@@ -109,8 +109,9 @@ def _vectors(function: str, values, name: str) -> np.ndarray:
 
 def sun_vector(altitude, azimuth) -> np.ndarray:
     """Unit vectors towards the sun, shape ``(..., 3)`` in (east, north, up)."""
-    _broadcast("sun_vector", altitude=altitude, azimuth=azimuth)
-    return direction_vectors(*checked_sun(altitude, azimuth, "sun_vector"))
+    alt, az = checked_sun(altitude, azimuth, "sun_vector")
+    _broadcast("sun_vector", altitude=alt, azimuth=az)
+    return direction_vectors(alt, az)
 
 
 def direction_vectors(altitude: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
@@ -180,8 +181,8 @@ def trough_angle(altitude, azimuth, axis_azimuth=0.0):
             raise HybridtrackError(f"unknown axis {axis_azimuth!r}; use 'ns', 'ew' or degrees")
         axis_azimuth = AXIS_AZIMUTH[axis_azimuth]
     axis = _finite(axis_azimuth, "axis azimuth")
-    _broadcast("trough_angle", altitude=altitude, azimuth=azimuth, axis_azimuth=axis)
     alt, az = checked_sun(altitude, azimuth, "trough_angle")
+    _broadcast("trough_angle", altitude=alt, azimuth=az, axis_azimuth=axis)
     return _like(altitude, _cross_axis_angle(alt, az, axis), "trough_angle")
 
 
@@ -246,8 +247,9 @@ def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):
     """
     receiver = receiver_angle(d, h)
     axis = _finite(axis_azimuth, "axis azimuth")
-    _broadcast("fresnel_angle", altitude=altitude, azimuth=azimuth, d=d, h=h, axis_azimuth=axis)
-    sun = _cross_axis_angle(*checked_sun(altitude, azimuth, "fresnel_angle"), axis)
+    alt, az = checked_sun(altitude, azimuth, "fresnel_angle")
+    _broadcast("fresnel_angle", altitude=alt, azimuth=az, d=d, h=h, axis_azimuth=axis)
+    sun = _cross_axis_angle(alt, az, axis)
     return _like(altitude, 0.5 * (sun + receiver), "fresnel_angle")
 
 
@@ -265,11 +267,9 @@ def receiver_angle(d, h):
 
 
 def _finite(values, name: str) -> np.ndarray:
-    """`values` as a float array, refused with its name unless every element is finite."""
-    try:
-        array = np.asarray(values, float)
-    except (TypeError, ValueError):
-        raise HybridtrackError(f"{name} must be numbers, got {values!r}") from None
+    """`values` as a float array, refused with its name unless every element is a finite number
+    (text and True had been read as numbers: "5" as 5 m)."""
+    array = finite_array(values, not_numbers=f"{name} must be numbers", infinite=f"{name} must be finite")
     if not np.all(np.isfinite(array)):
         raise HybridtrackError(f"{name} must be finite, got {array.tolist()!r}")
     return array
@@ -299,8 +299,8 @@ def fresnel_end_loss(altitude, azimuth, d, h):
     d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
     if not np.all(h > 0):  # the hypotenuse would hide the sign: -10 m gave +10 m's loss
         raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
-    _broadcast("fresnel_end_loss", altitude=altitude, azimuth=azimuth, d=d, h=h)
     alt, az = checked_sun(altitude, azimuth, "fresnel_end_loss")
+    _broadcast("fresnel_end_loss", altitude=alt, azimuth=az, d=d, h=h)
     a = np.radians(alt)
     gs = np.radians(az - 180.0)
     f = np.hypot(d, h)
@@ -335,12 +335,15 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     sun : numpy.ndarray, optional
         ``sun_vector(altitude, azimuth)``, if computed already (a field's heliostats share it).
     """
-    target = np.asarray(aim, float)
+    try:
+        target = finite_array(aim, not_numbers="aim point", infinite="aim point")
+    except HybridtrackError:  # text and ragged lists are no point ("0", "20", "100" had been read as one)
+        target = np.zeros(0)
     norm = np.linalg.norm(target, axis=-1, keepdims=True) if target.ndim else np.zeros(1)
     if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
-    _broadcast("heliostat_normal", altitude=altitude, azimuth=azimuth, aim_points=target[..., 0])
     alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
+    _broadcast("heliostat_normal", altitude=alt, azimuth=az, aim_points=target[..., 0])
     s = direction_vectors(alt, az) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)

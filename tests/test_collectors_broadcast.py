@@ -8,7 +8,7 @@ import pytest
 from hybridtrack import HybridtrackError
 from hybridtrack.collectors import (
     THREE_POINT_SUPPORT, fresnel_angle, fresnel_end_loss, heliostat_normal, jack_heights, normal_angles,
-    receiver_angle, tracking_rate, trough_angle,
+    receiver_angle, sun_vector, tracking_rate, trough_angle,
 )
 from hybridtrack.sun import altitude_azimuth, solar_position
 from hybridtrack.times import local_range
@@ -218,3 +218,26 @@ def test_normal_angles_take_a_normal_of_any_length_and_refuse_none():
     np.testing.assert_allclose(azimuth, [0.0, 0.0, 270.0], atol=1e-12)
     with pytest.raises(HybridtrackError, match="zero vector"):
         normal_angles([0.0, 0.0, 0.0])
+
+
+RAGGED = [[10.0, 20.0], [30.0]]
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: fresnel_angle(50.0, 180.0, "5", 10.0), "row distance d must be numbers"),  # had been read as 5 m
+    (lambda: fresnel_angle(50.0, 180.0, True, 10.0), "row distance d must be numbers"),  # had been read as 1 m
+    (lambda: fresnel_end_loss(50.0, 180.0, 5.0, ["10"]), "receiver height h must be numbers"),
+    (lambda: receiver_angle(5.0, "10"), "receiver height h must be numbers"),
+    (lambda: trough_angle(50.0, 180.0, ["90"]), "axis azimuth must be numbers"),  # had been read as 90°
+    (lambda: heliostat_normal(50.0, 180.0, ["0", "20", "100"]), "aim point must be three finite"),  # was taken
+    (lambda: heliostat_normal(50.0, 180.0, "abc"), "aim point must be three finite"),  # numpy's ValueError
+    (lambda: heliostat_normal(50.0, 180.0, [[0, 20, 100], [0, 20]]), "aim point must be three finite"),  # ragged
+    (lambda: trough_angle(RAGGED, 90.0), "trough_angle: altitude must be numbers"),  # numpy's ValueError
+    (lambda: sun_vector(30.0, RAGGED), "sun_vector: azimuth must be numbers"),
+    (lambda: heliostat_normal(RAGGED, 90.0, [0, 20, 100]), "heliostat_normal: altitude must be numbers"),
+])
+def test_collector_parameters_and_sun_positions_that_are_no_numbers_are_refused_by_name(call, message):
+    """Text and True are no metres or degrees: the sun position refused them, the collector's
+    parameters read them as numbers; a ragged list raised numpy's ValueError."""
+    with pytest.raises(HybridtrackError, match=message):
+        call()
