@@ -95,12 +95,11 @@ def _degrees(values, name: str, function: str) -> np.ndarray:
 
 
 def _vectors(function: str, values, name: str) -> np.ndarray:
-    """`values` as float vectors ``(..., 3)``, refused with their shape unless they are."""
-    try:
-        vectors = np.atleast_2d(np.asarray(values, float))
-    except (TypeError, ValueError):  # text, ragged lists
-        raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors of numbers, got "
-                               f"{values!r:.60}") from None
+    """`values` as float vectors ``(..., 3)``, refused with their shape unless they are; NaN
+    stands for no sun, an infinite component for no direction (it had given angles and heights)."""
+    vectors = np.atleast_2d(finite_array(values, not_numbers=f"{function}: {name} must be (east, north, up) vectors "
+                                         "of numbers", infinite=f"{function}: {name} must be finite (NaN where there "
+                                         "is no sun)"))
     if vectors.shape[-1] != 3:
         raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors, shape (..., 3); got shape "
                                f"{vectors.shape}")
@@ -146,6 +145,7 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     """
     vectors = _vectors("across_angle", vectors, "vectors").reshape(np.shape(vectors))  # its own shape kept
     b = np.radians(_finite(axis_azimuth, "axis azimuth"))
+    _broadcast("across_angle", vectors=vectors[..., 0], axis_azimuth=b)
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     return np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
@@ -390,7 +390,7 @@ def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         if np.any(n[..., 2] <= 0):  # a mirror facing the horizon or down has no jack heights (inf and nan)
             raise HybridtrackError("jack_heights: normals must point up (n_z > 0); NaN where there is no sun")
-    xy = np.asarray(supports, float)
+    xy = _finite(supports, "supports")
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise HybridtrackError(f"supports must be (x, y) pairs, got shape {xy.shape}")
     with np.errstate(invalid="ignore", divide="ignore"):

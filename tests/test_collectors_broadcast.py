@@ -7,7 +7,7 @@ import pytest
 
 from hybridtrack import HybridtrackError
 from hybridtrack.collectors import (
-    THREE_POINT_SUPPORT, fresnel_angle, fresnel_end_loss, heliostat_normal, jack_heights, normal_angles,
+    THREE_POINT_SUPPORT, across_angle, fresnel_angle, fresnel_end_loss, heliostat_normal, jack_heights, normal_angles,
     receiver_angle, sun_vector, tracking_rate, trough_angle,
 )
 from hybridtrack.sun import altitude_azimuth, solar_position
@@ -241,3 +241,24 @@ def test_collector_parameters_and_sun_positions_that_are_no_numbers_are_refused_
     parameters read them as numbers; a ragged list raised numpy's ValueError."""
     with pytest.raises(HybridtrackError, match=message):
         call()
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: normal_angles([np.inf, 0.0, 1.0]), "normal_angles: normals must be finite"),  # gave 90°, 0°
+    (lambda: jack_heights([np.inf, 0.0, 1.0]), "jack_heights: normals must be finite"),  # gave nan, inf, -inf
+    (lambda: across_angle([np.inf, 0.0, 1.0], 0.0), "across_angle: vectors must be finite"),  # gave 0°
+    (lambda: across_angle(np.eye(3), [0.0, 90.0]),
+     r"across_angle: the shapes vectors \(3,\), axis_azimuth \(2,\) do not broadcast together"),  # numpy's
+    (lambda: jack_heights([0.0, 0.0, 1.0], "ab"), "supports must be numbers"),  # numpy's ValueError
+    (lambda: jack_heights([0.0, 0.0, 1.0], [[np.nan, 1.0]]), "supports must be finite"),  # gave NaN heights
+])
+def test_vectors_and_supports_that_are_not_finite_or_do_not_broadcast_are_refused_by_name(call, message):
+    with pytest.raises(HybridtrackError, match=message):
+        call()
+
+
+def test_across_angle_takes_one_axis_per_vector():
+    """Hand cases: east is 0° across a north-south axis, the zenith 90°, west 180°; north is 0°
+    across an east-west axis (azimuth 270°, its 0° faces north)."""
+    vectors = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    np.testing.assert_allclose(across_angle(vectors, [0.0, 0.0, 0.0, 270.0]), [0.0, 90.0, 180.0, 0.0], atol=1e-12)
