@@ -88,6 +88,19 @@ def checked_sun(altitude, azimuth, function: str) -> tuple[np.ndarray, np.ndarra
     return alt, az
 
 
+def sun_path(altitude, azimuth, function: str) -> tuple[np.ndarray, np.ndarray]:
+    """A sun path as two 1-D float arrays of one value a step (`checked_sun`'s): one position is a
+    path of one step; a path is one value a step, of the same length in both, refused by
+    `function`'s name otherwise (a length-1 azimuth had been reused against a longer altitude,
+    and a scalar or a column raised numpy's IndexError)."""
+    alt, az = checked_sun(altitude, azimuth, function)
+    alt, az = np.atleast_1d(alt), np.atleast_1d(az)
+    if alt.ndim != 1 or alt.shape != az.shape:
+        raise HybridtrackError(f"{function} takes a sun path: altitude and azimuth of one value a step, the same "
+                               f"length; got shapes {alt.shape} and {az.shape}")
+    return alt, az
+
+
 def _degrees(values, name: str, function: str) -> np.ndarray:
     """`values` as a float array of angles: real numbers (NaN allowed), never infinite."""
     return finite_array(values, not_numbers=f"{function}: {name} must be numbers (degrees)",

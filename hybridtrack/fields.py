@@ -34,11 +34,11 @@ from .collectors import (
     AXIS_AZIMUTH,
     MAX_DISTANCE,
     Collector,
-    checked_sun,
     fresnel_angle,
     fresnel_end_loss,
     heliostat_normal,
     normal_angles,
+    sun_path,
     trough_angle,
 )
 from .errors import HybridtrackError
@@ -141,14 +141,8 @@ class ImperfectionSpread:
 
 
 def _sun_columns(altitude, azimuth) -> tuple[np.ndarray, np.ndarray]:
-    """Sun path as (T, 1) columns that broadcast against N collectors: one position is a path of
-    one step; a path is one value a step, of the same length in both (a length-1 azimuth had been
-    reused against a longer altitude, and a scalar raised numpy's IndexError)."""
-    alt, az = checked_sun(altitude, azimuth, "a field's geometry")
-    alt, az = np.atleast_1d(alt), np.atleast_1d(az)
-    if alt.ndim != 1 or alt.shape != az.shape:
-        raise HybridtrackError(f"a field's geometry takes a sun path: altitude and azimuth of one value a step, the "
-                               f"same length; got shapes {alt.shape} and {az.shape}")
+    """Sun path (`sun_path`) as (T, 1) columns that broadcast against N collectors."""
+    alt, az = sun_path(altitude, azimuth, "a field's geometry")
     return alt[:, None], az[:, None]
 
 

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .collectors import Collector, across_angle, heliostat_normal, normal_angles, receiver_angle, sun_vector
+from .collectors import (Collector, across_angle, as_collector, heliostat_normal, normal_angles, receiver_angle,
+                         sun_path, sun_vector)
+from .params import number
 from .reuse import shared
 
 __all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine",
@@ -33,10 +35,14 @@ def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_az
     encoder offset; for a heliostat's pedestal the tilt and roll are its two tilt components,
     and the turn is the same as an azimuth encoder offset (Stone 1986).
     """
-    b = np.radians(axis_azimuth)
-    turn = _about(np.array([0.0, 0.0, 1.0]), np.radians(axis_azimuth_error))
-    tilt = _about(np.array([np.cos(b), -np.sin(b), 0.0]), np.radians(axis_tilt_error))
-    roll = _about(np.array([np.sin(b), np.cos(b), 0.0]), np.radians(axis_roll_error))
+    given = {"axis_azimuth_error": axis_azimuth_error, "axis_tilt_error": axis_tilt_error,
+             "axis_azimuth": axis_azimuth, "axis_roll_error": axis_roll_error}
+    # one finite angle each: an array raised numpy's ValueError, None its TypeError, NaN gave NaNs
+    radians = {name: np.radians(number(value, f"mounting_rotation: {name} (degrees)")) for name, value in given.items()}
+    b = radians["axis_azimuth"]
+    turn = _about(np.array([0.0, 0.0, 1.0]), radians["axis_azimuth_error"])
+    tilt = _about(np.array([np.cos(b), -np.sin(b), 0.0]), radians["axis_tilt_error"])
+    roll = _about(np.array([np.sin(b), np.cos(b), 0.0]), radians["axis_roll_error"])
     return (roll @ tilt @ turn).T  # world -> mounting
 
 
@@ -50,7 +56,8 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     `vectors` are this sun's `pointing_vectors` (with the same `night`) when the caller has them,
     `sun` its unit vectors (a heliostat's, `heliostat_sun`) otherwise.
     """
-    alt, az = np.asarray(altitude, float), np.asarray(azimuth, float)
+    alt, az = sun_path(altitude, azimuth, "mount_targets")
+    collector = as_collector(collector)
     if night:
         return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
                                else vectors, collector, rotation)
@@ -130,8 +137,9 @@ def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np
     heliostat's is the cosine of half the angle between sun and aim point. Zero at night.
     `sun`: the sun's unit vectors (`sun_vector`), if computed already.
     """
-    alt = np.asarray(altitude, float)
-    s = sun_vector(alt, np.asarray(azimuth, float)) if sun is None else sun
+    alt, az = sun_path(altitude, azimuth, "incidence_cosine")
+    collector = as_collector(collector)
+    s = sun_vector(alt, az) if sun is None else sun
     if collector.kind == "heliostat":
         r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
         cos = np.sqrt(np.clip((1.0 + np.einsum("nc,c->n", s, r)) / 2.0, 0.0, 1.0))

@@ -201,3 +201,41 @@ def test_within_turn_is_numpys_remainder_bit_for_bit():
     got = within_turn(angles)
     assert np.array_equal(got, expected, equal_nan=True)
     assert np.array_equal(np.signbit(got), np.signbit(expected))
+
+
+@pytest.mark.parametrize("kind", ["trough-ns", "trough-ew"])
+def test_mount_targets_and_incidence_take_one_sun_position_as_a_path_of_one_step(kind):
+    """pvlib's single-axis tracker (no backtracking, no limit) is the reference: ρ = 90° + θ and
+    the incidence its aoi. One position had raised a TypeError (len() of unsized object) and an
+    IndexError."""
+    from hybridtrack.mounting import incidence_cosine, mount_targets
+
+    collector = Collector(kind)
+    track = pvlib.tracking.singleaxis(90.0 - 30.0, 120.0, axis_azimuth=collector.axis + 180.0, max_angle=180.0,
+                                      backtrack=False)
+    np.testing.assert_allclose(mount_targets(30.0, 120.0, collector), 90.0 + np.ravel(track["tracker_theta"])[:, None])
+    np.testing.assert_allclose(incidence_cosine(30.0, 120.0, collector), np.cos(np.radians(np.ravel(track["aoi"]))))
+
+
+THREE = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda m: m.mount_targets(THREE[0], THREE[1][:2], Collector()),
+     r"mount_targets takes a sun path: .* got shapes \(3,\) and \(2,\)"),  # numpy's IndexError
+    (lambda m: m.mount_targets(THREE[0][:, None], THREE[1][:, None], Collector("heliostat")),
+     r"mount_targets takes a sun path: .* got shapes \(3, 1\) and \(3, 1\)"),  # numpy's IndexError
+    (lambda m: m.incidence_cosine(THREE[0][:, None], THREE[1][:, None], Collector()),
+     r"incidence_cosine takes a sun path"),  # numpy's IndexError
+    (lambda m: m.mount_targets(*THREE, "trough"), "unknown collector 'trough'"),  # AttributeError
+    (lambda m: m.incidence_cosine(*THREE, 5), "collector must be a kind's name"),  # AttributeError
+    (lambda m: m.mount_targets("a", "b", Collector()), "mount_targets: altitude must be numbers"),  # ValueError
+    (lambda m: m.mounting_rotation([0.1, 0.2], 0.0, 0.0), "axis_azimuth_error"),  # numpy's ValueError
+    (lambda m: m.mounting_rotation(0.1, None, 0.0), "axis_tilt_error"),  # numpy's TypeError
+    (lambda m: m.mounting_rotation(0.1, 0.0, np.nan), "axis_azimuth"),  # a rotation of NaNs
+])
+def test_mounting_refuses_what_is_no_sun_path_collector_or_angle_by_name(call, message):
+    from hybridtrack import mounting
+
+    with pytest.raises(HybridtrackError, match=message):
+        call(mounting)
