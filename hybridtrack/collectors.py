@@ -140,7 +140,12 @@ def within_turn(angle: np.ndarray) -> np.ndarray:
     """`angle` % 360 (degrees, a float array), bit for bit, without numpy's float remainder on
     every element: that takes ~45 ns an angle below zero and ~110 ns a NaN (0.06 s for a
     year's azimuths with its nights), against ~10 ns for the add below. Angles within a turn of
-    zero (-360 to 360) add 360 where negative, as the remainder itself does; the rest take it."""
+    zero (-360 to 360) add 360 where negative, as the remainder itself does; the rest take it.
+    A number or a list is taken as well (a float had raised an AttributeError, a list a TypeError)."""
+    array = np.asarray(angle)
+    if array.dtype.kind not in "fiu":  # text, None, True and False are no angle
+        raise HybridtrackError(f"within_turn: angles must be numbers (degrees), got {angle!r:.60}")
+    angle = array.astype(float, copy=False)
     within = np.where(angle < 0.0, angle + 360.0, angle + 0.0)  # + 0.0: -0.0 % 360 is 0.0
     beyond = (angle < -360.0) | (angle >= 360.0)
     if beyond.any():

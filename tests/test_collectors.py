@@ -239,3 +239,15 @@ def test_mounting_refuses_what_is_no_sun_path_collector_or_angle_by_name(call, m
 
     with pytest.raises(HybridtrackError, match=message):
         call(mounting)
+
+
+def test_within_turn_takes_a_number_or_a_list_and_refuses_what_is_no_angle():
+    """A float raised an AttributeError ('bool' object has no attribute 'any') and a list a
+    TypeError; Python's own remainder is the reference."""
+    from hybridtrack.collectors import within_turn
+
+    assert within_turn(-10.0) == -10.0 % 360.0 and within_turn(-400) == -400 % 360
+    np.testing.assert_array_equal(within_turn([-10.0, 400.0, 720.0]), [-10.0 % 360.0, 400.0 % 360.0, 0.0])
+    for angle in ("a", None, [True, False]):
+        with pytest.raises(HybridtrackError, match="within_turn: angles must be numbers"):
+            within_turn(angle)
