@@ -10,6 +10,7 @@ import numpy as np
 
 from .collectors import (Collector, across_angle, as_collector, heliostat_normal, normal_angles, receiver_angle,
                          sun_path, sun_vector)
+from .errors import HybridtrackError
 from .params import number
 from .reuse import shared
 
@@ -58,6 +59,9 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     """
     alt, az = sun_path(altitude, azimuth, "mount_targets")
     collector = as_collector(collector)
+    if rotation is not None and np.shape(rotation) != (3, 3):  # numpy's ValueError, deep in a product
+        raise HybridtrackError(f"mount_targets: rotation must be a 3 x 3 matrix (mounting_rotation), got shape "
+                               f"{np.shape(rotation)}")
     if night:
         return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
                                else vectors, collector, rotation)

@@ -233,6 +233,8 @@ THREE = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
     (lambda m: m.mounting_rotation([0.1, 0.2], 0.0, 0.0), "axis_azimuth_error"),  # numpy's ValueError
     (lambda m: m.mounting_rotation(0.1, None, 0.0), "axis_tilt_error"),  # numpy's TypeError
     (lambda m: m.mounting_rotation(0.1, 0.0, np.nan), "axis_azimuth"),  # a rotation of NaNs
+    (lambda m: m.mount_targets(*THREE, Collector(), np.eye(2)),
+     r"mount_targets: rotation must be a 3 x 3 matrix .* got shape \(2, 2\)"),  # numpy's ValueError
 ])
 def test_mounting_refuses_what_is_no_sun_path_collector_or_angle_by_name(call, message):
     from hybridtrack import mounting
