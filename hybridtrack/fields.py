@@ -75,6 +75,8 @@ SPACING_TOLERANCE = 1e-9
 #: The most heliostats a field (one tower) may have, as `HeliostatField.rings` takes: Ivanpah's
 #: 173,500 heliostats serve three towers, some 58,000 each.
 MAX_HELIOSTATS = 100_000
+#: A positions table's columns that give each heliostat its own aim point (`hybridtrack field --positions`).
+AIM_COLUMNS = ("aim_east", "aim_north", "aim_up")
 #: A heliostat field's aim point when none is given: 100 m above the tower's foot, a tower of the
 #: size the rings' default 60 m first radius serves.
 DEFAULT_AIM = (0.0, 0.0, 100.0)
@@ -486,7 +488,8 @@ class HeliostatField:
 def _by_name(positions):
     """A table's ``east``, ``north`` (and ``up``) columns, by name, as a positions file is read; any
     other positions as they are. A table had been read by its columns' order: an ``id, east,
-    north`` table put the mirrors 100 m underground, and a ``north, east`` one mirrored the field."""
+    north`` table put the mirrors 100 m underground, and a ``north, east`` one mirrored the field.
+    Its aim columns (`AIM_COLUMNS`) are refused: they are given as ``aims``."""
     if not isinstance(positions, pd.DataFrame):
         return positions
     names = {str(column).strip().lower(): column for column in positions.columns}
@@ -494,6 +497,11 @@ def _by_name(positions):
     if wanted[:2] != ["east", "north"]:
         raise HybridtrackError(f"heliostat positions: a table needs columns 'east' and 'north' (and 'up'), m; it has "
                                f"{', '.join(map(str, positions.columns)) or 'none'}")
+    aims = [names[column] for column in AIM_COLUMNS if column in names]
+    if aims:  # dropped, every mirror had aimed at the default point, not the table's
+        raise HybridtrackError(f"heliostat positions: the table's {', '.join(map(str, aims))} are aim points, which "
+                               f"positions does not read: give the table without them, and them as "
+                               f"aims=table[{list(AIM_COLUMNS)}]")
     table = positions[[names[axis] for axis in wanted]]
     if all(pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind) for kind in table.dtypes):
         return table.to_numpy(dtype=float, na_value=np.nan)  # pandas' nullable numbers too; NA is not finite

@@ -558,6 +558,17 @@ def test_a_table_of_heliostat_positions_is_read_by_its_columns_names():
         HeliostatField(positions=pd.DataFrame({"x": [1.0], "y": [2.0]}))
 
 
+def test_a_table_of_positions_with_aim_points_is_refused_not_aimed_elsewhere():
+    """A positions file's aim columns, which `hybridtrack field --positions` reads, had been dropped
+    from a table: its mirrors aimed at (0, 0, 100) m, not at the file's 60 m."""
+    table = pd.DataFrame({"east": [0.0, 50.0], "north": [-100.0, -90.0], "aim_east": [0.0, 0.0],
+                          "aim_north": [0.0, 0.0], "aim_up": [60.0, 60.0]})
+    with pytest.raises(HybridtrackError, match="aim_east, aim_north, aim_up are aim points.*without them.*aims="):
+        HeliostatField(positions=table)
+    field = HeliostatField(positions=table[["east", "north"]], aims=table[["aim_east", "aim_north", "aim_up"]])
+    np.testing.assert_array_equal(field.relative_aims, [[0.0, 100.0, 60.0], [-50.0, 90.0, 60.0]])
+
+
 def test_a_spread_takes_numpys_numbers_and_refuses_an_integer_past_any_float():
     spread = ImperfectionSpread(encoder_offset=np.float32(0.25), axis_tilt_error=np.int64(0))
     assert spread.encoder_offset == pytest.approx(0.25) and type(spread.axis_tilt_error) is float  # both had been refused

@@ -86,6 +86,7 @@ def _numbers(text: str, flag: str) -> list[float]:
 def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
     """Mirror centres (N, 2 or 3) and optional aim points (N, 3) from a CSV file (comma,
     semicolon, tab or bar; ``#`` comments), as `hybridtrack.io.read_table` reads small tables."""
+    from ..fields import AIM_COLUMNS
     from ..io import numeric_columns
     from ..io.tables import read_table
 
@@ -94,7 +95,7 @@ def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
         if column not in table.columns:
             raise HybridtrackError(f"{path}: no column {column!r}; columns are {', '.join(table.columns)}")
     position_columns = [c for c in ("east", "north", "up") if c in table.columns]
-    aim_columns = [c for c in ("aim_east", "aim_north", "aim_up") if c in table.columns]
+    aim_columns = [c for c in AIM_COLUMNS if c in table.columns]
     if aim_columns and len(aim_columns) != 3:
         raise HybridtrackError(f"{path}: aim points need all of aim_east, aim_north, aim_up")
     columns = position_columns + aim_columns
