@@ -85,17 +85,6 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
         dataclasses.replace(own, aim=(0.0, 0.0, 80.0))
 
 
-def test_replacing_a_heliostat_fields_aim_or_mirrors_moves_them():
-    """A new aim point had been refused as a second one beside the stored copies of the old, and
-    new mirrors had kept the old mirrors' count of aim points."""
-    field = HeliostatField(positions=[[0.0, -100.0], [30.0, -80.0]], aim=(0, 0, 100))
-    higher = dataclasses.replace(field, aim=(0.0, 0.0, 120.0))
-    np.testing.assert_array_equal(higher.relative_aims, [[0, 100, 120], [-30, 80, 120]])
-    more = dataclasses.replace(field, positions=[[0.0, -50.0], [10.0, -50.0], [20.0, -50.0]])
-    np.testing.assert_array_equal(more.relative_aims, [[0, 50, 100], [-10, 50, 100], [-20, 50, 100]])
-    assert more.aim == (0.0, 0.0, 100.0)
-
-
 @pytest.mark.parametrize("make, message", [
     (lambda: HeliostatField(positions=[[0.0, np.nan]]), "heliostat 1: position is not finite"),
     (lambda: HeliostatField(positions=[[0, 0, 0, 0]]), r"\(N, 2\) or \(N, 3\)"),
