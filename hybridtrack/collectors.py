@@ -159,12 +159,15 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     Measured from the horizontal direction at ``axis_azimuth + 90°`` through the zenith, the
     single-axis convention of this module, within [-90, 270) so that a direction just below
     either horizon stays next to 0 or 180. `axis_azimuth` (degrees) broadcasts against
-    ``vectors[..., 0]``.
+    ``vectors[..., 0]``. A zero vector has no direction and is refused (it had given 0°).
     """
     vectors = _vectors("across_angle", vectors, "vectors").reshape(np.shape(vectors))  # its own shape kept
     b = np.radians(_finite(axis_azimuth, "axis azimuth"))
     _broadcast("across_angle", vectors=vectors[..., 0], axis_azimuth=b)
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
+    flat = (across == 0.0) & (vectors[..., 2] == 0.0)  # along the axis, or no vector: a year's check in ~3 ms
+    if flat.any() and np.any(flat & (vectors[..., 0] == 0.0) & (vectors[..., 1] == 0.0)):
+        raise HybridtrackError("across_angle: a zero vector has no direction")
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     return np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
 

@@ -251,6 +251,8 @@ def test_collector_parameters_and_sun_positions_that_are_no_numbers_are_refused_
      r"across_angle: the shapes vectors \(3,\), axis_azimuth \(2,\) do not broadcast together"),  # numpy's
     (lambda: jack_heights([0.0, 0.0, 1.0], "ab"), "supports must be numbers"),  # numpy's ValueError
     (lambda: jack_heights([0.0, 0.0, 1.0], [[np.nan, 1.0]]), "supports must be finite"),  # gave NaN heights
+    (lambda: across_angle([0.0, 0.0, 0.0], 0.0), "across_angle: a zero vector has no direction"),  # gave 0°
+    (lambda: across_angle([[0.0, 0.0, 1.0], [0.0, 0.0, 0.0]], [0.0, 90.0]), "a zero vector"),  # gave [90°, 0°]
 ])
 def test_vectors_and_supports_that_are_not_finite_or_do_not_broadcast_are_refused_by_name(call, message):
     with pytest.raises(HybridtrackError, match=message):
