@@ -131,12 +131,16 @@ def _real(value) -> bool:
 def finite_array(values, *, not_numbers: str, infinite: str) -> np.ndarray:
     """`values` (a Series, frame, array, list or number) as a float array of real numbers, NaN
     where a value is missing (a None among numbers in a list too); refused with ``"<not_numbers>, got ..."``
-    unless numbers (text, True and complex numbers are not) and ``"<infinite>, got inf"`` where
-    one is infinite; a ragged list is no numbers either (numpy raised its ValueError)."""
+    unless numbers (text, True and complex numbers are not, nor a True among numbers in a list) and
+    ``"<infinite>, got inf"`` where one is infinite; a ragged list is no numbers either (numpy
+    raised its ValueError)."""
     try:
         array = np.asarray(values.to_numpy() if isinstance(values, (pd.Series, pd.DataFrame)) else values)
     except ValueError:
         raise HybridtrackError(f"{not_numbers}, got {values!r:.60}") from None
+    if isinstance(values, (list, tuple)) and any(isinstance(v, (bool, np.bool_))
+                                                 for v in np.asarray(values, dtype=object).flat):
+        raise HybridtrackError(f"{not_numbers}, got {values!r:.60}")  # numpy read [True, 2.0] as [1.0, 2.0]
     cells = list(array.flat) if array.dtype.kind == "O" else []
     if any(_real(v) for v in cells) and all(_real(v) or v is None for v in cells):
         array = array.astype(float)  # Python's numbers in a list with a None: None is missing (None alone is not)

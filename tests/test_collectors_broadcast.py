@@ -235,6 +235,10 @@ RAGGED = [[10.0, 20.0], [30.0]]
     (lambda: trough_angle(RAGGED, 90.0), "trough_angle: altitude must be numbers"),  # numpy's ValueError
     (lambda: sun_vector(30.0, RAGGED), "sun_vector: azimuth must be numbers"),
     (lambda: heliostat_normal(RAGGED, 90.0, [0, 20, 100]), "heliostat_normal: altitude must be numbers"),
+    (lambda: fresnel_angle(50.0, 180.0, [True, 2.0], 10.0), "row distance d must be numbers"),  # read as 1 m
+    (lambda: trough_angle(50.0, 180.0, [0.0, True]), "axis azimuth must be numbers"),  # read as 1°
+    (lambda: heliostat_normal(50.0, 180.0, [True, 0, 1]), "aim point must be three finite"),  # read as 1 m east
+    (lambda: trough_angle([True, 30.0], [90.0, 90.0]), "trough_angle: altitude must be numbers"),  # read as 1°
 ])
 def test_collector_parameters_and_sun_positions_that_are_no_numbers_are_refused_by_name(call, message):
     """Text and True are no metres or degrees: the sun position refused them, the collector's
