@@ -733,14 +733,14 @@ def _events_frame(index: pd.DatetimeIndex, events: list) -> pd.DataFrame:
 
 def _day_cycle(events: pd.DataFrame, site: sites.Site) -> list[dict]:
     """When the collector woke and stowed for the night each day (local time), and why."""
-    woke = events[(events["from"] == "stow_night") & (events["to"] != "stow_night")]
-    slept = events[(events["to"] == "stow_night") & (events["from"] != "stow_night")]
-    both = pd.concat([woke.assign(kind="woke"), slept.assign(kind="stowed")]).sort_values("time")
+    woke = (events["from"] == "stow_night") & (events["to"] != "stow_night")
+    slept = (events["to"] == "stow_night") & (events["from"] != "stow_night")
+    both = events[woke | slept]  # in the events' order: a night slept in a gap stows and wakes at one scan
     if both.empty:
         return []
     local = pd.DatetimeIndex(both["time"]).tz_convert(site.tz)
-    return [{"time": time.isoformat(), "event": kind, "reason": reason}
-            for time, kind, reason in zip(local, both["kind"], both["reason"])]
+    return [{"time": time.isoformat(), "event": "woke" if up else "stowed", "reason": reason}
+            for time, up, reason in zip(local, woke[woke | slept], both["reason"])]
 
 
 def _wind_data(frame: pd.DataFrame) -> str:

@@ -20,6 +20,7 @@ from hybridtrack.faults import SCENARIOS
 from hybridtrack.simulation import FAULTS, SimulationConfig
 from hybridtrack.sky import synthetic
 from hybridtrack.skyinputs import SkyInputConfig
+from hybridtrack.sun import solar_position
 from hybridtrack.world import Imperfections
 
 COLLECTORS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
@@ -296,6 +297,17 @@ def test_a_rolled_heliostat_pedestal_runs_the_same_compiled(mixed_day):
 def test_irregular_scans_run_the_same_compiled(mixed_day):
     keep = np.random.default_rng(1).random(len(mixed_day)) > 0.3
     assert_same_run(*both(mixed_day[keep], "lanzhou"))
+
+
+@pytest.mark.parametrize("collector", ["trough-ns", "heliostat"])
+def test_a_frame_without_its_nights_runs_the_same_compiled(collector):
+    """Nights slept in the frame's gaps (`ControllerPlan.slept`), with the clock watch's evening
+    verdict, on a trough and a heliostat."""
+    days = synthetic("lanzhou", "2021-06-20", "2021-06-22", weather="mixed", seed=4)
+    day_only = days[solar_position(days.index, "lanzhou")["altitude"].to_numpy() > -2.0]
+    runs = both(day_only, "lanzhou", collector=collector)
+    assert runs[1].events["reason"].str.contains("asleep through it").sum() == 2
+    assert_same_run(*runs)
 
 
 @pytest.mark.slow

@@ -215,6 +215,50 @@ def test_day_cycle_wakes_before_sunrise_and_stows_after_sunset():
     assert abs(at_sunrise["angle"] - max(at_sunrise["target_true"], 0.0)) < 1.0  # pre-positioned
 
 
+def _sun_altitude(index, site):
+    """pvlib's SPA altitude at a site (the sites' own coordinates), independent of the run."""
+    import pvlib
+
+    from hybridtrack import sites
+
+    site = sites.get(site)
+    return pvlib.solarposition.spa_python(index, site.latitude, site.longitude, site.altitude)["elevation"].to_numpy()
+
+
+def test_a_frame_without_its_nights_sleeps_each_night_in_its_gap():
+    """A logger that records only by day: each night is slept at the first scan after it, so the
+    day cycle is the one the same days with their nights give (which end stowed, after the last
+    evening the day-only frame does not reach)."""
+    days = synthetic("lanzhou", "2021-06-20", "2021-06-22", weather="sunny", seed=3)
+    day_only = days[_sun_altitude(days.index, "lanzhou") > -2.0]
+    result = simulate(day_only, "lanzhou", config=perfect())
+    nights = result.events[result.events["reason"].str.contains("across the night")]
+    mornings = [day_only.index[day_only.index.day == day][0] for day in (21, 22)]
+    evenings = [day_only.index[day_only.index.day == day][-1] for day in (20, 21)]
+    assert list(nights["time"]) == mornings
+    assert list(nights["reason"]) == [f"no scans for {(m - e) / pd.Timedelta(hours=1):.1f} h across the night: "
+                                      "asleep through it" for m, e in zip(mornings, evenings)]
+    assert (nights["from"] != "stow_night").all() and (nights["to"] == "stow_night").all()
+    whole = simulate(days, "lanzhou", config=perfect())
+    cycle = [d["event"] for d in result.summary["day_cycle"]]
+    assert cycle == [d["event"] for d in whole.summary["day_cycle"]][:-1] == ["woke", "stowed"] * 2 + ["woke"]
+    woke = result.events[result.events["reason"] == "awake and sun up"]
+    assert list(woke["time"])[1:] == mornings  # and woken at the same scan
+
+
+def test_only_a_gap_across_a_night_is_slept():
+    """Two hours missing at noon are no night; a logger dead from one noon to the next is."""
+    days = synthetic("lanzhou", "2021-06-20", "2021-06-21", weather="sunny", seed=3)
+    noon_hole = days[(days.index < "2021-06-20 12:00+08:00") | (days.index >= "2021-06-20 14:00+08:00")]
+    held = simulate(noon_hole, "lanzhou", config=perfect()).events
+    assert not held["reason"].str.contains("across the night").any()
+    dead_overnight = days[(days.index < "2021-06-20 12:00+08:00") | (days.index >= "2021-06-21 12:00+08:00")]
+    events = simulate(dead_overnight, "lanzhou", config=perfect()).events
+    nights = events[events["reason"].str.contains("across the night")]
+    assert list(nights["time"]) == [pd.Timestamp("2021-06-21 12:00+08:00")]
+    assert nights["reason"].iloc[0].startswith("no scans for 24.0 h")
+
+
 @pytest.mark.parametrize("collector", ["trough-ew", "fresnel", "heliostat"])
 def test_every_collector_tracks(collector):
     frame = synthetic("lanzhou", "2021-09-23", weather="sunny", seed=10)

@@ -192,6 +192,10 @@ class Controller:
         return self.plan.awake.tolist()
 
     @functools.cached_property
+    def slept(self) -> list:
+        return self.plan.slept.tolist()
+
+    @functools.cached_property
     def clock_steps(self) -> list:
         return self.plan.clock_steps.tolist()
 
@@ -305,6 +309,8 @@ class Controller:
             self.out["sky"][i] = UNKNOWN
             self._record(i, NOT_READ, [self._night_target(a) for a in range(self.axes)], reading)
             return [0.0] * self.axes
+        if self.slept[i]:
+            self._night_in_gap(i, t, dt)
         self._day_and_wind(i, t, awake, gusty, wind)
         if self.was_awake and not awake and self.clock is not None:  # the day's end: judge the clock
             for alarm in self.clock.verdict():
@@ -322,6 +328,20 @@ class Controller:
             for gate in self.gates:
                 gate.forget()
         return moves
+
+    def _night_in_gap(self, i: int, t: float, minutes: float) -> None:
+        """The night slept in the gap before scan `i` (`ControllerPlan.slept`: a frame without its
+        nights), as an evening ends a day: the stow, the clock's verdict, the filters forgotten.
+        `_day_and_wind` then wakes the controller at this scan."""
+        if self.mode not in (STOW_WIND, FAULT, STOW_NIGHT):
+            self._switch(i, STOW_NIGHT, f"no scans for {minutes / 60.0:.1f} h across the night: asleep through it", t)
+            self.found_today = False
+        if self.was_awake and self.clock is not None:
+            for alarm in self.clock.verdict():
+                self._alarm(i, alarm)
+        for gate in self.gates:
+            gate.forget()
+        self.was_awake = False
 
     def _daylight(self, t: float, intensity: float) -> bool:
         """The sensor-only tracker's day: light above dusk, or dark for less than 30 minutes."""

@@ -16,7 +16,10 @@ own per-scan computation would:
   than 15 minutes ago (to catch the last light), within the working hours, which by default span
   the whole day: the day is set by the sun, and clock hours are an optional limit. The
   sensor-only tracker has no sun model and no working hours: it wakes and sleeps by the light
-  its sensor reads (`Controller`), so its plan is awake throughout.
+  its sensor reads (`Controller`), so its plan is awake throughout;
+* slept: the scans awake after a gap in the scans, from a scan awake, within which the
+  controller would have been asleep: a frame with its nights left out (a logger that records
+  only by day). The controller sleeps that night at the scan after the gap (`Controller.step`).
 """
 
 from __future__ import annotations
@@ -104,6 +107,11 @@ class ControllerPlan:
     alarms: dict = field(default_factory=dict)
     clear_light: np.ndarray | None = None
     apparent_altitude: np.ndarray | None = None
+    slept: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.slept is None:  # no night in a gap between scans
+            self.slept = np.zeros(len(self.awake), bool)
 
 
 def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeIndex, np.ndarray, dict]:
@@ -154,13 +162,14 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
         The controller's belief about its mount; nominal by default.
     """
     sun_key = ("plan's sun", Same(clock), Content(minutes), site, config)
-    clock, steps, alarms, altitude, azimuth, apparent, awake = shared(
+    clock, steps, alarms, altitude, azimuth, apparent, awake, slept = shared(
         sun_key, lambda: _plan_sun(clock, minutes, site, config))
     vectors = shared(geometry_key(sun_key, "pointing", collector),
                      lambda: pointing_vectors(altitude, azimuth, collector, night=True,
                                               sun=heliostat_sun(sun_key, altitude, azimuth, collector, night=True)))
     model = (mount or MountEstimate()).vector_targets(vectors, collector)
-    plan = ControllerPlan(np.asarray(minutes, float), model, awake, steps, alarms=alarms, apparent_altitude=apparent)
+    plan = ControllerPlan(np.asarray(minutes, float), model, awake, steps, alarms=alarms, apparent_altitude=apparent,
+                          slept=slept)
     if config.calibrates:
         lit = np.isfinite(model).all(axis=1)
         plan.jacobian = shared(geometry_key((*sun_key, Content(lit)), "derivatives", collector),
@@ -174,13 +183,45 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
 def _plan_sun(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, config: ControllerConfig) -> tuple:
     """What the plan computes from the clock alone, the same for every collector a field controller
     drives: the re-based clock, its steps and alarms, the computed sun (altitude, azimuth, apparent
-    altitude) and the scans awake."""
+    altitude), the scans awake and those after a gap the controller slept through."""
     clock, steps, alarms = _rebased(clock, minutes)
-    working = _working(clock.tz_convert(site.tz), config.working_hours)
     sun = solar_position(clock, site, config.sun_model)
     altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
-    awake = np.ones(len(clock), bool) if config.sensor_only else working & _sun_day(clock, altitude, site, config)
-    return clock, steps, alarms, altitude, azimuth, sun["apparent_altitude"].to_numpy(), np.asarray(awake, bool)
+    if config.sensor_only:
+        awake, slept = np.ones(len(clock), bool), np.zeros(len(clock), bool)
+    else:
+        awake = _awake(clock, altitude, site, config)
+        slept = _slept_in_gaps(clock, awake, site, config)
+    return clock, steps, alarms, altitude, azimuth, sun["apparent_altitude"].to_numpy(), awake, slept
+
+
+def _awake(clock: pd.DatetimeIndex, altitude: np.ndarray, site: Site, config: ControllerConfig) -> np.ndarray:
+    """Scans within the working hours and the sun's day (`_sun_day`)."""
+    working = _working(clock.tz_convert(site.tz), config.working_hours)
+    return np.asarray(working & _sun_day(clock, altitude, site, config), bool)
+
+
+#: Minutes between the instants at which a gap in the scans is looked into for a night.
+GAP_LOOK_MINUTES = 5.0
+
+
+def _slept_in_gaps(clock: pd.DatetimeIndex, awake: np.ndarray, site: Site, config: ControllerConfig) -> np.ndarray:
+    """Scans awake after a gap from a scan awake, within which the controller would have been
+    asleep at one of the instants `GAP_LOOK_MINUTES` apart (its clock run on evenly between the
+    two scans): the night of a frame that leaves its nights out."""
+    slept = np.zeros(len(clock), bool)
+    minutes = np.asarray((clock[1:] - clock[:-1]) / pd.Timedelta(minutes=1), float)
+    gaps = np.flatnonzero((minutes > GAP_LOOK_MINUTES) & awake[:-1] & awake[1:])
+    if not len(gaps):
+        return slept
+    looks = np.ceil(minutes[gaps] / GAP_LOOK_MINUTES).astype(int) - 1  # instants strictly inside each gap
+    owner = np.repeat(np.arange(len(gaps)), looks)
+    within = np.arange(len(owner)) - np.repeat(np.cumsum(looks) - looks, looks) + 1
+    instants = clock[gaps[owner]] + pd.to_timedelta(within * GAP_LOOK_MINUTES, unit="min")
+    altitude = solar_position(instants, site, config.sun_model)["altitude"].to_numpy()
+    asleep = ~_awake(instants, altitude, site, config)
+    slept[gaps[np.unique(owner[asleep])] + 1] = True
+    return slept
 
 
 #: Degrees a minute the sun's altitude can change at most (the earth turns 0.25° a minute), with

@@ -120,7 +120,8 @@ def _plan(controller: Controller) -> kc.ControllerPlanArrays:
         return np.full(n, np.nan) if values is None else values
 
     return kc.ControllerPlanArrays(
-        _read_only(plan.model, float), _read_only(plan.awake, bool), _read_only(plan.clock_steps, float),
+        _read_only(plan.model, float), _read_only(plan.awake, bool), _read_only(plan.slept, bool),
+        _read_only(plan.clock_steps, float),
         _read_only(alarm), _read_only(scans(plan.clear_light), float), _read_only(scans(plan.apparent_altitude), float),
         _read_only(jacobian, float), _read_only(weight, float))
 

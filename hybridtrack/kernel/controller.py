@@ -61,7 +61,7 @@ ControllerSettings = namedtuple("ControllerSettings", [
     "deadband", "speed", "stow_speed", "low", "high", "stow", "resolution", "circular"])
 #: The plan (`hybridtrack.control.plan.ControllerPlan`) as arrays; `alarm` marks its alarms' scans.
 ControllerPlanArrays = namedtuple("ControllerPlanArrays", [
-    "model", "awake", "clock_steps", "alarm", "clear_light", "altitude", "jacobian", "weight"])
+    "model", "awake", "slept", "clock_steps", "alarm", "clear_light", "altitude", "jacobian", "weight"])
 #: Every piece's state. `s` (floats) and `k` (integers) hold the scalars named below.
 ControllerState = namedtuple("ControllerState", [
     "s", "k", "encoder", "jumped", "kf", "gate", "stuck_angles", "stuck_expected", "stuck_fill",
@@ -1082,6 +1082,19 @@ def _read_encoders(cfg, state, log, i, t, obs_axes, reading):
 
 
 @kernel
+def _night_in_gap(cfg, state, log, i, t, minutes):
+    """Controller._night_in_gap: the night slept in the gap before scan `i`."""
+    mode = state.k[MODE]
+    if mode != STOW_WIND and mode != FAULT and mode != STOW_NIGHT:
+        _switch(i, STOW_NIGHT, ev.NIGHT_GAP, minutes, t, state, log)
+        state.k[FOUND_TODAY] = 0
+    if state.k[WAS_AWAKE] and cfg.has_fit:
+        clock_verdict(cfg, state, log, i)
+    state.gate[:, READY] = 0
+    state.k[WAS_AWAKE] = 0
+
+
+@kernel
 def _day_and_wind(cfg, state, log, i, t, awake, gusty, wind):
     mode = state.k[MODE]
     resume = SENSOR if cfg.sensor_only else ASTRONOMICAL
@@ -1219,6 +1232,8 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading
         _record(cfg, plan, state, out, i, NOT_READ, targets, reading)
         moves[:] = 0.0
         return
+    if plan.slept[i]:
+        _night_in_gap(cfg, state, log, i, t, dt)
     _day_and_wind(cfg, state, log, i, t, awake, gusty, wind)
     if k[WAS_AWAKE] and not awake and cfg.has_fit:  # the day's end: judge the clock
         clock_verdict(cfg, state, log, i)

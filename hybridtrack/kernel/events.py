@@ -15,7 +15,7 @@ __all__ = ["wording"]
 (PLAN_ALARM, CLOCK_STEPPED, ENCODER_FROZEN, ENCODER_BELIEVED, ENCODER_GLITCH, ANEMOMETER_MOVING, ANEMOMETER_STUCK,
  WIND_MISSING, WIND_HIGH, WIND_RELEASED, WIND_RELEASED_FROZEN, NEW_DAY_PROBE, NIGHT, WAKE, SENSOR_LOST, SKY_NOT_SUNNY,
  TRUE_SKY_NOT_SUNNY, SENSOR_TRUSTED, SKY_SUNNY, SUN_BACK, OUT_OF_FINE_VIEW, DISAGREEMENT, CLOCK_OFF,
- CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED, HELD_OFF) = range(1, 27)
+ CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED, HELD_OFF, NIGHT_GAP) = range(1, 28)
 #: A flag added to the wind codes when the stow is a timed move from the last trusted reading.
 BLIND = 100
 
@@ -45,6 +45,7 @@ def wording(config, plan_alarms: dict):
         NEW_DAY_PROBE: lambda value, other, scan, third: "a new day: probing the encoder again",
         NIGHT: lambda value, other, scan, third: "dark for 30 minutes" if config.sensor_only
             else "outside working hours or sun down",
+        NIGHT_GAP: lambda value, other, scan, third: f"no scans for {value / 60.0:.1f} h across the night: asleep through it",
         WAKE: lambda value, other, scan, third: "awake and sun up" if config.uses_model else "daylight",
         SENSOR_LOST: lambda value, other, scan, third: f"sensor lost ({SENSOR_STATUS[int(value)]})",
         SKY_NOT_SUNNY: lambda value, other, scan, third: f"sky {SKY_CODES[int(value)]}",
