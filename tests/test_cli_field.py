@@ -34,8 +34,20 @@ def test_a_positions_files_columns_it_does_not_read_are_named(tmp_path, capsys):
     path.write_text("id,east,north,elevation\n1,0,-100,3\n")
     positions, _ = read_positions(str(path))
     assert positions.tolist() == [[0.0, -100.0]]
-    assert capsys.readouterr().out == f"{path}: not read: id, elevation (mirrors are read from east, north, up and " \
+    assert capsys.readouterr().err == f"{path}: not read: id, elevation (mirrors are read from east, north, up and " \
                                       "aim_east, aim_north, aim_up)\n"
+
+
+def test_a_positions_files_note_goes_to_stderr_leaving_stdout_the_results(tmp_path, capsys):
+    """The "not read" note had been printed on standard output, above the field's summary."""
+    path = tmp_path / "mirrors.csv"
+    path.write_text("name,east,north\nm1,0,-80\n")
+    assert main(["field", "heliostat", "--site", "nanjing", "--date", "2021-03-20", "--freq", "30min",
+                 "--positions", str(path)]) == 0
+    printed = capsys.readouterr()
+    assert "not read" not in printed.out and printed.out.startswith("nanjing, 2021-03-20")
+    assert printed.err.splitlines()[0] == f"{path}: not read: name (mirrors are read from east, north, up and " \
+                                          "aim_east, aim_north, aim_up)"
 
 
 def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):

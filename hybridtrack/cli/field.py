@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 
 import numpy as np
 
@@ -100,9 +101,9 @@ def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
         raise HybridtrackError(f"{path}: aim points need all of aim_east, aim_north, aim_up")
     columns = position_columns + aim_columns
     unread = [c for c in table.columns if c not in columns]
-    if unread:  # an id or a name, or an 'elevation' meant as up: said, not dropped without a word
+    if unread:  # an id or a name, or an 'elevation' meant as up: said (on stderr: stdout is the results), not dropped
         print(f"{path}: not read: {', '.join(map(str, unread))} (mirrors are read from east, north, up and "
-              "aim_east, aim_north, aim_up)")
+              "aim_east, aim_north, aim_up)", file=sys.stderr)
     table = numeric_columns(table, columns, str(path), required=columns)
     aims = table[aim_columns].to_numpy(float) if aim_columns else None
     return table[position_columns].to_numpy(float), aims
