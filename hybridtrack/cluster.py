@@ -36,13 +36,15 @@ def cores() -> int:
 
 def check_where(scheduler: str | None, workers: int | None, threads: int | None = None) -> None:
     """Refuse a `scheduler` that is not an address (an empty one is an unset ``$VAR``, not a local
-    cluster), a scheduler beside `workers`, and `threads` of this process beside either: the checks
-    of `dask_client` (and of a field's threads), for callers that make them before their work
-    starts."""
+    cluster), a scheduler beside `workers`, a count of `workers` out of range, and `threads` of
+    this process beside either: the checks of `dask_client` (and of a field's threads), for callers
+    that make them before their work starts."""
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
         raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
     if scheduler and workers is not None:
         raise HybridtrackError("give either --scheduler or --workers, not both")
+    if workers is not None:
+        params.whole(workers, "workers", 1, MAX_WORKERS)
     if threads is not None and (scheduler is not None or workers is not None):
         raise HybridtrackError("threads (--threads) run the collectors in this process; workers or a scheduler "
                                "(--workers, --scheduler) send them to Dask: give one or the other")

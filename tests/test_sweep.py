@@ -220,6 +220,21 @@ def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, fla
     assert list(tmp_path.iterdir()) == [path] or list((tmp_path / "out").iterdir())  # no empty --out left behind
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "give either --scheduler or --workers, not both"),
+    (["--workers", "0"], "workers must be a whole number within [1, 1,024], got 0"),
+    (["--scheduler", ""], "scheduler must be an address such as 'tcp://host:8786', got ''"),
+])
+def test_where_the_runs_go_is_checked_before_anything_is_printed(tmp_path, capsys, flags, message):
+    """The run count ("s.toml: 2 runs over seed") had been printed above the refusal."""
+    path = tmp_path / "s.toml"
+    path.write_text("[base]\nfreq = '30min'\n[grid]\nseed = [0, 1]\n")
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), *flags]) == 2
+    printed = capsys.readouterr()
+    assert printed.out == "" and printed.err == f"hybridtrack: error: {message}\n"
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_run_whose_task_dies_is_a_row_and_the_sweep_goes_on(monkeypatch):
     """A worker killed mid-run (out of memory, a signal) raises at the client; the run is still a row."""
     from dask.distributed import LocalCluster

@@ -20,9 +20,11 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
 @command("sweep", "run a grid of runs (config fields, sites, dates, weather, seeds, strategies, collectors) on Dask",
          _sweep_arguments)
 def _sweep(args: argparse.Namespace) -> int:
+    from ..cluster import check_where
     from ..outputs import claim
     from ..sweep import Sweep, SweepInterrupted, partial_file, pareto_front, run_sweep, save_sweep, sweep_files
 
+    check_where(args.scheduler, args.workers)  # before anything is printed: a refusal is the one line
     sweep = Sweep.from_toml(args.file)
     # a folder that cannot be used fails now, not after the runs
     claim([*sweep_files(args.out).values(), partial_file(args.out)])
