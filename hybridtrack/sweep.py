@@ -26,7 +26,8 @@ field of the run config in its TOML layout (``drive.deadband``, ``controller.sun
 starts, and so are the base values the grid leaves alone (every run would fail on them), by the
 code the runs check them with: each run key alone, then the collector, the synthetic weather (its
 dates, one weather a day, its span against the memory budget) and the config as a whole when the
-grid sets none of their keys. A bad grid value is checked by its run, so it fails that run only.
+grid sets none of their keys. A bad grid value is checked by its run, so it fails that run only;
+the run's error names the grid's key and value (``grid.drive.deadband = -1: ...``).
 
 Every run is independent and seeded, and the table is sorted by run number, so it is the same
 whatever the number of workers. A run that fails is kept, with its error, and the sweep goes on.
@@ -46,7 +47,7 @@ import pandas as pd
 
 from . import params
 from .cluster import WorkersGone, close, dask_client, finished
-from .errors import HybridtrackError
+from .errors import HybridtrackError, blamed
 from .outputs import claim, output_folder, removing_empty_folders, together, write
 
 __all__ = ["Sweep", "SweepInterrupted", "run_sweep", "run_one", "save_sweep", "pareto_front", "plot_tradeoff", "RUN_KEYS", "METRICS",
@@ -345,26 +346,50 @@ def _plain(value):
 
 
 def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
-    """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``."""
-    from .simulation import one_thread, simulate
-
-    spec = _spec(base, grid_values)
-    row = _row(spec)
+    """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``,
+    which names the grid's key and value (``grid.drive.deadband = -1: ...``) when the value the
+    run refused came from the grid."""
+    row = _row(_spec(base, grid_values))
     try:
-        seed = params.seed(spec["seed"])  # 1.5 or true is refused, not truncated to another run's seed
-        dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
-        config = dataclasses.replace(_config_from(base.get("config", {}), dotted, source), seed=seed)
-        weather = _weather_arguments(spec)
-        frame = _frame(*weather, seed)
-        with one_thread():  # the sweep spreads its runs over the cores itself
-            summary = simulate(frame, weather[0], collector=_collector(spec), strategy=spec["strategy"],
-                               config=config).summary
-        error = summary["tracking_error_deg"]
-        row.update({m: error[m] if m in error else summary[m] for m in METRICS})
-        row["error"] = None
+        setup = _setup(base, grid_values, source)
+    except HybridtrackError as exc:  # a value refused before the run: the grid's, or not
+        return _failed(row, exc, _from_grid(base, grid_values, source, str(exc)))
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, not the end of the sweep
         return _failed(row, exc)
+    try:
+        row.update(_metrics(_spec(base, grid_values), *setup), error=None)
+    except Exception as exc:  # noqa: BLE001
+        return _failed(row, exc)
     return row
+
+
+def _setup(base: dict, grid_values: dict, source: str) -> tuple:
+    """A run's seed, config, weather arguments and collector, each checked as the run uses it,
+    and its strategy checked."""
+    spec = _spec(base, grid_values)
+    _strategy(spec["strategy"])
+    seed = params.seed(spec["seed"])  # 1.5 or true is refused, not truncated to another run's seed
+    dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
+    config = dataclasses.replace(_config_from(base.get("config", {}), dotted, source), seed=seed)
+    return seed, config, _weather_arguments(spec), _collector(spec)
+
+
+def _metrics(spec: dict, seed: int, config, weather: tuple, collector) -> dict:
+    """The metrics of a run set up by `_setup`."""
+    from .simulation import one_thread, simulate
+
+    frame = _frame(*weather, seed)
+    with one_thread():  # the sweep spreads its runs over the cores itself
+        summary = simulate(frame, weather[0], collector=collector, strategy=spec["strategy"], config=config).summary
+    error = summary["tracking_error_deg"]
+    return {m: error[m] if m in error else summary[m] for m in METRICS}
+
+
+def _from_grid(base: dict, grid_values: dict, source: str, error: str) -> dict:
+    """The grid's values of a run that `error`, its refusal by `_setup`, came from (`blamed`)."""
+    given = {key: value for key, value in grid_values.items() if key != "run"}
+    keys = blamed(lambda values: _setup(base, values, source), given, error)
+    return {key: given[key] for key in keys}
 
 
 def _spec(base: dict, grid_values: dict) -> dict:
@@ -379,8 +404,16 @@ def _row(spec: dict) -> dict:
     return row
 
 
-def _failed(row: dict, exc: BaseException) -> dict:
-    return {**row, **{m: None for m in METRICS}, "error": f"{type(exc).__name__}: {exc}"}
+def _failed(row: dict, exc: BaseException, grid: dict | None = None) -> dict:
+    """`row` of a failed run: no metrics, and the error, after the `grid` values it came from."""
+    named = "".join(f"grid.{key} = {_shown(value)}, " for key, value in (grid or {}).items())
+    named = f"{named[:-2]}: " if named else ""
+    return {**row, **{m: None for m in METRICS}, "error": f"{type(exc).__name__}: {named}{exc}"}
+
+
+def _shown(value) -> str:
+    """A grid value as an error shows it: a date as written in the sweep, anything else as Python writes it."""
+    return value.isoformat() if hasattr(value, "isoformat") else repr(value)
 
 
 def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None = None,

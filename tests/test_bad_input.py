@@ -496,3 +496,35 @@ def test_options_that_add_up_may_be_repeated(tmp_path):
     day = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
     day[["ghi", "dni", "dhi"]].rename(columns={"ghi": "G", "dni": "B"}).to_csv(path, index_label="time")
     assert main(["check", str(path), "--site", "lanzhou", "--map", "ghi=G", "--map", "dni=B"]) == 0
+
+
+def _refuse_above_ten(values: dict) -> None:
+    """A check for `blamed`: a, b and c default to 1; a or c above 10 is refused, and so is a + b above 10."""
+    a, b, c = (values.get(name, 1) for name in "abc")
+    if a > 10 or c > 10:
+        raise HybridtrackError("a or c is above 10")
+    if a + b > 10:
+        raise HybridtrackError("a + b is above 10")
+
+
+@pytest.mark.parametrize("given, named", [
+    ({"a": 11, "b": 1, "c": 1}, ["a"]),  # alone
+    ({"a": 11, "b": 1, "c": 11}, ["a", "c"]),  # each alone, the same refusal
+    ({"a": 6, "b": 6, "c": 1}, ["a", "b"]),  # only together: each named, not c
+    ({"a": 1, "b": 1, "c": 11}, ["c"]),
+])
+def test_a_refusal_is_blamed_on_the_values_it_came_from(given, named):
+    from hybridtrack.errors import blamed
+
+    with pytest.raises(HybridtrackError) as refused:
+        _refuse_above_ten(given)
+    assert blamed(_refuse_above_ten, given, str(refused.value)) == named
+
+
+def test_a_refusal_without_any_of_the_values_is_blamed_on_none():
+    from hybridtrack.errors import blamed
+
+    def refused_always(values):
+        raise HybridtrackError("the file is bad")
+
+    assert blamed(refused_always, {"a": 1, "b": 2}, "the file is bad") == []

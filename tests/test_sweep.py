@@ -94,13 +94,49 @@ def test_bad_sweeps_are_refused_before_any_run(data, message):
 
 
 @pytest.mark.parametrize("key, value, message", [
-    ("days", [1], "HybridtrackError: days must be a whole number from 1 to 3660, got [1]"),
-    ("freq", ["1min"], "HybridtrackError: freq must be a step such as '1min' or '10s', got ['1min']"),
-    ("weather", "sunny,cloudy", "HybridtrackError: 2 weathers given for 1 days; give one per day"),
+    ("days", [1], "HybridtrackError: grid.days = [1]: days must be a whole number from 1 to 3660, got [1]"),
+    ("freq", ["1min"], "HybridtrackError: grid.freq = ['1min']: freq must be a step such as '1min' or '10s', "
+                       "got ['1min']"),
+    ("weather", "sunny,cloudy", "HybridtrackError: grid.weather = 'sunny,cloudy': 2 weathers given for 1 days; "
+                                "give one per day"),
+    ("strategy", "psychic", "HybridtrackError: grid.strategy = 'psychic': unknown strategy 'psychic'"),
+    ("collector.row_distance", "x", "HybridtrackError: grid.collector.row_distance = 'x': collector: row_distance"),
+    ("start", dt.date(2262, 6, 1), "HybridtrackError: grid.start = 2262-06-01: date '2262-06-01' is outside"),
 ])
 def test_a_bad_grid_value_fails_its_run_naming_its_key(key, value, message):
-    """A list where days or freq is one value failed its run with "unhashable type: 'list'"."""
+    """A list where days or freq is one value failed its run with "unhashable type: 'list'"; the
+    error had not said the grid gave the value."""
     assert run_one(Sweep.from_dict(TINY).base, {"run": 0, key: value})["error"].startswith(message)
+
+
+@pytest.mark.parametrize("base, run, named", [
+    # neither alone: 3 days of mixed weather and 2 of sunny,cloudy are each fine; together refused
+    ({"days": 2}, {"days": 3, "weather": "sunny,cloudy"}, "grid.days = 3, grid.weather = 'sunny,cloudy': "
+                                                          "2 weathers given for 3 days"),
+    # the base's weather is wrong for the grid's days: the days are what the grid gave
+    ({"weather": ["sunny", "cloudy"]}, {"days": 3}, "grid.days = 3: 2 weathers given for 3 days"),
+    # the seed is not to blame, though it came from the grid too
+    ({}, {"seed": 4, "drive.deadband": 20}, "grid.drive.deadband = 20: s.toml: drive: deadband (degrees) = 20 is "
+                                            "outside [0, 10]"),
+    # a base value refused whatever the grid gives is the base's, not the grid's
+    ({"collector.row_distance": "x"}, {"collector": "fresnel"}, "collector: row_distance (m) must be a finite"),
+])
+def test_a_failed_runs_error_names_the_grid_values_it_came_from_and_no_others(base, run, named):
+    error = run_one({"freq": "30min", **base, "config": {}}, {"run": 7, **run}, "s.toml")["error"]
+    assert error.startswith(f"HybridtrackError: {named}")
+
+
+def test_a_sweep_with_one_bad_grid_value_runs_the_others_and_names_it(tmp_path, capsys):
+    """grid."drive.deadband" = [0.1, -1]: the bad run's error had not said which grid value it was."""
+    path = tmp_path / "s.toml"
+    path.write_text("[base]\nfreq = '30min'\n[grid]\n\"drive.deadband\" = [0.1, -1]\nseed = [0, 1]\n")
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--workers", "1"]) == 0
+    table = pd.read_parquet(tmp_path / "out" / "runs.parquet")
+    assert table["error"].isna().tolist() == [True, True, False, False] and table["rms"][:2].notna().all()
+    want = f"HybridtrackError: grid.drive.deadband = -1: {path}: drive: deadband (degrees) = -1 is outside [0, 10]"
+    assert table["error"][2] == table["error"][3] == want
+    printed = capsys.readouterr().out
+    assert f"  run 2: {want}\n  run 3: {want}\n" in printed
 
 
 def test_a_bad_base_value_the_grid_overrides_fails_no_run():
@@ -209,7 +245,7 @@ def test_sweep_command_writes_the_table_and_the_plot(tmp_path, capsys):
     ("[base]\nstart = 2021-06-21T10:00:00\n[grid]\nseed = [0]\n", ["--workers", "1"],
      "s.toml: base.start: date '2021-06-21T10:00:00' does not exist"),
     ("[base]\nfreq = '30min'\n[grid]\nstart = ['2021-02-30']\n", ["--workers", "1"],
-     "every run failed; run 0: HybridtrackError: date '2021-02-30' does not exist"),
+     "every run failed; run 0: HybridtrackError: grid.start = '2021-02-30': date '2021-02-30' does not exist"),
 ])
 def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, flags, message):
     path = tmp_path / "s.toml"
