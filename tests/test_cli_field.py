@@ -126,6 +126,58 @@ def test_bad_field_flags(capsys, flags, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["fresnel", "--rows", "nan"], "--rows: row distances must be finite, got [nan]"),
+    (["fresnel", "--rows=-1,2,-1"], "--rows: rows 1 and 3 are both at -1 m from the receiver line: two collectors "
+                                    "cannot share a place"),
+    (["fresnel", "--rows=1,2", "--receiver-height", "-1"], "--receiver-height: receiver height must be finite and "
+                                                           "positive, got [-1.0]"),
+    (["fresnel", "--row-length", "0"], "--row-length: row length must be finite and positive, got [0.0]"),
+    (["fresnel", "--axis-azimuth", "nan"], "--axis-azimuth: axis azimuth must be finite, got [nan]"),
+    (["trough", "--count", "0"], "--count: trough loop: count must be a whole number from 1 to 100000, got 0"),
+    (["trough", "--collector-length", "-5", "--count", "3"], "--collector-length: collector length must be finite and "
+                                                             "positive, got [-5.0]"),
+    # 33 of the default 150 m (4950 m) and 12 of 160 m are within 5000 m; 33 of 160 m are not: both named
+    (["trough", "--count", "33", "--collector-length", "160", "--axis-azimuth", "10"],
+     "--count, --collector-length: trough loop: 33 collectors of 160 m reach 5120 m along the axis, beyond 5000 m"),
+    (["heliostat", "--count", "0"], "--count: heliostat count must be a whole number from 1 to 100000, got 0"),
+    (["heliostat", "--count", "3", "--aim", "0", "0", "-5"], "--aim: heliostat 1: its aim point is not above the "
+                                                             "mirror (-5 m up from it): a heliostat reflects the sun "
+                                                             "up to its receiver"),
+    (["fresnel", "--spread", "encoder_offset=-1"], "--spread encoder_offset: imperfection spread: encoder_offset "
+                                                   "must be a finite number >= 0, got -1.0"),
+    (["fresnel", "--freq", "soon"], "--freq: step 'soon' is not a duration such as '1min' or '10s'"),
+    (["fresnel", "--weather", "sunny,cloudy"], "--weather: 2 weathers given for 1 days; give one per day"),
+])
+def test_a_field_flags_refusal_names_the_flag(capsys, flags, message):
+    """--rows nan said "row distances must be finite, got [nan]", naming no flag."""
+    assert main(["field", *flags, "--site", "lanzhou", "--date", "2021-06-21"]) == 2
+    printed = capsys.readouterr()
+    assert printed.err == f"hybridtrack: error: {message}\n" and printed.out == ""
+
+
+def test_a_positions_files_refusal_names_the_file_and_aim_only_when_it_came_from_aim(tmp_path, capsys):
+    path = tmp_path / "mirrors.csv"
+    path.write_text("east,north\n0,-80\n0,-80\n")
+    base = ["field", "heliostat", "--site", "nanjing", "--date", "2021-03-20", "--positions", str(path)]
+    assert main([*base, "--aim", "0", "0", "100"]) == 2  # the file's two mirrors in one place, not --aim's fault
+    assert capsys.readouterr().err == f"hybridtrack: error: {path}: heliostats 1 and 2 are both at 0, -80, 0 m " \
+                                      "(east, north, up): two collectors cannot share a place\n"
+    path.write_text("east,north\n0,-80\n")
+    assert main([*base, "--aim", "0", "0", "-100"]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {path}: --aim: heliostat 1: its aim point is not above " \
+                                      "the mirror (-100 m up from it): a heliostat reflects the sun up to its receiver\n"
+
+
+def test_the_apis_field_messages_name_no_flag():
+    from hybridtrack import HybridtrackError
+    from hybridtrack.fields import FresnelField
+
+    with pytest.raises(HybridtrackError) as refused:
+        FresnelField(row_distances=[float("nan")])
+    assert str(refused.value) == "row distances must be finite, got [nan]"
+
+
 def test_a_config_files_strategy_runs_unless_the_flag_gives_another(tmp_path, capsys):
     """--strategy's default (hybrid) had replaced the config file's: a sensor-only field was
     reported, and scored, as hybrid."""

@@ -4,7 +4,8 @@ recorded files, synthetic days and runs."""
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+import contextlib
+from collections.abc import Callable, Iterator
 
 from .. import params, sites
 from ..errors import HybridtrackError
@@ -238,10 +239,11 @@ def add_synthetic_arguments(parser: argparse.ArgumentParser, *, date_required: b
 
 def synthetic_span(args: argparse.Namespace):
     """The first and last day of the synthetic run the arguments ask for, with its ``--days``,
-    ``--seed`` and ``--gusts-per-day`` checked."""
+    ``--seed``, ``--gusts-per-day``, ``--date``, ``--freq`` and ``--weather`` checked."""
     import datetime as dt
 
-    from ..times import parse_date
+    from ..sky import check_weather
+    from ..times import parse_date, parse_freq
 
     if not 1 <= args.days <= 3660:
         raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
@@ -249,8 +251,23 @@ def synthetic_span(args: argparse.Namespace):
         args.seed = _config_seed(args)
     params.seed(args.seed, "--seed")
     params.number(args.gusts_per_day, "--gusts-per-day", 0, 200)
-    first = parse_date(args.date)
+    with flag_named("--date"):
+        first = parse_date(args.date)
+    with flag_named("--freq"):
+        parse_freq(args.freq)
+    with flag_named("--weather"):
+        check_weather(args.weather.split(",") if "," in args.weather else args.weather, args.days)
     return first, first + dt.timedelta(days=args.days - 1)
+
+
+@contextlib.contextmanager
+def flag_named(flag: str) -> Iterator[None]:
+    """Within the block, a refusal (`HybridtrackError`) names `flag`, whose value it refused:
+    ``--freq: step 'soon' is not a duration ...`` (the API's message after the flag)."""
+    try:
+        yield
+    except HybridtrackError as exc:
+        raise HybridtrackError(f"{flag}: {exc}") from None
 
 
 def _config_seed(args: argparse.Namespace) -> int:

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from ..errors import HybridtrackError
+from ..errors import HybridtrackError, blamed
 from .base import (
     add_dask_arguments, add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config,
     STRATEGY_HELP, real_number, site_from_arguments, synthetic_frame, whole_number,
@@ -71,10 +71,10 @@ def _spread(args: argparse.Namespace):
         if name not in known:
             raise HybridtrackError(f"--spread: unknown imperfection {name!r}; known: {', '.join(sorted(known))}")
         try:
-            changes[name] = real_number(value)
+            changes[f"--spread {name}"] = (name, real_number(value))
         except argparse.ArgumentTypeError as exc:
             raise HybridtrackError(f"--spread {name}: {exc}") from None
-    return ImperfectionSpread(**changes)
+    return _built(ImperfectionSpread, changes)
 
 
 def _numbers(text: str, flag: str) -> list[float]:
@@ -110,29 +110,48 @@ def read_positions(path: str) -> tuple[np.ndarray, np.ndarray | None]:
 
 
 def field_from_arguments(args: argparse.Namespace):
-    """The field the flags describe."""
+    """The field the flags describe; a refusal names the flags it came from (`_built`)."""
     from ..fields import FresnelField, HeliostatField, TroughLoop
 
     _refuse_other_kinds_flags(args)
     spread = _spread(args)
     if args.kind == "fresnel":
         rows = _numbers(args.rows, "--rows") if args.rows is not None else None
-        return FresnelField(**_given(row_distances=rows, receiver_height=args.receiver_height,
-                                     row_length=args.row_length, axis_azimuth=args.axis_azimuth), spread=spread)
+        return _built(FresnelField, {"--rows": ("row_distances", rows),
+                                     "--receiver-height": ("receiver_height", args.receiver_height),
+                                     "--row-length": ("row_length", args.row_length),
+                                     "--axis-azimuth": ("axis_azimuth", args.axis_azimuth)}, spread=spread)
     if args.kind == "trough":
-        return TroughLoop(**_given(count=args.count, collector_length=args.collector_length,
-                                   axis_azimuth=args.axis_azimuth), spread=spread)
-    aim = tuple(args.aim) if args.aim is not None else None
+        return _built(TroughLoop, {"--count": ("count", args.count),
+                                   "--collector-length": ("collector_length", args.collector_length),
+                                   "--axis-azimuth": ("axis_azimuth", args.axis_azimuth)}, spread=spread)
+    aim = {"--aim": ("aim", tuple(args.aim) if args.aim is not None else None)}
     if args.positions:
         positions, aims = read_positions(args.positions)
-        if aims is not None and aim is not None:
+        if aims is not None and args.aim is not None:
             raise HybridtrackError(f"--aim gives every mirror one aim point; {args.positions} gives each its own "
                                    "(aim_east, aim_north, aim_up): give one or the other")
         try:
-            return HeliostatField(positions=positions, aims=aims, spread=spread, **_given(aim=aim))
+            return _built(HeliostatField, aim, positions=positions, aims=aims, spread=spread)
         except HybridtrackError as exc:  # heliostat N is the file's N-th mirror
             raise HybridtrackError(f"{args.positions}: {exc}") from None
-    return HeliostatField.rings(**_given(count=args.count, aim=aim), spread=spread)
+    return _built(HeliostatField.rings, {"--count": ("count", args.count), **aim}, spread=spread)
+
+
+def _built(make, flags: dict, **fixed):
+    """``make(**fixed, ...)`` with the values `flags` gave, each flag's as ``(argument, value)``
+    (a value of None: not given, the field's own default stands); a refusal names the flags it
+    came from (`hybridtrack.errors.blamed`), as ``--rows: ...``, its message the API's own."""
+
+    def build(chosen: dict):
+        return make(**fixed, **dict(chosen.values()))
+
+    given = {flag: pair for flag, pair in flags.items() if pair[1] is not None}
+    try:
+        return build(given)
+    except HybridtrackError as exc:
+        named = blamed(build, given, str(exc))
+        raise HybridtrackError(f"{', '.join(named)}: {exc}" if named else str(exc)) from None
 
 
 #: The field flags, and the kinds of field each describes.
@@ -150,11 +169,6 @@ def _refuse_other_kinds_flags(args: argparse.Namespace) -> None:
                                    f"{args.kind} one")
     if args.kind == "heliostat" and args.positions is not None and args.count is not None:
         raise HybridtrackError("--count places mirrors on rings; --positions gives them: give one or the other")
-
-
-def _given(**values) -> dict:
-    """The values a flag gave (the field's own defaults stand for the others)."""
-    return {name: value for name, value in values.items() if value is not None}
 
 
 def field_table(summary: dict) -> str:
