@@ -128,6 +128,111 @@ def test_force_replaces_and_says_which(tmp_path, capsys):
     assert last == "replaced (--force): " + ", ".join(str(out / name) for name in RUN_FILES)
 
 
+# -- files an earlier run wrote and this one does not: removed with --force, and said -------------
+
+FIELD = ["field", "trough", "--count", "2", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "30min"]
+ABLATE = ["ablate", "--sites", "lanzhou", "--seasons", "summer", "--seeds", "1", "--collectors", "fresnel",
+          "--policies", "hybrid"]
+TRADEOFF = ABLATE + ["--tradeoff", "--deadbands", "0.1"]
+
+
+def _removals(err: str) -> list[str]:
+    """The lines of standard error that say a file of an earlier run was removed (not the progress bars)."""
+    return [line for line in err.splitlines() if ": removed, from an earlier run (" in line]
+
+
+def _run_twice(first: list, again: list, out: Path, capsys) -> str:
+    """Run `first` into `out`, put a file of the user's there, run `again` with --force; its standard error."""
+    assert main(first + ["--out", str(out)]) == 0
+    (out / "notes.txt").write_text("the user's own\n")
+    capsys.readouterr()
+    assert main(again + ["--out", str(out), "--force"]) == 0
+    return capsys.readouterr().err
+
+
+@pytest.mark.parametrize("first, again, left_out, reason, kept", [
+    # a log.nc beside a --no-log field's collectors.csv had been read as that field's log
+    (FIELD, FIELD + ["--no-log"], "log.nc", "--no-log", ("collectors.csv", "events.csv", "field_map.png",
+                                                         "summary.json")),
+    (SHORT, SHORT + ["--stream"], "report.png", "--stream", ("log.parquet", "events.csv", "summary.json")),
+    (ABLATE, TRADEOFF, "ablation.png", "--tradeoff", ("runs.csv", "table.csv", "tradeoff.png")),
+    (TRADEOFF, ABLATE, "tradeoff.png", "without --tradeoff", ("runs.csv", "table.csv", "ablation.png")),
+])
+def test_force_removes_the_file_an_earlier_run_wrote_and_this_one_does_not(tmp_path, capsys, first, again, left_out,
+                                                                           reason, kept):
+    out = tmp_path / "out"
+    err = _run_twice(first, again, out, capsys)
+    assert _removals(err) == [f"{out / left_out}: removed, from an earlier run ({reason})"]
+    assert sorted(p.name for p in out.iterdir()) == sorted([*kept, "notes.txt"])
+    assert (out / "notes.txt").read_text() == "the user's own\n"  # a name no run writes is never touched
+
+
+def test_replay_stream_with_force_removes_an_earlier_runs_report(tmp_path, capsys):
+    day = tmp_path / "day.csv"
+    assert main(["sky", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10min", "--out", str(day)]) == 0
+    replay = ["replay", str(day), "--site", "lanzhou"]
+    out = tmp_path / "out"
+    err = _run_twice(replay, replay + ["--stream"], out, capsys)
+    assert _removals(err) == [f"{out / 'report.png'}: removed, from an earlier run (--stream)"]
+    assert sorted(p.name for p in out.iterdir()) == ["events.csv", "log.parquet", "notes.txt", "summary.json"]
+
+
+def test_compare_with_force_removes_the_oracles_run_it_leaves_out(tmp_path, capsys):
+    """A file without a true sky leaves hybrid-oracle out; its folder from a synthetic comparison had stayed."""
+    record = tmp_path / "no-sky.csv"
+    pd.read_csv(RECORD).drop(columns="sky").to_csv(record, index=False)
+    synthetic = ["compare", "--site", "nanjing", "--date", "2013-03-20", "--freq", "30min"]
+    out = tmp_path / "out"
+    err = _run_twice(synthetic, ["compare", str(record), "--site", "nanjing", "--step", "30min"], out, capsys)
+    oracle = out / "hybrid-oracle"
+    assert _removals(err) == [f"{oracle / name}: removed, from an earlier run (hybrid-oracle left out)"
+                              for name in ("events.csv", "log.parquet", "summary.json")]
+    assert list(oracle.iterdir()) == [] and "hybrid-oracle" not in strict((out / "comparison.json").read_text())
+
+
+def test_without_force_a_file_an_earlier_run_left_is_refused_and_kept(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "log.nc").write_text("an earlier field's log\n")
+    assert main(FIELD + ["--no-log", "--out", str(out)]) == 2
+    printed = capsys.readouterr()
+    assert printed.err == (f"hybridtrack: error: would leave 1 file of an earlier run beside this run's results: "
+                           f"{out / 'log.nc'} (not written: --no-log); give --force to remove it, or write elsewhere\n")
+    assert printed.out == "" and [p.name for p in out.iterdir()] == ["log.nc"]
+
+
+def test_a_failed_force_run_leaves_the_earlier_runs_files_and_says_no_removal(tmp_path, monkeypatch, capsys):
+    from hybridtrack.fields import FieldResult
+
+    out = tmp_path / "out"
+    assert main(FIELD + ["--out", str(out)]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def full_disk(self, folder, metric="rms"):
+        raise HybridtrackError(f"{folder}/collectors.csv: cannot write (No space left on device)")
+
+    monkeypatch.setattr(FieldResult, "save", full_disk)
+    capsys.readouterr()
+    assert main(FIELD + ["--no-log", "--out", str(out), "--force"]) == 2
+    assert _removals(capsys.readouterr().err) == []
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # log.nc is still the one beside its field
+
+
+def test_a_file_of_an_earlier_run_that_cannot_be_removed_is_refused_before_the_run(tmp_path, monkeypatch, capsys):
+    """A folder whose files may be rewritten but not removed (no write permission on the folder)."""
+    out = tmp_path / "out"
+    assert main(FIELD + ["--out", str(out)]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    access = os.access
+    monkeypatch.setattr(os, "access", lambda path, mode: access(path, mode) and Path(path) != out)
+    capsys.readouterr()
+    assert main(FIELD + ["--no-log", "--out", str(out), "--force"]) == 2
+    printed = capsys.readouterr()
+    assert printed.err == (f"hybridtrack: error: {out / 'log.nc'}: from an earlier run, and cannot be removed (no "
+                           f"permission in {out}); remove it, or write elsewhere\n")
+    assert printed.out == "" and {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 def test_demo_run_twice_replaces_its_own_folder_but_not_another(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["demo"]) == 0

@@ -9,7 +9,7 @@ import sys
 from .. import params
 from ..errors import HybridtrackError
 from ..outputs import claim, write
-from .base import add_force_argument, command, real_number, whole_number
+from .base import add_force_argument, command, leaving_out, real_number, whole_number
 
 
 def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
@@ -41,8 +41,6 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
 @command("ablate", "run every policy over a seeded set of days: what the classifier is worth, and why",
          _ablate_arguments)
 def _ablate(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from tqdm import tqdm
 
     from ..ablation import AblationPlan, ablate
@@ -57,18 +55,32 @@ def _ablate(args: argparse.Namespace) -> int:
     plan = AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), tuple(args.policies or STRATEGIES))
     config = SimulationConfig.from_toml(args.config) if args.config else None
-    files = [Path(args.out) / name for name in ("runs.csv", "table.csv", "ablation.png")] if args.out else []
+    files = _files(args.out, "ablation.png")
     claim(files)  # before the runs, not after them
     days = len(plan.days())
-    with tqdm(total=days, unit="day", desc="ablate", file=sys.stderr) as bar:
-        result = ablate(plan, config=config, workers=args.workers, progress=bar.update)
-    print(f"{days} day-runs ({len(args.sites)} sites × {len(args.seasons)} seasons × {len(args.weather)} weather × "
-          f"{args.seeds} seeds × {len(args.collectors)} collectors), every policy on the same world")
-    print(result.table.to_string(float_format=lambda v: f"{v:.4f}"))
-    print(result.gap_note())
-    if args.out:
-        _write(files, result)
+    with _leaving_out_the_other_picture(args, "tradeoff.png", "without --tradeoff"):
+        with tqdm(total=days, unit="day", desc="ablate", file=sys.stderr) as bar:
+            result = ablate(plan, config=config, workers=args.workers, progress=bar.update)
+        print(f"{days} day-runs ({len(args.sites)} sites × {len(args.seasons)} seasons × {len(args.weather)} "
+              f"weather × {args.seeds} seeds × {len(args.collectors)} collectors), every policy on the same world")
+        print(result.table.to_string(float_format=lambda v: f"{v:.4f}"))
+        print(result.gap_note())
+        if args.out:
+            _write(files, result)
     return 0
+
+
+def _files(out: str | None, picture: str) -> list:
+    """The files an ablation or a trade-off writes into `out` (none without it)."""
+    from pathlib import Path
+
+    return [Path(out) / name for name in ("runs.csv", "table.csv", picture)] if out else []
+
+
+def _leaving_out_the_other_picture(args: argparse.Namespace, picture: str, reason: str):
+    """`leaving_out` for `picture`, the picture of the other mode (ablation or trade-off), which
+    an earlier run's may have left beside this run's runs.csv and table.csv."""
+    return leaving_out(args, _files(args.out, picture)[2:], reason)
 
 
 def _write(files: list, result) -> None:
@@ -94,8 +106,6 @@ def _deadbands(text: str) -> tuple[float, ...]:
 
 def _tradeoff(args: argparse.Namespace) -> int:
     """``ablate --tradeoff``: one policy over deadbands and scan periods."""
-    from pathlib import Path
-
     from tqdm import tqdm
 
     from ..simulation import SimulationConfig
@@ -105,13 +115,14 @@ def _tradeoff(args: argparse.Namespace) -> int:
                         tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), (args.policies or ["hybrid"])[0])
     config = SimulationConfig.from_toml(args.config) if args.config else None
-    files = [Path(args.out) / name for name in ("runs.csv", "table.csv", "tradeoff.png")] if args.out else []
+    files = _files(args.out, "tradeoff.png")
     claim(files)  # before the runs, not after them
-    with tqdm(total=len(plan.days()), unit="day", desc="tradeoff", file=sys.stderr) as bar:
-        result = tradeoff(plan, config=config, workers=args.workers, progress=bar.update)
-    print(f"{plan.policy} over {len(plan.deadbands)} deadbands × {len(plan.periods)} scan periods on "
-          f"{len(plan.days()) // len(plan.periods)} day(s); held: the error between scans")
-    print(result.table.to_string(float_format=lambda v: f"{v:.4g}"))
-    if args.out:
-        _write(files, result)
+    with _leaving_out_the_other_picture(args, "ablation.png", "--tradeoff"):
+        with tqdm(total=len(plan.days()), unit="day", desc="tradeoff", file=sys.stderr) as bar:
+            result = tradeoff(plan, config=config, workers=args.workers, progress=bar.update)
+        print(f"{plan.policy} over {len(plan.deadbands)} deadbands × {len(plan.periods)} scan periods on "
+              f"{len(plan.days()) // len(plan.periods)} day(s); held: the error between scans")
+        print(result.table.to_string(float_format=lambda v: f"{v:.4g}"))
+        if args.out:
+            _write(files, result)
     return 0

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 
 from .. import params, sites
 from ..errors import HybridtrackError
@@ -185,6 +185,46 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
     """``--force``: replace existing output files (and say which); without it they are refused."""
     parser.add_argument("--force", action="store_true",
                         help="replace output files that exist already (default: refuse, naming them)")
+
+
+@contextlib.contextmanager
+def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Iterator[None]:
+    """Within the block a command writes its results without `paths`, files it writes on other
+    runs (`reason`: why not on this one, such as ``--no-log``).
+
+    Such a file there already is an earlier run's, and would be read as this run's. Without
+    ``--force`` it is refused before the block, as a file to replace is; with it, it is removed
+    once the block has written the results (a failed run leaves the earlier run whole), each said
+    in one line on standard error. Only regular files are taken: a folder or a symbolic link of
+    such a name is none a run wrote, and is left as it is.
+
+    Raises
+    ------
+    HybridtrackError
+        Without ``--force``, if any of `paths` is there; with it, if one cannot be removed.
+    """
+    import os
+    import sys
+    from pathlib import Path
+
+    stale = [path for path in map(Path, paths) if path.is_file() and not path.is_symlink()]
+    if stale and not args.force:
+        some = len(stale) > 1
+        raise HybridtrackError(f"would leave {len(stale)} file{'s' if some else ''} of an earlier run beside this "
+                               f"run's results: {', '.join(map(str, stale))} (not written: {reason}); give --force "
+                               f"to remove {'them' if some else 'it'}, or write elsewhere")
+    for path in stale:  # before the run, not after it
+        if not os.access(path.parent, os.W_OK | os.X_OK):
+            raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed (no permission in "
+                                   f"{path.parent}); remove it, or write elsewhere")
+    yield
+    for path in stale:
+        try:
+            path.unlink(missing_ok=True)
+        except OSError as exc:
+            raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed ({exc.strerror or exc}); "
+                                   "the results beside it are this run's") from None
+        print(f"{path}: removed, from an earlier run ({reason})", file=sys.stderr)
 
 
 #: ``--strategy``'s help: without it the ``--config`` file's strategy runs, not a default over it.

@@ -10,8 +10,8 @@ import numpy as np
 
 from ..errors import HybridtrackError, blamed
 from .base import (
-    add_dask_arguments, add_force_argument, add_synthetic_arguments, command, parse_mapping, simulation_config,
-    STRATEGY_HELP, real_number, site_from_arguments, synthetic_frame, whole_number,
+    add_dask_arguments, add_force_argument, add_synthetic_arguments, command, leaving_out, parse_mapping,
+    simulation_config, STRATEGY_HELP, real_number, site_from_arguments, synthetic_frame, whole_number,
 )
 
 
@@ -209,11 +209,13 @@ def _field(args: argparse.Namespace) -> int:
     frame = synthetic_frame(args, site)
     if args.out:
         claim(FieldResult.files(args.out, log=not args.no_log).values())
-    result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
-                            seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True,
-                            threads=args.threads, workers=args.workers, scheduler=args.scheduler)
-    # saved first: a standard output that fails to print loses nothing
-    written = result.save(args.out, metric=args.metric or "rms") if args.out else None
+    no_log = [FieldResult.files(args.out)["log"]] if args.out and args.no_log else []
+    with leaving_out(args, no_log, "--no-log"):
+        result = simulate_field(frame, site, field, strategy=args.strategy, config=simulation_config(args, args.seed),
+                                seed=args.seed, keep_log=not args.no_log and bool(args.out), progress=True,
+                                threads=args.threads, workers=args.workers, scheduler=args.scheduler)
+        # saved first: a standard output that fails to print loses nothing
+        written = result.save(args.out, metric=args.metric or "rms") if args.out else None
     print(f"{site.name}, {args.date} ({args.days} day{'s' if args.days > 1 else ''}, {args.weather}), "
           f"{result.summary['field']} of {len(result.collectors)} ({result.summary['kind']}), "
           f"{result.summary['strategy']}")

@@ -19,6 +19,7 @@ from .base import (
     add_synthetic_arguments,
     collector_from_arguments,
     command,
+    leaving_out,
     read_record,
     simulation_config,
     site_from_arguments,
@@ -121,12 +122,14 @@ def _add_stream_argument(parser: argparse.ArgumentParser, what: str) -> None:
 
 def _stream(source, args, config, *, heading: str) -> int:
     """A streamed run (`hybridtrack.streaming`): a progress bar on stderr, the summary, the files."""
+    from ..simulation import Result
     from ..streaming import progress_bar, stream, stream_files
 
     if not args.out:
         raise HybridtrackError("--stream writes its log to disk: give --out FOLDER")
     claim(stream_files(args.out).values())  # a bad --out is refused before the bar
-    with progress_bar(source, label=config.controller.strategy) as bar:
+    with leaving_out(args, [Result.files(args.out)["report"]], "--stream"), \
+            progress_bar(source, label=config.controller.strategy) as bar:
         result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
                         config=config, progress=bar.update)
     print(heading + f" (streamed in {result.summary['streamed']['segments']} day-long segments)")
@@ -270,8 +273,11 @@ def _compare(args: argparse.Namespace) -> int:
         print("hybrid-oracle left out: the frame has no true 'sky' column")
     if args.out:
         claim(_compare_files(args.out, policies))
-    results = {strategy: _run(frame, site, args, strategy, config) for strategy in policies}
-    written = _save_comparison(results, args.out) if args.out else None  # first: a failing standard output loses none
+    left_out = sorted(set(_compare_files(args.out, STRATEGIES)) - set(_compare_files(args.out, policies))) \
+        if args.out else []
+    with leaving_out(args, left_out, "hybrid-oracle left out"):
+        results = {strategy: _run(frame, site, args, strategy, config) for strategy in policies}
+        written = _save_comparison(results, args.out) if args.out else None  # first: a failing stdout loses none
     first = next(iter(results.values()))
     print(f"{site.name}, {first.summary['start'][:10]} to {first.summary['end'][:10]}, {first.collector.kind}: "
           "every strategy on the same weather and world")
