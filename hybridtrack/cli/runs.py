@@ -160,10 +160,10 @@ def _simulate(args: argparse.Namespace) -> int:
 def _stream_synthetic(args: argparse.Namespace, site) -> int:
     from ..streaming import synthetic_days
 
-    first, last = synthetic_span(args)
-    if "," in args.weather:
+    if "," in args.weather:  # before synthetic_span counts the list against --days
         raise HybridtrackError("--stream takes one --weather for every day (climate draws each day from the site's "
                                "monthly climate), not a per-day list")
+    first, last = synthetic_span(args)
     source = synthetic_days(site, first, last, weather=args.weather, freq=args.freq, seed=args.seed,
                             gusts_per_day=args.gusts_per_day)
     config = simulation_config(args, args.seed)
