@@ -166,7 +166,8 @@ def test_a_positions_files_refusal_names_the_file_and_aim_only_when_it_came_from
     path.write_text("east,north\n0,-80\n")
     assert main([*base, "--aim", "0", "0", "-100"]) == 2
     assert capsys.readouterr().err == f"hybridtrack: error: {path}: --aim: heliostat 1: its aim point is not above " \
-                                      "the mirror (-100 m up from it): a heliostat reflects the sun up to its receiver\n"
+                                      "the mirror (-100 m up from it): a heliostat reflects the sun up to its " \
+                                      "receiver\n"
 
 
 def test_the_apis_field_messages_name_no_flag():
