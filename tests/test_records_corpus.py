@@ -64,6 +64,16 @@ CASES = [
      refused("line 2, column 'Date/Time'", "could be day-first or month-first", "--dayfirst")),
     ("05/06/2021 with --dayfirst", "ambiguous-dates.csv", {"site": "lanzhou", "dayfirst": True},
      read("lanzhou-day", ["ghi", "dni", "dhi"], wind="missing")),
+    ("yy-mm-dd over ten days", "yymmdd-days.csv", {"site": "lanzhou"},
+     read("lanzhou-days", ["ghi", "dni", "dhi"], wind="missing",
+          order="year-first (line 2 is no date month-first; read day-first, line 26 moves a month or more)")),
+    ("yy-mm-dd on one day is ambiguous", "yymmdd-one-day.csv", {"site": "lanzhou"},
+     refused("line 2, column 'Date/Time': '21-06-05 05:00' could be day-first or year-first (2005-06-21 or "
+             "2021-06-05)", "write the years with four digits")),
+    ("yymmdd over ten days", "yymmdd-six-digits.csv", {"site": "lanzhou"},
+     read("lanzhou-days", ["ghi", "dni", "dhi"], wind="missing", order="year-first (line 2 is no date month-first")),
+    ("the clock before dd/mm/yyyy", "clock-first-days.csv", {"site": "lanzhou"},
+     read("lanzhou-days", ["ghi", "dni", "dhi"], wind="missing", order="day-first (line 194 is no date month-first)")),
     ("HH:MM only", "clock-only.csv", {"site": "lanzhou"}, refused("line 2, column 'Time'", "has no date")),
     ("date and time columns", "date-and-time-columns.csv", {"tz": SHANGHAI},
      read("lanzhou-day", ["ghi", "dni", "dhi", "wind_speed"])),
@@ -178,6 +188,8 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
         assert report["sun_check"].startswith("WARNING") and "UTC+00:00" in report["sun_check"]
     if "notes" in expect:
         assert expect["notes"] in str(report["header_notes"])
+    if "order" in expect:
+        assert report["date_order"].startswith(expect["order"]), report["date_order"]
     if "comments" in expect:
         assert len(report["skipped"]["comments"]) == expect["comments"]
     if expect.get("erbs"):

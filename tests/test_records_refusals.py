@@ -35,6 +35,9 @@ def zipped(members: dict) -> bytes:
 REFUSALS = [
     ("dates mixing day-first and month-first", "time,ghi\n13/06/2021 10:00,500\n06/14/2021 10:00,500\n",
      {"tz": "UTC"}, ["--tz", "UTC"], ["line 3, column 'time'", "the column mixes both"]),
+    ("the clock before a date nothing orders", "time,ghi\n10:00 05/06/2021,500\n11:00 05/06/2021,600\n",
+     {"tz": "UTC"}, ["--tz", "UTC"], ["line 2, column 'time': '10:00 05/06/2021' could be day-first or month-first",
+                                      "--dayfirst or --monthfirst"]),
     ("dates written two ways", "time,ghi\n05/06/2021 10:00,500\n2021-06-05 11:00,500\n", {"tz": "UTC"},
      ["--tz", "UTC"], ["line 3, column 'time'", "is not written like the column's other dates"]),
     ("an empty stamp", "time,ghi\n2021-06-05 10:00,500\n,500\n", {"tz": "UTC"}, ["--tz", "UTC"],

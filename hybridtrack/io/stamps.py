@@ -10,7 +10,8 @@ Decided for the whole column, never cell by cell:
   or back. The reading whose dates move a month or more least often is taken. A column that no reading makes
   all dates is refused; so is one that more than one reading makes dates running as days do, and
   the user asked (``dayfirst=True``/``False``, ``--dayfirst``/``--monthfirst``, or four-digit
-  years). Dotted dates (``05.06.2021``) are never month-first.
+  years). Dotted dates (``05.06.2021``) are never month-first. Dates after their clock
+  (``12:00 05/06/2021``) and six-digit dates (``210605``) are decided so too.
 * **Epoch seconds**: a column of 9- or 10-digit numbers is seconds since 1970-01-01 UTC.
 * **Stamps without a date** (``12:00``) are refused: the date cannot be guessed.
 * **The file's zone**: stamps with UTC offsets (``+08:00``, ``Z``, `` UTC``) keep them, or are
@@ -40,6 +41,12 @@ CLOCK_ZONES = {"mst": "-07:00", "pst": "-08:00", "cst": "-06:00", "est": "-05:00
 #: ``toLocaleString('en-GB')`` writes ``10/06/2021, 00:00:00``: such stamps had been read by
 #: pandas one at a time, 10-12 June as 6 October, November and December).
 _DMY = re.compile(r"^(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?=$|[ T,])(.*)$")
+#: A date after its clock (``12:00 05/06/2021``): pandas read such stamps one at a time,
+#: month-first, and ``12:00 21-06-22`` as 21 June 2022, without a word.
+_CLOCK_FIRST = re.compile(r"^(\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?)[ ,]+(\d{1,2}[./-]\d{1,2}[./-]\d{2,4})$")
+#: A date of six digits (``210622``: yymmdd, ddmmyy or mmddyy), alone or before its clock: pandas
+#: read ``210622`` as 21 June 2022, day-first, without a word.
+_SIX_DIGITS = re.compile(r"^(\d{2})(\d{2})(\d{2})(?=$|[ T])")
 _CLOCK_ONLY = re.compile(r"^\d{1,2}:\d{2}(:\d{2}(\.\d+)?)?$")
 _EPOCH = re.compile(r"^\d{9,10}(\.\d+)?$")
 #: A UTC offset after a clock time: ``+08:00``, ``+0800``, ``Z``, and the hour alone (``+08``, as
@@ -175,11 +182,19 @@ def _date_reading(column: _Column, parts: pd.DataFrame, dayfirst: bool | None) -
     return fitting[0], f"{fitting[0]} ({'; '.join(why)})"
 
 
+def _date_before_clock(text: pd.Series) -> pd.Series:
+    """Dates written after their clock, or as six digits, rewritten as ``a-b-c clock``, so that
+    their order is decided for the whole column as any other's is."""
+    text = text.str.replace(_CLOCK_FIRST, r"\2 \1", regex=True)
+    return text.str.replace(_SIX_DIGITS, r"\1-\2-\3", regex=True)
+
+
 def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
     """Dates in ``d/m/y``, ``m/d/y`` or ``yy/m/d`` form rewritten as ``yyyy-mm-dd``, decided for the whole column."""
-    if not column.text.str.contains(r"^\d{1,2}[./-]\d{1,2}[./-]\d", regex=True).any():
+    text = _date_before_clock(column.text)
+    if not text.str.contains(r"^\d{1,2}[./-]\d{1,2}[./-]\d", regex=True).any():
         return column.text  # year first (ISO) or another form the parser reads whole
-    parts = column.text.str.extract(_DMY)
+    parts = text.str.extract(_DMY)
     matched = parts[0].notna().to_numpy()
     if not matched.any():
         return column.text
