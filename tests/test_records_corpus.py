@@ -53,6 +53,8 @@ CASES = [
     ("naive stamps, no zone, no site", "naive-no-zone.csv", {},
      refused("line 2, column ''", "naive time stamps", "give the time zone")),
     ("Campbell TOA5", "toa5-cr1000.dat", {"tz": SHANGHAI}, read("lanzhou-day")),
+    ("TOA5 with a card's NUL padding", "toa5-nul-padded.dat", {"tz": SHANGHAI},
+     read("lanzhou-day", report={"padding": (None, 512)}, padding_line=102)),
     ("TOA5, WS_ms_S_WVT, zero offsets", "toa5-wvt-offsets.dat", {"site": "lanzhou"},
      read("lanzhou-day", zero={"wind_speed": [0, 1, 2, 3]}, report={"calm_clipped": ("wind_speed", 4)})),
     ("dd.mm.yyyy, semicolons, decimal commas", "dotted-dates.csv", {"tz": SHANGHAI}, read("lanzhou-day")),
@@ -188,6 +190,8 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
         assert report["sun_check"].startswith("WARNING") and "UTC+00:00" in report["sun_check"]
     if "notes" in expect:
         assert expect["notes"] in str(report["header_notes"])
+    if "padding_line" in expect:
+        assert report["padding"]["lines"] == [expect["padding_line"]]
     if "order" in expect:
         assert report["date_order"].startswith(expect["order"]), report["date_order"]
     if "comments" in expect:

@@ -6,6 +6,8 @@ export tool writes it (found by a helper replaying messy files).
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -398,3 +400,27 @@ def test_monthfirst_reads_a_one_day_two_digit_year_file_month_first(tmp_path, ca
     frame = read_weather(path, tz="Asia/Shanghai", dayfirst=False)
     assert frame.index[0] == pd.Timestamp("2021-06-12 00:00", tz="Asia/Shanghai") and len(frame) == len(day)
     assert main(["check", str(path), "--tz", "Asia/Shanghai", "--monthfirst"]) == 0
+
+
+def test_nul_padding_after_a_short_or_utf16_file_is_dropped_and_counted(tmp_path, day):
+    """A card's unwritten tail within a file's first 4096 bytes had made it 'binary'; in UTF-16
+    the last character's NUL half belongs to the text, the seven bytes after it do not."""
+    rows = day.iloc[70:76]  # 11:40 to 12:30
+    text = _write(tmp_path / "t.csv", rows.index.strftime("%Y-%m-%dT%H:%M:%S+08:00"), rows).read_text()
+    for name, raw, count in (("short.csv", text.encode() + b"\x00" * 100, 100),
+                             ("wide.csv", text.encode("utf-16") + b"\x00" * 7, 7)):
+        (tmp_path / name).write_bytes(raw)
+        frame = read_weather(tmp_path / name)
+        assert (frame.index == rows.index).all() and np.array_equal(frame[["ghi", "dni", "dhi"]], rows)
+        assert frame.attrs["validation"]["padding"] == {"count": count, "lines": [8]}
+
+
+def test_nul_bytes_inside_the_text_are_refused_naming_the_line(tmp_path, capsys, day):
+    path = _write(tmp_path / "cut.csv", day.index.strftime("%Y-%m-%dT%H:%M:%S+08:00"), day)
+    lines = path.read_bytes().split(b"\n")
+    path.write_bytes(b"\n".join(lines[:119] + [b"\x00" * 10 + lines[119]] + lines[120:]))
+    message = f"{path}: line 120: NUL bytes inside the text (a damaged file?)"
+    with pytest.raises(HybridtrackError, match=re.escape(message)):
+        read_weather(path)
+    assert main(["check", str(path)]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"

@@ -88,12 +88,45 @@ def _looks_utf16(raw: bytes) -> str | None:
     return None
 
 
-def decode(path: Path, raw: bytes) -> tuple[str, str]:
-    """Text and the encoding it was read in; binary data is refused."""
+def _without_padding(raw: bytes, wide: bool) -> tuple[bytes, int]:
+    """`raw` without the NUL bytes after its text (a logger card's unwritten tail), and how many:
+    a Campbell TOA5 file so padded had been refused at its last line, a cell of NULs quoted whole.
+    In UTF-16 (`wide`) the last character's NUL half is kept."""
+    kept = len(raw.rstrip(b"\x00"))
+    kept += kept % 2 if wide else 0
+    return raw[:kept], len(raw) - kept
+
+
+def _refuse_nul(path: Path, raw: bytes) -> None:
+    """Refuse NUL bytes inside 8-bit text: binary data, or a damaged file, named by its line."""
+    at = raw.find(b"\x00")
+    if at < 0:
+        return
+    if at < 4096:
+        raise HybridtrackError(f"{path}: looks binary, not a text table")
+    line = raw.count(b"\n", 0, at) + 1
+    raise HybridtrackError(f"{path}: line {line}: NUL bytes inside the text (a damaged file?)")
+
+
+def decode(path: Path, raw: bytes, report: dict | None = None) -> tuple[str, str]:
+    """Text and the encoding it was read in; binary data is refused. Given a `report` (a weather
+    file's), NUL padding after the text is dropped and counted in it (``padding``)."""
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
         encoding = "utf-16"
     else:
-        encoding = _looks_utf16(raw) or ""
+        encoding = _looks_utf16(raw if report is None else raw.rstrip(b"\x00")) or ""
+    padding = 0
+    if report is not None:
+        raw, padding = _without_padding(raw, bool(encoding))
+    text, encoding = _decoded(path, raw, encoding)
+    if padding:
+        line = text.count("\n") + 1
+        report["padding"] = {"count": padding, "lines": [line]}
+    return text, encoding
+
+
+def _decoded(path: Path, raw: bytes, encoding: str) -> tuple[str, str]:
+    """`raw` as text: in `encoding` if given, else UTF-8, Windows-1252 or Latin-1."""
     if encoding:
         try:
             return raw.decode(encoding).lstrip("\ufeff"), encoding.upper()
@@ -102,8 +135,7 @@ def decode(path: Path, raw: bytes) -> tuple[str, str]:
     if raw[:4] == b"PAR1":  # a frame written already (hybridtrack check --out x.parquet)
         raise HybridtrackError(f"{path}: a Parquet file, not a text table: replay it with --stream, or read it "
                                "with pandas.read_parquet")
-    if b"\x00" in raw[:4096]:
-        raise HybridtrackError(f"{path}: looks binary, not a text table")
+    _refuse_nul(path, raw)
     try:
         return raw.decode("utf-8-sig"), "UTF-8"
     except UnicodeDecodeError:
@@ -114,11 +146,12 @@ def decode(path: Path, raw: bytes) -> tuple[str, str]:
         return raw.decode("latin-1"), "Latin-1"
 
 
-def file_text(path, what: str = "file") -> tuple[str, str]:
-    """The text of a (possibly packed) file and a note of how it was read, e.g. ``'gzip, UTF-16'``."""
+def file_text(path, what: str = "file", report: dict | None = None) -> tuple[str, str]:
+    """The text of a (possibly packed) file and a note of how it was read, e.g. ``'gzip, UTF-16'``;
+    NUL padding after the text is dropped and counted in `report` (see `decode`)."""
     path = input_path(path, what)
     raw, packing = unpack(path, read_bytes(path, what))
-    text, encoding = decode(path, raw)
+    text, encoding = decode(path, raw, report)
     if not text.strip():
         raise HybridtrackError(f"{path}: the file is empty")
     return text, ", ".join(part for part in (packing, encoding) if part)

@@ -163,13 +163,13 @@ def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict, text: str | N
                encoding: str = "UTF-8") -> tuple[pd.DataFrame, dict]:
     """A pvlib format's data as a frame with the frame's names, and its metadata (site, zone).
 
-    A packed or non-UTF-8 file is handed to pvlib as a decoded copy (`text`).
+    A packed, non-UTF-8 or NUL-padded file is handed to pvlib as a decoded copy (`text`).
     """
     import tempfile
 
     if fmt not in PVLIB_FORMATS:
         raise HybridtrackError(f"unknown format {fmt!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
-    if text is not None and encoding != "UTF-8":
+    if text is not None and (encoding != "UTF-8" or "padding" in report):
         with tempfile.TemporaryDirectory() as folder:
             data, meta = _call(_plain_copy(path, text, folder), fmt, shown=path)
     else:

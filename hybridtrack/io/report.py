@@ -21,6 +21,7 @@ _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "
              "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING"}
 
 _CHANGES = {
+    "padding": "dropped (NUL bytes after the text: a logger card's unwritten tail)",
     "units_converted": "converted", "unreadable": "set to NaN (unreadable text)",
     "truncated": "dropped (a last line cut short)",
     "missing_markers": "set to NaN (a logger's missing-value marker: -9999, 7999, ...)",

@@ -341,9 +341,10 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         check_tz(tz)
     check_names(units or {}, "--units")
     site = get(site) if site is not None else None
-    text, encoding = file_text(path)
+    report: dict = {"source": str(path)}
+    text, report["read_as"] = file_text(path, report=report)
+    encoding = report["read_as"]
     fmt = str(format).lower() if format is not None else detect_format(text)
-    report: dict = {"source": str(path), "read_as": encoding}
     if fmt == "csv":
         frame, meta = _read_csv(path, text, columns, tz, units, site, dayfirst, strict, report), {}
     elif fmt in PVLIB_FORMATS:

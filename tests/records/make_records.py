@@ -94,6 +94,11 @@ def toa5(wind_name="WS_ms_Avg", offsets=False) -> str:
     return "\n".join(head + rows) + "\n"
 
 
+def toa5_padded() -> bytes:
+    """A TOA5 file copied whole from a logger's card: NUL bytes after the last line."""
+    return toa5().encode("utf-8") + b"\x00" * 512
+
+
 def dotted_dates() -> str:
     day = truth("lanzhou-day")
     out = _renamed(day, {"ghi": "Global", "dni": "Direct", "dhi": "Diffuse", "wind_speed": "Wind",
@@ -315,7 +320,7 @@ def _packed_zip() -> bytes:
 FILES = {
     "pandas-index.csv": pandas_index, "pandas-index-naive.csv": pandas_index_naive,
     "toa5-cr1000.dat": toa5, "toa5-wvt-offsets.dat": lambda: toa5("WS_ms_S_WVT", offsets=True),
-    "dotted-dates.csv": dotted_dates, "ddmmyyyy-days.csv": lambda: day_month("%d/%m/%Y %H:%M"),
+    "toa5-nul-padded.dat": toa5_padded, "dotted-dates.csv": dotted_dates, "ddmmyyyy-days.csv": lambda: day_month("%d/%m/%Y %H:%M"),
     "mmddyyyy-days.csv": lambda: day_month("%m/%d/%Y %H:%M"),
     "ambiguous-dates.csv": lambda: day_month("%d/%m/%Y %H:%M", "lanzhou-day"),
     "yymmdd-days.csv": lambda: day_month("%y-%m-%d %H:%M"),
