@@ -58,6 +58,14 @@ CASES = [
     ("TOA5, WS_ms_S_WVT, zero offsets", "toa5-wvt-offsets.dat", {"site": "lanzhou"},
      read("lanzhou-day", zero={"wind_speed": [0, 1, 2, 3]}, report={"calm_clipped": ("wind_speed", 4)})),
     ("dd.mm.yyyy, semicolons, decimal commas", "dotted-dates.csv", {"tz": SHANGHAI}, read("lanzhou-day")),
+    ("ISO T stamps, semicolons, decimal commas", "iso-t-semicolons.csv", {"tz": SHANGHAI},
+     read("lanzhou-day", decimal=",")),
+    ("French Date;Heure, Windows-1252, CRLF", "french-date-heure.csv", {"site": "lanzhou"},
+     read("lanzhou-days", order="day-first (line 194 is no date month-first)", decimal=",")),
+    ("tabs and decimal commas", "tab-decimal-commas.txt", {"tz": SHANGHAI},
+     read("lanzhou-day", ["ghi", "dni", "dhi", "temp_air"], wind="missing", decimal=",")),
+    ("quoted decimal commas, comma-separated", "quoted-decimal-commas.csv", {"tz": SHANGHAI},
+     read("lanzhou-day", decimal=",")),
     ("dd/mm/yyyy over ten days", "ddmmyyyy-days.csv", {"site": "lanzhou"},
      read("lanzhou-days", ["ghi", "dni", "dhi"], wind="missing")),
     ("mm/dd/yyyy over ten days", "mmddyyyy-days.csv", {"site": "lanzhou"},
@@ -192,6 +200,8 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
         assert expect["notes"] in str(report["header_notes"])
     if "padding_line" in expect:
         assert report["padding"]["lines"] == [expect["padding_line"]]
+    if "decimal" in expect:
+        assert report["decimal"] == expect["decimal"]
     if "order" in expect:
         assert report["date_order"].startswith(expect["order"]), report["date_order"]
     if "comments" in expect:

@@ -36,6 +36,14 @@ MISSING = ("", "nan", "na", "n/a", "#n/a", "-", "null", "none", "--")
 
 _SEPARATORS = {",": "comma", ";": "semicolon", "\t": "tab", "|": "bar"}
 _NUMBER = re.compile(r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|[-+]?inf(inity)?", re.I)
+#: A number written with a decimal comma (``812,5``), and one with a decimal point (``812.5``).
+_COMMA_DECIMAL = re.compile(r"[-+]?\d*,\d+")
+_POINT_DECIMAL = re.compile(r"[-+]?\d*\.\d+([eE][-+]?\d+)?")
+#: A number whose thousands are grouped with commas beside a decimal point: ``1,060.2``, ``12,000``
+#: (never ``0,812``: a group starts with a digit other than 0).
+COMMA_GROUPED = re.compile(r"[-+]?[1-9]\d{0,2}(,\d{3})+(\.\d*)?")
+#: An ISO 8601 stamp, whose ``T`` is no letter of a column's name.
+_ISO_STAMP = re.compile(r"\s*\d{4}-\d{2}-\d{2}T\d")
 
 
 @dataclass
@@ -97,12 +105,19 @@ def _meta_row(fields: list[str]) -> bool:
     return not any(_is_number(c) for c in cells if c) and not re.search(r"\d", cells[0] if cells else "")
 
 
+def _named(field: str) -> bool:
+    """Whether a field may be a column's name: it has letters, and is no ISO stamp (``...T12:00``)."""
+    return bool(re.search(r"[A-Za-z]", field)) and not _ISO_STAMP.match(field)
+
+
 def _choose_separator(path: Path, kept: list[tuple[int, str]]) -> tuple[int, str]:
     """Index (into `kept`) of the header and the separator.
 
     For each separator the data's usual field count is read off the last lines; the header is
-    the first line with that many fields of which one has letters. The separator that splits
-    the rows below its header most consistently (then widest) wins.
+    the first line with that many fields of which one is a name (`_named`). The separator that
+    splits the rows below its header most consistently (then widest, then with the earlier
+    header) wins: ``2021-06-21T12:00:00;812,5;...`` split at its commas had been taken for a
+    header, its ``T`` for a name.
     """
     tail = [line for _, line in kept[-30:]]
     best = None
@@ -113,13 +128,13 @@ def _choose_separator(path: Path, kept: list[tuple[int, str]]) -> tuple[int, str
             continue
         for position, (_, line) in enumerate(kept):
             fields = _split(line, sep)
-            if len(fields) == width and any(re.search(r"[A-Za-z]", f) for f in fields):
+            if len(fields) == width and any(_named(f) for f in fields):
                 rest = kept[position + 1:]
                 sample = rest[::max(1, len(rest) // 500)]  # enough lines to judge, in big files too
                 below = [len(_split(x, sep)) for _, x in sample]
                 share = below.count(width) / max(len(below), 1)
-                if best is None or (share, width) > best[0]:
-                    best = ((share, width), position, sep)
+                if best is None or (share, width, -position) > best[0]:
+                    best = ((share, width, -position), position, sep)
                 break
     if best is None:
         raise HybridtrackError(f"{path}: no table found: no header row of named columns separated by comma, "
@@ -213,8 +228,21 @@ def locate_table(path: Path, text: str) -> Table:
         raise HybridtrackError(f"{path}: the table has a header but no rows")
     rows, numbers = _rows(path, body, sep, headers, kept[position][0], skipped)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
-    decimal = "," if sep == ";" and any(re.fullmatch(r"[-+]?\d*,\d+", f.strip()) for r in rows for f in r) else "."
+    decimal = _decimal(sep, rows)
     return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind)
+
+
+def _decimal(sep: str, rows: list[list[str]]) -> str:
+    """The table's decimal mark: ``','`` where a cell is a number written with a decimal comma, in
+    a semicolon-separated table any (``0,5``, ``1,060``); in a tab-, bar- or comma-separated one
+    (the cell quoted) one that is no group of thousands (``812,5``, ``0,812``, not ``1,060``), where
+    no number has a decimal point. Such tables had been refused, every number unreadable."""
+    commas = [cell for cell in (f.strip() for row in rows for f in row if "," in f) if _COMMA_DECIMAL.fullmatch(cell)]
+    if sep == ";":
+        return "," if commas else "."
+    if all(COMMA_GROUPED.fullmatch(cell) for cell in commas):
+        return "."
+    return "." if any(_POINT_DECIMAL.fullmatch(f.strip()) for row in rows for f in row) else ","
 
 
 @_long_fields()

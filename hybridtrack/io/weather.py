@@ -25,7 +25,7 @@ from .formats import PVLIB_FORMATS, detect_format, read_pvlib
 from .gapfill import fill_components
 from .resample import resample
 from .stamps import CLOCK_ZONES, parse_stamps
-from .tables import MISSING, Table, locate_table
+from .tables import COMMA_GROUPED, MISSING, Table, locate_table
 from .units import looks_like_unit, spellings, to_frame_units
 
 __all__ = ["read_weather"]
@@ -85,10 +85,6 @@ def _read_numbers(path: Path, table: Table, header: str, column: list[str], deci
     return values.to_numpy(float)
 
 
-#: A number whose thousands are grouped with commas beside a decimal point: ``1,060.2``, ``12,000``.
-_COMMA_GROUPED = re.compile(r"[-+]?\d{1,3}(,\d{3})+(\.\d*)?")
-
-
 def _thousands_by_commas(strings: pd.Series, name: str, report: dict) -> pd.Series:
     """A dot-decimal column's cells with thousands grouped by commas (US Excel's quoted
     ``"1,060.2"``) without their commas, counted: every value of 1000 or more had been unreadable
@@ -96,7 +92,7 @@ def _thousands_by_commas(strings: pd.Series, name: str, report: dict) -> pd.Seri
     commas = strings.str.contains(",", regex=False)
     if not commas.any():
         return strings
-    grouped = strings.str.fullmatch(_COMMA_GROUPED)
+    grouped = strings.str.fullmatch(COMMA_GROUPED)
     if not grouped[commas].all():
         return strings
     _count_thousands(report, name, int(grouped.sum()), "','", "with the decimal point")

@@ -106,6 +106,36 @@ def dotted_dates() -> str:
     return "Anlage: Lanzhou Dach\n" + _csv(out, sep=";", decimal=",")
 
 
+def iso_t_semicolons() -> str:
+    day = truth("lanzhou-day")
+    out = _renamed(day, {"ghi": "GHI (W/m2)", "dni": "DNI (W/m2)", "dhi": "DHI (W/m2)", "wind_speed": "Wind speed (m/s)",
+                         "temp_air": "Temperature (°C)"}, _local(day, SHANGHAI, "%Y-%m-%dT%H:%M:%S"), "Timestamp")
+    return _csv(out, sep=";", decimal=",")
+
+
+def french_date_heure() -> bytes:
+    days = truth("lanzhou-days")
+    out = _renamed(days, {"ghi": "Rayonnement global (W/m²)", "dni": "Rayonnement direct (W/m²)",
+                          "dhi": "Rayonnement diffus (W/m²)", "wind_speed": "Vitesse du vent (m/s)",
+                          "temp_air": "Température (°C)"}, _local(days, SHANGHAI, "%d/%m/%Y"), "Date")
+    out.insert(0, "Heure", _local(days, SHANGHAI, "%H:%M"))
+    return _csv(out, sep=";", decimal=",").replace("\n", "\r\n").encode("cp1252")
+
+
+def tab_decimal_commas() -> bytes:
+    day = truth("lanzhou-day")
+    out = _renamed(day, {"ghi": "GHI", "dni": "DNI", "dhi": "DHI", "temp_air": "Temperatur (°C)"},
+                   _local(day, SHANGHAI, "%d.%m.%Y %H:%M"), "Zeitstempel")
+    return _csv(out, sep="\t", decimal=",").replace("\n", "\r\n").encode("cp1252")
+
+
+def quoted_decimal_commas() -> str:
+    day = truth("lanzhou-day")
+    out = _renamed(day, {"ghi": "GHI", "dni": "DNI", "dhi": "DHI", "wind_speed": "Wind", "temp_air": "Temp"},
+                   _local(day, SHANGHAI, "%Y-%m-%d %H:%M"), "Timestamp")
+    return _csv(out, decimal=",")  # the cells holding a comma quoted, as LibreOffice writes them
+
+
 def day_month(fmt: str, name: str = "lanzhou-days") -> str:
     days = truth(name)
     out = _renamed(days, {"ghi": "GHI", "dni": "DNI", "dhi": "DHI"}, _local(days, SHANGHAI, fmt), "Date/Time")
@@ -327,6 +357,8 @@ FILES = {
     "yymmdd-one-day.csv": lambda: day_month("%y-%m-%d %H:%M", "lanzhou-day"),
     "yymmdd-six-digits.csv": lambda: day_month("%y%m%d %H:%M"),
     "clock-first-days.csv": lambda: day_month("%H:%M:%S %d/%m/%Y"),
+    "iso-t-semicolons.csv": iso_t_semicolons, "french-date-heure.csv": french_date_heure,
+    "tab-decimal-commas.txt": tab_decimal_commas, "quoted-decimal-commas.csv": quoted_decimal_commas,
     "clock-only.csv": clock_only, "date-and-time-columns.csv": date_and_time_columns,
     "epoch-seconds.csv": epoch_seconds,
     "utc-declared-local.csv": utc_declared_local, "kilowatts-unlabelled.csv": lambda: kilowatts(False),
