@@ -43,6 +43,11 @@ def refused(*parts):
     return {"refused": parts}
 
 
+#: An NSRDB PSM3 file: every third row of the truth (half-hourly), irradiance written in whole
+#: W/m² and wind in tenths, its site (Golden, at NSRDB's grid point) from its site lines.
+PSM3 = {"every": 3, "decimals": {"ghi": 0, "dni": 0, "dhi": 0, "wind_speed": 1},
+        "site": ("NSRDB 149190", 39.74, -105.18, 1829.0, "Etc/GMT+7")}
+
 # (id, file, read_weather keywords, what must come out)
 CASES = [
     ("pandas index, offsets", "pandas-index.csv", {}, read("lanzhou-day")),
@@ -126,6 +131,10 @@ CASES = [
     ("NREL MIDC at the wrong site", "midc-bms.csv", {"site": "lanzhou"},
      refused("line 9, column 'Direct Normal [W/m^2]'", "while the sun is down", "shifted by +620min",
              "beyond any time zone: is the file from another site? Give")),
+    ("NSRDB PSM3 in local standard time", "nsrdb-psm3-local.csv", {}, read("golden-day", **PSM3)),
+    ("NSRDB PSM3 in UTC", "nsrdb-psm3-utc.csv", {}, read("golden-day", **PSM3)),
+    ("NSRDB PSM3 at the wrong site", "nsrdb-psm3-local.csv", {"site": "lanzhou"},
+     refused("line 1: the file's header places it at NSRDB 149190 (39.740°, -105.180°)", "give the right site")),
     ("NOAA SURFRAD", "surfrad-bon.dat", {}, {"pvlib": "surfrad"}),
     ("University of Oregon SRML", "srml-eugene.tsv", {"site": EUGENE}, {"pvlib": "srml"}),
     ("BSRN station-to-archive", "bsrn-bon.dat", {}, {"pvlib": "bsrn"}),
@@ -161,7 +170,9 @@ def cli_flags(kwargs: dict) -> list[str]:
 
 
 def _expected(expect: dict) -> pd.DataFrame:
-    frame = truth(expect["truth"])[expect["columns"]].copy()
+    frame = truth(expect["truth"])[expect["columns"]].iloc[::expect.get("every", 1)].copy()
+    for name, digits in expect.get("decimals", {}).items():  # as the file writes them
+        frame[name] = [float(f"{value:.{digits}f}") for value in frame[name]]
     for name, rows in expect.get("nan", {}).items():
         frame.iloc[rows, frame.columns.get_loc(name)] = np.nan
     for name, rows in expect.get("zero", {}).items():
@@ -200,6 +211,11 @@ def check_read(frame: pd.DataFrame, expect: dict) -> None:
         assert expect["notes"] in str(report["header_notes"])
     if "padding_line" in expect:
         assert report["padding"]["lines"] == [expect["padding_line"]]
+    if "site" in expect:
+        name, latitude, longitude, altitude, tz = expect["site"]
+        assert frame.attrs["site"] == name and report["site"] == (
+            f"{name} ({latitude:.3f}°, {longitude:.3f}°, {altitude:g} m, {tz}), from the file's header")
+        assert report["sun_check"].startswith(f"light follows the sun at {name}")
     if "decimal" in expect:
         assert report["decimal"] == expect["decimal"]
     if "order" in expect:

@@ -18,8 +18,8 @@ from collections.abc import Mapping
 from ..errors import HybridtrackError
 from .units import any_known_unit
 
-__all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "split_header", "resolve_columns",
-           "check_names"]
+__all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "STAMP_PARTS", "split_header",
+           "resolve_columns", "check_names"]
 
 #: The columns of a weather frame, in order.
 WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent", "pointing", "pointing_2")
@@ -50,13 +50,18 @@ ALIASES = {
                    "wind", "ws", "wspd", "ws_ms", "wind_ms", "avg wind speed", "wind speed avg", "wsp"),
     "temp_air": ("temp_air", "air temperature", "temperature", "temp", "tair", "t_air", "ta", "airtc", "airtk",
                  "air_temp", "tamb", "t_amb", "ambient temperature", "dry bulb", "drybulb", "temp_c", "t2m",
-                 "dry bulb temp", "tower dry bulb temp", "temperatur", "température", "temperatura", "lufttemperatur"),
+                 "dry bulb temp", "tower dry bulb temp", "tdry", "temperatur", "température", "temperatura", "lufttemperatur"),
     "photocurrent": ("photocurrent", "photocurrent_ma", "intensity", "intensity_ma", "sensor current"),
     # the sun sensor's pointing signal: the sun's offset from its axis, on each axis it serves
     "pointing": ("pointing", "pointing_deg", "sensor_offset", "sensor offset", "sun sensor offset", "pointing_1",
                  "sensor_offset_1"),
     "pointing_2": ("pointing_2", "sensor_offset_2"),
 }
+
+#: A stamp written in columns of its own, as NSRDB and SAM CSV files write it: year, month, day,
+#: hour and (optionally) minute. Read as a date column and a clock column, it had been the day of
+#: the month and the hour alone.
+STAMP_PARTS = ("year", "month", "day", "hour", "minute")
 
 #: Suffixes loggers append to a measurement's name that keep it the quantity (Campbell: _Avg,
 #: _Smp, _S_WVT ...). A statistic of it (_Std, _Tot, _Max, _Min, _Count ...) keeps its suffix, so
@@ -106,7 +111,7 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
     """Quantity -> file header, from the user's mapping first, then `ALIASES`.
 
     The result may hold ``date`` and ``clock`` instead of ``time`` when the file keeps them in
-    two columns.
+    two columns, or `STAMP_PARTS` when it keeps the stamp in columns of its own.
     """
     columns = dict(columns or {})
     check_names(columns, "--map")
@@ -135,9 +140,21 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
         if found:
             mapping[name] = found[0]
             taken.add(found[0])
+    if "time" not in mapping and _stamp_parts(headers, taken, mapping):
+        return mapping
     if "time" not in mapping or split_header(mapping["time"])[0] in ALIASES["clock"] and "time" not in columns:
         _date_and_clock(headers, taken, mapping)
     return mapping
+
+
+def _stamp_parts(headers: list[str], taken: set, mapping: dict[str, str]) -> bool:
+    """Whether the stamp is in columns of its own (`STAMP_PARTS`: a minute column is optional);
+    they are then put in `mapping`."""
+    found = {split_header(h)[0]: h for h in reversed(headers) if h not in taken}
+    if not all(part in found for part in STAMP_PARTS[:4]):
+        return False
+    mapping.update({part: found[part] for part in STAMP_PARTS if part in found})
+    return True
 
 
 def _find(headers: list[str], wanted: str) -> str | None:

@@ -1,4 +1,5 @@
-"""pvlib's weather formats: recognised by their content, read by `pvlib.iotools`, names mapped.
+"""pvlib's weather formats: recognised by their content, read by `pvlib.iotools`, names mapped;
+and the site lines of NSRDB and SAM CSV files, which are read as tables (`header_site`).
 
 `detect_format` looks at a file's first lines: ``LOCATION,`` (EPW), a TMY3 station line
 followed by ``Date (MM/DD/YYYY),Time (HH:MM)``, a TMY2 station line (WBAN, city, state, zone,
@@ -29,7 +30,7 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .columns import IRRADIANCE, WEATHER_COLUMNS, resolve_columns
 
-__all__ = ["PVLIB_FORMATS", "TYPICAL_YEAR", "detect_format", "read_pvlib"]
+__all__ = ["PVLIB_FORMATS", "TYPICAL_YEAR", "detect_format", "read_pvlib", "header_site", "one_typical_year"]
 
 #: Formats read through pvlib.iotools.
 PVLIB_FORMATS = {"epw": "read_epw", "tmy3": "read_tmy3", "tmy2": "read_tmy2", "midc": "read_midc",
@@ -87,30 +88,92 @@ def _call(path: Path, fmt: str, shown: Path | None = None):
     return data, dict(meta) if isinstance(meta, Mapping) else {}
 
 
-def _real_years(index: pd.DatetimeIndex) -> bool:
-    """Whether the stamps are real years (AMY data, or part of them, an hour missing or not): they
-    run forward, their year changes only from a December to the next January, and no 29 February
-    of their span is missing. A typical year's months come from different years, so its year
-    changes between other months or goes back; one written in a single leap year lacks 29 February."""
-    naive = index.tz_localize(None)
-    if len(naive) < 2 or not (np.diff(naive.as_unit("ns").asi8) > 0).all():
-        return False
+def _years_turn_at_new_year(naive: pd.DatetimeIndex) -> bool:
+    """Whether the stamps' year changes, in the file's order, only from a December to the next
+    January. A typical year's months come from different years, so its year changes between
+    other months or goes back."""
     years, months = naive.year.to_numpy(), naive.month.to_numpy()
     new = np.flatnonzero(np.diff(years) != 0)
-    if not ((years[new + 1] == years[new] + 1) & (months[new] == 12) & (months[new + 1] == 1)).all():
+    return bool(((years[new + 1] == years[new] + 1) & (months[new] == 12) & (months[new + 1] == 1)).all())
+
+
+def _real_years(index: pd.DatetimeIndex) -> bool:
+    """Whether the stamps are real years (AMY data, or part of them, an hour missing or not): they
+    run forward, their year turns only at New Year, and no 29 February of their span is missing
+    (one written in a single leap year lacks it)."""
+    naive = index.tz_localize(None)
+    if len(naive) < 2 or not (np.diff(naive.as_unit("ns").asi8) > 0).all() or not _years_turn_at_new_year(naive):
         return False
     days = pd.date_range(naive[0].normalize(), naive[-1], freq="D")
     return bool(days[(days.month == 2) & (days.day == 29)].isin(naive.normalize()).all())
 
 
-def _coerce_year(path: Path, fmt: str, index: pd.DatetimeIndex) -> pd.DatetimeIndex:
+def one_typical_year(path: Path, index: pd.DatetimeIndex, lines: np.ndarray, report: dict) -> pd.DatetimeIndex:
+    """Stamps from a table's year, month, day and hour columns in one year when their year changes
+    between other months than December and January (a typical year's months from different years,
+    as NSRDB's TMY files hold them), reported; they had been read as a decade with gaps."""
+    if _years_turn_at_new_year(index.tz_localize(None)):
+        return index
+    report["time"] += f"; one year ({TYPICAL_YEAR}) for a typical-year file (its years change between months)"
+    return _coerce_year(path, index, lines, "")
+
+
+#: The numbers of an NSRDB or SAM CSV file's site lines: the name, its key in the site's
+#: metadata, what it is, and the range it must lie in.
+_SITE_NUMBERS = {"Latitude": ("latitude", "latitude", -90.0, 90.0),
+                 "Longitude": ("longitude", "longitude", -180.0, 180.0),
+                 "Elevation": ("altitude", "height in metres", -500.0, 9000.0),
+                 "Time Zone": ("zone", "UTC offset in hours", -14.0, 14.0),
+                 "Local Time Zone": ("local", "UTC offset in hours", -14.0, 14.0)}
+
+
+def _site_number(path: Path, table, name: str) -> float | None:
+    """A site line's number, None where it is empty or ``-``; refused naming its line and column
+    where it is no number or out of its range."""
+    text = table.site.get(name, "")
+    if text in ("", "-"):
+        return None
+    _, what, low, high = _SITE_NUMBERS[name]
+    try:
+        value = float(text)
+    except ValueError:
+        value = np.nan
+    if not low <= value <= high:
+        raise HybridtrackError(f"{path}: line {table.site_line}, column {name!r}: {text!r} is not a {what} "
+                               f"({low:g} to {high:g})")
+    return value
+
+
+def _offset(hours: float) -> str:
+    """``-7`` -> ``'-07:00'``, ``5.5`` -> ``'+05:30'``."""
+    minutes = round(abs(hours) * 60)
+    return f"{'-' if hours < 0 else '+'}{minutes // 60:02d}:{minutes % 60:02d}"
+
+
+def header_site(path: Path, table) -> dict:
+    """An NSRDB or SAM CSV file's site lines (`tables.Table.site`) as the site's metadata
+    (``latitude``, ``longitude``, ``altitude``, ``name``, and ``site_tz`` from ``Local Time Zone``
+    in whole hours) and the stamps' zone, ``zone``: the UTC offset ``Time Zone`` gives (0 for a
+    UTC download, else the site's standard time)."""
+    numbers = {_SITE_NUMBERS[name][0]: _site_number(path, table, name) for name in _SITE_NUMBERS}
+    meta = {key: value for key, value in numbers.items() if value is not None and key not in ("zone", "local")}
+    if numbers["zone"] is not None:
+        meta["zone"] = _offset(numbers["zone"])
+    local = numbers["local"]
+    if local is not None and local == int(local):
+        meta["site_tz"] = "UTC" if local == 0 else f"Etc/GMT{-int(local):+d}"
+    city, location = table.site.get("City", "-"), table.site.get("Location ID", "")
+    meta["name"] = city if city not in ("", "-") else f"{table.site.get('Source', 'NSRDB')} {location}".strip()
+    return meta
+
+
+def _coerce_year(path: Path, index: pd.DatetimeIndex, lines: np.ndarray, why: str) -> pd.DatetimeIndex:
     """Typical-year stamps in one year, as pvlib does for TMY3; a 29 February is refused by its line."""
     naive = index.tz_localize(None)
     leap = np.flatnonzero((naive.month == 2) & (naive.day == 29))
     if len(leap):
-        why = " (its stamps do not run forward through real years)" if fmt == "epw" else ""
-        raise HybridtrackError(f"{path}: line {_FIRST_DATA_LINE[fmt] + int(leap[0])}: 29 February in a typical-year "
-                               f"file{why}, which is read in {TYPICAL_YEAR}, a year without one; remove that day")
+        raise HybridtrackError(f"{path}: line {int(lines[leap[0]])}: 29 February in a typical-year file{why}, which "
+                               f"is read in {TYPICAL_YEAR}, a year without one; remove that day")
     moved = pd.to_datetime({"year": TYPICAL_YEAR, "month": naive.month, "day": naive.day, "hour": naive.hour,
                             "minute": naive.minute})
     return pd.DatetimeIndex(moved).tz_localize(index.tz)
@@ -181,7 +244,8 @@ def read_pvlib(path: Path, fmt: str, tz: str | None, report: dict, text: str | N
     if fmt == "epw" and _real_years(frame.index):
         years = ", the file's own years (its stamps run forward in real years: AMY data)"
     elif fmt in _FIRST_DATA_LINE:
-        frame.index = _coerce_year(path, fmt, frame.index)
+        why = " (its stamps do not run forward through real years)" if fmt == "epw" else ""
+        frame.index = _coerce_year(path, frame.index, _FIRST_DATA_LINE[fmt] + np.arange(len(frame)), why)
     if frame.index.tz is None:
         if tz is None:
             raise HybridtrackError(f"{path}: the {fmt.upper()} stamps carry no time zone; give one (tz=..., --tz)")

@@ -62,6 +62,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
     lines.append(f"  time: {report.get('time', '?')}" + "".join(f"; {prefix}{report[key]}" for key, prefix in
                                                             (("offset_written", ""), ("date_order", "dates "))
                                                             if key in report))
+    if "site" in report:
+        lines.append(f"  site: {report['site']}")
     if "place" in report:
         lines.append(f"  place: {report['place']}")
     if "sun_check" in report:

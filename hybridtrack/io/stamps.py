@@ -281,7 +281,8 @@ def _localise(column: _Column, index: pd.DatetimeIndex, tz, how: str, report: di
 
 def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *, tz: str | None,
                  site_tz: str | None = None, clock_zone: str | None = None, dayfirst: bool | None = None,
-                 report: dict) -> tuple[pd.DatetimeIndex, np.ndarray]:
+                 report: dict,
+                 zone_from: str = "the time or clock column's name") -> tuple[pd.DatetimeIndex, np.ndarray]:
     """The column's stamps as a tz-aware index, and which rows to keep (DST gaps dropped).
 
     Parameters
@@ -296,15 +297,17 @@ def parse_stamps(path: Path, header: str, text: pd.Series, lines: np.ndarray, *,
         The site's zone, taken for naive stamps when nothing else says (and reported so).
     clock_zone : str, optional
         A UTC offset named by the time or clock column's header (``'-07:00'`` for ``MST``,
-        ``'+00:00'`` for ``time_utc``).
+        ``'+00:00'`` for ``time_utc``), or by what `zone_from` says (an NSRDB file's ``Time Zone``).
     dayfirst : bool, optional
         Whether ``a/b/yyyy`` dates are day-first; None decides from the column.
     report : dict
         The validation report, which gets ``time`` (and ``date_order``, ``dst_*``).
+    zone_from : str
+        What gives `clock_zone`, for the report.
     """
     column = _Column(path, header, text.astype(str).str.strip(), lines)
     cut = _cut_short_last(column, report)
-    index, keep = _read_stamps(column, tz, site_tz, clock_zone, dayfirst, report)
+    index, keep = _read_stamps(column, tz, site_tz, clock_zone, dayfirst, report, zone_from)
     if cut:
         keep = keep.copy()
         keep[-1] = False
@@ -363,7 +366,7 @@ def _end_of_day(iso: pd.Series) -> tuple[pd.Series, np.ndarray]:
     return iso.str.replace(r"([ T])24:00((?::00)?)$", r"\g<1>00:00\g<2>", regex=True), midnight
 
 
-def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dict):
+def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dict, zone_from: str):
     """`parse_stamps` on a column whose stamps are whole."""
     path, header, lines = column.path, column.header, column.lines
     empty = np.flatnonzero((column.text == "").to_numpy())
@@ -394,7 +397,7 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
         return _localise(column, index, tz, f"naive stamps localised to {tz}", report)
     if clock_zone is not None:
         zone = fixed_zone(clock_zone)
-        report["time"] = f"naive stamps in UTC{clock_zone}, as the time or clock column's name says"
+        report["time"] = f"naive stamps in UTC{clock_zone}, as {zone_from} says"
         return index.tz_localize(zone), np.ones(len(index), bool)
     if site_tz is not None:
         return _localise(column, index, site_tz, f"naive stamps read as the site's local time ({site_tz}); give "

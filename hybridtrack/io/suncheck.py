@@ -33,7 +33,7 @@ from ..errors import HybridtrackError
 from ..sky import LIGHT_AT_NIGHT
 from .checks import first_lines, span
 
-__all__ = ["sun_check", "place_check", "LIGHT", "BIN", "FAR"]
+__all__ = ["sun_check", "place_check", "meta_name", "LIGHT", "BIN", "FAR"]
 
 #: W/m²: light a sensor cannot read with the sun below the horizon (`hybridtrack.sky.LIGHT_AT_NIGHT`).
 LIGHT = LIGHT_AT_NIGHT
@@ -182,6 +182,11 @@ def _distance(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
     return float(6371.0 * np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
+def meta_name(meta: dict, default: str) -> str:
+    """The place a file's header (pvlib's `meta`, or NSRDB's site lines) names."""
+    return next((str(meta[k]).strip('" ') for k in ("city", "City", "Name", "name") if meta.get(k)), default)
+
+
 def place_check(path: Path, meta: dict, site, report: dict, *, lenient: bool = False) -> None:
     """Refuse (or, `lenient`, warn about in ``report["place"]``) a file whose header (EPW, TMY3,
     ...: pvlib's `meta`) places it more than `FAR` km from `site`.
@@ -198,7 +203,7 @@ def place_check(path: Path, meta: dict, site, report: dict, *, lenient: bool = F
     km = _distance(lat, lon, site.latitude, site.longitude)
     if km <= FAR:
         return
-    name = next((str(meta[k]).strip('" ') for k in ("city", "City", "Name", "name") if meta.get(k)), "a place")
+    name = meta_name(meta, "a place")
     message = (f"{path}: line 1: the file's header places it at {name} ({lat:.3f}°, {lon:.3f}°), {km:,.0f} km from "
                f"the site {site.name} ({site.latitude:.3f}°, {site.longitude:.3f}°); give the right site"
                + ("" if lenient else ", or --lenient to read it anyway"))

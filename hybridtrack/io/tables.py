@@ -6,6 +6,9 @@ A weather table is found in text that may carry, before or inside it:
 * comment lines starting with ``#``, anywhere, skipped with their line numbers kept;
 * a Campbell Scientific TOA5 header: an environment line (``"TOA5",station,logger,...``),
   the field names, a units row and a processing row (``Smp``, ``Avg``);
+* an NSRDB (PSM3, PSM4) or SAM CSV header: a line of names from ``Source`` to ``Latitude``,
+  ``Longitude``, ``Time Zone``, ``Elevation`` (and ``GHI Units`` ...) and a line of their values,
+  above the table's own header (`Table.site`);
 * a units row under the header in other loggers' files;
 * a comma, semicolon, tab or bar separator (sniffed on the data's own lines), and decimal
   commas with semicolons anywhere in the table.
@@ -59,6 +62,10 @@ class Table:
     notes: dict[str, str] = field(default_factory=dict)
     skipped: dict[str, list[int]] = field(default_factory=dict)
     kind: str = "table"
+    #: An NSRDB or SAM CSV file's site lines: each name of the first with its value in the second,
+    #: and that second line's number.
+    site: dict[str, str] = field(default_factory=dict)
+    site_line: int = 0
 
 
 #: The longest field the csv module is let read: Python's default, 131,072 characters, had
@@ -198,26 +205,33 @@ def rows_with_values(body: list[tuple[int, str]], sep: str) -> bool:
     return any(any(f.strip() for f in _split(line, sep)) for _, line in body)
 
 
+def _header(path: Path, kept: list[tuple[int, str]]) -> tuple[list, int, str, str, dict[str, str]]:
+    """The lines from Excel's ``sep=`` line on, the header's index in them, the separator, the
+    table's kind and an NSRDB or SAM CSV file's site (see the module's notes)."""
+    first = _split(kept[0][1], ",")
+    hint = re.fullmatch(r"\s*sep=(.)\s*", kept[0][1])  # Excel's separator line
+    if hint and hint.group(1) in _SEPARATORS:
+        return kept[1:], *_header_after_hint(path, kept[1:], hint.group(1)), {}
+    if first and first[0].strip().upper() == "TOA5":
+        if len(kept) < 5:
+            raise HybridtrackError(f"{path}: a TOA5 file needs its four header lines and data")
+        return kept, 1, ",", f"Campbell TOA5 ({', '.join(c for c in first[1:3] if c)})", {}
+    if _site_header(first):
+        if len(kept) < 4:
+            raise HybridtrackError(f"{path}: an NSRDB or SAM CSV file needs its site lines, a header and data")
+        return kept, 2, ",", "NSRDB / SAM CSV (the site on lines 1-2)", _site_values(first, kept)
+    return kept, *_choose_separator(path, kept), "table", {}
+
+
 @_long_fields()
 def locate_table(path: Path, text: str) -> Table:
     """The weather table in `text` (see the module's notes)."""
     kept, comments = _kept_lines(text)
     if len(kept) < 2:
         raise HybridtrackError(f"{path}: no table found (fewer than two lines of data)")
-    first = _split(kept[0][1], ",")
-    kind = "table"
-    hint = re.fullmatch(r"\s*sep=(.)\s*", kept[0][1])  # Excel's separator line
-    if hint and hint.group(1) in _SEPARATORS:
-        kept = kept[1:]
-        position, sep, kind = _header_after_hint(path, kept, hint.group(1))
-    elif first and first[0].strip().upper() == "TOA5":
-        if len(kept) < 5:
-            raise HybridtrackError(f"{path}: a TOA5 file needs its four header lines and data")
-        position, sep, kind = 1, ",", f"Campbell TOA5 ({', '.join(c for c in first[1:3] if c)})"
-    else:
-        position, sep = _choose_separator(path, kept)
+    kept, position, sep, kind, site = _header(path, kept)
     headers = [h.strip() for h in _split(kept[position][1], sep)]
-    skipped = {"notes before the header": [n for n, _ in kept[:position]], "comments": comments}
+    skipped = {"notes before the header": [] if site else [n for n, _ in kept[:position]], "comments": comments}
     body = kept[position + 1:]
     meta = []
     while body and len(meta) < 2 and _meta_row(_split(body[0][1], sep)):
@@ -228,8 +242,22 @@ def locate_table(path: Path, text: str) -> Table:
         raise HybridtrackError(f"{path}: the table has a header but no rows")
     rows, numbers = _rows(path, body, sep, headers, kept[position][0], skipped)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
+    units.update({h: site[f"{h} Units"] for h in headers if site.get(f"{h} Units")})  # NSRDB: 'GHI Units'
     decimal = _decimal(sep, rows)
-    return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind)
+    return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind,
+                 site=site, site_line=kept[1][0] if site else 0)
+
+
+def _site_header(first: list[str]) -> bool:
+    """Whether a file's first line names an NSRDB or SAM CSV file's site: ``Source``, ...,
+    ``Latitude``, ``Longitude``."""
+    names = [name.strip() for name in first]
+    return bool(names) and names[0] == "Source" and {"Latitude", "Longitude"} <= set(names)
+
+
+def _site_values(first: list[str], kept: list[tuple[int, str]]) -> dict[str, str]:
+    """Each name of an NSRDB or SAM CSV file's first line with its value in the second."""
+    return {name.strip(): value.strip() for name, value in zip(first, _split(kept[1][1], ",")) if name.strip()}
 
 
 def _decimal(sep: str, rows: list[list[str]]) -> str:

@@ -19,12 +19,14 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .checks import check_frame, check_magnitude, refuse_repairs
 from .closure import closure_check
-from .columns import IRRADIANCE, LABEL_COLUMN, WEATHER_COLUMNS, check_names, resolve_columns, split_header
+from .columns import (IRRADIANCE, LABEL_COLUMN, STAMP_PARTS, WEATHER_COLUMNS, check_names, resolve_columns,
+                      split_header)
 from .files import file_text
-from .formats import PVLIB_FORMATS, detect_format, read_pvlib
+from .formats import PVLIB_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
 from .resample import resample
 from .stamps import CLOCK_ZONES, parse_stamps
+from .suncheck import meta_name
 from .tables import COMMA_GROUPED, MISSING, Table, locate_table
 from .units import looks_like_unit, spellings, to_frame_units
 
@@ -135,8 +137,23 @@ def _count_thousands(report: dict, name: str, count: int, separator: str, why: s
     report["thousands"] = f"{separator} in {sum(counts.values()):,} values of {', '.join(counts)} ({why})"
 
 
-def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, report):
-    if "date" in mapping:
+def _stamp_from_parts(mapping: dict, cells) -> tuple[pd.Series, str]:
+    """Year, month, day, hour and minute columns (NSRDB, SAM CSV) as ``yyyy-mm-dd HH:MM`` stamps,
+    and the columns' names."""
+    names = [mapping[part] for part in STAMP_PARTS if part in mapping]
+    year, month, day, hour, *minute = (pd.Series(cells(name)).str.strip() for name in names)
+    minute = minute[0].str.zfill(2) if minute else "00"
+    text = year + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + " " + hour.str.zfill(2) + ":" + minute
+    return text, " + ".join(names)
+
+
+def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, report, file_zone=None):
+    """The stamps as a tz-aware index and the rows kept (`stamps.parse_stamps`), from a time
+    column, a date and a clock column, or year, month, day and hour columns; naive ones in
+    `file_zone` (a UTC offset an NSRDB file's site lines give), else a zone the clock's name gives."""
+    if "year" in mapping:
+        (text, header), zone = _stamp_from_parts(mapping, cells), None
+    elif "date" in mapping:
         text = pd.Series(cells(mapping["date"])).str.strip() + " " + pd.Series(cells(mapping["clock"])).str.strip()
         header = f"{mapping['date']} + {mapping['clock']}"
         zone = _zone_in_name(mapping["clock"])
@@ -146,8 +163,10 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
     else:
         text, header = pd.Series(cells(mapping["time"])), mapping["time"]
         zone = _zone_in_name(header)
-    return parse_stamps(path, header, text, table.lines, tz=tz, site_tz=site.tz if site is not None else None,
-                        clock_zone=zone, dayfirst=dayfirst, report=report)
+    zone_from = {"zone_from": f"the file's Time Zone (line {table.site_line})"} if file_zone else {}
+    index, keep = parse_stamps(path, header, text, table.lines, tz=tz, site_tz=site.tz if site is not None else None,
+                               clock_zone=file_zone or zone, dayfirst=dayfirst, report=report, **zone_from)
+    return (one_typical_year(path, index, table.lines, report) if "year" in mapping else index), keep
 
 
 def _without_empty_columns(table: Table, report: dict) -> Table:
@@ -206,7 +225,8 @@ def _refuse_unknown_unit(path: Path, header: str, name: str, note: str) -> None:
                                f"give its unit with --units {name}=UNIT if it is one of those")
 
 
-def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict, report) -> pd.DataFrame:
+def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict, report) -> tuple[pd.DataFrame, dict]:
+    """The table's frame, and the site an NSRDB or SAM CSV file's site lines give (else {})."""
     table = _without_empty_columns(locate_table(path, text), report)
     position = {h: i for i, h in enumerate(table.headers)}
     repeated = sorted({h for h in table.headers if table.headers.count(h) > 1})
@@ -221,14 +241,15 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
                   decimal=table.decimal,
                   skipped={k: v for k, v in table.skipped.items() if v},
                   columns={k: v for k, v in mapping.items() if k in WEATHER_COLUMNS})
-    if "time" not in mapping and "date" not in mapping:
+    if not {"time", "date", "year"} & set(mapping):
         raise HybridtrackError(f"{path}: no time column found; name it with columns={{'time': ...}} "
                                f"(--map time=COLUMN, or --map time= for an unnamed first column); columns are "
                                f"{', '.join(repr(h) if not h else h for h in table.headers)}")
     if not any(name in mapping for name in (*IRRADIANCE, "photocurrent")):
         raise HybridtrackError(f"{path}: no irradiance column found (ghi, dni, dhi); map one, e.g. --map "
                                f"dni=COLUMN; columns are {', '.join(table.headers)}")
-    index, keep = _stamps(path, table, mapping, cells, tz, site, dayfirst, report)
+    meta = header_site(path, table) if table.site else {}
+    index, keep = _stamps(path, table, mapping, cells, tz, site, dayfirst, report, meta.get("zone"))
     frame = pd.DataFrame(index=index)
     conversions, notes = {}, {}
     for name in WEATHER_COLUMNS:
@@ -256,16 +277,16 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
     if label is not None:
         frame[LABEL_COLUMN] = pd.Series(cells(label)).str.strip().str.lower().replace({"": np.nan}).to_numpy()
     frame["_line"] = table.lines.astype(float)
-    return frame[keep]
+    return frame[keep], meta
 
 
 def _site_from_meta(meta: dict):
     from ..sites import custom
 
     try:
-        return custom(float(meta["latitude"]), float(meta["longitude"]), "UTC",
+        return custom(float(meta["latitude"]), float(meta["longitude"]), meta.get("site_tz", "UTC"),
                       float(meta.get("altitude", meta.get("elevation", 0.0)) or 0.0),
-                      name=str(meta.get("Name", meta.get("City", meta.get("name", "the file's site")))).strip('" '))
+                      name=meta_name(meta, "the file's site"))
     except (HybridtrackError, TypeError, ValueError):
         return None
 
@@ -342,7 +363,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
     encoding = report["read_as"]
     fmt = str(format).lower() if format is not None else detect_format(text)
     if fmt == "csv":
-        frame, meta = _read_csv(path, text, columns, tz, units, site, dayfirst, strict, report), {}
+        frame, meta = _read_csv(path, text, columns, tz, units, site, dayfirst, strict, report)
     elif fmt in PVLIB_FORMATS:
         if columns or units:
             raise HybridtrackError(f"{path}: --map and --units apply to tables; a {fmt.upper()} file names its own "
@@ -353,6 +374,9 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         raise HybridtrackError(f"unknown format {format!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
     if site is None and {"latitude", "longitude"} <= set(meta):
         site = _site_from_meta(meta)
+        if site is not None:
+            report["site"] = (f"{site.name} ({site.latitude:.3f}°, {site.longitude:.3f}°, {site.altitude:g} m, "
+                              f"{site.tz}), from the file's header")
     elif site is not None:
         from .suncheck import place_check
 

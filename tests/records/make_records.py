@@ -108,8 +108,8 @@ def dotted_dates() -> str:
 
 def iso_t_semicolons() -> str:
     day = truth("lanzhou-day")
-    out = _renamed(day, {"ghi": "GHI (W/m2)", "dni": "DNI (W/m2)", "dhi": "DHI (W/m2)", "wind_speed": "Wind speed (m/s)",
-                         "temp_air": "Temperature (°C)"}, _local(day, SHANGHAI, "%Y-%m-%dT%H:%M:%S"), "Timestamp")
+    out = _renamed(day, {"ghi": "GHI (W/m2)", "dni": "DNI (W/m2)", "dhi": "DHI (W/m2)",
+                         "wind_speed": "Wind speed (m/s)", "temp_air": "Temperature (°C)"}, _local(day, SHANGHAI, "%Y-%m-%dT%H:%M:%S"), "Timestamp")
     return _csv(out, sep=";", decimal=",")
 
 
@@ -274,6 +274,37 @@ def epw() -> str:
     return "\n".join(head + rows) + "\n"
 
 
+#: NSRDB PSM3's site lines (the v3.2.2 CSV the NSRDB API and Data Viewer give): names, then values.
+_PSM3_NAMES = ("Source,Location ID,City,State,Country,Latitude,Longitude,Time Zone,Elevation,Local Time Zone,"
+               "Dew Point Units,DHI Units,DNI Units,GHI Units,Temperature Units,Pressure Units,Relative Humidity Units,"
+               "Precipitable Water Units,Wind Direction Units,Wind Speed Units,Cloud Type -15,Cloud Type 0,"
+               "Cloud Type 1,Cloud Type 2,Cloud Type 3,Cloud Type 4,Cloud Type 5,Cloud Type 6,Cloud Type 7,"
+               "Cloud Type 8,Cloud Type 9,Cloud Type 10,Cloud Type 11,Cloud Type 12,Fill Flag 0,Fill Flag 1,"
+               "Fill Flag 2,Fill Flag 3,Fill Flag 4,Fill Flag 5,Surface Albedo Units,Version")
+_PSM3_VALUES = ("NSRDB,149190,-,-,-,39.74,-105.18,{zone},1829,-7,c,w/m2,w/m2,w/m2,c,mbar,%,cm,Degrees,m/s,N/A,Clear,"
+                "Probably Clear,Fog,Water,Super-Cooled Water,Mixed,Opaque Ice,Cirrus,Overlapping,Overshooting,Unknown,"
+                "Dust,Smoke,N/A,Missing Image,Low Irradiance,Exceeds Clearsky,Missing CLoud Properties,"
+                "Rayleigh Violation,N/A,3.2.2")
+_PSM3_HEADER = ("Year,Month,Day,Hour,Minute,DHI,DNI,GHI,Clearsky DHI,Clearsky DNI,Clearsky GHI,Cloud Type,Dew Point,"
+                "Solar Zenith Angle,Fill Flag,Surface Albedo,Wind Speed,Precipitable Water,Wind Direction,"
+                "Relative Humidity,Temperature,Pressure")
+
+
+def psm3(zone: int) -> str:
+    """An NSRDB PSM3 half-hourly CSV at Golden, its stamps in UTC`zone` (0: a UTC download; -7: the
+    site's standard time): irradiance in whole W/m², wind in tenths of m/s, as NSRDB writes them."""
+    import pvlib
+
+    day = truth("golden-day").iloc[::3]  # 05:00, 05:30, ... MST
+    zenith = pvlib.solarposition.get_solarposition(day.index, 39.74, -105.18)["zenith"].to_numpy()
+    rows = []
+    for stamp, row, angle in zip(day.index.tz_convert(f"Etc/GMT{-zone:+d}"), day.itertuples(), zenith):
+        rows.append(f"{stamp.year},{stamp.month},{stamp.day},{stamp.hour},{stamp.minute},{row.dhi:.0f},{row.dni:.0f},"
+                    f"{row.ghi:.0f},{row.dhi:.0f},{row.dni:.0f},{row.ghi:.0f},0,2.0,{angle:.2f},0,0.18,"
+                    f"{row.wind_speed:.1f},1.2,200,30.5,{row.temp_air:.1f},820")
+    return "\n".join([_PSM3_NAMES, _PSM3_VALUES.format(zone=zone), _PSM3_HEADER] + rows) + "\n"
+
+
 def midc() -> str:
     day = truth("golden-day")
     out = _renamed(day, {"ghi": "Global Horizontal [W/m^2]", "dni": "Direct Normal [W/m^2]",
@@ -350,7 +381,8 @@ def _packed_zip() -> bytes:
 FILES = {
     "pandas-index.csv": pandas_index, "pandas-index-naive.csv": pandas_index_naive,
     "toa5-cr1000.dat": toa5, "toa5-wvt-offsets.dat": lambda: toa5("WS_ms_S_WVT", offsets=True),
-    "toa5-nul-padded.dat": toa5_padded, "dotted-dates.csv": dotted_dates, "ddmmyyyy-days.csv": lambda: day_month("%d/%m/%Y %H:%M"),
+    "toa5-nul-padded.dat": toa5_padded, "dotted-dates.csv": dotted_dates,
+    "ddmmyyyy-days.csv": lambda: day_month("%d/%m/%Y %H:%M"),
     "mmddyyyy-days.csv": lambda: day_month("%m/%d/%Y %H:%M"),
     "ambiguous-dates.csv": lambda: day_month("%d/%m/%Y %H:%M", "lanzhou-day"),
     "yymmdd-days.csv": lambda: day_month("%y-%m-%d %H:%M"),
@@ -366,6 +398,7 @@ FILES = {
     "header-notes.csv": header_note, "semicolon-zero-rows.csv": semicolon_zero_rows, "plain.csv": plain,
     "logger.csv.gz": _packed_gzip, "logger.zip": _packed_zip, "excel-unicode.txt": excel_unicode,
     "latin1.csv": latin1, "utf8-bom.csv": utf8_bom, "comments-anywhere.csv": comments_anywhere, "messy.csv": messy,
+    "nsrdb-psm3-local.csv": lambda: psm3(-7), "nsrdb-psm3-utc.csv": lambda: psm3(0),
     "ghi-only.csv": ghi_only, "lanzhou.epw": epw, "midc-bms.csv": midc, "surfrad-bon.dat": surfrad,
     "naive-no-zone.csv": naive_no_zone, "srml-eugene.tsv": srml, "bsrn-bon.dat": bsrn,
 }
