@@ -108,3 +108,12 @@ def test_a_half_hour_zone_and_a_sam_csv_without_minutes(tmp_path):
     assert frame.index[12] == pd.Timestamp("2021-03-20 06:30", tz="UTC") and frame["ghi"].iloc[12] == 500.0
     assert frame["temp_air"].iloc[0] == 15.0 and frame.attrs["site"] == "Delhi"
     assert frame.attrs["validation"]["time"] == "naive stamps in UTC+05:30, as the file's Time Zone (line 2) says"
+
+
+def test_a_file_without_its_site_values_line_is_refused_naming_it(tmp_path, capsys):
+    """The second line cut out: the table's header under line 1's names had been read as the site's
+    values, and the first data row as the header ('column '0' appears more than once')."""
+    path = tmp_path / "psm3.csv"
+    path.write_text("\n".join([_PSM3_NAMES, _PSM3_HEADER] + _rows([(2021, 6, 5)])) + "\n")
+    _refused(path, capsys, f"{path}: line 2: no number under line 1's names (Latitude, Longitude, ...): an NSRDB or "
+                           "SAM CSV file's second line holds the site's values")

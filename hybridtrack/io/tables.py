@@ -219,6 +219,9 @@ def _header(path: Path, kept: list[tuple[int, str]]) -> tuple[list, int, str, st
     if _site_header(first):
         if len(kept) < 4:
             raise HybridtrackError(f"{path}: an NSRDB or SAM CSV file needs its site lines, a header and data")
+        if not any(_is_number(cell) for cell in _split(kept[1][1], ",")):
+            raise HybridtrackError(f"{path}: line {kept[1][0]}: no number under line {kept[0][0]}'s names (Latitude, "
+                                   "Longitude, ...): an NSRDB or SAM CSV file's second line holds the site's values")
         return kept, 2, ",", "NSRDB / SAM CSV (the site on lines 1-2)", _site_values(first, kept)
     return kept, *_choose_separator(path, kept), "table", {}
 
