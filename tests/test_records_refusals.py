@@ -41,6 +41,8 @@ REFUSALS = [
     ("decimal commas beside decimal points, tab-separated", "time\tghi\n2021-06-05 10:00\t812.5\n"
      "2021-06-05 11:00\t700,5\n", {"tz": "UTC"}, ["--tz", "UTC"],
      ["line 3, column 'ghi': '700,5' is not a number (nor are 1 of its 2 values)"]),
+    ("a date after its clock beside an ISO stamp", "time,ghi\n2021-06-05 10:00,500\n11:00 05/06/2021,600\n",
+     {"tz": "UTC"}, ["--tz", "UTC"], ["line 2, column 'time'", "is not written like the column's other dates"]),
     ("dates written two ways", "time,ghi\n05/06/2021 10:00,500\n2021-06-05 11:00,500\n", {"tz": "UTC"},
      ["--tz", "UTC"], ["line 3, column 'time'", "is not written like the column's other dates"]),
     ("an empty stamp", "time,ghi\n2021-06-05 10:00,500\n,500\n", {"tz": "UTC"}, ["--tz", "UTC"],
