@@ -268,12 +268,13 @@ def _decimal(sep: str, rows: list[list[str]]) -> str:
     a semicolon-separated table any (``0,5``, ``1,060``); in a tab-, bar- or comma-separated one
     (the cell quoted) one that is no group of thousands (``812,5``, ``0,812``, not ``1,060``), where
     no number has a decimal point. Such tables had been refused, every number unreadable."""
-    commas = [cell for cell in (f.strip() for row in rows for f in row if "," in f) if _COMMA_DECIMAL.fullmatch(cell)]
+    commas = (cell for cell in (f.strip() for row in rows for f in row if "," in f) if _COMMA_DECIMAL.fullmatch(cell))
     if sep == ";":
-        return "," if commas else "."
-    if all(COMMA_GROUPED.fullmatch(cell) for cell in commas):
+        return "," if next(commas, None) is not None else "."
+    if all(COMMA_GROUPED.fullmatch(cell) for cell in commas):  # stops at the first that is no group
         return "."
-    return "." if any(_POINT_DECIMAL.fullmatch(f.strip()) for row in rows for f in row) else ","
+    points = (f.strip() for row in rows for f in row if "." in f)
+    return "." if any(_POINT_DECIMAL.fullmatch(cell) for cell in points) else ","
 
 
 @_long_fields()
