@@ -35,7 +35,8 @@ UNNAMED = ""
 ALIASES = {
     "time": ("time", "timestamp", "datetime", "date_time", "date time", "date/time", "time stamp", "tmstamp",
              "utc", "local time", "time_utc", "epoch", "unix time", "unixtime", UNNAMED, "unnamed: 0", "index",
-             "zeit", "zeitstempel", "datum/zeit", "horodatage", "date heure", "date et heure", "fecha hora", "fecha y hora"),
+             "zeit", "zeitstempel", "datum/zeit", "horodatage", "date heure", "date et heure", "fecha hora",
+             "fecha y hora"),
     "date": ("date", "day", "date (mm/dd/yyyy)", "yyyy-mm-dd", "datum", "fecha"),
     "clock": ("time", "hour", "clock", "hh:mm", "time (hh:mm)", "mst", "pst", "lst", "est", "cst", "uhrzeit", "hora",
               "heure"),
@@ -50,7 +51,8 @@ ALIASES = {
                    "wind", "ws", "wspd", "ws_ms", "wind_ms", "avg wind speed", "wind speed avg", "wsp"),
     "temp_air": ("temp_air", "air temperature", "temperature", "temp", "tair", "t_air", "ta", "airtc", "airtk",
                  "air_temp", "tamb", "t_amb", "ambient temperature", "dry bulb", "drybulb", "temp_c", "t2m",
-                 "dry bulb temp", "tower dry bulb temp", "tdry", "temperatur", "température", "temperatura", "lufttemperatur"),
+                 "dry bulb temp", "tower dry bulb temp", "tdry", "temperatur", "température", "temperatura",
+                 "lufttemperatur"),
     "photocurrent": ("photocurrent", "photocurrent_ma", "intensity", "intensity_ma", "sensor current"),
     # the sun sensor's pointing signal: the sun's offset from its axis, on each axis it serves
     "pointing": ("pointing", "pointing_deg", "sensor_offset", "sensor offset", "sun sensor offset", "pointing_1",
