@@ -117,3 +117,14 @@ def test_a_file_without_its_site_values_line_is_refused_naming_it(tmp_path, caps
     path.write_text("\n".join([_PSM3_NAMES, _PSM3_HEADER] + _rows([(2021, 6, 5)])) + "\n")
     _refused(path, capsys, f"{path}: line 2: no number under line 1's names (Latitude, Longitude, ...): an NSRDB or "
                            "SAM CSV file's second line holds the site's values")
+
+
+def test_a_table_whose_header_starts_with_source_and_latitude_is_a_table(tmp_path):
+    """A mobile logger's 'Source,Latitude,Longitude,Timestamp,...' header names no site lines:
+    its first row is data, not the site's values."""
+    path = tmp_path / "rover.csv"
+    path.write_text("Source,Latitude,Longitude,Timestamp,GHI,DNI,DHI\n"
+                    + "".join(f"rover,36.10,103.73,2021-06-05T{h}:00:00+08:00,500,700,100\n" for h in (11, 12, 13)))
+    frame = read_weather(path)
+    assert len(frame) == 3 and frame.index[0] == pd.Timestamp("2021-06-05 11:00", tz="Asia/Shanghai")
+    assert frame.attrs["validation"]["table"] == "table"

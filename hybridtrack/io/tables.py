@@ -253,9 +253,10 @@ def locate_table(path: Path, text: str) -> Table:
 
 def _site_header(first: list[str]) -> bool:
     """Whether a file's first line names an NSRDB or SAM CSV file's site: ``Source``, ...,
-    ``Latitude``, ``Longitude``."""
+    ``Latitude``, ``Longitude``, ``Time Zone`` (a mobile logger's header ``Source,Latitude,
+    Longitude,Timestamp,...`` is no such line)."""
     names = [name.strip() for name in first]
-    return bool(names) and names[0] == "Source" and {"Latitude", "Longitude"} <= set(names)
+    return bool(names) and names[0] == "Source" and {"Latitude", "Longitude", "Time Zone"} <= set(names)
 
 
 def _site_values(first: list[str], kept: list[tuple[int, str]]) -> dict[str, str]:
