@@ -30,6 +30,7 @@ __all__ = [
     "Collector",
     "as_collector",
     "KINDS",
+    "trough_kind",
     "sun_vector",
     "across_angle",
     "trough_angle",
@@ -429,8 +430,20 @@ def _aim_point(aim) -> tuple[float, float, float]:
     return tuple(number(value, "collector: aim (m)", -MAX_DISTANCE, MAX_DISTANCE) for value in values)
 
 
-#: The collector kinds the project serves.
-KINDS = ("trough-ns", "trough-ew", "fresnel", "heliostat")
+#: The collector kinds the project serves: "trough" is a trough on any horizontal axis (its
+#: `axis_azimuth` given), "trough-ns" and "trough-ew" the two usual axes by name.
+KINDS = ("trough-ns", "trough-ew", "trough", "fresnel", "heliostat")
+
+#: The axis line each named trough kind stands for, as its axis azimuth modulo 180 degrees.
+NAMED_TROUGHS = {"trough-ns": AXIS_AZIMUTH["ns"] % 180.0, "trough-ew": AXIS_AZIMUTH["ew"] % 180.0}
+
+
+def trough_kind(axis_azimuth: float) -> str:
+    """The kind of a trough whose horizontal axis lies at `axis_azimuth` degrees from north:
+    "trough-ns" or "trough-ew" on exactly those lines (0 or 180; 90 or 270, and a turn either
+    way), "trough" on any other, so that a kind never names an axis the trough does not have."""
+    line = axis_azimuth % 180.0
+    return next((kind for kind, named in NAMED_TROUGHS.items() if line == named), "trough")
 
 
 #: Metres: the farthest a row, receiver or aim point may lie from a collector (a large tower
@@ -439,7 +452,7 @@ MAX_DISTANCE = 5_000.0
 
 
 #: The kinds of collector each geometry field of `Collector` describes.
-GEOMETRY_KINDS = {"axis_azimuth": ("trough-ns", "trough-ew", "fresnel"), "row_distance": ("fresnel",),
+GEOMETRY_KINDS = {"axis_azimuth": ("trough-ns", "trough-ew", "trough", "fresnel"), "row_distance": ("fresnel",),
                   "receiver_height": ("fresnel",), "aim": ("heliostat",)}
 
 
@@ -449,12 +462,15 @@ class Collector:
 
     Parameters
     ----------
-    kind : {"trough-ns", "trough-ew", "fresnel", "heliostat"}
-        Parabolic trough on a north-south or east-west horizontal axis, a linear Fresnel
-        mirror row, or a two-axis heliostat.
+    kind : {"trough-ns", "trough-ew", "trough", "fresnel", "heliostat"}
+        Parabolic trough on a north-south or east-west horizontal axis, or on any other
+        horizontal axis ("trough", its `axis_azimuth` required), a linear Fresnel mirror row, or
+        a two-axis heliostat.
     axis_azimuth : float, optional
         Trough or Fresnel axis azimuth in degrees from north; by default the kind's own
-        (0 for "trough-ns" and "fresnel", 270 for "trough-ew", see `AXIS_AZIMUTH`).
+        (0 for "trough-ns" and "fresnel", 270 for "trough-ew", see `AXIS_AZIMUTH`). A named
+        trough takes only its own line: 0 or 180 for "trough-ns", 90 or 270 for "trough-ew"
+        (a turn either way too); see `trough_kind`.
     row_distance, receiver_height : float
         Fresnel row: signed lateral distance from the receiver line and receiver height (m).
     aim : tuple of float
@@ -477,6 +493,7 @@ class Collector:
         number(self.receiver_height, "collector: receiver_height (m)", 0, MAX_DISTANCE, above=True)
         object.__setattr__(self, "aim", _aim_point(self.aim))  # a tuple: a list or an array made it unhashable
         self._refuse_other_kinds_geometry()
+        self._refuse_untruthful_axis()
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
             if not self.aim[2] > 0:
@@ -494,6 +511,17 @@ class Collector:
                 continue
             raise HybridtrackError(f"collector: {f.name} describes a {' or '.join(kinds)} collector, "
                                    f"not a {self.kind}; it would be ignored")
+
+    def _refuse_untruthful_axis(self) -> None:
+        """Refuse a trough whose kind would misname its axis: a "trough-ns" on a 45° axis had been
+        taken and reported as north-south; and a "trough" without the axis it stands for."""
+        if self.kind == "trough" and self.axis_azimuth is None:
+            raise HybridtrackError("collector: a trough needs its axis_azimuth (degrees from north); trough-ns and "
+                                   "trough-ew name the north-south and east-west axes")
+        if self.kind in NAMED_TROUGHS and self.axis_azimuth is not None and trough_kind(self.axis) != self.kind:
+            raise HybridtrackError(f"collector: axis_azimuth {self.axis:g} is no {self.kind} axis (a {self.kind} lies "
+                                   f"at {NAMED_TROUGHS[self.kind]:g} or {NAMED_TROUGHS[self.kind] + 180:g} degrees); "
+                                   f"it is a {trough_kind(self.axis)} collector")
 
     @property
     def single_axis(self) -> bool:

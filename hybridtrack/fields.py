@@ -31,7 +31,6 @@ from . import params, sites
 from .budget import BYTES_PER_STEP, check_steps
 from .cluster import MAX_WORKERS, check_where, cores
 from .collectors import (
-    AXIS_AZIMUTH,
     MAX_DISTANCE,
     Collector,
     fresnel_angle,
@@ -40,6 +39,7 @@ from .collectors import (
     normal_angles,
     sun_path,
     trough_angle,
+    trough_kind,
 )
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
@@ -345,7 +345,8 @@ class TroughLoop:
 
     @property
     def kind(self) -> str:
-        return "trough-ew" if self.axis_azimuth % 180.0 == AXIS_AZIMUTH["ew"] % 180.0 else "trough-ns"
+        """The loop's collector kind, which names its axis (`hybridtrack.collectors.trough_kind`)."""
+        return trough_kind(self.axis_azimuth)
 
     @property
     def names(self) -> list[str]:

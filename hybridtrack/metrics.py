@@ -35,7 +35,7 @@ __all__ = ["summarize", "score", "RunningSummary", "offered_light", "daily", "sh
            "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
 
 TRACKING_MODES = ("sensor", "astronomical", "search")
-ACCEPTANCE_HALF_ANGLE = {"trough-ns": 1.0, "trough-ew": 1.0, "fresnel": 0.8, "heliostat": 0.25}
+ACCEPTANCE_HALF_ANGLE = {"trough-ns": 1.0, "trough-ew": 1.0, "trough": 1.0, "fresnel": 0.8, "heliostat": 0.25}
 
 
 def acceptance(error, half_angle: float) -> np.ndarray:

@@ -158,6 +158,34 @@ def test_collector_spec_gives_targets_for_each_kind():
     np.testing.assert_allclose(ew, trough_angle(sun.altitude, sun.azimuth, "ew"))
 
 
+@pytest.mark.parametrize("axis, kind", [(0.0, "trough-ns"), (180.0, "trough-ns"), (-180.0, "trough-ns"),
+                                        (360.0, "trough-ns"), (-0.0, "trough-ns"), (90.0, "trough-ew"),
+                                        (270.0, "trough-ew"), (-90.0, "trough-ew"), (45.0, "trough"),
+                                        (1e-9, "trough"), (269.99, "trough"), (-135.0, "trough")])
+def test_a_troughs_kind_names_its_axis_and_no_other(axis, kind):
+    """A 45° trough had been a "trough-ns"; its targets are pvlib's tracker (ρ = 90° + θ, pvlib's
+    axis pointing the other way) on that axis, whatever the kind's name."""
+    from hybridtrack.collectors import trough_kind
+
+    assert trough_kind(axis) == kind
+    collector = Collector(kind, axis)
+    assert collector.axis == axis
+    for other in {"trough-ns", "trough-ew"} - {kind}:
+        with pytest.raises(HybridtrackError, match=rf"axis_azimuth {axis:g} is no {other} axis .* it is a {kind} "):
+            Collector(other, axis)
+    sun = sun_on("2021-06-21", "lanzhou", "10min")
+    up = sun[sun.altitude > 0]
+    pv = pvlib.tracking.singleaxis(90 - up.altitude, up.azimuth, axis_azimuth=axis + 180.0, backtrack=False,
+                                   max_angle=180.0)
+    np.testing.assert_allclose(collector.angles(up.altitude, up.azimuth)["angle"], 90.0 + pv.tracker_theta,
+                               rtol=0, atol=1e-9)
+
+
+def test_a_trough_on_no_named_axis_needs_its_axis():
+    with pytest.raises(HybridtrackError, match="a trough needs its axis_azimuth"):
+        Collector("trough")
+
+
 @pytest.mark.parametrize("kwargs, message", [({"kind": "dish"}, "unknown collector 'dish'"),
                                              ({"kind": "fresnel", "receiver_height": 0}, "receiver_height"),
                                              ({"kind": "heliostat", "aim": (0, 0, 0)}, "aim point")])
@@ -176,7 +204,8 @@ def test_rotate_is_the_matrix_product_row_by_row():
 
 @pytest.mark.parametrize("kind, geometry, message", [
     ("trough-ns", {"row_distance": 2.0}, "row_distance describes a fresnel collector, not a trough-ns"),
-    ("heliostat", {"axis_azimuth": 10.0}, "axis_azimuth describes a trough-ns or trough-ew or fresnel collector"),
+    ("heliostat", {"axis_azimuth": 10.0}, "axis_azimuth describes a trough-ns or trough-ew or trough or fresnel "
+                                          "collector"),
     ("fresnel", {"aim": (0.0, 0.0, 50.0)}, "aim describes a heliostat collector, not a fresnel"),
 ])
 def test_geometry_of_another_kind_is_refused_not_ignored(kind, geometry, message):
@@ -227,7 +256,8 @@ THREE = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
      r"mount_targets takes a sun path: .* got shapes \(3, 1\) and \(3, 1\)"),  # numpy's IndexError
     (lambda m: m.incidence_cosine(THREE[0][:, None], THREE[1][:, None], Collector()),
      r"incidence_cosine takes a sun path"),  # numpy's IndexError
-    (lambda m: m.mount_targets(*THREE, "trough"), "unknown collector 'trough'"),  # AttributeError
+    (lambda m: m.mount_targets(*THREE, "dish"), "unknown collector 'dish'"),  # AttributeError
+    (lambda m: m.mount_targets(*THREE, "trough"), "a trough needs its axis_azimuth"),  # a kind of its own now
     (lambda m: m.incidence_cosine(*THREE, 5), "collector must be a kind's name"),  # AttributeError
     (lambda m: m.mount_targets("a", "b", Collector()), "mount_targets: altitude must be numbers"),  # ValueError
     (lambda m: m.mounting_rotation([0.1, 0.2], 0.0, 0.0), "axis_azimuth_error"),  # numpy's ValueError

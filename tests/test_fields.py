@@ -7,11 +7,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
+import pvlib
 import pytest
 from matplotlib.figure import Figure
 
 from hybridtrack import HybridtrackError, simulate, simulate_field
-from hybridtrack.collectors import fresnel_angle, heliostat_normal, trough_angle
+from hybridtrack.collectors import Collector, fresnel_angle, heliostat_normal, trough_angle
 from hybridtrack.fields import (FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns,
                                 run_collectors)
 from hybridtrack.simulation import SimulationConfig
@@ -54,6 +55,28 @@ def test_trough_loop_lies_on_one_axis_line(sun):
     np.testing.assert_allclose(loop.positions, [[0, 0, 0], [-150, 0, 0], [-300, 0, 0]], atol=1e-9)
     np.testing.assert_array_equal(loop.targets(sun.altitude, sun.azimuth)[:, 2],
                                   trough_angle(sun.altitude, sun.azimuth, 270.0).to_numpy())
+
+
+@pytest.mark.parametrize("axis, kind", [(0.0, "trough-ns"), (180.0, "trough-ns"), (90.0, "trough-ew"),
+                                        (270.0, "trough-ew"), (45.0, "trough"), (-100.0, "trough")])
+def test_trough_loops_collectors_name_their_axis(axis, kind):
+    """A loop on a 45° axis had reported its collectors as "trough-ns"."""
+    loop = TroughLoop(count=2, axis_azimuth=axis)
+    assert loop.kind == kind
+    assert loop.collectors() == [Collector(kind, axis)] * 2
+
+
+def test_a_trough_loop_on_a_slanted_axis_runs_as_what_it_is(day):
+    """Scored and summarised as a "trough" on its own axis; its nominal targets are pvlib's tracker
+    on that axis (ρ = 90° + θ, pvlib's axis pointing the other way)."""
+    loop = TroughLoop(count=2, axis_azimuth=45.0, spread=ImperfectionSpread.none())
+    result = simulate_field(day, "lanzhou", loop, seed=2, keep_log=False)
+    assert result.summary["kind"] == "trough" and result.summary["collectors"] == 2
+    sun = solar_position(day.index, "lanzhou")
+    up = sun[sun.altitude > 0]
+    pv = pvlib.tracking.singleaxis(90 - up.altitude, up.azimuth, axis_azimuth=225.0, backtrack=False, max_angle=180)
+    np.testing.assert_allclose(loop.targets(up.altitude, up.azimuth), np.c_[pv.tracker_theta, pv.tracker_theta] + 90,
+                               rtol=0, atol=1e-9)
 
 
 def test_heliostat_field_aims_each_mirror_from_its_own_place(sun):
