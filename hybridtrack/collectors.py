@@ -133,7 +133,7 @@ def direction_vectors(altitude: np.ndarray, azimuth: np.ndarray) -> np.ndarray:
     already, or an axis's angles, which may stand past the zenith (a heliostat's elevation axis
     parked at 90° with its encoder's offset stood at 90.01°, and a 1,000-mirror field's scoring
     had refused it as no sun)."""
-    a, g = np.radians(altitude), np.radians(azimuth)
+    a, g = np.broadcast_arrays(np.radians(altitude), np.radians(azimuth))  # one altitude, many azimuths too
     return np.stack([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)], axis=-1)
 
 

@@ -67,6 +67,18 @@ def test_elementwise_broadcast_keeps_a_series_and_axes_per_collector(sun):
         np.testing.assert_array_equal(table[:, i], trough_angle(up.altitude, up.azimuth, axis).to_numpy())
 
 
+def test_one_altitude_broadcasts_against_many_azimuths(sun):
+    """A scalar altitude against an array of azimuths had raised numpy's ValueError ('all input
+    arrays must have the same shape') in every function; pvlib's tracker is the reference."""
+    azimuths = np.array([60.0, 120.0, 200.0, 300.0])
+    np.testing.assert_allclose(sun_vector(30.0, azimuths), sun_vector(np.full(4, 30.0), azimuths), rtol=0, atol=0)
+    np.testing.assert_allclose(sun_vector(30.0, 90.0), [np.cos(np.radians(30.0)), 0.0, 0.5], rtol=0, atol=1e-16)
+    pv = pvlib.tracking.singleaxis(np.full(4, 60.0), azimuths, axis_azimuth=180, backtrack=False, max_angle=90)
+    np.testing.assert_allclose(trough_angle(30.0, azimuths), 90 + pv["tracker_theta"], rtol=0, atol=1e-9)
+    assert fresnel_angle(30.0, azimuths, 5.0, 10.0).shape == fresnel_end_loss(30.0, azimuths, 5.0, 10.0).shape == (4,)
+    assert heliostat_normal(30.0, azimuths, (0.0, 20.0, 100.0)).shape == (4, 3)
+
+
 def test_trough_hand_case_sun_along_and_across_the_axis():
     # sun low in the east at 30°: a north-south trough faces it at 30°; an east-west axis sees it along itself
     assert trough_angle(30.0, 90.0, [0.0, 90.0]) == pytest.approx([30.0, 90.0])
