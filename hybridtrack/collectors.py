@@ -159,18 +159,38 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
 
     Measured from the horizontal direction at ``axis_azimuth + 90°`` through the zenith, the
     single-axis convention of this module, within [-90, 270) so that a direction just below
-    either horizon stays next to 0 or 180. `axis_azimuth` (degrees) broadcasts against
-    ``vectors[..., 0]``. A zero vector has no direction and is refused (it had given 0°).
+    either horizon stays next to 0 or 180. A vector on the horizon along the axis has no part
+    across it and gives 90°, the limit of a vector above the horizon along the axis, however its
+    direction was rounded. `axis_azimuth` (degrees) broadcasts against ``vectors[..., 0]``. A
+    zero vector has no direction and is refused (it had given 0°).
     """
     vectors = _vectors("across_angle", vectors, "vectors").reshape(np.shape(vectors))  # its own shape kept
     b = np.radians(_finite(axis_azimuth, "axis azimuth"))
     _broadcast("across_angle", vectors=vectors[..., 0], axis_azimuth=b)
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
-    flat = (across == 0.0) & (vectors[..., 2] == 0.0)  # along the axis, or no vector: a year's check in ~3 ms
-    if flat.any() and np.any(flat & (vectors[..., 0] == 0.0) & (vectors[..., 1] == 0.0)):
-        raise HybridtrackError("across_angle: a zero vector has no direction")
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
-    return np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
+    angle = np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
+    level = vectors[..., 2] == 0.0  # a year's check in ~1 ms; the rest only for a vector on the horizon
+    return _level_along_axis(vectors, b, across, angle) if level.any() else angle
+
+
+#: How small a horizontal vector's part across an axis may be, as a share of its part along the
+#: axis, and still lie along it: sin 360° is -2.4e-16 in floating point, not 0, and such rounding
+#: of an azimuth written a few turns either way stays below 1e-14; an azimuth 1e-12° off the axis
+#: gives 1.7e-14.
+ALONG_AXIS = 1e-13
+
+
+def _level_along_axis(vectors: np.ndarray, b: np.ndarray, across: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """`across_angle`'s `angle` with 90° where a vector lies on the horizon along the axis: it has
+    no part across the axis, and the rounding of its azimuth had given 0° or 180° by how the
+    azimuth was written (0 or 360, 180 or -180). 90° is the limit of a vector above the horizon
+    along the axis. A zero vector has no direction and is refused (it had given 0°)."""
+    level = vectors[..., 2] == 0.0
+    if np.any(level & (vectors[..., 0] == 0.0) & (vectors[..., 1] == 0.0)):
+        raise HybridtrackError("across_angle: a zero vector has no direction")
+    along = vectors[..., 0] * np.sin(b) + vectors[..., 1] * np.cos(b)
+    return np.where(level & (np.abs(across) <= ALONG_AXIS * np.abs(along)), 90.0, angle)
 
 
 def _cross_axis_angle(altitude, azimuth, axis_azimuth) -> np.ndarray:
@@ -197,6 +217,17 @@ def trough_angle(altitude, azimuth, axis_azimuth=0.0):
         axis), 90 the zenith (stow), 180 the opposite horizon. NaN while the sun is down.
         For a north-south axis ρ = atan2(tan α, sin γ), i.e. 90° + pvlib's
         ``tracking.singleaxis`` tracker_theta with axis_azimuth 180 and no backtracking.
+        A sun on the horizon (α = 0) exactly along the axis has no projection across it:
+        ρ is 90° there, however the azimuth is written (0 or 360, 180 or -180), the limit of
+        a sun just above the horizon along the axis (where pvlib's tracker_theta is 0).
+
+    References
+    ----------
+    .. [1] W. F. Marion and A. P. Dobos, "Rotation angle for the optimum tracking of one-axis
+       trackers", NREL/TP-6A20-58891, 2013.
+    .. [2] W. F. Holmgren, C. W. Hansen and M. A. Mikofski, "pvlib python: a python package for
+       modeling solar energy systems", Journal of Open Source Software 3(29), 884, 2018,
+       doi:10.21105/joss.00884 (``pvlib.tracking.singleaxis``).
     """
     if isinstance(axis_azimuth, str):
         if axis_azimuth not in AXIS_AZIMUTH:

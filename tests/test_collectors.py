@@ -49,6 +49,37 @@ def test_east_west_axis_tracks_north_south_with_y_for_x():
     np.testing.assert_allclose(trough_angle(alt, az, 180.0), 180 - trough_angle(alt, az, 0.0))
 
 
+@pytest.mark.parametrize("axis, along", [
+    (0.0, [0.0, 360.0, -360.0, 720.0, 180.0, -180.0, 540.0]),
+    (270.0, [90.0, -270.0, 450.0, 270.0, -90.0, 3690.0]),
+    (45.0, [45.0, 225.0, -135.0, 405.0, -315.0]),
+])
+def test_a_sun_on_the_horizon_along_the_axis_gives_90_however_its_azimuth_is_written(axis, along):
+    """It gave 0° or 180° by the rounding of sin 360° (0 against 360, 180 against -180). pvlib's
+    tracker defines the angle just above the horizon on that line (tracker_theta 0: ρ 90°), and
+    on the horizon off the line (±90°: ρ 0° or 180°); at exactly 0° its own answer is rounding."""
+    along = np.array(along)
+    np.testing.assert_array_equal(trough_angle(0.0, along, axis), 90.0)
+    np.testing.assert_array_equal(trough_angle(-0.0, along, axis), 90.0)
+    np.testing.assert_array_equal(fresnel_angle(0.0, along, 5.0, 10.0, axis),
+                                  fresnel_angle(0.0, along[0], 5.0, 10.0, axis))
+    low = pvlib.tracking.singleaxis(np.full(len(along), 90.0 - 1e-4), along, axis_azimuth=axis + 180.0,
+                                    backtrack=False, max_angle=180.0)
+    np.testing.assert_allclose(trough_angle(1e-4, along, axis), 90.0 + low["tracker_theta"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(trough_angle(0.0, along, axis), 90.0 + low["tracker_theta"], rtol=0, atol=1e-6)
+    off = np.array([1.0, 30.0, 100.0, 181.0, 250.0, 330.0, -1.0]) + axis
+    horizon = pvlib.tracking.singleaxis(np.full(len(off), 90.0), off, axis_azimuth=axis + 180.0, backtrack=False,
+                                        max_angle=180.0)
+    np.testing.assert_allclose(trough_angle(0.0, off, axis), 90.0 + horizon["tracker_theta"], rtol=0, atol=1e-9)
+
+
+def test_mount_targets_follow_a_sun_on_the_horizon_along_the_axis_as_trough_angle_does():
+    from hybridtrack.mounting import mount_targets
+
+    az = np.array([0.0, 360.0, 180.0, -180.0, 90.0])
+    np.testing.assert_array_equal(mount_targets(np.zeros(5), az, Collector())[:, 0], [90.0, 90.0, 90.0, 90.0, 0.0])
+
+
 def peak_rate(date, start, end):
     sun = sun_on(date, freq="5s", start=start, end=end)
     return tracking_rate(trough_angle(sun.altitude, sun.azimuth)).max()
