@@ -13,7 +13,10 @@ Every function broadcasts its sun position against its collector parameters (row
 receiver heights, axis azimuths, aim points) by numpy's rules, as pvlib's functions do: equal
 shapes go element by element, and a sun path with a trailing axis against N collectors gives a
 (T, N) table in one call, e.g. ``fresnel_angle(alt[:, None], az[:, None], d, h)`` with ``d`` of
-shape (N,). A pandas Series comes back as a Series when the result has its shape.
+shape (N,). A pandas Series comes back as a Series when the result has its shape. A value
+that is one number for scalar input (an angle, a loss) is a numpy.float64, as numpy's and
+pvlib's are, and one vector in gives one vector out: `heliostat_normal` of one sun position and
+one aim point is (3,), `normal_angles` of one normal two numpy.float64, `jack_heights` (K,).
 """
 
 from __future__ import annotations
@@ -53,10 +56,18 @@ THREE_POINT_SUPPORT = np.array([[0.0, 1.0], [-0.707, -0.707], [0.707, -0.707]])
 
 
 def _like(template, values: np.ndarray, name: str | None = None):
-    """Return `values` as a Series on the template's index when the template is a Series of its shape."""
+    """Return `values` as a Series on the template's index when the template is a Series of its
+    shape, else as `_scalar` does."""
     if isinstance(template, pd.Series) and np.shape(values) == template.shape:
         return pd.Series(values, index=template.index, name=name)
-    return values
+    return _scalar(values)
+
+
+def _scalar(values):
+    """`values`, a numpy.float64 where it is one number (a 0-d array): the one type every function
+    of this module gives for scalar input, as numpy's and pvlib's do (they had given a 0-d array,
+    a numpy.float64 or a Python float by function). Arrays stay arrays."""
+    return values[()] if np.ndim(values) == 0 else values
 
 
 def _broadcast(function: str, **arrays) -> None:
@@ -109,12 +120,12 @@ def _degrees(values, name: str, function: str) -> np.ndarray:
 
 
 def _vectors(function: str, values, name: str) -> np.ndarray:
-    """`values` as float vectors ``(..., 3)``, refused with their shape unless they are; NaN
-    stands for no sun, an infinite component for no direction (it had given angles and heights)."""
-    vectors = np.atleast_2d(finite_array(values, not_numbers=f"{function}: {name} must be (east, north, up) vectors "
-                                         "of numbers", infinite=f"{function}: {name} must be finite (NaN where there "
-                                         "is no sun)"))
-    if vectors.shape[-1] != 3:
+    """`values` as float vectors ``(..., 3)`` of their own shape (one vector is (3,)), refused with
+    their shape unless they are; NaN stands for no sun, an infinite component for no direction (it
+    had given angles and heights)."""
+    vectors = finite_array(values, not_numbers=f"{function}: {name} must be (east, north, up) vectors of numbers",
+                           infinite=f"{function}: {name} must be finite (NaN where there is no sun)")
+    if vectors.shape[-1:] != (3,):
         raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors, shape (..., 3); got shape "
                                f"{vectors.shape}")
     return vectors
@@ -150,8 +161,9 @@ def within_turn(angle: np.ndarray) -> np.ndarray:
     within = np.where(angle < 0.0, angle + 360.0, angle + 0.0)  # + 0.0: -0.0 % 360 is 0.0
     beyond = (angle < -360.0) | (angle >= 360.0)
     if beyond.any():
-        within[beyond] = angle[beyond] % 360.0
-    return within
+        with np.errstate(invalid="ignore"):  # an infinite angle is NaN, as numpy's remainder gives it
+            within[beyond] = angle[beyond] % 360.0
+    return _scalar(within)
 
 
 def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
@@ -164,14 +176,14 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     direction was rounded. `axis_azimuth` (degrees) broadcasts against ``vectors[..., 0]``. A
     zero vector has no direction and is refused (it had given 0°).
     """
-    vectors = _vectors("across_angle", vectors, "vectors").reshape(np.shape(vectors))  # its own shape kept
+    vectors = _vectors("across_angle", vectors, "vectors")
     b = np.radians(_finite(axis_azimuth, "axis azimuth"))
     _broadcast("across_angle", vectors=vectors[..., 0], axis_azimuth=b)
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     angle = np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
     level = vectors[..., 2] == 0.0  # a year's check in ~1 ms; the rest only for a vector on the horizon
-    return _level_along_axis(vectors, b, across, angle) if level.any() else angle
+    return _scalar(_level_along_axis(vectors, b, across, angle) if level.any() else angle)
 
 
 #: How small a horizontal vector's part across an axis may be, as a share of its part along the
@@ -212,7 +224,7 @@ def trough_angle(altitude, azimuth, axis_azimuth=0.0):
 
     Returns
     -------
-    ndarray or pandas.Series
+    numpy.float64, ndarray or pandas.Series
         ρ in 0-180°: 0 faces the horizon at ``axis_azimuth + 90°`` (east for a north-south
         axis), 90 the zenith (stow), 180 the opposite horizon. NaN while the sun is down.
         For a north-south axis ρ = atan2(tan α, sin γ), i.e. 90° + pvlib's
@@ -294,7 +306,7 @@ def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):
 
     Returns
     -------
-    ndarray or pandas.Series
+    numpy.float64, ndarray or pandas.Series
         Angle of the mirror normal in the trough convention (90° = mirror horizontal, facing
         the zenith; below 90° tilted towards the ``axis_azimuth + 90°`` side). NaN at night.
     """
@@ -309,14 +321,13 @@ def fresnel_angle(altitude, azimuth, d, h, axis_azimuth=0.0):
 def receiver_angle(d, h):
     """Direction (trough convention, degrees) from a Fresnel row at lateral distance `d` to its receiver.
 
-    A float for scalar `d` and `h`, else an array of their broadcast shape.
+    A numpy.float64 for scalar `d` and `h`, else an array of their broadcast shape.
     """
     d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
     _broadcast("receiver_angle", d=d, h=h)
     if not np.all(h > 0):
         raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
-    angle = np.degrees(np.arctan2(h, -d))
-    return float(angle) if angle.ndim == 0 else angle
+    return _scalar(np.degrees(np.arctan2(h, -d)))
 
 
 def _finite(values, name: str) -> np.ndarray:
@@ -345,7 +356,7 @@ def fresnel_end_loss(altitude, azimuth, d, h):
 
     Returns
     -------
-    ndarray or pandas.Series
+    numpy.float64, ndarray or pandas.Series
         Metres; positive means the light is lost past the north end, negative the south end.
         NaN while the sun is down.
     """
@@ -380,8 +391,9 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Unit normals in (east, north, up), of the broadcast shape of the sun position and the
-        aim points (a scalar sun gives (1, 3)); NaN while the sun is down. Altitudes of shape
-        (T, 1) against aim points (M, 3) give all M mirrors at T steps, (T, M, 3).
+        aim points (one position and one aim point give (3,)); NaN while the sun is down.
+        Altitudes of shape (T, 1) against aim points (M, 3) give all M mirrors at T steps,
+        (T, M, 3).
 
     Other Parameters
     ----------------
@@ -400,12 +412,12 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     s = direction_vectors(alt, az) if sun is None else sun
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
-    n = np.where((alt < 0.0)[..., None], np.nan, n)
-    return np.atleast_2d(n)
+    return np.where((alt < 0.0)[..., None], np.nan, n)
 
 
 def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
-    """Azimuth (from north, 0-360) and elevation of normals ``(..., 3)``, degrees, shape ``(...)``.
+    """Azimuth (from north, 0-360) and elevation of normals ``(..., 3)``, degrees, shape ``(...)``
+    (two numpy.float64 for one normal).
 
     The normals need not be unit vectors: the elevation is the angle above the horizontal plane
     (``arctan2(up, horizontal length)``), so a normal of any length gives its direction's angles
@@ -417,7 +429,7 @@ def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:
         raise HybridtrackError("normal_angles: a zero vector has no direction")
     azimuth = within_turn(np.degrees(np.arctan2(n[..., 0], n[..., 1])))
     elevation = np.degrees(np.arctan2(n[..., 2], horizontal))
-    return azimuth, elevation
+    return azimuth, _scalar(elevation)
 
 
 def jack_heights(normals, supports=THREE_POINT_SUPPORT) -> np.ndarray:

@@ -172,11 +172,11 @@ def test_jacks_rear_pair_equal_at_noon_and_mirror_morning_and_evening():
 def test_published_jack_table_needs_an_unnormalised_receiver_vector():
     """docs/physics.md §3: the printed table adds (0, 20, 100) un-normalised; we keep the true law."""
     alt, az = altitude_azimuth(23.44, -45.0, 37.352317)
-    ours = heliostat_normal(alt, az, (0, 20, 100))
-    s = sun_vector(alt, az)[0]
+    ours = heliostat_normal(alt, az, (0, 20, 100))  # one position: one normal, (3,)
+    s = sun_vector(alt, az)  # its [0] had been the east component alone, added to every coordinate
     swamped = s + np.array([0, 20, 100.0])
     swamped /= np.linalg.norm(swamped)
-    assert np.degrees(np.arccos(np.clip(ours[0] @ swamped, -1, 1))) > 10  # not a rounding matter
+    assert np.degrees(np.arccos(np.clip(ours @ swamped, -1, 1))) > 10  # not a rounding matter
 
 
 def test_collector_spec_gives_targets_for_each_kind():

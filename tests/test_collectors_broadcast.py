@@ -79,6 +79,41 @@ def test_one_altitude_broadcasts_against_many_azimuths(sun):
     assert heliostat_normal(30.0, azimuths, (0.0, 20.0, 100.0)).shape == (4, 3)
 
 
+SCALARS = [30.0, 30, np.float64(30.0), np.array(30.0)]  # a Python float and int, numpy's float and a 0-d array
+
+
+@pytest.mark.parametrize("alt", SCALARS)
+def test_every_function_gives_a_numpy_float_for_one_number_and_arrays_for_arrays(alt):
+    """They had given a 0-d array (trough_angle, fresnel_end_loss, across_angle), a numpy.float64
+    (fresnel_angle) or a Python float (receiver_angle). References: pvlib's tracker, hand cases."""
+    from hybridtrack.collectors import within_turn
+
+    az = 120.0 if isinstance(alt, float) else np.array(120.0) if isinstance(alt, np.ndarray) else 120
+    pv = pvlib.tracking.singleaxis(60.0, 120.0, axis_azimuth=180, backtrack=False, max_angle=90)
+    lean = np.degrees(np.arctan2(np.cos(np.radians(30.0)) * np.sin(np.radians(120.0)), 0.5))  # across ⊥ zenith
+    singles = {
+        "trough_angle": (trough_angle(alt, az), 90.0 + np.ravel(pv["tracker_theta"])[0]),
+        "fresnel_angle": (fresnel_angle(90.0, 0.0, alt / 3.0, 10.0), 112.5),  # zenith sun, receiver at 135°
+        "receiver_angle": (receiver_angle(alt / 3.0, 10.0), 135.0),
+        "fresnel_end_loss": (fresnel_end_loss(90.0 - alt, 180.0, 0.0, 10.0), 10.0 / np.tan(np.radians(60.0))),
+        "across_angle": (across_angle(sun_vector(alt, az), 0.0), 90.0 - lean),
+        "within_turn": (within_turn(-alt), 330.0),
+        "normal_angles azimuth": (normal_angles([1.0, 0.0, 1.0])[0], 90.0),
+        "normal_angles elevation": (normal_angles([1.0, 0.0, 1.0])[1], 45.0),
+    }
+    for name, (got, expected) in singles.items():
+        assert type(got) is np.float64, name
+        assert got == pytest.approx(expected, abs=1e-9), name
+    assert sun_vector(alt, az).shape == heliostat_normal(alt, az, (0.0, 20.0, 100.0)).shape == (3,)
+    np.testing.assert_allclose(jack_heights([0.0, 0.0, 1.0]), [0.0, 0.0, 0.0])  # a level mirror: jacks at 0
+    assert jack_heights([0.0, 0.0, 1.0]).shape == (3,)
+    assert type(trough_angle([alt], [az])) is np.ndarray and trough_angle([alt], [az]).shape == (1,)
+    assert type(trough_angle(alt, az, [0.0, 90.0])) is np.ndarray  # one sun, two axes
+    assert type(receiver_angle([10.0], 10.0)) is np.ndarray and type(within_turn([-30.0])) is np.ndarray
+    assert normal_angles([[1.0, 0.0, 1.0]])[1].shape == (1,)
+    assert isinstance(trough_angle(pd.Series([30.0]), pd.Series([120.0])), pd.Series)
+
+
 def test_trough_hand_case_sun_along_and_across_the_axis():
     # sun low in the east at 30°: a north-south trough faces it at 30°; an east-west axis sees it along itself
     assert trough_angle(30.0, 90.0, [0.0, 90.0]) == pytest.approx([30.0, 90.0])
@@ -103,7 +138,7 @@ def test_heliostat_hand_cases():
     # sun at the zenith: aim straight up keeps the mirror flat; aim due north on the horizon tilts it 45°
     n = heliostat_normal(90.0, 0.0, [[0.0, 0.0, 50.0], [0.0, 100.0, 0.0]])
     np.testing.assert_allclose(n, [[0.0, 0.0, 1.0], [0.0, np.sqrt(0.5), np.sqrt(0.5)]], atol=1e-12)
-    assert heliostat_normal(45.0, 180.0, (0.0, 20.0, 100.0)).shape == (1, 3)  # a scalar sun keeps its (1, 3)
+    assert heliostat_normal(45.0, 180.0, (0.0, 20.0, 100.0)).shape == (3,)  # one sun, one mirror: one normal
     night = heliostat_normal(np.array([[-5.0], [30.0]]), np.array([[90.0], [120.0]]), [[0, 1, 1], [1, 0, 1]])
     assert np.isnan(night[0]).all() and np.isfinite(night[1]).all()
 

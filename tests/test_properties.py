@@ -36,7 +36,7 @@ def test_morning_and_evening_mirror_each_other(alt, az):
 
 @given(altitude, azimuth, st.tuples(st.floats(-200, 200), st.floats(-200, 200), st.floats(1, 300)))
 def test_heliostats_obey_the_law_of_reflection(alt, az, aim):
-    n = heliostat_normal(alt, az, aim)[0]
+    n = heliostat_normal(alt, az, aim)
     s = sun_vector(alt, az)
     reflected = 2 * np.dot(n, s) * n - s
     target = np.asarray(aim) / np.linalg.norm(aim)
