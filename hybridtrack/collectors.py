@@ -123,12 +123,28 @@ def _vectors(function: str, values, name: str) -> np.ndarray:
     """`values` as float vectors ``(..., 3)`` of their own shape (one vector is (3,)), refused with
     their shape unless they are; NaN stands for no sun, an infinite component for no direction (it
     had given angles and heights)."""
-    vectors = finite_array(values, not_numbers=f"{function}: {name} must be (east, north, up) vectors of numbers",
-                           infinite=f"{function}: {name} must be finite (NaN where there is no sun)")
-    if vectors.shape[-1:] != (3,):
-        raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors, shape (..., 3); got shape "
-                               f"{vectors.shape}")
-    return vectors
+    return checked_vectors(finite_array(values, not_numbers=f"{function}: {name} must be (east, north, up) vectors "
+                                        "of numbers", infinite=f"{function}: {name} must be finite (NaN where there "
+                                        "is no sun)"), function, name)
+
+
+def checked_vectors(values, function: str, name: str, shape: tuple | None = None) -> np.ndarray:
+    """`values` as an array of (east, north, up) vectors, ``(..., 3)`` or exactly `shape`, refused
+    by `function`'s and the argument's `name` with the shape expected and got (a wrong shape had
+    raised numpy's IndexError or ValueError deep in a product). Only O(1) checks of the shape and
+    type, for vectors a caller computed already (a year's sun); `_vectors` checks each value."""
+    try:
+        array = np.asarray(values)
+    except ValueError:  # a ragged list
+        array = np.asarray(None)
+    expected = "(..., 3)" if shape is None else str(tuple(shape))
+    if array.dtype.kind not in "fiu":
+        raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors of numbers, shape {expected}; "
+                               f"got {values!r:.60}")
+    if array.shape[-1:] != (3,) or (shape is not None and array.shape != tuple(shape)):
+        raise HybridtrackError(f"{function}: {name} must be (east, north, up) vectors, shape {expected}; got shape "
+                               f"{array.shape}")
+    return array
 
 
 def sun_vector(altitude, azimuth) -> np.ndarray:
@@ -398,7 +414,8 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     Other Parameters
     ----------------
     sun : numpy.ndarray, optional
-        ``sun_vector(altitude, azimuth)``, if computed already (a field's heliostats share it).
+        ``sun_vector(altitude, azimuth)``, if computed already (a field's heliostats share it):
+        of the sun position's shape and (3,); another is refused.
     """
     try:
         target = finite_array(aim, not_numbers="aim point", infinite="aim point")
@@ -409,7 +426,10 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
     alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
     _broadcast("heliostat_normal", altitude=alt, azimuth=az, aim_points=target[..., 0])
-    s = direction_vectors(alt, az) if sun is None else sun
+    if sun is None:
+        s = direction_vectors(alt, az)
+    else:
+        s = checked_vectors(sun, "heliostat_normal", "sun", np.broadcast_shapes(alt.shape, az.shape) + (3,))
     bisector = s + target / norm
     n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
     return np.where((alt < 0.0)[..., None], np.nan, n)

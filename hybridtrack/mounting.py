@@ -2,66 +2,96 @@
 
 Both sides use it: the world with the mount's true errors, the controller with its own
 estimate of them (none, or a commissioning fit). Frame: x east, y north, z up.
+
+What broadcasts: `mounting_rotation` over its angles by numpy's rules (arrays give one rotation
+each, ``(..., 3, 3)``), `rotate` rotations ``(..., 3, 3)`` against vectors ``(..., 3)``, and
+`angles_on_mount` its vectors against its rotation. `mount_targets`, `pointing_vectors` and
+`incidence_cosine` take one `Collector` and a sun path (one value a step): the collector's kind
+chooses the geometry, and a simulation runs one collector at a time; a field of many uses the
+broadcasting functions of `hybridtrack.collectors` (`hybridtrack.fields`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .collectors import (Collector, across_angle, as_collector, heliostat_normal, normal_angles, receiver_angle,
-                         sun_path, sun_vector)
+from .collectors import (Collector, _broadcast, _finite, across_angle, as_collector, checked_vectors, heliostat_normal,
+                         normal_angles, receiver_angle, sun_path, sun_vector)
 from .errors import HybridtrackError
-from .params import number
 from .reuse import shared
 
 __all__ = ["mounting_rotation", "mount_targets", "pointing_vectors", "angles_on_mount", "incidence_cosine",
            "geometry_key", "rotate"]
 
 
-def _about(direction: np.ndarray, angle: float) -> np.ndarray:
-    """Rodrigues' rotation by `angle` radians about the unit vector `direction`."""
-    x, y, z = direction
-    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+def _about(x, y, z, angle: np.ndarray) -> np.ndarray:
+    """Rodrigues' rotations ``(..., 3, 3)`` by `angle` radians about the unit vectors (x, y, z),
+    each an array broadcast against the others."""
+    k = np.zeros(np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z), np.shape(angle)) + (3, 3))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -z, y, -x
+    k[..., 1, 0], k[..., 2, 0], k[..., 2, 1] = z, -y, x
+    sine, versine = np.sin(angle), 1.0 - np.cos(angle)
+    return np.eye(3) + sine[..., None, None] * k + versine[..., None, None] * (k @ k)
 
 
-def mounting_rotation(axis_azimuth_error: float, axis_tilt_error: float, axis_azimuth: float,
-                      axis_roll_error: float = 0.0) -> np.ndarray:
-    """Rotation taking world vectors into a misaligned mounting's nominal frame (3x3).
+def mounting_rotation(axis_azimuth_error, axis_tilt_error, axis_azimuth, axis_roll_error=0.0) -> np.ndarray:
+    """Rotation taking world vectors into a misaligned mounting's nominal frame.
 
     The true axis is the nominal one (at `axis_azimuth`) turned about the vertical by
     `axis_azimuth_error` (clockwise from above), tilted about the horizontal cross-axis
     direction by `axis_tilt_error` (its far end up) and rolled about its own nominal direction
-    by `axis_roll_error`, all in degrees. For a single-axis collector a roll is the same as an
-    encoder offset; for a heliostat's pedestal the tilt and roll are its two tilt components,
-    and the turn is the same as an azimuth encoder offset (Stone 1986).
+    by `axis_roll_error`. For a single-axis collector a roll is the same as an encoder offset;
+    for a heliostat's pedestal the tilt and roll are its two tilt components, and the turn is
+    the same as an azimuth encoder offset [1]_.
+
+    Parameters
+    ----------
+    axis_azimuth_error, axis_tilt_error, axis_azimuth, axis_roll_error : float or array_like
+        Degrees, finite; arrays (one mount each) broadcast together by numpy's rules.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        One rotation matrix per element of the parameters' broadcast shape: (3, 3) for
+        numbers. Apply it with `rotate`.
+
+    References
+    ----------
+    .. [1] K. W. Stone, "Automatic heliostat track alignment method", US Patent 4,564,275, 1986.
     """
     given = {"axis_azimuth_error": axis_azimuth_error, "axis_tilt_error": axis_tilt_error,
              "axis_azimuth": axis_azimuth, "axis_roll_error": axis_roll_error}
-    # one finite angle each: an array raised numpy's ValueError, None its TypeError, NaN gave NaNs
-    radians = {name: np.radians(number(value, f"mounting_rotation: {name} (degrees)")) for name, value in given.items()}
+    # finite angles: None had raised numpy's TypeError, NaN given NaNs
+    radians = {name: np.radians(_finite(value, f"mounting_rotation: {name} (degrees)"))
+               for name, value in given.items()}
+    _broadcast("mounting_rotation", **radians)
     b = radians["axis_azimuth"]
-    turn = _about(np.array([0.0, 0.0, 1.0]), radians["axis_azimuth_error"])
-    tilt = _about(np.array([np.cos(b), -np.sin(b), 0.0]), radians["axis_tilt_error"])
-    roll = _about(np.array([np.sin(b), np.cos(b), 0.0]), radians["axis_roll_error"])
-    return (roll @ tilt @ turn).T  # world -> mounting
+    turn = _about(0.0, 0.0, 1.0, radians["axis_azimuth_error"])
+    tilt = _about(np.cos(b), -np.sin(b), 0.0, radians["axis_tilt_error"])
+    roll = _about(np.sin(b), np.cos(b), 0.0, radians["axis_roll_error"])
+    return np.swapaxes(roll @ tilt @ turn, -1, -2)  # world -> mounting
 
 
 def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,
                   night: bool = False, vectors: np.ndarray | None = None, sun: np.ndarray | None = None) -> np.ndarray:
-    """Target angles of a collector on a mount turned by `rotation` (`mounting_rotation`), degrees.
+    """Target angles of one collector on a mount turned by `rotation` (`mounting_rotation`), degrees.
 
     Returns shape (N, 1) for single-axis collectors (trough convention) and (N, 2) for a
-    heliostat (normal azimuth and elevation). NaN while the sun is down, unless `night`:
-    then the geometry is followed below the horizon too (to pre-position before sunrise).
-    `vectors` are this sun's `pointing_vectors` (with the same `night`) when the caller has them,
-    `sun` its unit vectors (a heliostat's, `heliostat_sun`) otherwise.
+    heliostat (normal azimuth and elevation), N the steps of the sun path (one position is a
+    path of one step). NaN while the sun is down, unless `night`: then the geometry is followed
+    below the horizon too (to pre-position before sunrise). `vectors` are this sun's
+    `pointing_vectors` (with the same `night`) when the caller has them, `sun` its unit vectors
+    (a heliostat's, `heliostat_sun`) otherwise: each (N, 3), refused by name otherwise (they had
+    raised numpy's IndexError). One collector and one (3, 3) rotation: `angles_on_mount`
+    broadcasts over rotations.
     """
     alt, az = sun_path(altitude, azimuth, "mount_targets")
     collector = as_collector(collector)
     if rotation is not None and np.shape(rotation) != (3, 3):  # numpy's ValueError, deep in a product
         raise HybridtrackError(f"mount_targets: rotation must be a 3 x 3 matrix (mounting_rotation), got shape "
                                f"{np.shape(rotation)}")
+    vectors, sun = (None if given is None else checked_vectors(given, "mount_targets", name, (len(alt), 3))
+                    for name, given in (("vectors", vectors), ("sun", sun)))
     if night:
         return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
                                else vectors, collector, rotation)
@@ -113,37 +143,62 @@ def geometry_key(base: tuple, what: str, collector: Collector) -> tuple | None:
     return (*base, what, collector.kind, collector.axis)
 
 
-def rotate(vectors: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """Each of `vectors` (N, 3) turned by `rotation` (3 × 3): ``vectors @ rotation.T``, summed by
-    numpy's einsum rather than BLAS. A year of scans is a tall, thin product that BLAS's threads
-    do not speed up, and they spin against other work on the machine: with another process busy
-    on one of two cores a site-year's `simulate` took 2.09 s instead of 1.31 s, most of the
-    difference in these products."""
-    return np.einsum("nc,dc->nd", vectors, rotation)
+def rotate(vectors, rotation) -> np.ndarray:
+    """`vectors` ``(..., 3)`` turned by `rotation` ``(..., 3, 3)``, broadcast by numpy's rules.
+
+    ``vectors @ rotation.T`` for one rotation, summed by numpy's einsum rather than BLAS. A year
+    of scans is a tall, thin product that BLAS's threads do not speed up, and they spin against
+    other work on the machine: with another process busy on one of two cores a site-year's
+    `simulate` took 2.09 s instead of 1.31 s, most of the difference in these products.
+
+    Parameters
+    ----------
+    vectors : array_like, shape (..., 3)
+    rotation : array_like, shape (..., 3, 3)
+        `mounting_rotation`'s; one per vector, or one for all.
+
+    Returns
+    -------
+    ndarray, shape (...) of both broadcast, then (3,)
+        One vector (3,) for one vector and one rotation.
+    """
+    vectors = checked_vectors(vectors, "rotate", "vectors")
+    matrices = np.asarray(rotation)
+    if matrices.dtype.kind not in "fiu" or matrices.shape[-2:] != (3, 3):
+        raise HybridtrackError(f"rotate: rotation must be 3 x 3 matrices of numbers (mounting_rotation), shape "
+                               f"(..., 3, 3); got shape {matrices.shape}")
+    _broadcast("rotate", vectors=vectors[..., 0], rotation=matrices[..., 0, 0])
+    return np.einsum("...c,...dc->...d", vectors, matrices)
 
 
-def angles_on_mount(vectors: np.ndarray, collector: Collector, rotation: np.ndarray | None = None) -> np.ndarray:
-    """The collector's angles (N, axes), degrees, that follow `vectors` (`pointing_vectors`) on
-    a mount turned by `rotation` (`mounting_rotation`; None: the nominal mount)."""
+def angles_on_mount(vectors, collector: Collector, rotation=None) -> np.ndarray:
+    """The collector's angles ``(..., axes)``, degrees, that follow `vectors` ``(..., 3)``
+    (`pointing_vectors`) on a mount turned by `rotation` (`mounting_rotation`, ``(..., 3, 3)``
+    broadcast against the vectors as `rotate` does; None: the nominal mount). One vector gives
+    one row of angles, (axes,); a wrong shape is refused by name (one vector had raised numpy's
+    IndexError)."""
+    vectors = checked_vectors(vectors, "angles_on_mount", "vectors")
     rotated = vectors if rotation is None else rotate(vectors, rotation)
     if collector.kind == "heliostat":
         return np.stack(normal_angles(rotated), axis=-1)
     sun = across_angle(rotated, collector.axis)
     if collector.kind == "fresnel":
         sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
-    return sun[:, None]
+    return np.asarray(sun)[..., None]
 
 
 def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np.ndarray:
-    """Cosine of the sun's incidence on a perfectly tracking aperture.
+    """Cosine of the sun's incidence on one collector's perfectly tracking aperture, (N,) for a
+    sun path of N steps.
 
     For a single-axis collector it is the part of the sun vector across the axis; a
     heliostat's is the cosine of half the angle between sun and aim point. Zero at night.
-    `sun`: the sun's unit vectors (`sun_vector`), if computed already.
+    `sun`: the sun's unit vectors (`sun_vector`), (N, 3), if computed already; another shape is
+    refused by name (it had raised numpy's errors).
     """
     alt, az = sun_path(altitude, azimuth, "incidence_cosine")
     collector = as_collector(collector)
-    s = sun_vector(alt, az) if sun is None else sun
+    s = sun_vector(alt, az) if sun is None else checked_vectors(sun, "incidence_cosine", "sun", (len(alt), 3))
     if collector.kind == "heliostat":
         r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
         cos = np.sqrt(np.clip((1.0 + np.einsum("nc,c->n", s, r)) / 2.0, 0.0, 1.0))

@@ -291,13 +291,95 @@ THREE = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
     (lambda m: m.mount_targets(*THREE, "trough"), "a trough needs its axis_azimuth"),  # a kind of its own now
     (lambda m: m.incidence_cosine(*THREE, 5), "collector must be a kind's name"),  # AttributeError
     (lambda m: m.mount_targets("a", "b", Collector()), "mount_targets: altitude must be numbers"),  # ValueError
-    (lambda m: m.mounting_rotation([0.1, 0.2], 0.0, 0.0), "axis_azimuth_error"),  # numpy's ValueError
+    (lambda m: m.mounting_rotation([0.1, 0.2], [0.0] * 3, 0.0),
+     r"mounting_rotation: the shapes axis_azimuth_error \(2,\), axis_tilt_error \(3,\).* do not broadcast"),
+    (lambda m: m.mounting_rotation([0.1, np.nan], 0.0, 0.0), "axis_azimuth_error"),  # a rotation of NaNs
+    (lambda m: m.mounting_rotation(True, 0.0, 0.0), "axis_azimuth_error"),  # read as 1°
     (lambda m: m.mounting_rotation(0.1, None, 0.0), "axis_tilt_error"),  # numpy's TypeError
     (lambda m: m.mounting_rotation(0.1, 0.0, np.nan), "axis_azimuth"),  # a rotation of NaNs
     (lambda m: m.mount_targets(*THREE, Collector(), np.eye(2)),
      r"mount_targets: rotation must be a 3 x 3 matrix .* got shape \(2, 2\)"),  # numpy's ValueError
 ])
 def test_mounting_refuses_what_is_no_sun_path_collector_or_angle_by_name(call, message):
+    from hybridtrack import mounting
+
+    with pytest.raises(HybridtrackError, match=message):
+        call(mounting)
+
+
+def test_mounts_broadcast_rotations_against_vectors_as_pvlibs_tilted_trackers():
+    """mounting_rotation of an array of tilts is one rotation each, (N, 3, 3); angles_on_mount of
+    the sun's vectors (T, 1, 3) on them is (T, N, 1), each pvlib's tracker on an axis tilted by
+    that much (the far end up is pvlib's axis_tilt with the axis pointing the other way)."""
+    from scipy.spatial.transform import Rotation
+
+    from hybridtrack.mounting import angles_on_mount, mounting_rotation, rotate
+
+    tilts = np.array([-4.0, 0.0, 2.0, 9.0])
+    alt, az = np.array([20.0, 45.0, 70.0, 5.0]), np.array([100.0, 160.0, 250.0, 290.0])
+    rotations = mounting_rotation(0.0, tilts, 0.0)
+    assert rotations.shape == (4, 3, 3) and mounting_rotation(0.0, 2.0, 0.0).shape == (3, 3)
+    got = angles_on_mount(sun_vector(alt, az)[:, None, :], Collector(), rotations)
+    assert got.shape == (4, 4, 1)
+    for i, tilt in enumerate(tilts):
+        pv = pvlib.tracking.singleaxis(90 - alt, az, axis_tilt=tilt, axis_azimuth=180, backtrack=False, max_angle=180)
+        np.testing.assert_allclose(got[:, i, 0], 90 + pv["tracker_theta"], rtol=0, atol=1e-9)
+    # every parameter an array, against scipy's rotations about each axis (the turn, tilt and roll in order)
+    turn, tilt, axis, roll = (np.array([0.3, -2.0]), np.array([1.0, 0.5]), np.array([0.0, 30.0]), np.array([-0.7, 4.0]))
+    for i in range(2):
+        b = np.radians(axis[i])
+        about = [([0.0, 0.0, 1.0], turn[i]), ([np.cos(b), -np.sin(b), 0.0], tilt[i]),
+                 ([np.sin(b), np.cos(b), 0.0], roll[i])]
+        composed = np.eye(3)
+        for direction, angle in about:
+            composed = Rotation.from_rotvec(np.radians(angle) * np.array(direction)).as_matrix() @ composed
+        np.testing.assert_allclose(mounting_rotation(turn, tilt, axis, roll)[i], composed.T, rtol=0, atol=1e-15)
+    vectors = np.random.default_rng(2).standard_normal((5, 1, 3))
+    np.testing.assert_allclose(rotate(vectors, rotations), (rotations @ vectors[..., None])[..., 0], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rotate(vectors[0, 0], rotations[1]), rotations[1] @ vectors[0, 0], rtol=0, atol=1e-15)
+
+
+def test_one_vector_on_a_mount_gives_one_row_of_angles():
+    """One (3,) vector had raised numpy's IndexError in angles_on_mount and einsum's ValueError in
+    rotate. References: pvlib's tracker; a heliostat normal due north at 45° by hand."""
+    from hybridtrack.mounting import angles_on_mount, mounting_rotation
+
+    one = angles_on_mount(sun_vector(30.0, 120.0), Collector())
+    pv = pvlib.tracking.singleaxis(60.0, 120.0, axis_azimuth=180, backtrack=False, max_angle=90)
+    assert one.shape == (1,) and one[0] == pytest.approx(90 + np.ravel(pv["tracker_theta"])[0], abs=1e-9)
+    assert angles_on_mount(sun_vector(30.0, 120.0), Collector(), mounting_rotation(0.0, 0.0, 0.0)) == \
+        pytest.approx(one, abs=1e-12)
+    np.testing.assert_allclose(angles_on_mount([0.0, 1.0, 1.0], Collector("heliostat")), [0.0, 45.0], atol=1e-12)
+    assert angles_on_mount(np.zeros((0, 3)), Collector()).shape == (0, 1)
+
+
+THREE_UP = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda m: m.mount_targets(*THREE_UP, Collector("heliostat"), sun=np.ones((2, 3))),
+     r"mount_targets: sun must be \(east, north, up\) vectors, shape \(3, 3\); got shape \(2, 3\)"),  # IndexError
+    (lambda m: m.mount_targets(*THREE_UP, Collector("heliostat"), sun=np.ones(3)),
+     r"mount_targets: sun must be .* shape \(3, 3\); got shape \(3,\)"),
+    (lambda m: m.mount_targets(*THREE_UP, Collector(), vectors=np.ones((3, 2))),
+     r"mount_targets: vectors must be .* shape \(3, 3\); got shape \(3, 2\)"),  # IndexError
+    (lambda m: m.mount_targets(*THREE_UP, Collector(), night=True, vectors=np.ones((4, 3))),
+     r"mount_targets: vectors must be .* got shape \(4, 3\)"),  # gave four rows for three steps
+    (lambda m: m.mount_targets(*THREE_UP, Collector(), vectors="abc"), "mount_targets: vectors must be .* of numbers"),
+    (lambda m: m.incidence_cosine(*THREE_UP, Collector("heliostat"), sun=np.ones((3, 2))),
+     r"incidence_cosine: sun must be .* shape \(3, 3\); got shape \(3, 2\)"),  # numpy's ValueError
+    (lambda m: m.pointing_vectors(*THREE_UP, Collector("heliostat"), sun=np.ones((2, 3))),
+     r"heliostat_normal: sun must be .* shape \(3, 3\); got shape \(2, 3\)"),  # numpy's ValueError
+    (lambda m: m.angles_on_mount(np.ones((3, 2)), Collector()),
+     r"angles_on_mount: vectors must be .* shape \(\.\.\., 3\); got shape \(3, 2\)"),
+    (lambda m: m.angles_on_mount([[0, 1, 1], [0, 1]], Collector()), "angles_on_mount: vectors must be .* of numbers"),
+    (lambda m: m.rotate(np.ones((4, 3)), np.ones((2, 3, 3))),
+     r"rotate: the shapes vectors \(4,\), rotation \(2,\) do not broadcast"),  # einsum's ValueError
+    (lambda m: m.rotate(np.ones(3), np.eye(2)), r"rotate: rotation must be 3 x 3 .* got shape \(2, 2\)"),
+    (lambda m: m.rotate(np.ones(2), np.eye(3)), r"rotate: vectors must be .* got shape \(2,\)"),
+    (lambda m: m.rotate(5.0, np.eye(3)), r"rotate: vectors must be .* got shape \(\)"),
+])
+def test_mounting_refuses_vectors_of_the_wrong_shape_by_name(call, message):
     from hybridtrack import mounting
 
     with pytest.raises(HybridtrackError, match=message):
