@@ -505,7 +505,7 @@ def trough_kind(axis_azimuth: float) -> str:
     """The kind of a trough whose horizontal axis lies at `axis_azimuth` degrees from north:
     "trough-ns" or "trough-ew" on exactly those lines (0 or 180; 90 or 270, and a turn either
     way), "trough" on any other, so that a kind never names an axis the trough does not have."""
-    line = axis_azimuth % 180.0
+    line = number(axis_azimuth, "trough_kind: axis_azimuth (degrees from north)") % 180.0
     return next((kind for kind, named in NAMED_TROUGHS.items() if line == named), "trough")
 
 

@@ -90,8 +90,8 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     if rotation is not None and np.shape(rotation) != (3, 3):  # numpy's ValueError, deep in a product
         raise HybridtrackError(f"mount_targets: rotation must be a 3 x 3 matrix (mounting_rotation), got shape "
                                f"{np.shape(rotation)}")
-    vectors, sun = (None if given is None else checked_vectors(given, "mount_targets", name, (len(alt), 3))
-                    for name, given in (("vectors", vectors), ("sun", sun)))
+    vectors, sun = (_path_vectors(given, "mount_targets", name, len(alt)) for name, given in (("vectors", vectors),
+                                                                                                ("sun", sun)))
     if night:
         return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
                                else vectors, collector, rotation)
@@ -105,6 +105,18 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     out = np.full((len(alt), 1 if collector.single_axis else 2), np.nan)
     out[up] = angles_on_mount(vectors, collector, rotation)
     return out
+
+
+def _path_vectors(given, function: str, name: str, steps: int) -> np.ndarray | None:
+    """None, or `given` as a sun path's vectors, (steps, 3), refused by `function`'s and `name`'s
+    name otherwise: one vector (3,) is a path of one step, as one sun position is."""
+    if given is None:
+        return None
+    try:
+        one = steps == 1 and np.shape(given) == (3,)
+    except ValueError:  # a ragged list, which checked_vectors refuses
+        one = False
+    return checked_vectors(np.reshape(given, (1, 3)) if one else given, function, name, (steps, 3))
 
 
 def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = False, sun=None) -> np.ndarray:
@@ -163,10 +175,14 @@ def rotate(vectors, rotation) -> np.ndarray:
         One vector (3,) for one vector and one rotation.
     """
     vectors = checked_vectors(vectors, "rotate", "vectors")
-    matrices = np.asarray(rotation)
+    try:
+        matrices = np.asarray(rotation)
+    except ValueError:  # a ragged list
+        matrices = np.asarray(None)
     if matrices.dtype.kind not in "fiu" or matrices.shape[-2:] != (3, 3):
+        got = f"shape {matrices.shape}" if matrices.dtype.kind in "fiu" else f"{rotation!r:.60}"
         raise HybridtrackError(f"rotate: rotation must be 3 x 3 matrices of numbers (mounting_rotation), shape "
-                               f"(..., 3, 3); got shape {matrices.shape}")
+                               f"(..., 3, 3); got {got}")
     _broadcast("rotate", vectors=vectors[..., 0], rotation=matrices[..., 0, 0])
     return np.einsum("...c,...dc->...d", vectors, matrices)
 
@@ -198,7 +214,7 @@ def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np
     """
     alt, az = sun_path(altitude, azimuth, "incidence_cosine")
     collector = as_collector(collector)
-    s = sun_vector(alt, az) if sun is None else checked_vectors(sun, "incidence_cosine", "sun", (len(alt), 3))
+    s = sun_vector(alt, az) if sun is None else _path_vectors(sun, "incidence_cosine", "sun", len(alt))
     if collector.kind == "heliostat":
         r = np.asarray(collector.aim, float) / np.linalg.norm(collector.aim)
         cos = np.sqrt(np.clip((1.0 + np.einsum("nc,c->n", s, r)) / 2.0, 0.0, 1.0))

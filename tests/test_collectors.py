@@ -213,8 +213,13 @@ def test_a_troughs_kind_names_its_axis_and_no_other(axis, kind):
 
 
 def test_a_trough_on_no_named_axis_needs_its_axis():
+    from hybridtrack.collectors import trough_kind
+
     with pytest.raises(HybridtrackError, match="a trough needs its axis_azimuth"):
         Collector("trough")
+    for axis in (np.nan, None, "0"):
+        with pytest.raises(HybridtrackError, match="trough_kind: axis_azimuth"):
+            trough_kind(axis)
 
 
 @pytest.mark.parametrize("kwargs, message", [({"kind": "dish"}, "unknown collector 'dish'"),
@@ -353,6 +358,21 @@ def test_one_vector_on_a_mount_gives_one_row_of_angles():
     assert angles_on_mount(np.zeros((0, 3)), Collector()).shape == (0, 1)
 
 
+def test_one_sun_position_takes_its_one_vector():
+    """One position is a path of one step, and its one vector (3,) the path's vectors (it had been
+    refused as no (1, 3), or raised numpy's IndexError). Reference: pvlib's aoi and tracker."""
+    from hybridtrack.mounting import incidence_cosine, mount_targets
+
+    pv = pvlib.tracking.singleaxis(60.0, 120.0, axis_azimuth=180, backtrack=False, max_angle=90)
+    s = sun_vector(30.0, 120.0)
+    assert incidence_cosine(30.0, 120.0, Collector(), sun=s) == pytest.approx(np.cos(np.radians(np.ravel(pv["aoi"]))))
+    np.testing.assert_allclose(mount_targets(30.0, 120.0, Collector(), vectors=s),
+                               90 + np.ravel(pv["tracker_theta"])[:, None], rtol=0, atol=1e-9)
+    helio = Collector("heliostat")
+    np.testing.assert_allclose(mount_targets(30.0, 120.0, helio, sun=s), mount_targets(30.0, 120.0, helio),
+                               rtol=0, atol=0)
+
+
 THREE_UP = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
 
 
@@ -378,6 +398,11 @@ THREE_UP = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
     (lambda m: m.rotate(np.ones(3), np.eye(2)), r"rotate: rotation must be 3 x 3 .* got shape \(2, 2\)"),
     (lambda m: m.rotate(np.ones(2), np.eye(3)), r"rotate: vectors must be .* got shape \(2,\)"),
     (lambda m: m.rotate(5.0, np.eye(3)), r"rotate: vectors must be .* got shape \(\)"),
+    (lambda m: m.rotate([1.0, 0.0, 0.0], "abc"), r"rotate: rotation must be 3 x 3 matrices of numbers.* got 'abc'"),
+    (lambda m: m.mount_targets([30.0, 40.0], [120.0, 130.0], Collector("heliostat"), sun=sun_vector(30.0, 120.0)),
+     r"mount_targets: sun must be .* shape \(2, 3\); got shape \(3,\)"),  # one vector is no path of two
+    (lambda m: m.mount_targets(30.0, 120.0, Collector("heliostat"), sun=[[0, 1, 1], [0, 1]]),
+     r"mount_targets: sun must be .* of numbers, shape \(1, 3\)"),  # numpy's ValueError (ragged)
 ])
 def test_mounting_refuses_vectors_of_the_wrong_shape_by_name(call, message):
     from hybridtrack import mounting
