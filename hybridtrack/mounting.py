@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .collectors import (Collector, _broadcast, _finite, across_angle, as_collector, checked_vectors, heliostat_normal,
-                         normal_angles, receiver_angle, sun_path, sun_vector)
+from .collectors import (Collector, _broadcast, _finite, across_angle, as_collector, checked_sun, checked_vectors,
+                         direction_vectors, heliostat_normal, normal_angles, receiver_angle, sun_path, sun_vector)
 from .errors import HybridtrackError
 from .reuse import shared
 
@@ -90,8 +90,8 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     if rotation is not None and np.shape(rotation) != (3, 3):  # numpy's ValueError, deep in a product
         raise HybridtrackError(f"mount_targets: rotation must be a 3 x 3 matrix (mounting_rotation), got shape "
                                f"{np.shape(rotation)}")
-    vectors, sun = (_path_vectors(given, "mount_targets", name, len(alt)) for name, given in (("vectors", vectors),
-                                                                                                ("sun", sun)))
+    vectors = _path_vectors(vectors, "mount_targets", "vectors", len(alt))
+    sun = _path_vectors(sun, "mount_targets", "sun", len(alt))
     if night:
         return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
                                else vectors, collector, rotation)
@@ -125,10 +125,12 @@ def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = F
     sun mirrored above the horizon). Computed once, they serve any number of mounts
     (`angles_on_mount`). `sun`: the sun's unit vectors (`sun_vector`, of the altitude mirrored
     above the horizon with `night`), if computed already (a heliostat field shares them)."""
-    alt = np.asarray(altitude, float)
+    alt, az = checked_sun(altitude, azimuth, "pointing_vectors")  # text had raised numpy's ValueError
+    collector = as_collector(collector)
     if collector.kind == "heliostat":
-        return heliostat_normal(np.abs(alt) if night else alt, azimuth, collector.aim, sun=sun)
-    return sun_vector(alt, np.asarray(azimuth, float))
+        return heliostat_normal(np.abs(alt) if night else alt, az, collector.aim, sun=sun)
+    _broadcast("pointing_vectors", altitude=alt, azimuth=az)
+    return direction_vectors(alt, az)
 
 
 def heliostat_sun(base: tuple, altitude, azimuth, collector: Collector, *, night: bool = False) -> np.ndarray | None:
@@ -171,8 +173,9 @@ def rotate(vectors, rotation) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (...) of both broadcast, then (3,)
-        One vector (3,) for one vector and one rotation.
+    ndarray, shape (..., 3)
+        The leading shapes of the vectors and the rotations broadcast: one vector (3,) for one
+        vector and one rotation, (T, N, 3) for vectors (T, 1, 3) and rotations (N, 3, 3).
     """
     vectors = checked_vectors(vectors, "rotate", "vectors")
     try:
@@ -193,7 +196,7 @@ def angles_on_mount(vectors, collector: Collector, rotation=None) -> np.ndarray:
     broadcast against the vectors as `rotate` does; None: the nominal mount). One vector gives
     one row of angles, (axes,); a wrong shape is refused by name (one vector had raised numpy's
     IndexError)."""
-    vectors = checked_vectors(vectors, "angles_on_mount", "vectors")
+    vectors, collector = checked_vectors(vectors, "angles_on_mount", "vectors"), as_collector(collector)
     rotated = vectors if rotation is None else rotate(vectors, rotation)
     if collector.kind == "heliostat":
         return np.stack(normal_angles(rotated), axis=-1)
