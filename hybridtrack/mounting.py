@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .collectors import (Collector, _broadcast, _finite, across_angle, as_collector, checked_sun, checked_vectors,
-                         direction_vectors, heliostat_normal, normal_angles, receiver_angle, sun_path, sun_vector)
+                         heliostat_normal, normal_angles, receiver_angle, sun_path, sun_vector)
 from .errors import HybridtrackError
 from .reuse import shared
 
@@ -125,12 +125,11 @@ def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = F
     sun mirrored above the horizon). Computed once, they serve any number of mounts
     (`angles_on_mount`). `sun`: the sun's unit vectors (`sun_vector`, of the altitude mirrored
     above the horizon with `night`), if computed already (a heliostat field shares them)."""
-    alt, az = checked_sun(altitude, azimuth, "pointing_vectors")  # text had raised numpy's ValueError
     collector = as_collector(collector)
-    if collector.kind == "heliostat":
-        return heliostat_normal(np.abs(alt) if night else alt, az, collector.aim, sun=sun)
-    _broadcast("pointing_vectors", altitude=alt, azimuth=az)
-    return direction_vectors(alt, az)
+    if collector.kind != "heliostat":
+        return sun_vector(altitude, azimuth)
+    alt, az = checked_sun(altitude, azimuth, "pointing_vectors")  # text had raised numpy's ValueError
+    return heliostat_normal(np.abs(alt) if night else alt, az, collector.aim, sun=sun)
 
 
 def heliostat_sun(base: tuple, altitude, azimuth, collector: Collector, *, night: bool = False) -> np.ndarray | None:

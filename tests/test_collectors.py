@@ -401,7 +401,8 @@ THREE_UP = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
     (lambda m: m.rotate([1.0, 0.0, 0.0], "abc"), r"rotate: rotation must be 3 x 3 matrices of numbers.* got 'abc'"),
     (lambda m: m.mount_targets([30.0, 40.0], [120.0, 130.0], Collector("heliostat"), sun=sun_vector(30.0, 120.0)),
      r"mount_targets: sun must be .* shape \(2, 3\); got shape \(3,\)"),  # one vector is no path of two
-    (lambda m: m.pointing_vectors("a", 120.0, Collector()), "pointing_vectors: altitude must be numbers"),  # numpy's
+    (lambda m: m.pointing_vectors("a", 120.0, Collector("heliostat")), "pointing_vectors: altitude must be numbers"),
+    (lambda m: m.pointing_vectors("a", 120.0, Collector()), "sun_vector: altitude must be numbers"),  # numpy's
     (lambda m: m.pointing_vectors(30.0, 120.0, 5), "collector must be a kind's name"),  # AttributeError
     (lambda m: m.angles_on_mount([0.0, 0.0, 1.0], None), "collector must be a kind's name"),  # AttributeError
     (lambda m: m.mount_targets(30.0, 120.0, Collector("heliostat"), sun=[[0, 1, 1], [0, 1]]),
