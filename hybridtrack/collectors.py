@@ -199,7 +199,7 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     angle = np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
     level = vectors[..., 2] == 0.0  # a year's check in ~1 ms; the rest only for a vector on the horizon
-    return _scalar(_level_along_axis(vectors, b, across, angle) if level.any() else angle)
+    return _scalar(_level_along_axis(vectors, b, across, angle, level) if level.any() else angle)
 
 
 #: How small a horizontal vector's part across an axis may be, as a share of its part along the
@@ -209,12 +209,12 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
 ALONG_AXIS = 1e-13
 
 
-def _level_along_axis(vectors: np.ndarray, b: np.ndarray, across: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """`across_angle`'s `angle` with 90° where a vector lies on the horizon along the axis: it has
-    no part across the axis, and the rounding of its azimuth had given 0° or 180° by how the
-    azimuth was written (0 or 360, 180 or -180). 90° is the limit of a vector above the horizon
-    along the axis. A zero vector has no direction and is refused (it had given 0°)."""
-    level = vectors[..., 2] == 0.0
+def _level_along_axis(vectors: np.ndarray, b: np.ndarray, across: np.ndarray, angle: np.ndarray,
+                      level: np.ndarray) -> np.ndarray:
+    """`across_angle`'s `angle` with 90° where a vector on the horizon (`level`) lies along the
+    axis: it has no part across the axis, and the rounding of its azimuth had given 0° or 180° by
+    how the azimuth was written (0 or 360, 180 or -180). 90° is the limit of a vector above the
+    horizon along the axis. A zero vector has no direction and is refused (it had given 0°)."""
     if np.any(level & (vectors[..., 0] == 0.0) & (vectors[..., 1] == 0.0)):
         raise HybridtrackError("across_angle: a zero vector has no direction")
     along = vectors[..., 0] * np.sin(b) + vectors[..., 1] * np.cos(b)
@@ -502,9 +502,25 @@ NAMED_TROUGHS = {"trough-ns": AXIS_AZIMUTH["ns"] % 180.0, "trough-ew": AXIS_AZIM
 
 
 def trough_kind(axis_azimuth: float) -> str:
-    """The kind of a trough whose horizontal axis lies at `axis_azimuth` degrees from north:
-    "trough-ns" or "trough-ew" on exactly those lines (0 or 180; 90 or 270, and a turn either
-    way), "trough" on any other, so that a kind never names an axis the trough does not have."""
+    """The kind of a trough on a horizontal axis, named so that it never names another axis.
+
+    Parameters
+    ----------
+    axis_azimuth : float
+        Azimuth of the axis, degrees from north, finite.
+
+    Returns
+    -------
+    str
+        "trough-ns" on exactly a north-south line (0 or 180, a turn either way too), "trough-ew"
+        on exactly an east-west one (90 or 270), "trough" on any other (`Collector` carries its
+        axis azimuth).
+
+    References
+    ----------
+    .. [1] W. F. Marion and A. P. Dobos, "Rotation angle for the optimum tracking of one-axis
+       trackers", NREL/TP-6A20-58891, 2013 (horizontal single axes at any azimuth).
+    """
     line = number(axis_azimuth, "trough_kind: axis_azimuth (degrees from north)") % 180.0
     return next((kind for kind, named in NAMED_TROUGHS.items() if line == named), "trough")
 
