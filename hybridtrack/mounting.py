@@ -38,7 +38,8 @@ def mounting_rotation(axis_azimuth_error, axis_tilt_error, axis_azimuth, axis_ro
     """Rotation taking world vectors into a misaligned mounting's nominal frame.
 
     The true axis is the nominal one (at `axis_azimuth`) turned about the vertical by
-    `axis_azimuth_error` (clockwise from above), tilted about the horizontal cross-axis
+    `axis_azimuth_error` (counterclockwise seen from above: the true axis's azimuth is
+    ``axis_azimuth - axis_azimuth_error``), tilted about the horizontal cross-axis
     direction by `axis_tilt_error` (its far end up) and rolled about its own nominal direction
     by `axis_roll_error`. For a single-axis collector a roll is the same as an encoder offset;
     for a heliostat's pedestal the tilt and roll are its two tilt components, and the turn is

@@ -473,7 +473,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     site : Site or str
     collector : str or Collector
         ``trough-ns``, ``trough-ew``, ``fresnel`` or ``heliostat``, or a `Collector` with
-        its geometry.
+        its geometry (``Collector("trough", axis_azimuth=45)`` for a trough on another axis).
     strategy : str, optional
         One of ``hybridtrack.control.STRATEGIES``; overrides the config's.
     config : SimulationConfig, optional

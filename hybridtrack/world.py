@@ -65,8 +65,8 @@ class Imperfections:
     Parameters
     ----------
     axis_azimuth_error, axis_tilt_error : float
-        Degrees the true axis is turned (clockwise from above) and tilted (its far end up)
-        from the nominal axis.
+        Degrees the true axis is turned (counterclockwise seen from above: its azimuth is the
+        nominal one minus this) and tilted (its far end up) from the nominal axis.
     encoder_offset : float
         Degrees the encoder's zero is off; the reading is the true angle plus this.
     clock_error : float

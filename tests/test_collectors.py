@@ -425,3 +425,17 @@ def test_within_turn_takes_a_number_or_a_list_and_refuses_what_is_no_angle():
     for angle in ("a", None, [True, False]):
         with pytest.raises(HybridtrackError, match="within_turn: angles must be numbers"):
             within_turn(angle)
+
+
+@pytest.mark.parametrize("axis_azimuth", [0.0, 30.0, 90.0, 270.0])
+def test_an_axis_azimuth_error_turns_the_true_axis_as_documented(axis_azimuth):
+    """The true axis (the nominal axis taken from the mounting's frame to the world's) points at
+    azimuth `axis_azimuth` − error (counterclockwise seen from above), its far end up by the tilt
+    error: worked from the unit vectors east, north, up by hand."""
+    from hybridtrack.mounting import mounting_rotation
+
+    to_world = mounting_rotation(1.0, 0.5, axis_azimuth).T
+    b = np.radians(axis_azimuth)
+    east, north, up = to_world @ np.array([np.sin(b), np.cos(b), 0.0])
+    assert np.degrees(np.arctan2(east, north)) % 360.0 == pytest.approx((axis_azimuth - 1.0) % 360.0, abs=1e-3)
+    assert np.degrees(np.arcsin(up)) == pytest.approx(0.5, abs=1e-3)
