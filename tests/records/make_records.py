@@ -106,6 +106,14 @@ def dotted_dates() -> str:
     return "Anlage: Lanzhou Dach\n" + _csv(out, sep=";", decimal=",")
 
 
+def _date_and_clock(frame, names: dict, zone, date: tuple, clock: str):
+    """`frame` renamed (`names`), its local date in a column (``date``: name and format) and its
+    local clock in column `clock` first, as loggers that split the stamp write it."""
+    out = _renamed(frame, names, _local(frame, zone, date[1]), date[0])
+    out.insert(0, clock, _local(frame, zone, "%H:%M"))
+    return out
+
+
 def iso_t_semicolons() -> str:
     day = truth("lanzhou-day")
     out = _renamed(day, {"ghi": "GHI (W/m2)", "dni": "DNI (W/m2)", "dhi": "DHI (W/m2)",
@@ -115,10 +123,9 @@ def iso_t_semicolons() -> str:
 
 def french_date_heure() -> bytes:
     days = truth("lanzhou-days")
-    out = _renamed(days, {"ghi": "Rayonnement global (W/m²)", "dni": "Rayonnement direct (W/m²)",
-                          "dhi": "Rayonnement diffus (W/m²)", "wind_speed": "Vitesse du vent (m/s)",
-                          "temp_air": "Température (°C)"}, _local(days, SHANGHAI, "%d/%m/%Y"), "Date")
-    out.insert(0, "Heure", _local(days, SHANGHAI, "%H:%M"))
+    out = _date_and_clock(days, {"ghi": "Rayonnement global (W/m²)", "dni": "Rayonnement direct (W/m²)",
+                                 "dhi": "Rayonnement diffus (W/m²)", "wind_speed": "Vitesse du vent (m/s)",
+                                 "temp_air": "Température (°C)"}, SHANGHAI, ("Date", "%d/%m/%Y"), "Heure")
     return _csv(out, sep=";", decimal=",").replace("\n", "\r\n").encode("cp1252")
 
 
@@ -307,10 +314,9 @@ def psm3(zone: int) -> str:
 
 def midc() -> str:
     day = truth("golden-day")
-    out = _renamed(day, {"ghi": "Global Horizontal [W/m^2]", "dni": "Direct Normal [W/m^2]",
-                         "dhi": "Diffuse Horizontal [W/m^2]", "wind_speed": "Avg Wind Speed @ 6ft [m/s]",
-                         "temp_air": "Tower Dry Bulb Temp [deg C]"}, _local(day, MST, "%m/%d/%Y"), "DATE (MM/DD/YYYY)")
-    out.insert(0, "MST", _local(day, MST, "%H:%M"))
+    out = _date_and_clock(day, {"ghi": "Global Horizontal [W/m^2]", "dni": "Direct Normal [W/m^2]",
+                                "dhi": "Diffuse Horizontal [W/m^2]", "wind_speed": "Avg Wind Speed @ 6ft [m/s]",
+                                "temp_air": "Tower Dry Bulb Temp [deg C]"}, MST, ("DATE (MM/DD/YYYY)", "%m/%d/%Y"), "MST")
     return _csv(out)
 
 
