@@ -349,24 +349,24 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
     """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``,
     which names the grid's key and value (``grid.drive.deadband = -1: ...``) when the value the
     run refused came from the grid."""
-    row = _row(_spec(base, grid_values))
+    spec = _spec(base, grid_values)
+    row = _row(spec)
     try:
-        setup = _setup(base, grid_values, source)
+        setup = _setup(spec, base, source)
     except HybridtrackError as exc:  # a value refused before the run: the grid's, or not
         return _failed(row, exc, _from_grid(base, grid_values, source, str(exc)))
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, not the end of the sweep
         return _failed(row, exc)
     try:
-        row.update(_metrics(_spec(base, grid_values), *setup), error=None)
+        row.update(_metrics(spec["strategy"], *setup), error=None)
     except Exception as exc:  # noqa: BLE001
         return _failed(row, exc)
     return row
 
 
-def _setup(base: dict, grid_values: dict, source: str) -> tuple:
-    """A run's seed, config, weather arguments and collector, each checked as the run uses it,
-    and its strategy checked."""
-    spec = _spec(base, grid_values)
+def _setup(spec: dict, base: dict, source: str) -> tuple:
+    """The seed, config, weather arguments and collector of a run given `spec` (`_spec`), each
+    checked as the run uses it, and its strategy checked."""
     _strategy(spec["strategy"])
     seed = params.seed(spec["seed"])  # 1.5 or true is refused, not truncated to another run's seed
     dotted = {k: v for k, v in spec.items() if "." in k and not k.startswith("collector.")}
@@ -374,13 +374,13 @@ def _setup(base: dict, grid_values: dict, source: str) -> tuple:
     return seed, config, _weather_arguments(spec), _collector(spec)
 
 
-def _metrics(spec: dict, seed: int, config, weather: tuple, collector) -> dict:
-    """The metrics of a run set up by `_setup`."""
+def _metrics(strategy: str, seed: int, config, weather: tuple, collector) -> dict:
+    """The metrics of a run of `strategy` set up by `_setup`."""
     from .simulation import one_thread, simulate
 
     frame = _frame(*weather, seed)
     with one_thread():  # the sweep spreads its runs over the cores itself
-        summary = simulate(frame, weather[0], collector=collector, strategy=spec["strategy"], config=config).summary
+        summary = simulate(frame, weather[0], collector=collector, strategy=strategy, config=config).summary
     error = summary["tracking_error_deg"]
     return {m: error[m] if m in error else summary[m] for m in METRICS}
 
@@ -388,7 +388,7 @@ def _metrics(spec: dict, seed: int, config, weather: tuple, collector) -> dict:
 def _from_grid(base: dict, grid_values: dict, source: str, error: str) -> dict:
     """The grid's values of a run that `error`, its refusal by `_setup`, came from (`blamed`)."""
     given = {key: value for key, value in grid_values.items() if key != "run"}
-    keys = blamed(lambda values: _setup(base, values, source), given, error)
+    keys = blamed(lambda values: _setup(_spec(base, values), base, source), given, error)
     return {key: given[key] for key in keys}
 
 
