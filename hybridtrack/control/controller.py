@@ -312,9 +312,8 @@ class Controller:
         if self.slept[i]:
             self._night_in_gap(i, t, dt)
         self._day_and_wind(i, t, awake, gusty, wind)
-        if self.was_awake and not awake and self.clock is not None:  # the day's end: judge the clock
-            for alarm in self.clock.verdict():
-                self._alarm(i, alarm)
+        if self.was_awake and not awake:  # the day's end
+            self._judge_clock(i)
         if awake and not self.was_awake:  # a new day: the residual offsets were the evening sky's
             for calibrator in self.calibrators:
                 calibrator.start_day()
@@ -336,12 +335,17 @@ class Controller:
         if self.mode not in (STOW_WIND, FAULT, STOW_NIGHT):
             self._switch(i, STOW_NIGHT, f"no scans for {minutes / 60.0:.1f} h across the night: asleep through it", t)
             self.found_today = False
-        if self.was_awake and self.clock is not None:
-            for alarm in self.clock.verdict():
-                self._alarm(i, alarm)
+        if self.was_awake:
+            self._judge_clock(i)
         for gate in self.gates:
             gate.forget()
         self.was_awake = False
+
+    def _judge_clock(self, i: int) -> None:
+        """At a day's end, the clock watch's verdict on the day's readings, as alarms."""
+        if self.clock is not None:
+            for alarm in self.clock.verdict():
+                self._alarm(i, alarm)
 
     def _daylight(self, t: float, intensity: float) -> bool:
         """The sensor-only tracker's day: light above dusk, or dark for less than 30 minutes."""
