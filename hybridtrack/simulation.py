@@ -560,8 +560,9 @@ class Tracked:
         memory = self.controller.carry(self.index[0])
         if self.config.controller.strategy == "astronomical-commissioned":
             memory["commissioned"] = self.mount
-        memory["origin"] = {"collector": self.collector.kind, "site": self.site.name,
-                            "latitude": self.site.latitude, "longitude": self.site.longitude, "end": self.index[-1]}
+        memory["origin"] = {"collector": self.collector.kind, "geometry": collector_geometry(self.collector),
+                            "site": self.site.name, "latitude": self.site.latitude, "longitude": self.site.longitude,
+                            "end": self.index[-1]}
         return memory
 
     def scores(self, events: pd.DataFrame) -> dict:
@@ -777,9 +778,9 @@ def _history(site, collector, config, start, classifier, warm_start):
 #: offsets, the light level, the clock watch's readings and a commissioned mount.
 MEMORY_KEYS = ("offsets", "theta", "p", "information", "evidence", "frozen", "updates", "light_level", "clock",
                "commissioned", "origin")
-#: Where and when a memory was left (`Tracked.memory`): the kind of collector, the site and the
-#: run's last step.
-_ORIGIN_KEYS = ("collector", "site", "latitude", "longitude", "end")
+#: Where and when a memory was left (`Tracked.memory`): the kind of collector and its geometry
+#: (`collector_geometry`), the site and the run's last step.
+_ORIGIN_KEYS = ("collector", "geometry", "site", "latitude", "longitude", "end")
 #: The numbers a memory holds, each an array or a number.
 _MEMORY_NUMBERS = ("offsets", "theta", "p", "information", "evidence", "light_level")
 #: The clock watch's readings (`ClockWatch.save`).
@@ -810,20 +811,28 @@ def _check_memory_form(memory: dict) -> None:
         refuse("commissioned must be a commissioned mount (MountEstimate)")
     origin = memory.get("origin")
     if origin is not None and (not isinstance(origin, dict) or set(origin) != set(_ORIGIN_KEYS)
-                               or not isinstance(origin["end"], pd.Timestamp) or origin["end"].tz is None):
+                               or not isinstance(origin["geometry"], dict) or not isinstance(origin["end"], pd.Timestamp) or origin["end"].tz is None):
         refuse("origin must say where and when the memory was left, as a run leaves it")
 
 
 def _check_origin(origin: dict | None, collector: Collector, site: sites.Site, start: pd.Timestamp) -> None:
     """Refuse a memory left by another kind of collector (a trough-ns fit carried into a trough-ew
-    run, whose mount terms mean something else), at another site, or by a run that ended after
-    this one starts (a June memory in January: the clock watch read -161.5 days). A memory of a
-    release that did not record its origin is taken as it is."""
+    run, whose mount terms mean something else) or another collector of the kind (a trough on
+    another axis, another Fresnel row, a heliostat with another aim: `collector_geometry`), at
+    another site, or by a run that ended after this one starts (a June memory in January: the
+    clock watch read -161.5 days). A memory of a release that did not record its origin is taken
+    as it is."""
     if origin is None:
         return
     if origin["collector"] != collector.kind:
         raise HybridtrackError(f"warm_start: this memory was left by a {origin['collector']} run; this is a "
                                f"{collector.kind} run, whose mount terms mean something else")
+    left, geometry = origin["geometry"], collector_geometry(collector)
+    for name in sorted(set(left) | set(geometry)):
+        if left.get(name) != geometry.get(name):
+            raise HybridtrackError(f"warm_start: this memory was left by a {collector.kind} with {name} "
+                                   f"{left.get(name)}; this run's has {geometry.get(name)}: its fit and offsets are "
+                                   "another collector's")
     if (origin["latitude"], origin["longitude"]) != (site.latitude, site.longitude):
         raise HybridtrackError(f"warm_start: this memory was left at {origin['site']} ({origin['latitude']:g}, "
                                f"{origin['longitude']:g}); this run is at {site.name} ({site.latitude:g}, "
@@ -831,6 +840,18 @@ def _check_origin(origin: dict | None, collector: Collector, site: sites.Site, s
     if origin["end"] >= start:
         raise HybridtrackError(f"warm_start: this memory was left by a run that ended at {origin['end']}, not before "
                                f"this run starts ({start}): carry a memory forward in time")
+
+
+def collector_geometry(collector: Collector) -> dict:
+    """What makes a collector of its kind the one it is, as its memory's origin records it: the
+    axis in effect (degrees from north; a trough-ew on 90° turns the other way from one on 270°),
+    a Fresnel row's distance and receiver height (m), a heliostat's aim (m)."""
+    if collector.kind == "heliostat":
+        return {"aim": tuple(float(x) for x in collector.aim)}
+    geometry = {"axis_azimuth": float(collector.axis)}
+    if collector.kind == "fresnel":
+        geometry.update(row_distance=float(collector.row_distance), receiver_height=float(collector.receiver_height))
+    return geometry
 
 
 def _check_memory(memory: dict, collector: Collector) -> None:

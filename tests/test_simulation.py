@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from hybridtrack import HybridtrackError, simulate
+from hybridtrack.collectors import Collector
 from hybridtrack.control import ControllerConfig
 from hybridtrack.drive import Drive
 from hybridtrack.fuzzy import FuzzyWeatherClassifier
@@ -486,6 +487,24 @@ def test_a_memory_from_later_elsewhere_or_another_axis_is_refused(frame_day, sit
     with pytest.raises(HybridtrackError, match=message):
         simulate(synthetic(site, frame_day, weather="sunny", freq="5min"), site, collector=collector,
                  warm_start=june.memory)
+
+
+@pytest.mark.parametrize("left_by, used_by, message", [
+    (Collector("trough", axis_azimuth=30.0), Collector("trough", axis_azimuth=45.0), "axis_azimuth 30.0; this run's has 45.0"),
+    (Collector("trough-ew", axis_azimuth=90.0), Collector("trough-ew"), "axis_azimuth 90.0; this run's has 270.0"),
+    (Collector("fresnel", row_distance=4.0), Collector("fresnel", row_distance=-6.0), "row_distance 4.0; this run's has -6.0"),
+    (Collector("heliostat"), Collector("heliostat", aim=(0.0, 40.0, 100.0)), "aim \\(0.0, 20.0, 100.0\\); this run's has"),
+])
+def test_a_memory_left_by_another_collector_of_the_kind_is_refused(left_by, used_by, message):
+    """Only the kind was compared: two troughs on 30° and 45° axes, an east-west trough turning the
+    other way (axis 90° against 270°), two Fresnel rows, two heliostats aimed apart all passed one
+    another's fit and offsets as their own."""
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="5min")
+    following = synthetic("lanzhou", "2021-06-22", weather="sunny", freq="5min")
+    memory = simulate(day, "lanzhou", collector=left_by).memory
+    with pytest.raises(HybridtrackError, match=f"left by a {left_by.kind} with {message}"):
+        simulate(following, "lanzhou", collector=used_by, warm_start=memory)
+    simulate(following, "lanzhou", collector=left_by, warm_start=memory)  # the same collector carries on
 
 
 def test_a_frame_of_steps_longer_than_an_hour_is_refused_and_night_gaps_are_not():
