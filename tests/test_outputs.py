@@ -136,18 +136,19 @@ ABLATE = ["ablate", "--sites", "lanzhou", "--seasons", "summer", "--seeds", "1",
 TRADEOFF = ABLATE + ["--tradeoff", "--deadbands", "0.1"]
 
 
-def _removals(err: str) -> list[str]:
-    """The lines of standard error that say a file of an earlier run was removed (not the progress bars)."""
-    return [line for line in err.splitlines() if ": removed, from an earlier run (" in line]
+def _removals(out: str) -> list[str]:
+    """The lines of standard output that say a file of an earlier run was removed."""
+    return [line for line in out.splitlines() if ": removed, from an earlier run (" in line]
 
 
 def _run_twice(first: list, again: list, out: Path, capsys) -> str:
-    """Run `first` into `out`, put a file of the user's there, run `again` with --force; its standard error."""
+    """Run `first` into `out`, put a file of the user's there, run `again` with --force; its standard
+    output (where the files it replaced and removed are said, as the files it wrote are)."""
     assert main(first + ["--out", str(out)]) == 0
     (out / "notes.txt").write_text("the user's own\n")
     capsys.readouterr()
     assert main(again + ["--out", str(out), "--force"]) == 0
-    return capsys.readouterr().err
+    return capsys.readouterr().out
 
 
 @pytest.mark.parametrize("first, again, left_out, reason, kept", [
@@ -187,7 +188,19 @@ def test_compare_with_force_removes_the_oracles_run_it_leaves_out(tmp_path, caps
     oracle = out / "hybrid-oracle"
     assert _removals(err) == [f"{oracle / name}: removed, from an earlier run (hybrid-oracle left out)"
                               for name in ("events.csv", "log.parquet", "summary.json")]
-    assert list(oracle.iterdir()) == [] and "hybrid-oracle" not in strict((out / "comparison.json").read_text())
+    # the folder it emptied goes too (an empty hybrid-oracle/ had stayed, to be read as a run)
+    assert f"{oracle}: removed, emptied of an earlier run's files (hybrid-oracle left out)" in err.splitlines()
+    assert not oracle.exists() and "hybrid-oracle" not in strict((out / "comparison.json").read_text())
+
+
+def test_force_leaves_a_left_out_runs_folder_holding_the_users_files(tmp_path, capsys):
+    record = tmp_path / "no-sky.csv"
+    pd.read_csv(RECORD).drop(columns="sky").to_csv(record, index=False)
+    out = tmp_path / "out"
+    assert main(["compare", "--site", "nanjing", "--date", "2013-03-20", "--freq", "30min", "--out", str(out)]) == 0
+    (out / "hybrid-oracle" / "mine.txt").write_text("the user's own\n")
+    assert main(["compare", str(record), "--site", "nanjing", "--step", "30min", "--out", str(out), "--force"]) == 0
+    assert sorted(p.name for p in (out / "hybrid-oracle").iterdir()) == ["mine.txt"]
 
 
 def test_without_force_a_file_an_earlier_run_left_is_refused_and_kept(tmp_path, capsys):

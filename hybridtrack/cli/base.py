@@ -195,8 +195,9 @@ def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Itera
     Such a file there already is an earlier run's, and would be read as this run's. Without
     ``--force`` it is refused before the block, as a file to replace is; with it, it is removed
     once the block has written the results (a failed run leaves the earlier run whole), each said
-    in one line on standard error. Only regular files are taken: a folder or a symbolic link of
-    such a name is none a run wrote, and is left as it is.
+    in one line on standard output, as ``replaced (--force)`` is; so is a folder below ``--out``
+    (a left-out run's) that this emptied, then removed. Only regular files are taken: a folder or
+    a symbolic link of such a name is none a run wrote, and is left as it is.
 
     Raises
     ------
@@ -204,7 +205,6 @@ def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Itera
         Without ``--force``, if any of `paths` is there; with it, if one cannot be removed.
     """
     import os
-    import sys
     from pathlib import Path
 
     stale = [path for path in map(Path, paths) if path.is_file() and not path.is_symlink()]
@@ -224,7 +224,11 @@ def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Itera
         except OSError as exc:
             raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed ({exc.strerror or exc}); "
                                    "the results beside it are this run's") from None
-        print(f"{path}: removed, from an earlier run ({reason})", file=sys.stderr)
+        print(f"{path}: removed, from an earlier run ({reason})")
+    for folder in sorted({path.parent for path in stale} - {Path(args.out)}):
+        with contextlib.suppress(OSError):  # a folder with anything else in it stays
+            folder.rmdir()
+            print(f"{folder}: removed, emptied of an earlier run's files ({reason})")
 
 
 #: ``--strategy``'s help: without it the ``--config`` file's strategy runs, not a default over it.
