@@ -379,9 +379,11 @@ class HeliostatField:
         The receiver's aim point, (east, north, up) metres from the tower's foot; (0, 0, 100)
         when neither it nor `aims` is given. With `aims`, it is their mean (where the map draws
         the receiver).
-    aims : array_like, shape (N, 3), optional
-        One aim point per heliostat (aim-point strategies spread the flux on the receiver);
-        refused beside `aim`, which one of the two would not be used. None (kept so) when every
+    aims : array_like, shape (N, 3), or pandas.DataFrame, optional
+        One aim point per heliostat, (east, north, up) metres from the tower's foot (aim-point
+        strategies spread the flux on the receiver); a table's columns ``aim_east``,
+        ``aim_north``, ``aim_up`` (or ``east``, ``north``, ``up``) are taken by name. Refused
+        beside `aim`, which one of the two would not be used. None (kept so) when every
         heliostat aims at `aim`.
     spread : ImperfectionSpread
     """
@@ -408,7 +410,8 @@ class HeliostatField:
         _distinct(xyz, "heliostats", "m (east, north, up)")
         _refuse_overlapping(xyz)
         object.__setattr__(self, "positions", xyz)
-        if self.aim is not None and self.aims is not None and not _aim_of(self.aim, self.aims):
+        given = _aims_by_name(self.aims)
+        if self.aim is not None and self.aims is not None and not _aim_of(self.aim, given):
             raise HybridtrackError("heliostat field: give aim (one point for every heliostat) or aims (one each), "
                                    "not both")
         if self.aims is None:
@@ -418,9 +421,11 @@ class HeliostatField:
                                        f"{_brief(self.aim)}")
             aims = np.broadcast_to(aim, xyz.shape)
         else:
-            aims = _as_numbers(self.aims)
+            aims = _as_numbers(given)
         if aims is None or aims.shape != xyz.shape:
-            raise HybridtrackError(f"heliostat aim points must be one (x, y, z) per heliostat, {xyz.shape}")
+            got = f"shape {aims.shape}" if aims is not None else _brief(self.aims)
+            raise HybridtrackError(f"heliostat aim points must be one (east, north, up) per heliostat, shape "
+                                   f"{xyz.shape}; got {got}")
         far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
         if far.any():
             raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
@@ -507,6 +512,25 @@ def _by_name(positions):
     if all(pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind) for kind in table.dtypes):
         return table.to_numpy(dtype=float, na_value=np.nan)  # pandas' nullable numbers too; NA is not finite
     return table
+
+
+def _aims_by_name(aims):
+    """A table of aim points by its columns' names, as `_by_name` reads positions: ``aim_east``,
+    ``aim_north``, ``aim_up`` (a positions file's, `AIM_COLUMNS`) or ``east``, ``north``, ``up``.
+    A table had been read by its columns' order: ``aim_north, aim_east, aim_up`` swapped every
+    aim point's east and north without a word. Any other aims as they are."""
+    if not isinstance(aims, pd.DataFrame):
+        return aims
+    names = {str(column).strip().lower(): column for column in aims.columns}
+    for wanted in (AIM_COLUMNS, ("east", "north", "up")):
+        if all(column in names for column in wanted):
+            table = aims[[names[column] for column in wanted]]
+            if all(pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind)
+                   for kind in table.dtypes):
+                return table.to_numpy(dtype=float, na_value=np.nan)
+            return table
+    raise HybridtrackError(f"heliostat aim points: a table needs columns {', '.join(AIM_COLUMNS)} (or east, north, "
+                           f"up), m; it has {', '.join(map(str, aims.columns)) or 'none'}")
 
 
 def _refuse_unreachable_aims(relative: np.ndarray) -> None:

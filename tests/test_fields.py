@@ -112,7 +112,8 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
     (lambda: HeliostatField(positions=[[0.0, np.nan]]), "heliostat 1: position is not finite"),
     (lambda: HeliostatField(positions=[[0, 0, 0, 0]]), r"\(N, 2\) or \(N, 3\)"),
     (lambda: HeliostatField(positions=[[1, 2], [0, 0]], aim=(0, 0, 0)), "heliostat 2: its aim point"),
-    (lambda: HeliostatField(positions=[[1, 2]], aims=[[0, 0, 1], [0, 0, 2]]), "one \\(x, y, z\\) per heliostat"),
+    (lambda: HeliostatField(positions=[[1, 2]], aims=[[0, 0, 1], [0, 0, 2]]),
+     "one \\(east, north, up\\) per heliostat, shape \\(1, 3\\); got shape \\(2, 3\\)"),
     # the one aim point was dropped for the aims without a word
     (lambda: HeliostatField(positions=[[1, 2]], aim=(0, 0, 50), aims=[[0, 0, 100]]), "give aim .* or aims .*not both"),
     (lambda: FresnelField(row_distances=[1.0, float("inf")]), "row distances must be finite"),
@@ -156,7 +157,7 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
      r"^heliostat 2: position is not finite$"),
     (lambda: HeliostatField(positions=pd.DataFrame({"east": ["1", "2"], "north": [3.0, 4.0]})),
      r"^heliostat positions must be numbers, \(N, 2\) or \(N, 3\) metres, got east north 0 1 3.0 1 2 4.0$"),
-    (lambda: HeliostatField(positions=[[1, 2]], aims=[["0", "0", "1"]]), "one \\(x, y, z\\) per heliostat"),
+    (lambda: HeliostatField(positions=[[1, 2]], aims=[["0", "0", "1"]]), "one \\(east, north, up\\) per heliostat"),
     # a spread of another type had been accepted, to fail at run time with an AttributeError
     (lambda: FresnelField(spread=None), "FresnelField: spread must be an ImperfectionSpread, got NoneType"),
     (lambda: TroughLoop(spread={"encoder_offset": 0.1}), "TroughLoop: spread must be an ImperfectionSpread"),
@@ -593,3 +594,21 @@ def test_a_field_map_of_a_metric_that_is_no_name_is_refused(day, tmp_path):
     for call in (lambda: result.plot_map(["rms"]), lambda: result.save(tmp_path / "out", metric=["rms"])):
         with pytest.raises(HybridtrackError, match="no collector metric"):  # a TypeError: unhashable list
             call()
+
+
+def test_a_table_of_aim_points_is_read_by_its_columns_names():
+    """A table of aims was read by its columns' order: aim_north, aim_east, aim_up swapped every aim
+    point's east and north without a word (positions were already read by name)."""
+    positions = [[0.0, -100.0], [50.0, -90.0]]
+    table = pd.DataFrame({"aim_north": [5.0, 6.0], "aim_up": [100.0, 90.0], "Aim_East": [1.0, 2.0]})
+    field = HeliostatField(positions=positions, aims=table)
+    # each aim point from its mirror, by hand: (aim_east - east, aim_north - north, aim_up)
+    np.testing.assert_array_equal(field.relative_aims, [[1.0, 105.0, 100.0], [-48.0, 96.0, 90.0]])
+    plain = pd.DataFrame({"up": [100.0, 90.0], "east": [1.0, 2.0], "north": [5.0, 6.0]})
+    np.testing.assert_array_equal(HeliostatField(positions=positions, aims=plain).relative_aims, field.relative_aims)
+    with pytest.raises(HybridtrackError, match="aim points: a table needs columns aim_east, aim_north, aim_up .*it "
+                                               "has x, y, z"):
+        HeliostatField(positions=positions, aims=pd.DataFrame({"x": [0.0, 0.0], "y": [0.0, 0.0], "z": [9.0, 9.0]}))
+    with pytest.raises(HybridtrackError, match=r"one \(east, north, up\) per heliostat, shape \(2, 3\); got shape "
+                                               r"\(1, 3\)"):
+        HeliostatField(positions=positions, aims=[[0.0, 0.0, 100.0]])
