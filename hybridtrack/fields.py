@@ -909,6 +909,8 @@ def _energy(light: np.ndarray, index: pd.DatetimeIndex) -> float:
 def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:
     """The collectors' rows with their positions first and, for a Fresnel field, their end loss last."""
     table = pd.DataFrame(rows, index=pd.Index(field.names, name="collector"))
+    for column in table.columns[table.dtypes == object]:  # a metric no step scored is None: NaN, as a number
+        table[column] = table[column].astype(float)
     for i, axis in enumerate(("east", "north", "up")):
         table.insert(i, axis, field.positions[:, i])
     if isinstance(field, FresnelField):

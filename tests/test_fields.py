@@ -11,7 +11,7 @@ import pvlib
 import pytest
 from matplotlib.figure import Figure
 
-from hybridtrack import HybridtrackError, simulate, simulate_field
+from hybridtrack import HybridtrackError, simulate, simulate_field, sites
 from hybridtrack.collectors import Collector, fresnel_angle, heliostat_normal, trough_angle
 from hybridtrack.fields import (FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns,
                                 run_collectors)
@@ -612,3 +612,16 @@ def test_a_table_of_aim_points_is_read_by_its_columns_names():
     with pytest.raises(HybridtrackError, match=r"one \(east, north, up\) per heliostat, shape \(2, 3\); got shape "
                                                r"\(1, 3\)"):
         HeliostatField(positions=positions, aims=[[0.0, 0.0, 100.0]])
+
+
+def test_a_field_under_polar_night_keeps_its_metrics_numbers():
+    """Where no step scored (the sun never rose) the metrics were None in object columns: the
+    table's `rms` had no numeric mean and printed "None" beside the end loss's NaN."""
+    site = sites.custom(-80.0, 0.0, "UTC")
+    frame = synthetic(site, "2021-06-21", weather="mixed", seed=1, freq="30min")
+    truth = pvlib.solarposition.get_solarposition(frame.index, -80.0, 0.0)
+    assert (truth["elevation"] < 0).all()  # the reference: polar night all day
+    result = simulate_field(frame, site, FresnelField(row_distances=[-1.0, 1.0]), keep_log=False)
+    for column in ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture"):
+        assert result.collectors[column].dtype == float and result.collectors[column].isna().all(), column
+    assert result.collectors["moves"].tolist() == [0, 0] and result.summary["rms"] is None
