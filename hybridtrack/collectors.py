@@ -355,11 +355,16 @@ def _finite(values, name: str) -> np.ndarray:
     return array
 
 
-def fresnel_end_loss(altitude, azimuth, d, h):
-    """End loss of a north-south Fresnel row: how far the reflected light runs past the receiver end.
+def fresnel_end_loss(altitude, azimuth, d, h, axis_azimuth=0.0):
+    """End loss of a Fresnel row: how far the reflected light runs past the receiver's end.
 
-    ``L_end = f cos α cos γ_s / sqrt(cos²α sin²γ_s + sin²α)`` with ``f = sqrt(d² + h²)`` and
-    γ_s the azimuth from south (east negative); at solar noon it reduces to ``f cot α``.
+    The mirror's normal lies across the row's axis, so the reflected ray keeps the sun's part
+    along the axis; it travels ``f = sqrt(d² + h²)`` across the axis to the receiver and so runs
+    ``L_end = -f s_a / sqrt(1 - s_a²)`` along it, ``s_a = cos α cos(γ - β)`` the sun vector's part
+    along the axis (β the axis azimuth), i.e. ``f`` times the tangent of the sun's angle out of
+    the plane across the axis. For a north-south row (β = 0) this is
+    ``f cos α cos γ_s / sqrt(cos²α sin²γ_s + sin²α)``, γ_s the azimuth from south, and at solar
+    noon ``f cot α``.
 
     Parameters
     ----------
@@ -369,23 +374,26 @@ def fresnel_end_loss(altitude, azimuth, d, h):
         Row's lateral distance from the receiver line and the receiver's height, metres; arrays
         give one row each, broadcast against the sun position (``altitude[:, None]`` against
         ``d`` of shape (N,) gives (T, N)).
+    axis_azimuth : float or array_like
+        Azimuth of the row's axis, degrees from north (0: a north-south row); broadcast too.
 
     Returns
     -------
     numpy.float64, ndarray or pandas.Series
-        Metres; positive means the light is lost past the north end, negative the south end.
-        NaN while the sun is down.
+        Metres; positive means the light is lost past the row's end at `axis_azimuth` (the
+        north end of a north-south row), negative past the other end. NaN while the sun is down.
     """
     d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
     if not np.all(h > 0):  # the hypotenuse would hide the sign: -10 m gave +10 m's loss
         raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
+    axis = _finite(axis_azimuth, "axis azimuth")
     alt, az = checked_sun(altitude, azimuth, "fresnel_end_loss")
-    _broadcast("fresnel_end_loss", altitude=alt, azimuth=az, d=d, h=h)
+    _broadcast("fresnel_end_loss", altitude=alt, azimuth=az, d=d, h=h, axis_azimuth=axis)
     a = np.radians(alt)
-    gs = np.radians(az - 180.0)
+    g = np.radians(az - axis)  # the sun's azimuth from the axis
     f = np.hypot(d, h)
     with np.errstate(invalid="ignore", divide="ignore"):
-        loss = f * np.cos(a) * np.cos(gs) / np.sqrt((np.cos(a) * np.sin(gs)) ** 2 + np.sin(a) ** 2)
+        loss = -f * np.cos(a) * np.cos(g) / np.sqrt((np.cos(a) * np.sin(g)) ** 2 + np.sin(a) ** 2)
     return _like(altitude, np.where(a > 0.0, loss, np.nan), "end_loss")
 
 
@@ -618,7 +626,7 @@ class Collector:
         """Target angles for a sun path, as a frame on the path's index.
 
         Single-axis kinds give ``angle`` (degrees, trough convention) and ``rate`` (°/min);
-        a Fresnel row adds ``end_loss`` (m, north-south rows); a heliostat gives
+        a Fresnel row adds ``end_loss`` (m, `fresnel_end_loss`); a heliostat gives
         ``normal_azimuth``, ``normal_elevation`` and the three ``jack_1..3`` heights (m) of the
         published support.
         """
@@ -638,8 +646,8 @@ class Collector:
             out["angle"] = trough_angle(altitude, azimuth, self.axis)
         if len(out) > 1:
             out["rate"] = tracking_rate(out["angle"])
-        if self.kind == "fresnel" and self.axis % 180.0 == 0.0:
-            out["end_loss"] = fresnel_end_loss(altitude, azimuth, self.row_distance, self.receiver_height)
+        if self.kind == "fresnel":
+            out["end_loss"] = fresnel_end_loss(altitude, azimuth, self.row_distance, self.receiver_height, self.axis)
         return out
 
 

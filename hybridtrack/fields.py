@@ -303,11 +303,10 @@ class FresnelField:
         return fresnel_angle(alt, az, np.asarray(self.row_distances), self.receiver_height, self.axis_azimuth)
 
     def end_loss(self, altitude, azimuth) -> np.ndarray:
-        """Every row's end loss (T, N), metres (north-south rows only; see `fresnel_end_loss`)."""
-        if self.axis_azimuth % 180.0 != 0.0:
-            raise HybridtrackError("end loss is defined for north-south rows (axis azimuth 0 or 180)")
+        """Every row's end loss (T, N), metres, positive past the rows' end at `axis_azimuth`
+        (see `fresnel_end_loss`); NaN at night."""
         alt, az = _sun_columns(altitude, azimuth)
-        return fresnel_end_loss(alt, az, np.asarray(self.row_distances), self.receiver_height)
+        return fresnel_end_loss(alt, az, np.asarray(self.row_distances), self.receiver_height, self.axis_azimuth)
 
 
 @dataclass(frozen=True)
@@ -679,7 +678,7 @@ def collector_columns(field) -> list[str]:
     """The columns `simulate_field` gives `field`'s collector table (what a field map can show)."""
     columns = ["east", "north", "up"] + (["row_distance"] if isinstance(field, FresnelField) else [])
     columns += [f.name for f in dataclasses.fields(Imperfections)] + list(COLLECTOR_METRICS) + ["offered"]
-    if isinstance(field, FresnelField) and field.axis_azimuth % 180.0 == 0.0:
+    if isinstance(field, FresnelField):
         columns += ["end_loss_m", "end_loss_share"]
     return columns
 
@@ -700,8 +699,6 @@ def _weighted(values: pd.Series, weights: pd.Series, *, squared: bool = False) -
 
 def _end_loss_columns(field: FresnelField, dni, altitude, azimuth) -> dict[str, np.ndarray]:
     """Each row's mean end loss (metres) and the share of its light lost past the receiver's end."""
-    if field.axis_azimuth % 180.0 != 0.0:
-        return {}
     up = (altitude > 0) & (np.nan_to_num(dni) > 0)
     loss = np.abs(field.end_loss(altitude[up], azimuth[up]))
     beam = (np.nan_to_num(dni) * incidence_cosine(altitude, azimuth, field.collectors()[0]))[up][:, None]

@@ -439,3 +439,54 @@ def test_an_axis_azimuth_error_turns_the_true_axis_as_documented(axis_azimuth):
     east, north, up = to_world @ np.array([np.sin(b), np.cos(b), 0.0])
     assert np.degrees(np.arctan2(east, north)) % 360.0 == pytest.approx((axis_azimuth - 1.0) % 360.0, abs=1e-3)
     assert np.degrees(np.arcsin(up)) == pytest.approx(0.5, abs=1e-3)
+
+
+def _traced_end_loss(alt, az, d, h, axis_azimuth):
+    """An independent ray trace: a mirror normal across the axis that sends the sun to the receiver
+    (its angle solved here by bisection of the two directions in the plane across the axis), the
+    sun reflected by the law of reflection, and the ray followed up to the receiver's height:
+    how far along the axis (towards `axis_azimuth`) it lands."""
+    b = np.radians(axis_azimuth)
+    along, across, up = np.array([np.sin(b), np.cos(b), 0.0]), np.array([np.cos(b), -np.sin(b), 0.0]), np.eye(3)[2]
+    a, g = np.radians(alt), np.radians(az)
+    s = np.array([np.cos(a) * np.sin(g), np.cos(a) * np.cos(g), np.sin(a)])
+    sun_across = np.arctan2(s @ up, s @ across)  # the sun's direction in the plane across the axis
+    to_receiver = np.arctan2(h, -d)
+    theta = 0.5 * (sun_across + to_receiver)
+    n = np.cos(theta) * across + np.sin(theta) * up
+    ray = 2.0 * (s @ n) * n - s  # reflected: from the mirror outwards
+    t = h / ray[2]
+    np.testing.assert_allclose(d * 1.0 + t * (ray @ across), 0.0, atol=1e-9)  # it does meet the receiver line
+    return t * (ray @ along)
+
+
+@pytest.mark.parametrize("axis_azimuth", [0.0, 90.0, 180.0, 270.0, -90.0, 45.0, 360.0])
+def test_end_loss_on_any_axis_is_where_the_reflected_ray_meets_the_receiver(axis_azimuth):
+    """Only north-south rows had an end loss: an east-west Fresnel field was given none, without a
+    word. On any axis it is where a ray traced by the law of reflection meets the receiver line."""
+    for alt, az in ((25.0, 110.0), (50.0, 180.0), (80.0, 250.0), (10.0, 300.0), (60.0, 20.0)):
+        for d in (-7.5, 0.0, 4.0):
+            want = _traced_end_loss(alt, az, d, 10.0, axis_azimuth)
+            assert float(fresnel_end_loss(alt, az, d, 10.0, axis_azimuth)) == pytest.approx(want, abs=1e-9)
+    # a north-south row keeps its sign: positive past the north end when the sun is south
+    assert fresnel_end_loss(50.0, 180.0, 0.0, 10.0) == pytest.approx(10.0 / np.tan(np.radians(50.0)))
+    # and broadcasts its axes like any collector parameter: one column per axis
+    table = fresnel_end_loss(np.array([30.0, 60.0])[:, None], np.array([120.0, 200.0])[:, None], 3.0, 10.0,
+                             [0.0, 90.0])
+    assert table.shape == (2, 2)
+    assert table[1, 1] == pytest.approx(_traced_end_loss(60.0, 200.0, 3.0, 10.0, 90.0), abs=1e-9)
+
+
+def test_an_east_west_fresnel_row_and_field_carry_their_end_loss():
+    import pandas as pd
+
+    from hybridtrack.fields import FresnelField, collector_columns
+
+    times = pd.date_range("2021-06-21 10:00", periods=3, freq="1h", tz="UTC")
+    alt, az = pd.Series([30.0, 50.0, 40.0], index=times), pd.Series([100.0, 170.0, 240.0], index=times)
+    out = Collector("fresnel", axis_azimuth=90.0, row_distance=3.0).angles(alt, az)
+    want = [_traced_end_loss(a, g, 3.0, 10.0, 90.0) for a, g in zip(alt, az)]
+    np.testing.assert_allclose(out["end_loss"], want, atol=1e-9)
+    field = FresnelField(row_distances=[-3.0, 3.0], axis_azimuth=90.0)
+    np.testing.assert_allclose(field.end_loss(alt, az)[:, 1], want, atol=1e-9)
+    assert collector_columns(field)[-2:] == ["end_loss_m", "end_loss_share"]

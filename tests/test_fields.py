@@ -625,3 +625,20 @@ def test_a_field_under_polar_night_keeps_its_metrics_numbers():
     for column in ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture"):
         assert result.collectors[column].dtype == float and result.collectors[column].isna().all(), column
     assert result.collectors["moves"].tolist() == [0, 0] and result.summary["rms"] is None
+
+
+def test_an_east_west_fresnel_field_reports_its_end_loss(day):
+    """It had no end_loss_m, end_loss_share nor field end loss, and --metric end_loss_share was refused."""
+    field = FresnelField(row_distances=[-2.0, 2.0], axis_azimuth=90.0)
+    result = simulate_field(day, "lanzhou", field, keep_log=False)
+    assert list(result.collectors.columns) == collector_columns(field)
+    # by hand: light-weighted |L_end| over the day, each step's L_end = f tan(θ) (docs/fields.md)
+    sun = solar_position(day.index, "lanzhou")
+    up = (sun["altitude"] > 0) & (day["dni"] > 0)
+    a, g = np.radians(sun["altitude"][up]), np.radians(sun["azimuth"][up] - 90.0)
+    s_along = np.cos(a) * np.cos(g)
+    loss = np.hypot(2.0, 10.0) * np.abs(s_along) / np.sqrt(1.0 - s_along**2)
+    beam = day["dni"][up] * np.sqrt(1.0 - s_along**2)
+    np.testing.assert_allclose(result.collectors["end_loss_m"], np.sum(beam * loss) / beam.sum(), rtol=1e-6)
+    assert 0 < result.summary["end_loss_share"] < 1
+    assert isinstance(result.plot_map("end_loss_share"), Figure)
