@@ -595,7 +595,19 @@ class FieldResult:
                 f"{summary['steps']:,} steps from {summary['start']}{': ' + figures if figures else ''}>")
 
     def _repr_html_(self) -> str:
-        return f"<p><b>{self.summary['field']}</b> at {self.site.name}</p>" + self.collectors.to_html(max_rows=20)
+        """The field's figures (as `repr` and the command line give them) above its collector table,
+        every text escaped: a site's name is anybody's text, and had been written into the page as
+        markup; the figures had not been shown at all."""
+        from html import escape
+
+        summary = self.summary
+        rows = [(label, summary[key]) for key, label in _SUMMARY_LABELS.items() if key in summary]
+        cells = "".join(f"<tr><th style='text-align:left'>{escape(label)}</th>"
+                        f"<td style='text-align:left'>{escape(_shown(value))}</td></tr>" for label, value in rows)
+        title = (f"<b>{escape(str(summary['field']))}</b> of {summary['collectors']:,} at {escape(self.site.name)}, "
+                 f"{escape(str(summary['strategy']))}, {summary['steps']:,} steps from {escape(str(summary['start']))}")
+        return (f"<div><p>{title}</p><table>{cells}</table>"
+                + self.collectors.to_html(max_rows=20, float_format=lambda v: f"{v:.4g}") + "</div>")
 
     def plot_map(self, metric: str = "rms"):
         """The field map: every collector at its position, coloured by `metric` (a column of `collectors`).
@@ -653,6 +665,23 @@ class FieldResult:
             if self.dataset is not None:
                 write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
         return written
+
+
+#: The field figures `FieldResult` shows, by their summary keys (the command line's table too).
+_SUMMARY_LABELS = {"collectors": "collectors", "steps": "steps", "energy_capture": "energy capture (field)",
+                   "rms": "pointing error RMS (°, field)", "rms_worst": "worst collector RMS (°)",
+                   "rms_worst_collector": "worst collector", "moves": "moves (all collectors)",
+                   "travel_deg": "travel (°, all)", "stow_events": "wind stow events", "faults": "faults",
+                   "end_loss_share": "end loss (share of the light)", "wind_data": "wind data"}
+
+
+def _shown(value) -> str:
+    """A summary figure as the field's table shows it: '-' for none, 4 significant digits."""
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:,.0f}" if abs(value) >= 1000 else f"{value:.4g}"
+    return f"{value:,}" if isinstance(value, int) else str(value)
 
 
 def _segments(field) -> np.ndarray | None:

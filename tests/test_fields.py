@@ -642,3 +642,16 @@ def test_an_east_west_fresnel_field_reports_its_end_loss(day):
     np.testing.assert_allclose(result.collectors["end_loss_m"], np.sum(beam * loss) / beam.sum(), rtol=1e-6)
     assert 0 < result.summary["end_loss_share"] < 1
     assert isinstance(result.plot_map("end_loss_share"), Figure)
+
+
+def test_a_field_shows_its_figures_in_a_notebook_and_escapes_its_texts(day):
+    """The notebook view had only the field's name and the table: none of its figures. And a site's
+    name went into the page as markup: a site named '<script>...' ran as one."""
+    site = sites.custom(36.1, 103.7, "Asia/Shanghai", name="<script>alert(1)</script>")
+    result = simulate_field(day, site, TroughLoop(count=2), keep_log=False)
+    html = result._repr_html_()
+    assert "<script>" not in html and "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    for label, key in (("energy capture (field)", "energy_capture"), ("pointing error RMS (°, field)", "rms")):
+        assert f"<th style='text-align:left'>{label}</th><td style='text-align:left'>{result.summary[key]:.4g}</td>" \
+            in html
+    assert "SCA 2" in html

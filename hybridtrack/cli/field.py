@@ -172,23 +172,12 @@ def _refuse_other_kinds_flags(args: argparse.Namespace) -> None:
 
 
 def field_table(summary: dict) -> str:
-    """A field summary as two aligned columns."""
-    labels = {"collectors": "collectors", "steps": "steps", "energy_capture": "energy capture (field)",
-              "rms": "pointing error RMS (°, field)", "rms_worst": "worst collector RMS (°)",
-              "rms_worst_collector": "worst collector", "moves": "moves (all collectors)",
-              "travel_deg": "travel (°, all)", "stow_events": "wind stow events", "faults": "faults",
-              "end_loss_share": "end loss (share of the light)", "wind_data": "wind data"}
-    rows = [(label, summary[key]) for key, label in labels.items() if key in summary]
+    """A field summary as two aligned columns (the figures `FieldResult._repr_html_` shows)."""
+    from ..fields import _SUMMARY_LABELS, _shown
+
+    rows = [(label, summary[key]) for key, label in _SUMMARY_LABELS.items() if key in summary]
     width = max(len(label) for label, _ in rows)
-    return "\n".join(f"{label:<{width}}  {_format(value)}" for label, value in rows)
-
-
-def _format(value) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:,.0f}" if abs(value) >= 1000 else f"{value:.4g}"
-    return f"{value:,}" if isinstance(value, int) else str(value)
+    return "\n".join(f"{label:<{width}}  {_shown(value)}" for label, value in rows)
 
 
 @command("field", "run a tracker for every collector of a Fresnel field, a trough loop or a heliostat field",
