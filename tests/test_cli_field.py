@@ -106,7 +106,8 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
     (["fresnel", "--receiver-height", "0"], "receiver height must be finite and positive"),
     (["trough", "--count", "0"], "count must be a whole number"),
     (["heliostat", "--positions", "/no/such/file.csv"], "no such file"),
-    (["trough", "--count", "2", "--threads", "0"], "threads must be a whole number within [1,"),
+    (["trough", "--count", "2", "--threads", "0"], "--threads must be a whole number within [1,"),
+    (["trough", "--count", "2", "--workers", "0"], "--workers must be a whole number within [1,"),  # named no flag
     (["trough", "--count", "2", "--threads", "2", "--workers", "1"], "give one or the other"),
     (["trough", "--count", "2", "--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler or --workers, not both"),
     (["fresnel", "--rows=1,,2"], "--rows takes numbers separated by commas, got '1,,2'"),  # not two rows

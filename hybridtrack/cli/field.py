@@ -183,10 +183,14 @@ def field_table(summary: dict) -> str:
 @command("field", "run a tracker for every collector of a Fresnel field, a trough loop or a heliostat field",
          _field_arguments)
 def _field(args: argparse.Namespace) -> int:
-    from ..cluster import check_where
+    from ..cluster import MAX_WORKERS, check_where
     from ..fields import FieldResult, collector_columns, simulate_field
     from ..outputs import claim
+    from ..params import whole
 
+    for flag, count in (("--threads", args.threads), ("--workers", args.workers)):
+        if count is not None:  # named as the flag, as every other refusal is ("threads must be ..." had not been)
+            whole(count, flag, 1, MAX_WORKERS)
     check_where(args.scheduler, args.workers, args.threads)  # at the door, not after the weather is made
     site = site_from_arguments(args)
     field = field_from_arguments(args)
