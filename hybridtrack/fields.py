@@ -67,6 +67,11 @@ MIN_SPACING = 1.0
 #: so rows this close would share their mirrors: a typo (rows 0.1 µm apart had been taken). Well
 #: below any built width, so that no real layout is refused.
 MIN_ROW_SPACING = 0.1
+#: The shortest `TroughLoop.collector_length`, metres: the loop's collectors stand this far apart
+#: centre to centre, so shorter ones would overlap or share a place (1e-300 m put two at one
+#: point). Built troughs come in modules of a few metres and more (a EuroTrough module is 12 m,
+#: small process-heat troughs some 2 to 6 m), so 1 m refuses no real loop.
+MIN_COLLECTOR_LENGTH = 1.0
 #: Metres two collectors may fall short of the least spacing and still be taken: positions written
 #: as decimals differ in binary floating point by a little less than they read (-7.2 - -8.2 is
 #: 0.9999999999999991), and "1 m apart: closer than 1 m" had refused layouts exactly at the limit.
@@ -318,7 +323,8 @@ class TroughLoop:
     count : int
         Number of collectors (solar collector assemblies), each with its own drive.
     collector_length : float
-        Length of one collector along the axis, metres (their centres are this far apart).
+        Length of one collector along the axis, metres (their centres are this far apart), at
+        least `MIN_COLLECTOR_LENGTH` (1 m).
     axis_azimuth : float
         Azimuth of the axis, degrees from north (0: north-south, 270: east-west).
     spread : ImperfectionSpread
@@ -336,6 +342,10 @@ class TroughLoop:
             raise HybridtrackError(f"trough loop: count must be a whole number from 1 to 100000, got {self.count!r}")
         object.__setattr__(self, "collector_length",
                            _finite_number(self.collector_length, "collector length", positive=True))
+        if self.collector_length < MIN_COLLECTOR_LENGTH:
+            raise HybridtrackError(f"trough loop: collector length must be at least {MIN_COLLECTOR_LENGTH:g} m (the "
+                                   f"collectors stand one length apart: shorter, they would overlap), got "
+                                   f"{self.collector_length:g}")
         object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
         if (self.count - 1) * self.collector_length > MAX_DISTANCE:  # each length was bounded, not the line
             raise HybridtrackError(f"trough loop: {self.count} collectors of {self.collector_length:g} m reach "

@@ -136,6 +136,9 @@ def test_bad_field_flags(capsys, flags, message):
     (["fresnel", "--row-length", "0"], "--row-length: row length must be finite and positive, got [0.0]"),
     (["fresnel", "--axis-azimuth", "nan"], "--axis-azimuth: axis azimuth must be finite, got [nan]"),
     (["trough", "--count", "0"], "--count: trough loop: count must be a whole number from 1 to 100000, got 0"),
+    (["trough", "--collector-length", "1e-300", "--count", "2"],  # both at one place
+     "--collector-length: trough loop: collector length must be at least 1 m (the collectors stand one length apart: "
+     "shorter, they would overlap), got 1e-300"),
     (["trough", "--collector-length", "-5", "--count", "3"], "--collector-length: collector length must be finite and "
                                                              "positive, got [-5.0]"),
     # 33 of the default 150 m (4950 m) and 12 of 160 m are within 5000 m; 33 of 160 m are not: both named

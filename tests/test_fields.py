@@ -655,3 +655,13 @@ def test_a_field_shows_its_figures_in_a_notebook_and_escapes_its_texts(day):
         assert f"<th style='text-align:left'>{label}</th><td style='text-align:left'>{result.summary[key]:.4g}</td>" \
             in html
     assert "SCA 2" in html
+
+
+def test_a_trough_loop_of_collectors_too_short_to_stand_apart_is_refused():
+    """collector_length=1e-300 was taken: its collectors, one length apart, all stood at the origin
+    (two collectors at one place, which every other field refuses)."""
+    with pytest.raises(HybridtrackError, match="collector length must be at least 1 m .* got 1e-300"):
+        TroughLoop(count=2, collector_length=1e-300)
+    with pytest.raises(HybridtrackError, match="got 0.5"):
+        TroughLoop(count=2, collector_length=0.5)
+    np.testing.assert_array_equal(TroughLoop(count=2, collector_length=1.0).positions, [[0, 0, 0], [0, 1, 0]])
