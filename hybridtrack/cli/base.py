@@ -225,7 +225,7 @@ def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Itera
             raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed ({exc.strerror or exc}); "
                                    "the results beside it are this run's") from None
         print(f"{path}: removed, from an earlier run ({reason})")
-    for folder in sorted({path.parent for path in stale} - {Path(args.out)}):
+    for folder in sorted({path.parent for path in stale} - {Path(args.out or ".")}):  # no --out: no stale files
         with contextlib.suppress(OSError):  # a folder with anything else in it stays
             folder.rmdir()
             print(f"{folder}: removed, emptied of an earlier run's files ({reason})")
