@@ -93,7 +93,8 @@ class Sweep:
             raise HybridtrackError(f"{source}: {unknown[0]}: unknown table; a sweep has [base], [grid] and [plot]")
         base = dict(_table_of_text_keys(data.get("base", {}), source, "[base]"))
         config = _table_of_text_keys(base.pop("config", {}), source, "[base.config]")
-        grid = _table_of_text_keys(data.get("grid", {}), source, "[grid]")
+        base = _dotted(base, source, "base")
+        grid = _dotted(_table_of_text_keys(data.get("grid", {}), source, "[grid]"), source, "grid")
         plot = _table_of_text_keys(data.get("plot", {}), source, "[plot]")
         for key in base:
             _check_key(key, source, "base")
@@ -105,6 +106,7 @@ class Sweep:
             _check_key(key, source, "grid")
             if not isinstance(values, list) or not values:
                 raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
+            _refuse_repeats(key, values, source)
         count = int(np.prod([len(v) for v in grid.values()], dtype=float))
         if count > MAX_RUNS:
             raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
@@ -115,6 +117,10 @@ class Sweep:
         unknown = sorted(set(plot) - {"x", "y"})
         if unknown:
             raise HybridtrackError(f"{source}: plot.{unknown[0]}: unknown key; known: x, y")
+        x, y = plot.get("x", "moves"), plot.get("y", "rms")
+        if x == y:  # one metric against itself: a diagonal, its "front" one point
+            unsaid = "".join(f" ({axis} by default)" for axis in ("x", "y") if axis not in plot)
+            raise HybridtrackError(f"{source}: plot.x and plot.y are both {x!r}{unsaid}; a trade-off needs two metrics")
         return cls({**base, "config": config}, dict(grid), plot.get("x", "moves"), plot.get("y", "rms"), source)
 
     def to_dict(self) -> dict:
@@ -147,6 +153,72 @@ def _table_of_text_keys(table, source: str, name: str) -> dict:
     return table
 
 
+def _dotted(table: dict, source: str, name: str) -> dict:
+    """`table` with each sub-table's keys as dotted keys, in order: TOML reads ``drive.deadband =
+    [...]`` unquoted, and ``[grid.drive]``, as a table ``drive`` holding ``deadband``, the key a
+    sweep writes ``"drive.deadband"``. No value of a sweep key is a table (a grid's are lists)."""
+    flat: dict = {}
+
+    def add(prefix: str, node: dict) -> None:
+        for key, value in _table_of_text_keys(node, source, f"[{name}{'.' if prefix else ''}{prefix[:-1]}]").items():
+            dotted = prefix + key
+            if isinstance(value, dict):
+                add(dotted + ".", value)
+            elif dotted in flat:
+                raise HybridtrackError(f"{source}: {name}.{dotted}: given twice, as \"{dotted}\" and as a table "
+                                       f"({dotted.rpartition('.')[0]}); give it once")
+            else:
+                flat[dotted] = value
+
+    add("", table)
+    return flat
+
+
+def _alike(value):
+    """What two grid values that make the same run have alike: equal numbers (1 and 1.0) but not a
+    true beside a 1 (a seed of true is refused by its run, 1 is not), lists by their items."""
+    if isinstance(value, bool):
+        return bool, value
+    if isinstance(value, (list, tuple)):
+        return list, tuple(_alike(v) for v in value)
+    if isinstance(value, dict):
+        return dict, tuple((k, _alike(v)) for k, v in value.items())
+    return None, value
+
+
+def _refuse_repeats(key: str, values: list, source: str) -> None:
+    """Refuse a grid value given twice: every combination with it would run twice, two rows alike
+    in all but their number, and a mean over them counted double."""
+    seen: dict = {}
+    for number, value in enumerate(values, 1):
+        try:
+            first = seen.setdefault(_alike(value), number)
+        except TypeError:  # unhashable in a way TOML does not make: judged by its run
+            continue
+        if first != number:
+            raise HybridtrackError(f"{source}: grid.{key}: {_shown(value)} is given twice (values {first} and "
+                                   f"{number}); each value makes its runs once")
+
+
+def _known_keys() -> list[str]:
+    """Every key a sweep takes: run keys, ``collector.FIELD`` and dotted config fields."""
+    from .collectors import Collector
+    from .simulation import SimulationConfig
+
+    keys = [*RUN_KEYS, *(f"collector.{f.name}" for f in dataclasses.fields(Collector) if f.name != "kind")]
+
+    def fields(node, prefix: str) -> None:
+        for f in dataclasses.fields(node):
+            value = getattr(node, f.name)
+            if dataclasses.is_dataclass(value):
+                fields(value, f"{prefix}{f.name}.")
+            elif prefix + f.name != STRATEGY_KEY:
+                keys.append(prefix + f.name)
+
+    fields(SimulationConfig(), "")
+    return keys
+
+
 def _check_key(key: str, source: str, table: str) -> None:
     """A run key, a collector field or a config field that exists; its value is checked by the run."""
     from .collectors import Collector
@@ -163,7 +235,11 @@ def _check_key(key: str, source: str, table: str) -> None:
     node = SimulationConfig()
     for part in key.split("."):
         if not dataclasses.is_dataclass(node) or part not in {f.name for f in dataclasses.fields(node)}:
-            raise HybridtrackError(f"{source}: {table}.{key}: unknown key; use {', '.join(RUN_KEYS)}, "
+            import difflib
+
+            near = difflib.get_close_matches(key, _known_keys(), n=1)
+            hint = f"did you mean {near[0]}? " if near else ""
+            raise HybridtrackError(f"{source}: {table}.{key}: unknown key; {hint}use {', '.join(RUN_KEYS)}, "
                                    "collector.FIELD or a dotted config key such as drive.deadband")
         node = getattr(node, part)
     if dataclasses.is_dataclass(node):

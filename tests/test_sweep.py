@@ -139,6 +139,65 @@ def test_a_sweep_with_one_bad_grid_value_runs_the_others_and_names_it(tmp_path, 
     assert f"  run 2: {want}\n  run 3: {want}\n" in printed
 
 
+@pytest.mark.parametrize("grid", [
+    'drive.deadband = [0.1, 0.4]\nseed = [0, 1]\n',  # TOML's dotted key, unquoted
+    '"drive.deadband" = [0.1, 0.4]\nseed = [0, 1]\n',
+    'seed = [0, 1]\n[grid.drive]\ndeadband = [0.1, 0.4]\n',  # a sub-table: the same key
+])
+def test_a_dotted_grid_key_unquoted_or_as_a_table_is_the_same_key(tmp_path, grid):
+    """TOML reads drive.deadband = [...] unquoted as a table drive holding deadband: it was refused
+    as "grid.drive: is a whole table; name one of its fields", though it names one."""
+    path = tmp_path / "s.toml"
+    path.write_text("[base]\ncollector = 'fresnel'\n'collector.row_distance' = -4.0\nimperfections.encoder_offset = 0.05\n"
+                    "[grid]\n" + grid)
+    sweep = Sweep.from_toml(path)
+    assert sorted(sweep.grid.items()) == [("drive.deadband", [0.1, 0.4]), ("seed", [0, 1])]
+    assert {k: v for k, v in sweep.base.items() if k != "config"} == {
+        "collector": "fresnel", "collector.row_distance": -4.0, "imperfections.encoder_offset": 0.05}
+    assert Sweep.from_toml(sweep.to_toml(tmp_path / "back.toml")).to_dict() == sweep.to_dict()
+
+
+def test_a_key_given_both_dotted_and_as_a_table_is_refused():
+    with pytest.raises(HybridtrackError, match=r"s.toml: grid.drive.deadband: given twice"):
+        Sweep.from_dict({"grid": {"drive.deadband": [0.1], "drive": {"deadband": [0.2]}}}, source="s.toml")
+
+
+@pytest.mark.parametrize("key, values, message", [
+    ("seed", [0, 1, 0], "grid.seed: 0 is given twice .values 1 and 3.; each value makes its runs once"),
+    ("drive.deadband", [0.1, 0.2, 0.10], "grid.drive.deadband: 0.1 is given twice .values 1 and 3."),
+    ("drive.deadband", [1, 0.5, 1.0], "grid.drive.deadband: 1.0 is given twice .values 1 and 3."),
+    ("weather", [["sunny", "cloudy"], ["sunny", "cloudy"]], r"grid.weather: \['sunny', 'cloudy'\] is given twice"),
+])
+def test_a_grid_value_given_twice_is_refused(key, values, message):
+    """seed = [0, 1, 0] ran seed 0 twice: two identical rows, the mean over seeds weighted to it."""
+    with pytest.raises(HybridtrackError, match=message):
+        Sweep.from_dict({"grid": {key: values}}, source="s.toml")
+
+
+def test_values_alike_only_to_python_are_not_refused_as_repeats():
+    """True == 1 in Python, but a seed of true is refused by its run and 1 is not: two runs."""
+    assert len(Sweep.from_dict({"grid": {"seed": [1, True], "drive.deadband": [float("nan"), float("nan")]}}).runs()) == 4
+
+
+@pytest.mark.parametrize("plot, message", [
+    ({"x": "rms", "y": "rms"}, "s.toml: plot.x and plot.y are both 'rms'; a trade-off needs two metrics"),
+    ({"x": "rms"}, "s.toml: plot.x and plot.y are both 'rms' .y by default.; a trade-off needs two metrics"),
+])
+def test_a_trade_off_of_a_metric_against_itself_is_refused(plot, message):
+    with pytest.raises(HybridtrackError, match=message):
+        Sweep.from_dict({"grid": {"seed": [0]}, "plot": plot}, source="s.toml")
+
+
+@pytest.mark.parametrize("key, suggestion", [
+    ("drive.deadbnd", "did you mean drive.deadband?"),
+    ("seeds", "did you mean seed?"),
+    ("collector.row_distanc", "did you mean collector.row_distance?"),
+])
+def test_a_grid_key_that_is_a_typo_names_the_real_one(key, suggestion):
+    with pytest.raises(HybridtrackError, match=f"s.toml: grid.{re.escape(key)}: unknown key; {re.escape(suggestion)}"):
+        Sweep.from_dict({"grid": {key: [0.1]}}, source="s.toml")
+
+
 def test_a_bad_base_value_the_grid_overrides_fails_no_run():
     """days = 0 in [base] is never run when the grid sets days: only a value a run uses is judged."""
     sweep = Sweep.from_dict({"base": {"days": 0, "site": "atlantis"}, "grid": {"days": [1], "site": ["lanzhou"]}})
