@@ -63,15 +63,34 @@ class TradeoffPlan:
         from .ablation import AblationPlan
         from .drive import Drive
 
+        from .times import parse_freq
+
+        # a text was run a letter a period, a number raised TypeError: each is a list of values
+        for name, example in (("deadbands", "of degrees such as (0.1, 0.4)"), ("periods", "of steps such as ('1min', "
+                                                                                         "'5min')")):
+            values = getattr(self, name)
+            if not isinstance(values, (tuple, list)):
+                raise HybridtrackError(f"tradeoff: {name} must be a list {example}, got {values!r:.60}")
+            object.__setattr__(self, name, tuple(values))
         for deadband in self.deadbands:
             Drive(deadband=deadband)  # refuses a deadband outside 0-10°
+        steps = {}
         for period in self.periods:
+            if not isinstance(period, str):  # a number would be nanoseconds to pandas
+                raise HybridtrackError(f"tradeoff: period {period!r:.60} is not a step such as '1min' or '10s'")
             try:
-                step = pd.Timedelta(period)
-            except ValueError:
-                raise HybridtrackError(f"tradeoff: period {period!r} is not a duration") from None
+                step = parse_freq(period)  # as the synthetic sky reads it
+            except HybridtrackError:
+                raise HybridtrackError(f"tradeoff: period {period!r} is not a step such as '1min' or '10s'") from None
             if not pd.Timedelta(seconds=10) <= step <= pd.Timedelta(minutes=30):
                 raise HybridtrackError(f"tradeoff: period {period!r} is outside 10 s to 30 min")
+            if step in steps:  # the same days run twice, and counted twice in the table's means
+                raise HybridtrackError(f"tradeoff: period {period!r} is given twice (as {steps[step]!r} and "
+                                       f"{period!r})")
+            steps[step] = period
+        for k, deadband in enumerate(self.deadbands):
+            if deadband in self.deadbands[:k]:
+                raise HybridtrackError(f"tradeoff: deadband {deadband!r} is given twice")
         if not self.deadbands or not self.periods:
             raise HybridtrackError("tradeoff: no deadbands or periods to run")
         AblationPlan(self.sites, self.seasons, self.weather, self.seeds, self.collectors, (self.policy,))

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hybridtrack import sites
+from hybridtrack import HybridtrackError, sites
 from hybridtrack.cli import main
 from hybridtrack.collectors import Collector
 from hybridtrack.tradeoff import SUBSTEPS, TradeoffPlan, held_error, tradeoff
@@ -56,3 +56,23 @@ def test_ablate_tradeoff_writes_its_table_and_plot(tmp_path, capsys):
 def test_bad_tradeoff_grids_are_refused(flags, message, capsys):
     assert main(["ablate", "--tradeoff", *flags]) == 2
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("options, message", [
+    # a float raised TypeError; a text was run letter by letter ("period '1' is outside 10 s to 30 min")
+    ({"deadbands": 0.1}, r"tradeoff: deadbands must be a list of degrees such as \(0.1, 0.4\), got 0.1"),
+    ({"periods": "1min"}, r"tradeoff: periods must be a list of steps such as \('1min', '5min'\), got '1min'"),
+    ({"periods": (60,)}, r"tradeoff: period 60 is not a step such as '1min' or '10s'"),
+    ({"periods": ("1T",)}, r"tradeoff: period '1T' is not a step"),  # pandas takes it, the synthetic sky did not
+    # each ran its days twice, as two rows of runs, and the table's mean over them counted them double
+    ({"deadbands": (0.1, 0.4, 0.10)}, r"tradeoff: deadband 0.1 is given twice"),
+    ({"periods": ("1min", "60s")}, r"tradeoff: period '60s' is given twice \(as '1min' and '60s'\)"),
+])
+def test_a_plan_that_is_not_a_grid_of_distinct_values_is_refused(options, message):
+    with pytest.raises(HybridtrackError, match=message):
+        TradeoffPlan(**options)
+
+
+def test_a_plan_takes_lists_as_well_as_tuples():
+    plan = TradeoffPlan(deadbands=[0.1, 0.4], periods=["1min", "90s"], sites=("lanzhou",), seasons=("summer",))
+    assert [(d["period"]) for d in plan.days()] == ["1min", "90s"] and plan.deadbands == (0.1, 0.4)
