@@ -19,7 +19,7 @@ from collections.abc import Iterable, Iterator
 from . import params
 from .errors import HybridtrackError
 
-__all__ = ["dask_client", "check_where", "close", "cores", "finished", "lost", "WorkersGone", "MAX_WORKERS",
+__all__ = ["dask_client", "check_where", "close", "holding_interrupts", "cores", "finished", "lost", "WorkersGone", "MAX_WORKERS",
            "WORKERS_GONE_AFTER"]
 
 #: The most worker processes a local cluster is asked for.
@@ -208,6 +208,29 @@ def _workers_starting() -> Iterator[list]:
     finally:
         signal.signal(signal.SIGINT, previous[0])
         signal.signal(signal.SIGTERM, previous[1])
+
+
+@contextlib.contextmanager
+def holding_interrupts() -> Iterator[list]:
+    """While a sweep closes its cluster and keeps its finished runs: hold a Ctrl-C or SIGTERM, and
+    name the signals held in the list it yields, for the caller to act on after the block.
+
+    A user presses Ctrl-C again when the first seems slow to act: raised amid the cluster's close
+    it ended the cleanup and lost the runs the first Ctrl-C was keeping. A signal already ignored
+    (a command run in the background) stays ignored; only the main thread may set a handler."""
+    held: list = []
+    if threading.current_thread() is not threading.main_thread():
+        yield held
+        return
+    previous = {}
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(signum) not in (signal.SIG_IGN, None):
+            previous[signum] = signal.signal(signum, lambda number, frame: held.append(number))
+    try:
+        yield held
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def close(client, cluster) -> None:

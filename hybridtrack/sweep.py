@@ -38,6 +38,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
+import signal
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +47,7 @@ import numpy as np
 import pandas as pd
 
 from . import params
-from .cluster import WorkersGone, close, dask_client, finished
+from .cluster import WorkersGone, close, dask_client, finished, holding_interrupts
 from .errors import HybridtrackError, blamed
 from .outputs import claim, output_folder, removing_empty_folders, together, write
 
@@ -513,6 +514,7 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     runs = sweep.runs()
     client, cluster = dask_client(scheduler, workers, what="sweeps")
     rows = []
+    stop = None
     try:
         # one map, not a submit a run: 100,000 submits took 45 s before the bar appeared
         futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
@@ -525,10 +527,19 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
                     bar.update()
             except WorkersGone as gone:  # the runs left are recorded as failed, with why
                 rows.extend(_failed(_row(_spec(sweep.base, run)), gone) for run in futures.values())
-    except KeyboardInterrupt as stop:
-        raise SweepInterrupted(_table(rows) if rows else None, len(runs), stop) from None
+    except KeyboardInterrupt as exc:
+        stop = exc
     finally:
-        close(client, cluster)
+        # a Ctrl-C pressed again while the cluster closes is held: raised there, it lost the runs
+        with holding_interrupts() as held:
+            close(client, cluster)
+    if held and stop is None:  # one that came after the last run: the runs are all there, kept as finished
+        try:
+            signal.raise_signal(held[0])  # as this process meets it (Ctrl-C, or the command line's SIGTERM)
+        except KeyboardInterrupt as exc:
+            stop = exc
+    if stop is not None:
+        raise SweepInterrupted(_table(rows) if rows else None, len(runs), stop) from None
     return _table(rows)
 
 

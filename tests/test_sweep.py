@@ -565,3 +565,59 @@ def test_local_workers_log_nothing_below_critical_and_the_setting_is_put_back(mo
     finally:
         close(client, cluster)
     assert "DASK_LOGGING__DISTRIBUTED" not in os.environ
+
+
+def _closing_after(signum, calls):
+    """`close` as a Ctrl-C (or SIGTERM) pressed again while the cluster closes would meet it."""
+    import signal
+
+    from hybridtrack import sweep as module
+
+    real = module.close
+
+    def close(client, cluster):
+        calls.append(signum)
+        signal.raise_signal(signum)
+        real(client, cluster)
+
+    return close
+
+
+def test_a_ctrl_c_while_the_cluster_closes_keeps_every_finished_run(monkeypatch):
+    """A second Ctrl-C, pressed while the local cluster closed after the first (5 in a row), raised
+    a bare KeyboardInterrupt out of run_sweep's cleanup: the runs that had finished (5 of 40) were
+    lost, no runs.partial.parquet was written, and the cluster was left half closed. One that came
+    as the cluster closed after the last run lost a whole sweep's table."""
+    import signal
+
+    from hybridtrack import sweep as module
+
+    calls = []
+    monkeypatch.setattr(module, "close", _closing_after(signal.SIGINT, calls))
+    sweep = Sweep.from_dict({"base": {"freq": "30min"}, "grid": {"seed": [0, 1]}})
+    with pytest.raises(module.SweepInterrupted) as stopped:
+        run_sweep(sweep, workers=1, progress=False)
+    assert calls == [signal.SIGINT] and stopped.value.planned == 2
+    assert list(stopped.value.table["run"]) == [0, 1] and stopped.value.table["error"].isna().all()
+
+
+def test_a_ctrl_c_after_the_first_while_the_cluster_closes_keeps_the_runs_of_the_first(monkeypatch):
+    import signal
+
+    from hybridtrack import cluster as workers
+    from hybridtrack import sweep as module
+
+    real = workers.finished
+
+    def first_then_ctrl_c(client, futures):
+        for outcome in real(client, futures):
+            yield outcome
+            raise KeyboardInterrupt  # Ctrl-C once the first run is in
+
+    calls = []
+    monkeypatch.setattr(module, "finished", first_then_ctrl_c)
+    monkeypatch.setattr(module, "close", _closing_after(signal.SIGINT, calls))
+    sweep = Sweep.from_dict({"base": {"freq": "30min"}, "grid": {"seed": [0, 1]}})
+    with pytest.raises(module.SweepInterrupted) as stopped:
+        run_sweep(sweep, workers=1, progress=False)
+    assert calls == [signal.SIGINT] and len(stopped.value.table) == 1 and stopped.value.planned == 2

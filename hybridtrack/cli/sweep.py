@@ -53,11 +53,13 @@ def _sweep(args: argparse.Namespace) -> int:
 
 def _keep_finished(stopped, out: str) -> str:
     """Write an interrupted sweep's finished runs to ``runs.partial.parquet``; what to tell the user."""
+    from ..cluster import holding_interrupts
     from ..outputs import write
     from ..sweep import partial_file
 
     if stopped.table is None:
         return f"none of the {stopped.planned} runs had finished; nothing written"
     path = partial_file(out)
-    write(path, lambda target: stopped.table.to_parquet(target, index=False))
+    with holding_interrupts():  # the user is already stopping: Ctrl-C again must not lose the runs being kept
+        write(path, lambda target: stopped.table.to_parquet(target, index=False))
     return f"the {len(stopped.table)} of {stopped.planned} runs that had finished are in {path}"
