@@ -66,6 +66,8 @@ METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capture", "mov
 COUNTS = ("moves", "mode_switches", "stow_events", "faults", "steps")
 #: The most runs one sweep may hold (each is a task on the scheduler and a row of the table).
 MAX_RUNS = 100_000
+#: The most values of a text grid key the plot names in a legend; more go on a colour bar.
+LEGEND_MOST = 12
 #: Metrics where more is better (the others: less is better).
 MAXIMISED = ("energy_capture", "within_0_5_deg")
 
@@ -632,6 +634,12 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
     if colour is not None and colour in ok and pd.api.types.is_numeric_dtype(ok[colour]):
         points = ax.scatter(ok[x], ok[y], c=ok[colour], cmap="viridis", s=36, edgecolors="0.3", linewidths=0.4)
         fig.colorbar(points, ax=ax, label=colour)
+    elif colour is not None and colour in ok and ok[colour].nunique() > LEGEND_MOST:
+        # a legend of 60 start dates ran off the figure: values in their order on a colour bar
+        codes, values = pd.factorize(ok[colour], sort=True)
+        points = ax.scatter(ok[x], ok[y], c=codes, cmap="viridis", s=36, edgecolors="0.3", linewidths=0.4)
+        bar = fig.colorbar(points, ax=ax, label=f"{colour} ({len(values)} values)")
+        bar.set_ticks([0, len(values) - 1], labels=[str(values[0]), str(values[-1])])
     elif colour is not None and colour in ok and not ok.empty:
         for value, group in ok.groupby(colour, sort=False):
             ax.scatter(group[x], group[y], s=36, label=f"{colour} = {value}", edgecolors="0.3", linewidths=0.4)

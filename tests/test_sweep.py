@@ -621,3 +621,25 @@ def test_a_ctrl_c_after_the_first_while_the_cluster_closes_keeps_the_runs_of_the
     with pytest.raises(module.SweepInterrupted) as stopped:
         run_sweep(sweep, workers=1, progress=False)
     assert calls == [signal.SIGINT] and len(stopped.value.table) == 1 and stopped.value.planned == 2
+
+
+def test_a_colour_of_many_text_values_is_a_colour_bar_not_a_legend_off_the_figure():
+    """A sweep over 60 start dates (text) drew a legend of 60 entries, running off the figure, and
+    matplotlib warned on stderr that the layout had collapsed."""
+    import warnings
+
+    starts = [str(dt.date(2021, 1, 1) + dt.timedelta(days=k)) for k in range(60)]
+    table = pd.DataFrame({"moves": np.arange(120), "rms": np.linspace(1, 0.1, 120), "start": starts * 2,
+                          "seed": [0] * 60 + [1] * 60, "error": pd.array([None] * 120, dtype="string")})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        figure = plot_tradeoff(table, "moves", "rms", colour="start")
+        figure.canvas.draw()  # the layout is made here
+    axes, bar = figure.axes
+    legend = axes.get_legend()
+    assert legend is None or len(legend.get_texts()) <= 12
+    assert bar.get_ylabel() == "start (60 values)"
+    assert [t.get_text() for t in bar.get_yticklabels()] == ["2021-01-01", "2021-03-01"]
+    few = plot_tradeoff(table[table["start"] < "2021-01-04"], "moves", "rms", colour="start")
+    assert [t.get_text() for t in few.axes[0].get_legend().get_texts()][:3] == [
+        "start = 2021-01-01", "start = 2021-01-02", "start = 2021-01-03"]
