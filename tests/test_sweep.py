@@ -643,3 +643,26 @@ def test_a_colour_of_many_text_values_is_a_colour_bar_not_a_legend_off_the_figur
     few = plot_tradeoff(table[table["start"] < "2021-01-04"], "moves", "rms", colour="start")
     assert [t.get_text() for t in few.axes[0].get_legend().get_texts()][:3] == [
         "start = 2021-01-01", "start = 2021-01-02", "start = 2021-01-03"]
+
+
+def test_a_second_sweep_into_the_folder_a_sweep_is_writing_is_refused_before_it_runs(tmp_path, monkeypatch, capsys):
+    """Two sweeps into one --out both passed the check of the empty folder; the one that finished
+    second was refused its files (they existed now) after all its runs, or with --force wrote its
+    table beside the other's sweep.toml and plot, in whatever order their writes fell."""
+    from hybridtrack import sweep as module
+
+    path = tmp_path / "s.toml"
+    path.write_text("[grid]\nseed = [0]\n")
+    out = str(tmp_path / "out")
+    second = []
+
+    def runs_while_another_starts(sweep, **options):
+        if not second:
+            second.append(None)
+            second[0] = main(["sweep", str(path), "--out", out, "--workers", "1"])
+        return _table([{"run": 0, "seed": 0, **{m: 1.0 for m in METRICS}, "error": None}])
+
+    monkeypatch.setattr(module, "run_sweep", runs_while_another_starts)
+    assert main(["sweep", str(path), "--out", out, "--workers", "1"]) == 0
+    assert second == [2] and "another run is writing there now" in capsys.readouterr().err
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["runs.parquet", "sweep.toml", "tradeoff.png"]

@@ -21,7 +21,7 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
          _sweep_arguments)
 def _sweep(args: argparse.Namespace) -> int:
     from ..cluster import check_where
-    from ..outputs import claim
+    from ..outputs import claim, held
     from ..sweep import Sweep, SweepInterrupted, partial_file, pareto_front, run_sweep, save_sweep, sweep_files
 
     check_where(args.scheduler, args.workers)  # before anything is printed: a refusal is the one line
@@ -30,11 +30,15 @@ def _sweep(args: argparse.Namespace) -> int:
     claim([*sweep_files(args.out).values(), partial_file(args.out)])
     runs = len(sweep.runs())
     print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
-    try:
-        table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
-    except SweepInterrupted as stopped:  # said as what stopped it: Ctrl-C (130) or SIGTERM (143)
-        raise type(stopped.stop or KeyboardInterrupt())(_keep_finished(stopped, args.out)) from None
-    written = save_sweep(table, sweep, args.out)
+    # the folder is this sweep's while its runs run: another sweep into it is refused before its
+    # own runs (both had passed the check of the empty folder, and the one that ended second lost
+    # its files to the other's, or with --force wrote its table beside the other's sweep.toml)
+    with held(sweep_files(args.out)["table"].parent):
+        try:
+            table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
+        except SweepInterrupted as stopped:  # said as what stopped it: Ctrl-C (130) or SIGTERM (143)
+            raise type(stopped.stop or KeyboardInterrupt())(_keep_finished(stopped, args.out)) from None
+    written = save_sweep(table, sweep, args.out)  # it claims its files again, as any run may now
     partial_file(args.out).unlink(missing_ok=True)  # an earlier interrupted sweep's, claimed (--force) and replaced
     failed = table[table["error"].notna()]
     keys = [k for k in ("run", *sweep.grid) if k in table]
