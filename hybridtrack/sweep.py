@@ -496,7 +496,7 @@ def _shown(value) -> str:
 
 
 def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None = None,
-              progress: bool = True) -> pd.DataFrame:
+              progress: bool = True, started=None) -> pd.DataFrame:
     """Run every run of `sweep` on Dask and return the table, one row per run, sorted by run.
 
     Parameters
@@ -508,16 +508,23 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         Worker processes of the local cluster, one thread each; the machine's cores by default.
     progress : bool
         A progress bar over runs on stderr.
+    started : callable, optional
+        Called with no argument once the cluster is up or the scheduler reached (and has a worker),
+        before the first run is sent: a refusal of where the runs go comes before whatever it says.
     """
     from tqdm import tqdm
 
     if not isinstance(sweep, Sweep):
         raise HybridtrackError(f"run_sweep: sweep must be a Sweep (Sweep.from_toml, Sweep.from_dict), got {sweep!r:.80}")
+    if started is not None and not callable(started):
+        raise HybridtrackError(f"run_sweep: started must be a callable or None, got {started!r:.60}")
     runs = sweep.runs()
     client, cluster = dask_client(scheduler, workers, what="sweeps")
     rows = []
     stop = None
     try:
+        if started is not None:
+            started()
         # one map, not a submit a run: 100,000 submits took 45 s before the bar appeared
         futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
                                       pure=False), runs))

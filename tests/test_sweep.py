@@ -316,6 +316,9 @@ def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, fla
 
 
 @pytest.mark.parametrize("flags, message", [
+    # these were refused by distributed once the run count had been printed above the refusal
+    (["--scheduler", "nonsense://x"], "cannot reach the Dask scheduler at nonsense://x: unknown address scheme"),
+    (["--scheduler", "tcp://"], "cannot reach the Dask scheduler at tcp://: "),
     (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "give either --scheduler or --workers, not both"),
     (["--workers", "0"], "workers must be a whole number within [1, 1,024], got 0"),
     (["--scheduler", ""], "scheduler must be an address such as 'tcp://host:8786', got ''"),
@@ -326,7 +329,8 @@ def test_where_the_runs_go_is_checked_before_anything_is_printed(tmp_path, capsy
     path.write_text("[base]\nfreq = '30min'\n[grid]\nseed = [0, 1]\n")
     assert main(["sweep", str(path), "--out", str(tmp_path / "out"), *flags]) == 2
     printed = capsys.readouterr()
-    assert printed.out == "" and printed.err == f"hybridtrack: error: {message}\n"
+    assert printed.out == "" and printed.err.startswith(f"hybridtrack: error: {message}")
+    assert printed.err.count("\n") == 1 and printed.err.endswith("\n")
     assert not (tmp_path / "out").exists()
 
 

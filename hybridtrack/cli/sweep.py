@@ -29,13 +29,15 @@ def _sweep(args: argparse.Namespace) -> int:
     # a folder that cannot be used fails now, not after the runs
     claim([*sweep_files(args.out).values(), partial_file(args.out)])
     runs = len(sweep.runs())
-    print(f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}")
+    heading = f"{args.file}: {runs} run{'s' if runs != 1 else ''} over {', '.join(sweep.grid)}"
     # the folder is this sweep's while its runs run: another sweep into it is refused before its
     # own runs (both had passed the check of the empty folder, and the one that ended second lost
     # its files to the other's, or with --force wrote its table beside the other's sweep.toml)
     with held(sweep_files(args.out)["table"].parent):
         try:
-            table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers)
+            # said once the runs have somewhere to go: a scheduler that cannot be reached is the one line
+            table = run_sweep(sweep, scheduler=args.scheduler, workers=args.workers,
+                              started=lambda: print(heading, flush=True))
         except SweepInterrupted as stopped:  # said as what stopped it: Ctrl-C (130) or SIGTERM (143)
             raise type(stopped.stop or KeyboardInterrupt())(_keep_finished(stopped, args.out)) from None
     written = save_sweep(table, sweep, args.out)  # it claims its files again, as any run may now
