@@ -144,6 +144,7 @@ def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str
     step = parse_freq(freq)
     params.seed(seed)
     days = (last - first).days + 1
+    _check_options(site, first, step, weather, freq, options)
 
     def each():
         for k in range(days):
@@ -152,6 +153,25 @@ def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str
 
     return DaySource(site, f"{first} to {last}, {weather} (synthetic, each day seeded from ({seed}, date))",
                      days * int(pd.Timedelta(days=1) // step), days, each)
+
+
+def _check_options(site, first: dt.date, step: pd.Timedelta, weather: str, freq: str, options: dict) -> None:
+    """Refuse `synthetic_days`' options as `synthetic` would, on two steps of the first day: an
+    unknown one was a TypeError out of the run's first day, after the run had claimed its folder."""
+    import inspect
+
+    from .sky import synthetic
+
+    known = sorted(name for name, p in inspect.signature(synthetic).parameters.items()
+                   if p.kind is p.KEYWORD_ONLY and name not in ("weather", "freq", "seed"))
+    for name in options:
+        if name not in known:
+            raise HybridtrackError(f"synthetic_days: unknown option {name!r}; it takes {', '.join(known)}")
+    start = pd.Timestamp(first)
+    try:
+        synthetic(site, start, start + step, weather=weather, freq=freq, seed=0, **options)
+    except (TypeError, ValueError) as exc:  # a value of the wrong shape (gust_peak="strong")
+        raise HybridtrackError(f"synthetic_days: options {options!r:.80}: {exc}") from None
 
 
 def _by_day(pieces: Iterator[pd.DataFrame], site: sites.Site, where: str) -> Iterator[tuple[dt.date, pd.DataFrame]]:

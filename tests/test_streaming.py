@@ -580,3 +580,16 @@ def test_callbacks_that_are_not_callable_are_refused_before_anything_is_written(
     with pytest.raises(HybridtrackError, match=message):
         stream(_two_days(), tmp_path / "run", **arguments)
     assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("options, message", [
+    # a TypeError out of the first day, after the run had claimed its folder
+    ({"colour": "red"}, r"synthetic_days: unknown option 'colour'; it takes climate, gust_peak, gusts_per_day, "
+                        r"wind_mean"),
+    ({"gusts_per_day": -1}, r"gusts_per_day = -1 is outside \[0, 200\]"),
+    ({"weather": "sunny", "end": "2021-06-21", "seed": 0, "gust_peak": "strong"}, r"gust_peak"),
+])
+def test_a_synthetic_sources_options_are_checked_when_it_is_made(tmp_path, options, message):
+    end = options.pop("end", None)
+    with pytest.raises(HybridtrackError, match=message):
+        synthetic_days("lanzhou", "2021-06-21", end, freq="30min", **options)
