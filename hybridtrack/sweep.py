@@ -96,8 +96,10 @@ class Sweep:
             raise HybridtrackError(f"{source}: {unknown[0]}: unknown table; a sweep has [base], [grid] and [plot]")
         base = dict(_table_of_text_keys(data.get("base", {}), source, "[base]"))
         config = _table_of_text_keys(base.pop("config", {}), source, "[base.config]")
-        base = _dotted(base, source, "base")
-        grid = _dotted(_table_of_text_keys(data.get("grid", {}), source, "[grid]"), source, "grid")
+        base = {k: _written(v, f"base.{k}", source) for k, v in _dotted(base, source, "base").items()}
+        config = _written(config, "base.config", source)
+        grid = {k: _written(v, f"grid.{k}", source)
+                for k, v in _dotted(_table_of_text_keys(data.get("grid", {}), source, "[grid]"), source, "grid").items()}
         plot = _table_of_text_keys(data.get("plot", {}), source, "[plot]")
         for key in base:
             _check_key(key, source, "base")
@@ -175,6 +177,24 @@ def _dotted(table: dict, source: str, name: str) -> dict:
 
     add("", table)
     return flat
+
+
+def _written(value, where: str, source: str):
+    """`value` as its sweep file holds it: numpy's numbers as the Python numbers they are (a grid
+    of ``list(np.arange(3))``), tuples as lists; refused if TOML cannot hold it. Each ran every
+    run, then failed with a TypeError writing ``sweep.toml``, after the table."""
+    import datetime as dt
+
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, (list, tuple)):
+        return [_written(v, where, source) for v in value]
+    if isinstance(value, dict):
+        return {k: _written(v, f"{where}.{k}", source) for k, v in value.items()}
+    if isinstance(value, (bool, int, float, str, dt.date, dt.time)):
+        return value
+    raise HybridtrackError(f"{source}: {where}: {value!r:.60} cannot be written in a sweep file; a sweep holds "
+                           "text, numbers, true or false, dates and times, lists and tables (as TOML)")
 
 
 def _alike(value):

@@ -670,3 +670,24 @@ def test_a_second_sweep_into_the_folder_a_sweep_is_writing_is_refused_before_it_
     assert main(["sweep", str(path), "--out", out, "--workers", "1"]) == 0
     assert second == [2] and "another run is writing there now" in capsys.readouterr().err
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["runs.parquet", "sweep.toml", "tradeoff.png"]
+
+
+def test_a_grid_made_with_numpy_is_taken_as_the_numbers_it_holds_and_round_trips(tmp_path):
+    """seed = list(np.arange(3)) ran every run, then save_sweep raised TypeError (int64 is not TOML
+    serializable) writing sweep.toml: a traceback, after the table, where a sweep file belongs."""
+    sweep = Sweep.from_dict({"base": {"days": np.int64(1)}, "grid": {"seed": list(np.arange(3)),
+                                                                      "collector.aim": [[np.int64(0), 20.0, 100.0]]}})
+    assert sweep.grid["seed"] == [0, 1, 2] and all(type(v) is int for v in sweep.grid["seed"])
+    assert type(sweep.base["days"]) is int and type(sweep.grid["collector.aim"][0][0]) is int
+    assert Sweep.from_toml(sweep.to_toml(tmp_path / "s.toml")).to_dict() == sweep.to_dict()
+
+
+@pytest.mark.parametrize("data, message", [
+    ({"grid": {"seed": [0, None]}}, r"s.toml: grid.seed: None cannot be written in a sweep file"),
+    ({"base": {"weather": object}, "grid": {"seed": [0]}}, r"s.toml: base.weather: <class 'object'> cannot be written"),
+    ({"base": {"config": {"drive": {"deadband": np.float64(0.3), "period": None}}}, "grid": {"seed": [0]}},
+     r"s.toml: base.config.drive.period: None cannot be written in a sweep file"),
+])
+def test_a_value_a_sweep_file_cannot_hold_is_refused_before_any_run(data, message):
+    with pytest.raises(HybridtrackError, match=message):
+        Sweep.from_dict(data, source="s.toml")
