@@ -717,8 +717,10 @@ def save_sweep(table: pd.DataFrame, sweep: Sweep, folder) -> dict[str, Path]:
             colour = next(iter(sweep.grid))
             figure = plot_tradeoff(table, sweep.x, sweep.y, colour=colour, title=Path(sweep.source).stem)
             write(written["plot"], lambda path: figure.savefig(path, dpi=120))
-    except HybridtrackError as exc:
+    except BaseException as exc:  # a Ctrl-C amid a long plot too: no earlier sweep's files beside this table
         for stale in (written["sweep"], written["plot"]):
             stale.unlink(missing_ok=True)
-        raise HybridtrackError(f"{exc}; the runs are in {written['table']}") from None
+        if isinstance(exc, HybridtrackError):
+            raise HybridtrackError(f"{exc}; the runs are in {written['table']}") from None
+        raise
     return written

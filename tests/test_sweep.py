@@ -462,6 +462,30 @@ def test_a_plot_that_cannot_be_written_leaves_no_earlier_sweeps_files_beside_the
     pd.testing.assert_frame_equal(pd.read_parquet(out / "runs.parquet"), table)
 
 
+@pytest.mark.parametrize("stop", [KeyboardInterrupt(), ValueError("a plot matplotlib cannot draw")])
+def test_a_plot_stopped_by_ctrl_c_or_an_error_leaves_no_earlier_sweeps_files_beside_the_new_table(tmp_path,
+                                                                                                   monkeypatch, stop):
+    """Only a HybridtrackError removed them: a Ctrl-C while 100,000 points were drawn, or any other
+    error, left the earlier sweep's sweep.toml and plot beside the new table."""
+    import hybridtrack.sweep as sweep_module
+    from hybridtrack.sweep import save_sweep
+
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("runs.parquet", "sweep.toml", "tradeoff.png"):
+        (out / name).write_text("the earlier sweep's\n")
+
+    def stopped(*args, **kwargs):
+        raise stop
+
+    monkeypatch.setattr(sweep_module, "plot_tradeoff", stopped)
+    table = pd.DataFrame({"run": [0, 1], "seed": [0, 1], "rms": [0.1, 0.2], "moves": [3, 4]})
+    with pytest.raises(type(stop)):
+        save_sweep(table, Sweep.from_dict({"grid": {"seed": [0, 1]}}), out)
+    assert sorted(p.name for p in out.iterdir()) == ["runs.parquet"]
+    pd.testing.assert_frame_equal(pd.read_parquet(out / "runs.parquet"), table)
+
+
 @pytest.mark.parametrize("signal_name, status, said", [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated")])
 def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_path, signal_name, status, said):
     """A terminal's Ctrl-C reaches the whole process group: each Dask worker printed distributed's
