@@ -233,6 +233,12 @@ def frame_days(frame: pd.DataFrame, site) -> DaySource:
     site = sites.get(site)
     if not isinstance(frame, pd.DataFrame) or not isinstance(frame.index, pd.DatetimeIndex) or frame.index.tz is None:
         raise HybridtrackError("the weather frame must be a DataFrame on a tz-aware DatetimeIndex")
+    back = np.flatnonzero(np.diff(frame.index.as_unit("ns").asi8) <= 0)
+    if len(back):  # judged before its span, which a frame backwards or its days swapped gets wrong
+        row, stamp, before = int(back[0]) + 1, frame.index[back[0] + 1], frame.index[back[0]]
+        what = "repeats" if stamp == before else "goes back"
+        raise HybridtrackError(f"the weather frame's time {what} at row {row} ({stamp} after {before}); sort it "
+                               "(frame.sort_index()) and drop repeated stamps")
     local = frame.index.tz_convert(site.tz)
     days = len(np.unique(_local_days(frame.index, site.tz)))
     covered = (frame.index[-1] - frame.index[0]) + (frame.index[1] - frame.index[0]) if len(frame) > 1 else None

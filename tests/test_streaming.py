@@ -593,3 +593,14 @@ def test_a_synthetic_sources_options_are_checked_when_it_is_made(tmp_path, optio
     end = options.pop("end", None)
     with pytest.raises(HybridtrackError, match=message):
         synthetic_days("lanzhou", "2021-06-21", end, freq="30min", **options)
+
+
+@pytest.mark.parametrize("order", [slice(None, None, -1), np.r_[144:288, 0:144]])
+def test_a_frame_out_of_order_is_refused_as_such(order):
+    """A frame backwards, or its days swapped, was refused as spanning less than a whole day
+    ("the frame spans 2021-06-21 23:50 to 2021-06-20 00:00"): true of no day in it."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic("lanzhou", "2021-06-20", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    with pytest.raises(HybridtrackError, match="the weather frame's time goes back at row [0-9]+ .2021-06-2"):
+        frame_days(frame.iloc[order], "lanzhou")
