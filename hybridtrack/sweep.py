@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 
 from . import params
-from .cluster import WorkersGone, close, dask_client, finished, holding_interrupts
+from .cluster import WorkersGone, check_where, close, cores, dask_client, finished, holding_interrupts
 from .errors import HybridtrackError, blamed
 from .outputs import claim, output_folder, removing_empty_folders, together, write
 
@@ -526,6 +526,7 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         Address of a running Dask scheduler (``tcp://host:8786``); by default a local cluster.
     workers : int, optional
         Worker processes of the local cluster, one thread each; the machine's cores by default.
+        Never more than the sweep has runs.
     progress : bool
         A progress bar over runs on stderr.
     started : callable, optional
@@ -539,6 +540,9 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     if started is not None and not callable(started):
         raise HybridtrackError(f"run_sweep: started must be a callable or None, got {started!r:.60}")
     runs = sweep.runs()
+    check_where(scheduler, workers)
+    if scheduler is None:  # a local cluster starts no worker without a run to do (64 for 2 runs had)
+        workers = min(cores() if workers is None else workers, len(runs))
     client, cluster = dask_client(scheduler, workers, what="sweeps")
     rows = []
     stop = None

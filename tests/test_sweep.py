@@ -715,3 +715,25 @@ def test_a_grid_made_with_numpy_is_taken_as_the_numbers_it_holds_and_round_trips
 def test_a_value_a_sweep_file_cannot_hold_is_refused_before_any_run(data, message):
     with pytest.raises(HybridtrackError, match=message):
         Sweep.from_dict(data, source="s.toml")
+
+
+@pytest.mark.parametrize("workers, runs, started", [(None, 2, 2), (8, 3, 3), (1, 3, 1), (2, 5, 2)])
+def test_a_local_cluster_starts_no_more_workers_than_the_sweep_has_runs(monkeypatch, workers, runs, started):
+    """A 2-run sweep on a 64-core machine started 64 worker processes (each a Python with numba and
+    pandas imported), 62 of them idle, and waited for all of them to start."""
+    from hybridtrack import sweep as module
+
+    asked = []
+
+    class Stop(Exception):
+        pass
+
+    def dask_client(scheduler, count, **options):
+        asked.append(count)
+        raise Stop
+
+    monkeypatch.setattr(module, "dask_client", dask_client)
+    monkeypatch.setattr(module, "cores", lambda: 64)
+    with pytest.raises(Stop):
+        run_sweep(Sweep.from_dict({"grid": {"seed": list(range(runs))}}), workers=workers, progress=False)
+    assert asked == [started]
