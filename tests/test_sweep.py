@@ -737,3 +737,14 @@ def test_a_local_cluster_starts_no_more_workers_than_the_sweep_has_runs(monkeypa
     with pytest.raises(Stop):
         run_sweep(Sweep.from_dict({"grid": {"seed": list(range(runs))}}), workers=workers, progress=False)
     assert asked == [started]
+
+
+def test_a_sweep_without_a_point_to_plot_says_so_not_pandas_empty_frame(tmp_path, capsys):
+    """Every run failed: 'Pareto front of moves against rms (0 of 0 runs):' was followed by pandas'
+    'Empty DataFrame / Columns: [...] / Index: []'."""
+    path = tmp_path / "s.toml"
+    path.write_text("[base]\nfreq = '30min'\n[grid]\n\"drive.deadband\" = [-1, 20]\n")
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--workers", "1"]) == 2
+    printed = capsys.readouterr().out
+    assert "Empty DataFrame" not in printed and "Index: []" not in printed
+    assert "Pareto front of moves against rms: no run has both (2 runs failed)\n" in printed

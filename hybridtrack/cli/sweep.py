@@ -45,8 +45,12 @@ def _sweep(args: argparse.Namespace) -> int:
     failed = table[table["error"].notna()]
     keys = [k for k in ("run", *sweep.grid) if k in table]
     front = pareto_front(table, sweep.x, sweep.y)
-    print(f"Pareto front of {sweep.x} against {sweep.y} ({len(front)} of {len(table) - len(failed)} runs):")
-    print(front[keys + [sweep.x, sweep.y]].to_string(index=False))
+    if len(front):
+        print(f"Pareto front of {sweep.x} against {sweep.y} ({len(front)} of {len(table) - len(failed)} runs):")
+        print(front[keys + [sweep.x, sweep.y]].to_string(index=False))
+    else:  # every run failed, or none has both metrics (no sun): not pandas' "Empty DataFrame"
+        print(f"Pareto front of {sweep.x} against {sweep.y}: no run has both ({len(failed)} run"
+              f"{'s' if len(failed) != 1 else ''} failed)")
     if len(failed):
         print(f"{len(failed)} run{'s' if len(failed) != 1 else ''} failed:")
         for _, row in failed.head(10).iterrows():
