@@ -404,6 +404,23 @@ def test_a_streamed_file_without_wind_is_tracked_through_as_in_memory(tmp_path, 
     assert summary["energy_capture"] > 0.9 and summary["mode_share"].get("stow_wind", 0.0) == 0.0
 
 
+@pytest.mark.parametrize("flags, named", [
+    (["--step", "30min"], "--step is not taken"),  # had run at the file's own 10 minutes without a word
+    (["--dayfirst"], "--dayfirst/--monthfirst is not taken"),
+    (["--lenient", "--decomposition", "dirint"], "--decomposition, --lenient are not taken"),
+    (["--map", "dni=DNI", "--units", "dni=kW/m2"], "--map, --units are not taken"),
+])
+def test_a_streamed_replay_refuses_the_record_readers_flags_it_would_not_take(tmp_path, capsys, flags, named):
+    frame = synthetic_days(SITE, "2021-06-21", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    path = tmp_path / "weather.csv"
+    next(iter(frame))[1].rename_axis("time").to_csv(path)
+    run = tmp_path / "run"
+    assert main(["replay", str(path), "--site", SITE, "--stream", "--out", str(run), *flags]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and named in err[0] and "run it without --stream" in err[0]
+    assert not run.exists()
+
+
 def test_a_failed_forced_rerun_leaves_the_earlier_run_whole(tmp_path, capsys):
     """--force replaces a finished run when the new one finishes; if the new run stops, the folder
     must not pair its partial log with the old run's summary.json: the old run is left as it was."""

@@ -177,7 +177,8 @@ def _replay_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="recorded weather file (CSV or a pvlib format)")
     add_site_arguments(parser, record=True)
     add_record_arguments(parser)
-    parser.add_argument("--step", default="1min", help="control step the record is resampled to (default 1min)")
+    parser.add_argument("--step", default=None, help="control step the record is resampled to (default 1min; not "
+                                                     "with --stream, which runs a frame at its own step)")
     add_run_arguments(parser)
     _add_stream_argument(parser, "a weather frame saved as .parquet or .csv (its own step, read as written: a "
                                  "value the reader would repair, such as a negative or impossible irradiance, is "
@@ -186,7 +187,7 @@ def _replay_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _replay_frame(args: argparse.Namespace):
     site = site_from_arguments(args)
-    frame = read_record(args, args.file, site=site, freq=args.step)
+    frame = read_record(args, args.file, site=site, freq=args.step or "1min")
     from ..io import validation_report
 
     print(validation_report(frame))
@@ -211,14 +212,31 @@ def _has_wind(frame) -> bool:
     return "wind_speed" in frame.columns and bool(np.isfinite(frame["wind_speed"].to_numpy(float)).any())
 
 
+#: The flags of a record's reading and resampling, by the argument each sets and its unset value:
+#: a streamed replay reads a weather frame as saved, at its own step, so none of them is taken.
+_READING_FLAGS = (("--map", "map", None), ("--units", "units", None), ("--format", "format", None),
+                  ("--step", "step", None), ("--dayfirst/--monthfirst", "dayfirst", None),
+                  ("--decomposition", "decomposition", "erbs"), ("--strict", "strict", False),
+                  ("--lenient", "lenient", False))
+
+
+def _refuse_reading_flags(args: argparse.Namespace) -> None:
+    """Refuse with ``--stream`` the flags it would not take (``--step 30min`` had run the file at
+    its own 10-minute step without a word; ``--dayfirst``, ``--lenient`` and the rest likewise)."""
+    given = [flag for flag, name, unset in _READING_FLAGS if getattr(args, name) != unset]
+    if given:
+        raise HybridtrackError(f"--stream reads a weather frame as saved (a time index, dni, ...), at its own step: "
+                               f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} not taken; convert the "
+                               "record once with read_weather (resampled to the step you want), or run it without "
+                               "--stream")
+
+
 @command("replay", "run a tracker over a recorded weather file", _replay_arguments)
 def _replay(args: argparse.Namespace) -> int:
     if args.stream:
         from ..streaming import recorded_days
 
-        if args.map or args.units or args.format:
-            raise HybridtrackError("--stream reads a weather frame as saved (a time index, dni, ...): --map, --units "
-                                   "and --format are not taken; convert the record once with read_weather")
+        _refuse_reading_flags(args)
         site = site_from_arguments(args)
         source = recorded_days(args.file, site, tz=args.tz)
         config = replay_config(args, source.wind_measured)
