@@ -48,8 +48,8 @@ def number(value, name: str, low: float = -math.inf, high: float = math.inf, *, 
     float
     """
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not _finite(value):
-        raise HybridtrackError(f"{name} must be a finite number within {_range(low, high, above)}, got "
-                               f"{value!r:.60}")
+        bounded = f" within {_range(low, high, above)}" if math.isfinite(low) or math.isfinite(high) else ""
+        raise HybridtrackError(f"{name} must be a finite number{bounded}, got {value!r:.60}")
     if value < low or value > high or (above and value == low):
         raise HybridtrackError(f"{name} = {value!r} is outside {_range(low, high, above)}")
     return float(value)

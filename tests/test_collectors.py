@@ -217,8 +217,9 @@ def test_a_trough_on_no_named_axis_needs_its_axis():
 
     with pytest.raises(HybridtrackError, match="a trough needs its axis_azimuth"):
         Collector("trough")
-    for axis in (np.nan, None, "0"):
-        with pytest.raises(HybridtrackError, match="trough_kind: axis_azimuth"):
+    for axis in (np.nan, None, "0", np.array([0.0, 90.0])):  # no range to name: "within [-inf, inf]" had been said
+        with pytest.raises(HybridtrackError, match=r"^trough_kind: axis_azimuth \(degrees from north\) must be a "
+                                                   r"finite number, got "):
             trough_kind(axis)
 
 
