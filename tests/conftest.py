@@ -2,6 +2,13 @@
 
 import pvlib
 import pytest
+from hypothesis import settings
+
+# No property test is timed (the suite has no timed test): Hypothesis's default 200 ms deadline
+# failed a property's first example on a cold call (the fuzzy engine built, a cache loaded) when
+# its module ran alone on a busy machine.
+settings.register_profile("untimed", deadline=None)
+settings.load_profile("untimed")
 
 
 @pytest.fixture
