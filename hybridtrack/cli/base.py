@@ -170,15 +170,31 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
                        help="refuse the file at the first thing the checks would repair (default: repair and report)")
     group.add_argument("--lenient", action="store_true",
                        help="warn instead of refusing when the light does not follow the site's sun")
+    group.add_argument("--fill-nights", action="store_true",
+                       help="put back the nights a logger left out (irradiance 0 with the sun down, wind carried "
+                            "across), so that each morning is pre-positioned as a PLC scanning all night would")
 
 
 def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | None = None):
-    """`read_weather` with the flags of `add_record_arguments` (``--tz`` is the file's zone)."""
-    from ..io import read_weather
+    """`read_weather` with the flags of `add_record_arguments` (``--tz`` is the file's zone); with
+    ``--fill-nights`` the nights the file leaves out put back (`hybridtrack.io.fill_nights`),
+    without it those nights named in the report."""
+    from ..io import fill_nights, read_weather
+    from ..io.nights import night_gaps
 
-    return read_weather(path, columns=parse_mapping(args.map, "--map"), tz=args.tz, format=args.format, site=site,
-                        units=parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition,
-                        strict=args.strict, dayfirst=args.dayfirst, lenient=args.lenient)
+    frame = read_weather(path, columns=parse_mapping(args.map, "--map"), tz=args.tz, format=args.format, site=site,
+                         units=parse_mapping(args.units, "--units"), freq=freq, decomposition=args.decomposition,
+                         strict=args.strict, dayfirst=args.dayfirst, lenient=args.lenient)
+    if args.fill_nights:
+        if site is None:
+            raise HybridtrackError("--fill-nights needs the site whose sun says when it is night: give --site")
+        return fill_nights(frame, site)
+    left_out = night_gaps(frame, site) if site is not None and len(frame) > 1 else 0
+    if left_out:
+        frame.attrs["validation"]["nights_left_out"] = (
+            f"{left_out} (no rows between an evening and the next morning: each morning's slew from stow is "
+            "scored, as no PLC scanning all night would show; --fill-nights puts them back)")
+    return frame
 
 
 def add_force_argument(parser: argparse.ArgumentParser) -> None:

@@ -217,7 +217,7 @@ def _has_wind(frame) -> bool:
 _READING_FLAGS = (("--map", "map", None), ("--units", "units", None), ("--format", "format", None),
                   ("--step", "step", None), ("--dayfirst/--monthfirst", "dayfirst", None),
                   ("--decomposition", "decomposition", "erbs"), ("--strict", "strict", False),
-                  ("--lenient", "lenient", False))
+                  ("--lenient", "lenient", False), ("--fill-nights", "fill_nights", False))
 
 
 def _refuse_reading_flags(args: argparse.Namespace) -> None:

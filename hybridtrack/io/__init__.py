@@ -15,6 +15,7 @@ One module per concern:
 ``suncheck``   the light against the site's sun: light at night, an offset daily curve
 ``gapfill``    missing components by closure, Erbs or DIRINT (pvlib, true zenith)
 ``resample``   to any step
+``nights``     the nights a logger left out, put back (`fill_nights`)
 ``report``     `validation_report`
 ``weather``    `read_weather`, which runs them in that order
 
@@ -25,9 +26,10 @@ from .checks import LIMITS
 from .columns import ALIASES, IRRADIANCE, LABEL_COLUMN, WEATHER_COLUMNS
 from .files import read_text, read_toml, write_toml
 from .formats import PVLIB_FORMATS
+from .nights import fill_nights
 from .report import validation_report
 from .tables import numeric_columns, read_table, table_row
 from .weather import read_weather
 
-__all__ = ["read_weather", "read_table", "read_toml", "write_toml", "read_text", "numeric_columns", "table_row",
+__all__ = ["read_weather", "fill_nights", "read_table", "read_toml", "write_toml", "read_text", "numeric_columns", "table_row",
            "validation_report", "WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "PVLIB_FORMATS", "LIMITS"]

@@ -18,7 +18,8 @@ ISSUES = ("unreadable", "missing_markers", "truncated", "dst_dropped", "unsorted
           "impossible", "light_at_night", "wind_missing", "empty_dropped")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
-             "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING"}
+             "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING",
+             "nights_left_out": "nights left out"}
 
 _CHANGES = {
     "padding": "dropped (NUL bytes after the text: a logger card's unwritten tail)",
@@ -29,6 +30,7 @@ _CHANGES = {
     "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
     "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",
     "empty_dropped": "dropped (irradiance column without a readable value)", "filled": "filled",
+    "nights_filled": "put back (the nights the logger left out, --fill-nights)",
 }
 
 
