@@ -63,6 +63,20 @@ def test_a_frame_that_leaves_no_night_out_is_left_as_it_is(days):
         fill_nights(full.tz_localize(None), SITE)
 
 
+def test_a_logger_down_by_day_as_well_is_no_night_to_fill(days):
+    """A gap with more than `TWILIGHT` of daylight in it (a logger dead from noon to noon; a file
+    that starts at 13:00) holds light nobody can tell: left as a gap, not drawn as a line."""
+    _, day = days
+    dead = day.drop(day.loc["2021-06-22 12:00":"2021-06-23 12:00"].index)
+    filled = fill_nights(dead, SITE)
+    assert night_gaps(dead, SITE) == 1 and filled.attrs["validation"]["nights_filled"]["nights"] == 1
+    assert not filled.index.isin(pd.date_range("2021-06-22 12:01", "2021-06-23 11:59", freq="min",
+                                               tz="Asia/Shanghai")).any()
+    late = fill_nights(day.loc["2021-06-21 13:00":], SITE)
+    assert late.index[0] == pd.Timestamp("2021-06-21 13:00", tz="Asia/Shanghai")
+    assert late.attrs["validation"]["nights_filled"]["ends of the first and last days"] == 1  # the last evening's
+
+
 def test_replay_names_the_nights_left_out_and_puts_them_back_when_asked(tmp_path, capsys, days):
     _, day = days
     path = tmp_path / "day.csv"

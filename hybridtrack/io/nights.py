@@ -15,8 +15,9 @@ frame's own step:
   collector all night and hold it in the morning (missing wind is never calm);
 * any other column missing.
 
-A gap is a night when the sun is down at one of its instants at least; gaps by day are left
-as they are (the reader reports them). So are the first day's start before the first reading
+A gap is a night when the sun is down at one of its instants at least and up for no longer than
+`TWILIGHT`; gaps by day, and a logger down for a day or more, are left as they are (the reader
+reports them). So are the first day's start before the first reading
 and the last day's end after the last (local midnight to midnight, as a PLC's day runs), so that
 the first morning is pre-positioned too. Every row put back is counted in the validation report.
 """
@@ -30,7 +31,13 @@ from .. import sites
 from ..errors import HybridtrackError
 from .columns import IRRADIANCE
 
-__all__ = ["fill_nights", "night_gaps"]
+__all__ = ["fill_nights", "night_gaps", "TWILIGHT"]
+
+#: The longest the sun may be up within a gap filled as a night: the twilight either side that a
+#: logger's light threshold leaves out (the sun's first few degrees take half an hour to an hour at
+#: mid-latitudes, longer towards the poles). A gap with more daylight in it is a logger down by
+#: day as well, whose light nobody can tell: left as a gap.
+TWILIGHT = pd.Timedelta(hours=3)
 
 
 def _step(index: pd.DatetimeIndex) -> pd.Timedelta:
@@ -58,13 +65,23 @@ def _sun_down(instants: pd.DatetimeIndex, site) -> np.ndarray:
     return solar_position(instants, site, "plc")["apparent_altitude"].to_numpy(float) < 0.0
 
 
+def _nights(owner: np.ndarray, down: np.ndarray, step: pd.Timedelta) -> np.ndarray:
+    """The gaps (by owner) with the sun down at one instant at least and up for `TWILIGHT` at most."""
+    dark = np.unique(owner[down])
+    up = pd.Series(~down).groupby(owner).sum()
+    return dark[(up.reindex(dark).to_numpy() * step) <= TWILIGHT]
+
+
 def night_gaps(frame: pd.DataFrame, site) -> int:
     """How many gaps of `frame` hold a night (the site's sun down at one instant of its step
     at least): the nights a logger left out."""
     index, site = _checked(frame), sites.get(site)
-    instants, owner = _instants(index, _step(index), site.tz)
-    inner = (owner >= 0) & (owner < len(index))  # between two readings: the day's edges are no night left out
-    return len(np.unique(owner[inner & _sun_down(instants, site)])) if inner.any() else 0
+    step = _step(index)
+    instants, owner = _instants(index, step, site.tz)
+    if not len(instants):
+        return 0
+    nights = _nights(owner, _sun_down(instants, site), step)
+    return int(((nights >= 0) & (nights < len(index))).sum())  # between two readings, not the days' ends
 
 
 def _checked(frame: pd.DataFrame) -> pd.DatetimeIndex:
@@ -100,9 +117,10 @@ def fill_nights(frame: pd.DataFrame, site) -> pd.DataFrame:
     """
     index = _checked(frame)
     site = sites.get(site)
-    instants, owner = _instants(index, _step(index), site.tz)
+    step = _step(index)
+    instants, owner = _instants(index, step, site.tz)
     down = _sun_down(instants, site) if len(instants) else np.zeros(0, bool)
-    nights = np.unique(owner[down])
+    nights = _nights(owner, down, step)
     keep = np.isin(owner, nights)
     added = instants[keep]
     attrs = {**frame.attrs, "validation": dict(frame.attrs.get("validation", {}))}
