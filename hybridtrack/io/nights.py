@@ -72,16 +72,26 @@ def _nights(owner: np.ndarray, down: np.ndarray, step: pd.Timedelta) -> np.ndarr
     return dark[(up.reindex(dark).to_numpy() * step) <= TWILIGHT]
 
 
+def _found(frame: pd.DataFrame, site) -> tuple:
+    """What both functions look at: the frame's index and step, the instants inside its gaps and
+    the days' ends, each one's gap, whether the sun is down at each, and the gaps that are nights."""
+    index = _checked(frame)
+    step = _step(index)
+    instants, owner = _instants(index, step, site.tz)
+    down = _sun_down(instants, site) if len(instants) else np.zeros(0, bool)
+    return index, step, instants, owner, down, _nights(owner, down, step)
+
+
+def _between_readings(nights: np.ndarray, rows: int) -> int:
+    """How many of `nights` lie between two readings (not the first day's start or the last's end)."""
+    return int(((nights >= 0) & (nights < rows)).sum())
+
+
 def night_gaps(frame: pd.DataFrame, site) -> int:
     """How many gaps of `frame` hold a night (the site's sun down at one instant of its step
     at least): the nights a logger left out."""
-    index, site = _checked(frame), sites.get(site)
-    step = _step(index)
-    instants, owner = _instants(index, step, site.tz)
-    if not len(instants):
-        return 0
-    nights = _nights(owner, _sun_down(instants, site), step)
-    return int(((nights >= 0) & (nights < len(index))).sum())  # between two readings, not the days' ends
+    index, *_, nights = _found(frame, sites.get(site))
+    return _between_readings(nights, len(index))
 
 
 def _checked(frame: pd.DataFrame) -> pd.DatetimeIndex:
@@ -115,15 +125,9 @@ def fill_nights(frame: pd.DataFrame, site) -> pd.DataFrame:
        Solar Energy 76(5), 577-589, 2004, doi:10.1016/j.solener.2003.12.003 (the sun below the
        horizon: no direct or diffuse light to fill but 0).
     """
-    index = _checked(frame)
-    site = sites.get(site)
-    step = _step(index)
-    instants, owner = _instants(index, step, site.tz)
-    down = _sun_down(instants, site) if len(instants) else np.zeros(0, bool)
-    nights = _nights(owner, down, step)
+    index, step, instants, owner, down, nights = _found(frame, sites.get(site))
     keep = np.isin(owner, nights)
     added = instants[keep]
-    attrs = {**frame.attrs, "validation": dict(frame.attrs.get("validation", {}))}
     if not len(added):
         return frame
     filled = frame.reindex(index.append(added).sort_values())
@@ -138,7 +142,8 @@ def fill_nights(frame: pd.DataFrame, site) -> pd.DataFrame:
             values = values.mask(dark & new, 0.0)
         through = values.interpolate(method="time", limit_area="inside").ffill().bfill()  # the edges: held
         filled[column] = values.where(~new, through)
-    inner = int(((nights >= 0) & (nights < len(index))).sum())
+    inner = _between_readings(nights, len(index))
+    attrs = {**frame.attrs, "validation": dict(frame.attrs.get("validation", {}))}
     attrs["validation"]["nights_filled"] = {
         "nights": inner, "ends of the first and last days": int(len(nights) - inner), "rows": int(len(added)),
         "how": "irradiance 0 with the sun down and a line to the day's readings; "
