@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from . import params, sites
-from .collectors import Collector, as_collector, within_turn
+from .collectors import GEOMETRY_KINDS, Collector, as_collector, within_turn
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
 from .control.clockwatch import ClockWatch
@@ -811,7 +811,8 @@ def _check_memory_form(memory: dict) -> None:
         refuse("commissioned must be a commissioned mount (MountEstimate)")
     origin = memory.get("origin")
     if origin is not None and (not isinstance(origin, dict) or set(origin) != set(_ORIGIN_KEYS)
-                               or not isinstance(origin["geometry"], dict) or not isinstance(origin["end"], pd.Timestamp) or origin["end"].tz is None):
+                               or not isinstance(origin["geometry"], dict)
+                               or not isinstance(origin["end"], pd.Timestamp) or origin["end"].tz is None):
         refuse("origin must say where and when the memory was left, as a run leaves it")
 
 
@@ -846,12 +847,11 @@ def collector_geometry(collector: Collector) -> dict:
     """What makes a collector of its kind the one it is, as its memory's origin records it: the
     axis in effect (degrees from north; a trough-ew on 90° turns the other way from one on 270°),
     a Fresnel row's distance and receiver height (m), a heliostat's aim (m)."""
-    if collector.kind == "heliostat":
-        return {"aim": tuple(float(x) for x in collector.aim)}
-    geometry = {"axis_azimuth": float(collector.axis)}
-    if collector.kind == "fresnel":
-        geometry.update(row_distance=float(collector.row_distance), receiver_height=float(collector.receiver_height))
-    return geometry
+    geometry = {name: getattr(collector, name) for name, kinds in GEOMETRY_KINDS.items() if collector.kind in kinds}
+    if "axis_azimuth" in geometry:
+        geometry["axis_azimuth"] = collector.axis  # the kind's own where none was given
+    return {name: tuple(map(float, value)) if isinstance(value, tuple) else float(value)
+            for name, value in geometry.items()}
 
 
 def _check_memory(memory: dict, collector: Collector) -> None:
