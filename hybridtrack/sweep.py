@@ -126,7 +126,7 @@ class Sweep:
         if x == y:  # one metric against itself: a diagonal, its "front" one point
             unsaid = "".join(f" ({axis} by default)" for axis in ("x", "y") if axis not in plot)
             raise HybridtrackError(f"{source}: plot.x and plot.y are both {x!r}{unsaid}; a trade-off needs two metrics")
-        return cls({**base, "config": config}, dict(grid), plot.get("x", "moves"), plot.get("y", "rms"), source)
+        return cls({**base, "config": config}, dict(grid), x, y, source)
 
     def to_dict(self) -> dict:
         """The sweep in its TOML layout; `from_dict` reads it back equal."""
