@@ -790,7 +790,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     """
     from .kernel import uses_kernel
     from .reuse import reuse_work
-    from .simulation import _check_frame, checked_config
+    from .simulation import _check_frame, checked_config, warn_of_nights_left_out
     from .sun import solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
@@ -804,6 +804,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     check_where(scheduler, workers, threads)  # before the sky is computed
     site = sites.get(site)
     frame = _check_frame(frame)
+    warn_of_nights_left_out(frame, site)
     if workers is not None:
         params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()

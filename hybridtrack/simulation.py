@@ -46,7 +46,7 @@ from .skyinputs import (SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy
 from .world import Imperfections, World, controller_clock, installed_site, scan_timer
 from .times import check_dates
 
-__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS"]
+__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS", "NightsLeftOutWarning"]
 #: The faults `simulate` can inject, with what each array holds.
 FAULTS = {
     "sensor": "(N,) or (N, axes): the reading the sensor gives (degrees); NaN where it works",
@@ -499,8 +499,36 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     -------
     Result
     """
+    warn_of_nights_left_out(frame, site)
     return _scored(track(frame, site, collector=collector, strategy=strategy, config=config, classifier=classifier,
                          faults=faults, progress=progress, bulk_nights=bulk_nights, warm_start=warm_start))
+
+
+class NightsLeftOutWarning(UserWarning):
+    """A weather frame leaves nights out (a logger that records by day only): each morning's slew
+    from stow is scored, as no PLC scanning all night would show (`hybridtrack.io.fill_nights`)."""
+
+
+def warn_of_nights_left_out(frame: pd.DataFrame, site) -> None:
+    """Warn (`NightsLeftOutWarning`) of the nights `frame` leaves out between its readings, unless
+    its validation report names them already (``read_weather``'s, from the command line's reader).
+    A day-only logger file had scored its hybrid tracker 0.70° RMS against 0.15° with its nights,
+    without a word from the API. A frame the run will refuse is left to the run to refuse."""
+    import warnings
+
+    from .io.nights import night_gaps
+
+    index = frame.index if isinstance(frame, pd.DataFrame) else None
+    if (not isinstance(index, pd.DatetimeIndex) or index.tz is None or len(index) < 2
+            or not index.is_monotonic_increasing or index.has_duplicates
+            or "nights_left_out" in frame.attrs.get("validation", {})):
+        return
+    left_out = night_gaps(frame, site)
+    if left_out:
+        warnings.warn(f"the frame leaves out {left_out} night{'s' if left_out > 1 else ''} (no rows between an "
+                      "evening and the next morning): each morning's slew from stow is scored, as no PLC scanning "
+                      "all night would show; hybridtrack.io.fill_nights(frame, site) puts them back",
+                      NightsLeftOutWarning, stacklevel=3)
 
 
 @dataclass

@@ -1,0 +1,69 @@
+"""The API says when a frame leaves nights out (`hybridtrack.simulation.NightsLeftOutWarning`): a
+day-only logger frame had scored each morning's slew from stow without a word."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from hybridtrack import simulate, simulate_field
+from hybridtrack.fields import FresnelField
+from hybridtrack.io import fill_nights, read_weather
+from hybridtrack.simulation import NightsLeftOutWarning
+from hybridtrack.sky import synthetic
+
+SITE = "lanzhou"
+
+
+@pytest.fixture(scope="module")
+def days():
+    """Three sunny days at 5 min, whole and cut to daylight (above 20 W/m² of global light), as a
+    logger with a light threshold writes them: two nights left out, by hand."""
+    full = synthetic(SITE, "2021-06-21", "2021-06-23", weather="sunny", seed=1, freq="5min")
+    return full, full[full["ghi"] > 20.0]
+
+
+def _nights_warned(run) -> list[str]:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run()
+    return [str(w.message) for w in caught if issubclass(w.category, NightsLeftOutWarning)]
+
+
+def test_a_day_only_frame_is_warned_of_with_its_nights_and_the_way_to_put_them_back(days):
+    _, day = days
+    with pytest.warns(NightsLeftOutWarning, match=r"^the frame leaves out 2 nights .*fill_nights") as caught:
+        simulate(day, SITE)
+    assert caught[0].filename == __file__  # the caller's line, not the package's
+    with pytest.warns(NightsLeftOutWarning, match=r"leaves out 2 nights"):
+        simulate_field(day, SITE, FresnelField(row_distances=[-4.0, 6.0]), keep_log=False)
+
+
+def test_whole_frames_and_frames_with_their_nights_put_back_are_not_warned_of(days):
+    full, day = days
+    assert _nights_warned(lambda: simulate(full, SITE)) == []
+    assert _nights_warned(lambda: simulate(fill_nights(day, SITE), SITE)) == []
+    # a frame that starts and ends by day leaves out no night between its readings
+    assert _nights_warned(lambda: simulate(full.between_time("06:00", "20:00").loc["2021-06-22"], SITE)) == []
+
+
+def test_a_gap_by_day_is_no_night_left_out(days):
+    full, _ = days
+    noon_gap = full.drop(full.loc["2021-06-22 11:00":"2021-06-22 13:00"].index)
+    assert _nights_warned(lambda: simulate(noon_gap, SITE)) == []
+
+
+def test_a_frame_whose_report_names_its_nights_is_not_warned_of_again(days, tmp_path):
+    """The command line's reader names them in the validation report already (``nights left out``)."""
+    _, day = days
+    path = tmp_path / "day.csv"
+    day[["ghi", "dni", "dhi", "wind_speed"]].to_csv(path)
+    frame = read_weather(path)
+    assert _nights_warned(lambda: simulate(frame, SITE)) == ["the frame leaves out 2 nights (no rows between an "
+                                                             "evening and the next morning): each morning's slew from "
+                                                             "stow is scored, as no PLC scanning all night would show; "
+                                                             "hybridtrack.io.fill_nights(frame, SITE) puts them back"
+                                                             .replace("SITE", "site")]
+    frame.attrs["validation"]["nights_left_out"] = "2"
+    assert _nights_warned(lambda: simulate(frame, SITE)) == []
+    assert np.isfinite(simulate(frame, SITE).summary["tracking_error_deg"]["rms"])
