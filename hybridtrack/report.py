@@ -9,9 +9,9 @@ and `save_figure` writes it to a file.
 from __future__ import annotations
 
 import datetime as dt
-
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
@@ -74,8 +74,6 @@ def _continuous_azimuth(azimuth):
 
     Returns the values and whether they were unwrapped.
     """
-    import numpy as np
-
     values = np.asarray(azimuth, float)
     finite = np.isfinite(values)
     if finite.sum() < 2 or not (np.abs(np.diff(values[finite])) > 180).any():
@@ -151,8 +149,6 @@ def plot_fuzzy_surface(classifier, *, points: int = 121, title: str | None = Non
     points : int
         Grid points along each input.
     """
-    import numpy as np
-
     from .fuzzy.engine import sample_term
 
     from matplotlib import colormaps
@@ -226,8 +222,6 @@ def _step(index: pd.DatetimeIndex) -> pd.Timedelta:
 
 def _gaps(index: pd.DatetimeIndex) -> list[tuple[int, int]]:
     """(last step before, first step after) of every gap longer than one and a half steps."""
-    import numpy as np
-
     if len(index) < 2:
         return []
     spacing = np.diff(index.to_numpy(dtype="datetime64[ns]").astype("int64"))  # ns, whatever the index's unit
@@ -236,8 +230,6 @@ def _gaps(index: pd.DatetimeIndex) -> list[tuple[int, int]]:
 
 def _broken(x, y, gaps):
     """`x`, `y` with a NaN after each gap's first side, so a line is not drawn across it."""
-    import numpy as np
-
     if not gaps:
         return x, np.asarray(y, float)
     cut = [g[1] for g in gaps]
@@ -252,8 +244,6 @@ def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0, colours:
     A run of one label ends at the next step or one step after its last, whichever is
     earlier, so a gap in the data stays unshaded.
     """
-    import numpy as np
-
     colours = SKY_COLOURS if colours is None else colours
     values = np.asarray(labels, dtype=object)
     if len(values) == 0:
@@ -270,8 +260,6 @@ def _label_band(ax, times, labels, *, y0: float = 0.0, y1: float = 1.0, colours:
 
 def _contiguous(times, first: int, stop: int, step):
     """Split steps ``first:stop`` where the spacing exceeds one and a half steps."""
-    import numpy as np
-
     t = np.asarray(times[first:stop])
     if np.issubdtype(t.dtype, np.datetime64):
         spacing, limit = np.diff(t.astype("datetime64[ns]")).astype("int64"), 1.5 * pd.Timedelta(step).value
@@ -312,7 +300,6 @@ def plot_sky(frame: pd.DataFrame, site, *, classifier=None, title: str | None = 
     classifier : FuzzyWeatherClassifier, optional
         The published one by default.
     """
-    import numpy as np
     from matplotlib.patches import Patch
 
     from .fuzzy import FuzzyWeatherClassifier
@@ -374,8 +361,6 @@ def plot_compare(results: dict, *, title: str | None = None):
     results : dict of str to Result
         One `hybridtrack.simulation.Result` per strategy, all on the same frame.
     """
-    import numpy as np
-
     first = next(iter(results.values()))
     local = first.log.index.tz_convert(first.site.tz).tz_localize(None)
     fig = figure(figsize=(12, 9), layout="constrained")
@@ -557,7 +542,6 @@ def _metrics_line(summary: dict) -> str:
 
 
 def _error_limit(error) -> float:
-    import numpy as np
 
     finite = np.abs(error[np.isfinite(error)])
     return float(max(1.0, min(np.quantile(finite, 0.99) * 1.3, 10.0))) if finite.size else 1.0
@@ -565,8 +549,6 @@ def _error_limit(error) -> float:
 
 def _draw_clipped(ax, x, error, limit: float, *, signed: bool) -> None:
     """Plot an error series clipped to ±`limit`, with the clipped steps marked and counted."""
-    import numpy as np
-
     over = np.isfinite(error) & (np.abs(error) > limit)
     ax.set_ylim(-limit * 1.08 if signed else 0, limit * 1.08)
     if over.any():
@@ -580,7 +562,6 @@ def _draw_clipped(ax, x, error, limit: float, *, signed: bool) -> None:
 
 
 def _plot_timeline(result, log: pd.DataFrame, title: str):
-    import numpy as np
 
     from .metrics import TRACKING_MODES
 
@@ -646,7 +627,6 @@ class _DayAxis:
     """
 
     def __init__(self, index: pd.DatetimeIndex, tz):
-        import numpy as np
 
         local = index.tz_convert(tz)
         dates = pd.DatetimeIndex(local.normalize().tz_localize(None))
@@ -664,7 +644,6 @@ class _DayAxis:
         self.minute = minute
 
     def slots(self, bins: int):
-        import numpy as np
 
         return np.minimum((self.minute * bins / 1440.0).astype(int), bins - 1)
 
@@ -710,8 +689,6 @@ class _DayAxis:
 
 def _category_grid(day, slot, shape, codes, count: int):
     """The most frequent category of each (time-of-day, day) cell; -1 where there is no step."""
-    import numpy as np
-
     counts = np.zeros((*shape, count), int)
     np.add.at(counts, (slot, day, codes), 1)
     grid = counts.argmax(axis=2)
@@ -721,7 +698,6 @@ def _category_grid(day, slot, shape, codes, count: int):
 
 def _rgb(grid, colours: list[str]):
     """RGBA image of a category grid; cells without data (-1) are transparent, so the hatch shows."""
-    import numpy as np
     from matplotlib.colors import to_rgba
 
     palette = np.array([to_rgba(c) for c in colours] + [(1.0, 1.0, 1.0, 0.0)])
@@ -738,7 +714,6 @@ def _hatch_background(ax, extent) -> None:
 
 
 def _plot_overview(result, title: str):
-    import numpy as np
     from matplotlib import colormaps
 
     from .metrics import TRACKING_MODES
@@ -834,8 +809,6 @@ def _legend_strip(ax, colours: dict, *, gaps: bool) -> None:
 
 def plot_days(result, *, days: int = 14):
     """One row per day (up to `days`): pointing error over a band of the mode, hours aligned."""
-    import numpy as np
-
     from .metrics import TRACKING_MODES
 
     log = result.log
@@ -890,7 +863,6 @@ def plot_tuning(before, after, samples: pd.DataFrame, *, points: int = 121):
     """
     import warnings
 
-    import numpy as np
     from matplotlib import colormaps
     from matplotlib.patches import Rectangle
 
@@ -938,7 +910,6 @@ def plot_confusion(before, after, samples: pd.DataFrame):
     """Confusion matrices (true label against the classifier's) of the starting and tuned configs."""
     import warnings
 
-    import numpy as np
 
     from .fuzzy import FuzzyWeatherClassifier
     from .fuzzy.classifier import UNKNOWN
@@ -980,7 +951,6 @@ def plot_rules(classifier, intensity: float, variation: float, *, title: str | N
     """
     import warnings
 
-    import numpy as np
 
     from .fuzzy.engine import sample_term
 
@@ -1038,7 +1008,13 @@ def plot_rules(classifier, intensity: float, variation: float, *, title: str | N
 
 def _moment(value, name: str, example: str) -> pd.Timestamp:
     """`value` (text, a date or a timestamp) as a timestamp, refused by `name` unless it is one: a
-    number had been read as nanoseconds since 1970, None as NaT, and 'junk' raised pandas' error."""
+    number had been read as nanoseconds since 1970, None as NaT, and 'junk' raised pandas' error.
+    A numpy datetime64 is refused with its reason: it has no zone, and the one a tz-aware index
+    gives (`Index.to_numpy`) is UTC, where naive text is the site's local time."""
+    if isinstance(value, np.datetime64):
+        raise HybridtrackError(f"{name} {value!r:.60} has no time zone (a tz-aware index's values are UTC as "
+                               f"numpy holds them): give a pandas Timestamp with its zone, or text in the site's "
+                               f"local time such as {example.removeprefix('a time such as ').removeprefix('a date such as ')}")
     if isinstance(value, (str, dt.date)):  # a datetime and a Timestamp are dates too
         try:
             stamp = pd.Timestamp(value)

@@ -124,6 +124,17 @@ def test_a_comparison_shows_each_run_by_its_own_summary(two_days):
     assert both.plot()._repr_png_()[:4] == b"\x89PNG"
 
 
+def test_explain_refuses_a_numpy_time_whose_zone_it_would_guess(two_days):
+    """A value of the log's index as numpy holds it is naive UTC (`Index.to_numpy`), where a naive
+    text is the site's local time: taken either way it could be 8 h off, so it is refused with why."""
+    stamp = two_days.events["time"].iloc[0]
+    with pytest.raises(HybridtrackError, match=r"^time np.datetime64\('.*' has no time zone .*UTC.*"
+                                               r"local time such as '2021-06-21 13:00'$"):
+        two_days.explain(stamp.tz_convert("UTC").tz_localize(None).to_datetime64())
+    with pytest.raises(HybridtrackError, match="has no time zone"):
+        two_days.plot(day=np.datetime64("2021-06-21"))
+
+
 def test_explain_outside_the_run_is_an_error(two_days):
     from hybridtrack import HybridtrackError
 
