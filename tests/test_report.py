@@ -128,7 +128,7 @@ def test_explain_refuses_a_numpy_time_whose_zone_it_would_guess(two_days):
     """A value of the log's index as numpy holds it is naive UTC (`Index.to_numpy`), where a naive
     text is the site's local time: taken either way it could be 8 h off, so it is refused with why."""
     stamp = two_days.events["time"].iloc[0]
-    with pytest.raises(HybridtrackError, match=r"^time np.datetime64\('.*' has no time zone .*UTC.*"
+    with pytest.raises(HybridtrackError, match=r"^time np.datetime64\('.*'\) has no time zone .*UTC.*"
                                                r"local time such as '2021-06-21 13:00'$"):
         two_days.explain(stamp.tz_convert("UTC").tz_localize(None).to_datetime64())
     with pytest.raises(HybridtrackError, match="has no time zone"):
