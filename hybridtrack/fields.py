@@ -43,7 +43,7 @@ from .collectors import (
 )
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
-from .outputs import claim, output_folder, removing_empty_folders, strict_json, together, write
+from .outputs import claim, output_folder, remove_earlier, removing_empty_folders, strict_json, together, write
 from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -663,9 +663,12 @@ class FieldResult:
     @removing_empty_folders()
     def save(self, folder, *, metric: str = "rms") -> dict[str, Path]:
         """Write ``collectors.csv``, ``events.csv``, ``summary.json`` (strict JSON), ``field_map.png``
-        and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`."""
+        and, when the logs were kept, ``log.nc`` (netCDF, the `dataset`); see `hybridtrack.outputs`.
+        Without the logs, an earlier save's ``log.nc`` is removed, as a file to replace is: left
+        there, it would be read as this field's."""
         written = self.files(folder, log=self.dataset is not None)
-        claim(written.values())
+        earlier = [] if self.dataset is not None else [self.files(folder)["log"]]
+        claim(written.values(), earlier=earlier)
         with together():  # all of this field's files, or none
             write(written["collectors"],
                   lambda path: self.collectors.to_csv(path, index_label="collector", float_format="%.6g"))
@@ -674,6 +677,7 @@ class FieldResult:
             write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
             if self.dataset is not None:
                 write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
+        remove_earlier(earlier)
         return written
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from . import params
 from .errors import HybridtrackError
 
-__all__ = ["claim", "held", "output_folder", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
+__all__ = ["claim", "remove_earlier", "held", "output_folder", "replacing", "removing_empty_folders", "write", "write_in_place", "together", "strict_json",
            "plain_numbers", "reader_may_leave"]
 
 _FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("hybridtrack_force", default=True)
@@ -89,7 +89,7 @@ def removing_empty_folders() -> Iterator[None]:
         _MADE.reset(token)
 
 
-def claim(paths: Iterable, *, folders: Iterable = ()) -> list[Path]:
+def claim(paths: Iterable, *, folders: Iterable = (), earlier: Iterable = ()) -> list[Path]:
     """Check the files about to be written, all before any is, and make their folders.
 
     Parameters
@@ -99,6 +99,11 @@ def claim(paths: Iterable, *, folders: Iterable = ()) -> list[Path]:
     folders : iterable of path
         Folders a run writes as one (a streamed run's segments), claimed as a file is: one that
         exists is replaced only as an existing file would be, and is named once.
+    earlier : iterable of path
+        Files this write leaves out that another writes (a log not kept, a plot not drawn): one
+        there is an earlier write's, which would be read as this one's. Such a regular file is
+        replaced as an existing file would be: refused under ``replacing(False)``, else removed
+        by `remove_earlier` once the new files are in place.
 
     Returns
     -------
@@ -122,10 +127,11 @@ def claim(paths: Iterable, *, folders: Iterable = ()) -> list[Path]:
             raise HybridtrackError(f"{folder} is a symbolic link; results are never written through one "
                                    "(remove it or write elsewhere)")
     existing = [path for path in (*paths, *folders) if path.exists()]
-    if existing and not _FORCE.get():
-        raise HybridtrackError(f"would replace {len(existing)} existing file{'s' if len(existing) > 1 else ''}: "
-                               f"{', '.join(map(str, existing))}; give --force to replace them, or write elsewhere")
-    replaced = _REPLACED.get()
+    refused = existing + earlier_files(earlier)
+    if refused and not _FORCE.get():
+        raise HybridtrackError(f"would replace {len(refused)} existing file{'s' if len(refused) > 1 else ''}: "
+                               f"{', '.join(map(str, refused))}; give --force to replace them, or write elsewhere")
+    replaced = _REPLACED.get()  # the command line names what it removes itself (`cli.base.leaving_out`)
     if replaced is not None:
         replaced.extend(p for p in existing if p not in replaced)
     for folder in dict.fromkeys(path.parent for path in paths):
@@ -133,6 +139,30 @@ def claim(paths: Iterable, *, folders: Iterable = ()) -> list[Path]:
         _make_folder(folder)
         _refuse_unwritable(folder, [path for path in paths if path.parent == folder])
     return paths
+
+
+def earlier_files(paths: Iterable) -> list[Path]:
+    """The regular files among `paths` (`claim`'s ``earlier``); a folder or a symbolic link of such
+    a name is nothing a write made, and is left as it is."""
+    return [path for path in map(output_path, paths) if path.is_file() and not path.is_symlink()]
+
+
+def remove_earlier(paths: Iterable) -> list[Path]:
+    """Remove `earlier_files` of `paths`, once a write's own files are in place; return them.
+
+    Raises
+    ------
+    HybridtrackError
+        If one cannot be removed: it names the file, and says the files beside it are new.
+    """
+    removed = earlier_files(paths)
+    for path in removed:
+        try:
+            path.unlink(missing_ok=True)
+        except OSError as exc:
+            raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed ({exc.strerror or exc}); "
+                                   "the results beside it are this run's") from None
+    return removed
 
 
 def _refuse_unwritable(folder: Path, paths: list[Path]) -> None:

@@ -33,7 +33,7 @@ from .control.plan import east_park
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
-from .outputs import claim, output_folder, removing_empty_folders, strict_json, together, write
+from .outputs import claim, output_folder, remove_earlier, removing_empty_folders, strict_json, together, write
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .kernel import ENGINES, run_compiled, uses_kernel
@@ -285,9 +285,13 @@ class Result:
     def save(self, folder, *, plot: bool = True, log_format: str = "parquet") -> dict[str, Path]:
         """Write ``log.parquet`` (``log_format="csv"``: ``log.csv``), ``events.csv``, ``summary.json``
         (strict JSON: ``null`` for a missing number) and ``report.png``; see `hybridtrack.outputs`
-        for what is refused."""
+        for what is refused. An earlier save's file that this one does not write (the log in the
+        other format, the report when `plot` is False) is removed, as a file to replace is: left
+        there, it would be read as this run's."""
         written = self.files(folder, plot=plot, log_format=log_format)
-        claim(written.values())
+        every = {*self.files(folder, log_format="csv").values(), *self.files(folder).values()}
+        earlier = sorted(every - set(written.values()))
+        claim(written.values(), earlier=earlier)
         with together():  # all of this run's files, or none
             if log_format == "parquet":
                 write(written["log"], self.log.to_parquet)
@@ -299,6 +303,7 @@ class Result:
                 from .report import plot_run, save_figure
 
                 save_figure(plot_run(self), written["report"])
+        remove_earlier(earlier)
         return written
 
     # -- for people (hybridtrack.report): a short repr, an HTML repr, pictures, a daily table --

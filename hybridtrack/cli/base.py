@@ -223,7 +223,9 @@ def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Itera
     import os
     from pathlib import Path
 
-    stale = [path for path in map(Path, paths) if path.is_file() and not path.is_symlink()]
+    from ..outputs import earlier_files, remove_earlier
+
+    stale = earlier_files(paths)
     if stale and not args.force:
         some = len(stale) > 1
         raise HybridtrackError(f"would leave {len(stale)} file{'s' if some else ''} of an earlier run beside this "
@@ -234,12 +236,8 @@ def leaving_out(args: argparse.Namespace, paths: Iterable, reason: str) -> Itera
             raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed (no permission in "
                                    f"{path.parent}); remove it, or write elsewhere")
     yield
+    remove_earlier(stale)  # a save may have removed them already, as the one it writes beside them
     for path in stale:
-        try:
-            path.unlink(missing_ok=True)
-        except OSError as exc:
-            raise HybridtrackError(f"{path}: from an earlier run, and cannot be removed ({exc.strerror or exc}); "
-                                   "the results beside it are this run's") from None
         print(f"{path}: removed, from an earlier run ({reason})")
     for folder in sorted({path.parent for path in stale} - {Path(args.out or ".")}):  # no --out: no stale files
         with contextlib.suppress(OSError):  # a folder with anything else in it stays
