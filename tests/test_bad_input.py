@@ -328,8 +328,9 @@ def test_a_date_in_other_digits_is_refused(text):
         parse_date(text)
 
 
-def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys):
+def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys, tmp_path):
     import hybridtrack.cli.runs as runs
+    import hybridtrack.streaming as streaming
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
@@ -337,7 +338,10 @@ def test_ctrl_c_is_one_line_and_the_shells_status(monkeypatch, capsys):
     monkeypatch.setattr(runs, "synthetic_frame", interrupted)
     assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21"]) == 130
     err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith("hybridtrack: interrupted") and "Traceback" not in err
+    assert err == "hybridtrack: interrupted; files already written are left as they are"  # no streamed run's files
+    monkeypatch.setattr(streaming, "stream", interrupted)
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--stream", "--out", str(tmp_path)]) == 130
+    assert capsys.readouterr().err.strip().endswith("(the finished days in log.partial.parquet and events.partial.csv)")
 
 
 def test_ctrl_c_while_the_command_loads_is_one_line_and_after_it_is_done_is_ignored(monkeypatch, capsys):

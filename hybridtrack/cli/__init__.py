@@ -99,6 +99,7 @@ def _terminate_as_interrupt() -> Iterator[None]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
+    args = None
     try:
         with _terminate_as_interrupt(), reader_may_leave():  # --help and --version print here too: a full standard output is one line
             args = build_parser().parse_args(argv)
@@ -117,8 +118,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         _tell(f"hybridtrack: error: {exc}")
         return EXIT_USAGE
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: one line, no traceback; the shell's status for the signal
-        what = str(exc) or ("files already written are left as they are (an unfinished streamed run leaves its "
-                            "finished days in log.partial.parquet and events.partial.csv)")
+        what = str(exc) or "files already written are left as they are" + (
+            " (the finished days in log.partial.parquet and events.partial.csv)" if getattr(args, "stream", False)
+            else "")
         stopped = "terminated" if isinstance(exc, Terminated) else "interrupted"
         _tell(f"\nhybridtrack: {stopped}; {what}")
         return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
