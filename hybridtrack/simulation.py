@@ -530,9 +530,9 @@ def warn_of_nights_left_out(frame: pd.DataFrame, site) -> None:
         return
     left_out = night_gaps(frame, site)
     if left_out:
-        warnings.warn(f"the frame leaves out {left_out} night{'s' if left_out > 1 else ''} (no rows between an "
-                      "evening and the next morning): each morning's slew from stow is scored, as no PLC scanning "
-                      "all night would show; hybridtrack.io.fill_nights(frame, site) puts them back",
+        warnings.warn(f"the frame leaves out {left_out} night{'s' if left_out > 1 else ''} (no rows from a night "
+                      "into its morning): each such morning's slew from stow is scored, as no PLC scanning all "
+                      "night would show; hybridtrack.io.fill_nights(frame, site) puts them back",
                       NightsLeftOutWarning, stacklevel=3)
 
 

@@ -47,10 +47,17 @@ def test_whole_frames_and_frames_with_their_nights_put_back_are_not_warned_of(da
     assert _nights_warned(lambda: simulate(full.between_time("06:00", "20:00").loc["2021-06-22"], SITE)) == []
 
 
-def test_a_gap_by_day_is_no_night_left_out(days):
+def test_only_a_gap_that_runs_into_a_morning_is_a_night_left_out(days):
+    """A gap by day, and one that ends in the dark (a logger down two hours around midnight, or
+    across dusk), cost the controller nothing: it meets no morning at stow. One from before dawn
+    into the day does (sunrise at Lanzhou on 22 June 2021: 05:51 Beijing time, by pvlib's SPA)."""
     full, _ = days
-    noon_gap = full.drop(full.loc["2021-06-22 11:00":"2021-06-22 13:00"].index)
-    assert _nights_warned(lambda: simulate(noon_gap, SITE)) == []
+    for start, end in (("2021-06-22 11:00", "2021-06-22 13:00"), ("2021-06-21 23:00", "2021-06-22 01:00"),
+                       ("2021-06-21 20:00", "2021-06-21 20:40")):
+        assert _nights_warned(lambda: simulate(full.drop(full.loc[start:end].index), SITE)) == []
+    dawn = full.drop(full.loc["2021-06-22 05:00":"2021-06-22 06:30"].index)
+    warned = _nights_warned(lambda: simulate(dawn, SITE))
+    assert len(warned) == 1 and warned[0].startswith("the frame leaves out 1 night (no rows from a night")
 
 
 def test_a_frame_whose_report_names_its_nights_is_not_warned_of_again(days, tmp_path):
@@ -59,11 +66,9 @@ def test_a_frame_whose_report_names_its_nights_is_not_warned_of_again(days, tmp_
     path = tmp_path / "day.csv"
     day[["ghi", "dni", "dhi", "wind_speed"]].to_csv(path)
     frame = read_weather(path)
-    assert _nights_warned(lambda: simulate(frame, SITE)) == ["the frame leaves out 2 nights (no rows between an "
-                                                             "evening and the next morning): each morning's slew from "
-                                                             "stow is scored, as no PLC scanning all night would show; "
-                                                             "hybridtrack.io.fill_nights(frame, SITE) puts them back"
-                                                             .replace("SITE", "site")]
+    assert _nights_warned(lambda: simulate(frame, SITE)) == [
+        "the frame leaves out 2 nights (no rows from a night into its morning): each such morning's slew from stow "
+        "is scored, as no PLC scanning all night would show; hybridtrack.io.fill_nights(frame, site) puts them back"]
     frame.attrs["validation"]["nights_left_out"] = "2"
     assert _nights_warned(lambda: simulate(frame, SITE)) == []
     assert np.isfinite(simulate(frame, SITE).summary["tracking_error_deg"]["rms"])

@@ -192,7 +192,7 @@ def read_record(args: argparse.Namespace, path: str, *, site=None, freq: str | N
     left_out = night_gaps(frame, site) if site is not None and len(frame) > 1 else 0
     if left_out:
         frame.attrs["validation"]["nights_left_out"] = (
-            f"{left_out} (no rows between an evening and the next morning: each morning's slew from stow is "
+            f"{left_out} (no rows from a night into its morning: each such morning's slew from stow is "
             "scored, as no PLC scanning all night would show; --fill-nights puts them back)")
     return frame
 

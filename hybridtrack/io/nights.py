@@ -88,10 +88,15 @@ def _between_readings(nights: np.ndarray, rows: int) -> int:
 
 
 def night_gaps(frame: pd.DataFrame, site) -> int:
-    """How many gaps of `frame` hold a night (the site's sun down at one instant of its step
-    at least): the nights a logger left out."""
-    index, *_, nights = _found(frame, sites.get(site))
-    return _between_readings(nights, len(index))
+    """How many gaps of `frame` run from a night into a morning (the site's sun down at one
+    instant of the gap at least, and up at the reading that ends it): the nights a logger left
+    out, each of whose mornings the controller meets at stow. A gap that ends in the dark (a logger
+    down for two hours around midnight, or across dusk) costs the controller nothing, and is not
+    counted; `fill_nights` fills it all the same."""
+    site = sites.get(site)
+    index, *_, nights = _found(frame, site)
+    inner = nights[(nights >= 0) & (nights < len(index) - 1)]
+    return int((~_sun_down(index[inner + 1], site)).sum()) if len(inner) else 0
 
 
 def _checked(frame: pd.DataFrame) -> pd.DatetimeIndex:
