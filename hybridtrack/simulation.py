@@ -528,7 +528,10 @@ def warn_of_nights_left_out(frame: pd.DataFrame, site) -> None:
             or not index.is_monotonic_increasing or index.has_duplicates
             or "nights_left_out" in frame.attrs.get("validation", {})):
         return
-    left_out = night_gaps(frame, site)
+    try:
+        left_out = night_gaps(frame, site)
+    except HybridtrackError:  # a site, or stamps, the run refuses with its own words
+        return
     if left_out:
         warnings.warn(f"the frame leaves out {left_out} night{'s' if left_out > 1 else ''} (no rows from a night "
                       "into its morning): each such morning's slew from stow is scored, as no PLC scanning all "
