@@ -294,6 +294,7 @@ def test_a_rolled_heliostat_pedestal_runs_the_same_compiled(mixed_day):
     assert_same_run(*runs)
 
 
+@pytest.mark.filterwarnings("ignore::hybridtrack.simulation.NightsLeftOutWarning")  # a gap into a morning, on purpose
 def test_irregular_scans_run_the_same_compiled(mixed_day):
     keep = np.random.default_rng(1).random(len(mixed_day)) > 0.3
     assert_same_run(*both(mixed_day[keep], "lanzhou"))

@@ -40,6 +40,7 @@ def test_the_nights_put_back_are_dark_where_the_sun_is_down_and_the_wind_runs_ac
     assert filled["wind_speed"].notna().all()
 
 
+@pytest.mark.filterwarnings("ignore::hybridtrack.simulation.NightsLeftOutWarning")  # a gap into a morning, on purpose
 @pytest.mark.parametrize("strategy", ["hybrid", "sensor"])
 def test_a_day_only_file_filled_tracks_as_the_file_with_its_nights_does(days, strategy):
     """Left out, each morning scores the slew from stow (no scan to pre-position in): RMS 0.70°

@@ -507,6 +507,7 @@ def test_a_memory_left_by_another_collector_of_the_kind_is_refused(left_by, used
     simulate(following, "lanzhou", collector=left_by, warm_start=memory)  # the same collector carries on
 
 
+@pytest.mark.filterwarnings("ignore::hybridtrack.simulation.NightsLeftOutWarning")  # a gap into a morning, on purpose
 def test_a_frame_of_steps_longer_than_an_hour_is_refused_and_night_gaps_are_not():
     """A 13-hour step made a day of two scans and a score of them; hourly records (TMY, EPW) run,
     and so does a logger file with its nights left out (its median step is a minute)."""
