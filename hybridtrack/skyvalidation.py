@@ -180,6 +180,8 @@ class SkyValidation:
         Per local day: samples counted, sky shares and agreement with each reference.
     overall : dict
         The same over the whole file, plus sunny precision and no-clear-called-overcast.
+    tz : str, optional
+        The site's zone, whose local days `days` counts (None: the samples' own zone).
     """
 
     samples: pd.DataFrame
@@ -187,6 +189,7 @@ class SkyValidation:
     overall: dict
     min_altitude: float = MIN_ALTITUDE
     notes: list = field(default_factory=list)
+    tz: str | None = None
 
     def confusion(self, reference: str = "beam_window_sky") -> pd.DataFrame:
         """Reference (rows) against classifier (columns) on the counted samples."""
@@ -299,17 +302,18 @@ def validate_sky(frame: pd.DataFrame, site: Site | str, *, sensor: SensorModel |
     counted = samples[samples["counted"]]
     if counted.empty:
         raise HybridtrackError(f"no sample has the sun above {min_altitude:g} degrees; nothing to score")
-    local_day = counted.index.tz_convert(site.tz).date if site.tz != "UTC" else counted.index.date
+    local_day = counted.index.tz_convert(site.tz).date
     days = pd.DataFrame([_scores(rows) for _, rows in counted.groupby(local_day)],
                         index=pd.Index(sorted(set(local_day)), name="day"))
-    return SkyValidation(samples, days, _scores(counted), min_altitude, notes)
+    return SkyValidation(samples, days, _scores(counted), min_altitude, notes, tz=site.tz)
 
 
 def plot_day(validation: SkyValidation, day=None):
     """A `matplotlib.figure.Figure` of one day: beam ratio, inputs and labels against time.
 
-    `day` is a date or ``YYYY-MM-DD`` among the validation's days; the worst-agreeing day
-    by default.
+    `day` is a date or ``YYYY-MM-DD`` among the validation's days (the site's local days); the
+    worst-agreeing day by default. The day is drawn on the site's clock: a file kept in UTC had
+    been drawn from UTC midnight, another day's morning in place of its own.
     """
     from matplotlib.figure import Figure
 
@@ -320,7 +324,7 @@ def plot_day(validation: SkyValidation, day=None):
     day = parse_date(day)
     if day not in set(days.index):
         raise HybridtrackError(f"no day {day} in the validation; days are {', '.join(map(str, days.index))}")
-    samples = validation.samples
+    samples = validation.samples if validation.tz is None else validation.samples.tz_convert(validation.tz)
     rows = samples[samples.index.date == day]
     figure = Figure(figsize=(10, 6.5), layout="constrained")
     top, middle, bottom = figure.subplots(3, 1, sharex=True)
