@@ -14,7 +14,7 @@ from .base import (
 
 def _validate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="recorded weather file with measured ghi, dni and dhi")
-    add_site_arguments(parser)
+    add_site_arguments(parser, record=True)  # --tz is the file's zone, beside --site too, as in check and replay
     add_record_arguments(parser)
     group = parser.add_argument_group("classifier")
     group.add_argument("--config", help="sky inputs (TOML with a [sky] table); the measured-best default otherwise")
