@@ -35,8 +35,9 @@ def _check(args: argparse.Namespace) -> int:
     from ..io import validation_report
 
     site = site_from_arguments(args, clock_required=False)
-    if args.out:
-        _refuse_other_formats(args.out)  # before the file is read, not after its report
+    if args.out:  # before the file is read, not after its report: an --out there already had been refused last
+        _refuse_other_formats(args.out)
+        claim([args.out])
     frame = read_record(args, args.file, site=site, freq=args.freq)
     print(validation_report(frame))
     if args.out:

@@ -41,6 +41,18 @@ def _sky_config(args: argparse.Namespace):
     return SkyInputConfig.from_toml(args.config) if args.config else SkyInputConfig()
 
 
+def _claim_outputs(args: argparse.Namespace) -> None:
+    """Refuse the output files before the file is read and scored, not after (a file there
+    already without --force, a folder, two flags naming one file)."""
+    given = {flag: path for flag, path in (("--json", args.json), ("--out", args.out), ("--plot", args.plot)) if path}
+    named: dict = {}
+    for flag, path in zip(given, claim(given.values())):
+        if path.resolve() in named:
+            raise HybridtrackError(f"{named[path.resolve()]} and {flag} both name {path}; one would be written over "
+                                   "the other")
+        named[path.resolve()] = flag
+
+
 @command("validate-sky", "score the sky classifier on a recorded file against beam-ratio and clear-sky references",
          _validate_arguments)
 def _validate(args: argparse.Namespace) -> int:
@@ -50,6 +62,7 @@ def _validate(args: argparse.Namespace) -> int:
     if args.day and not args.plot:
         raise HybridtrackError("--day chooses the day to draw; give --plot PNG too")
     site = site_from_arguments(args)
+    _claim_outputs(args)
     config = _sky_config(args)
     classifier = None
     if args.classifier:
