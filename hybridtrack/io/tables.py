@@ -66,6 +66,10 @@ class Table:
     #: and that second line's number.
     site: dict[str, str] = field(default_factory=dict)
     site_line: int = 0
+    #: The last row, when it alone has fewer fields than the header (a logger that lost power
+    #: mid-line): how many fields it has. Its last field may be a number cut short (``645.3``
+    #: written as ``64``), so it is not read (`hybridtrack.io.weather`).
+    cut_short: int = 0
 
 
 #: The longest field the csv module is let read: Python's default, 131,072 characters, had
@@ -169,9 +173,10 @@ def _without_repeated_header(rows: list[list[str]], numbers: list[int], headers:
 
 
 def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str], header_line: int,
-          skipped: dict) -> tuple[list[list[str]], list[int]]:
+          skipped: dict) -> tuple[list[list[str]], list[int], int]:
     """The rows' fields, each as long as `headers`, and their file lines; empty rows and repeated
-    headers skipped, long rows refused."""
+    headers skipped, long rows refused; and the field count of a last row cut short
+    (`Table.cut_short`, else 0)."""
     width = len(headers)
     empty = [not line.strip(sep + ' \t"') for _, line in body]  # ';;;;': a row the logger left empty
     if any(empty):
@@ -182,6 +187,8 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
     if len(rows) != len(numbers):
         _refuse_open_quote(path, body)
     rows, numbers = _without_repeated_header(rows, numbers, headers, skipped)
+    short = [len(fields) < width for fields in rows]
+    cut_short = len(rows[-1]) if len(rows) > 2 and short[-1] and not any(short[:-1]) else 0
     for i, fields in enumerate(rows):
         if len(fields) == width:
             continue
@@ -189,7 +196,7 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
             raise HybridtrackError(f"{path}: line {numbers[i]}: {len(fields)} fields, but the header on line "
                                    f"{header_line} names {width}")
         rows[i] = fields[:width] + [""] * (width - len(fields))
-    return rows, numbers
+    return rows, numbers, cut_short
 
 
 def _refuse_open_quote(path: Path, body: list[tuple[int, str]]) -> None:
@@ -243,12 +250,12 @@ def locate_table(path: Path, text: str) -> Table:
         body = body[1:]
     if not body or not rows_with_values(body, sep):
         raise HybridtrackError(f"{path}: the table has a header but no rows")
-    rows, numbers = _rows(path, body, sep, headers, kept[position][0], skipped)
+    rows, numbers, cut_short = _rows(path, body, sep, headers, kept[position][0], skipped)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
     units.update({h: site[f"{h} Units"] for h in headers if site.get(f"{h} Units")})  # NSRDB: 'GHI Units'
     decimal = _decimal(sep, rows)
     return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind,
-                 site=site, site_line=kept[1][0] if site else 0)
+                 site=site, site_line=kept[1][0] if site else 0, cut_short=cut_short)
 
 
 def _site_header(first: list[str]) -> bool:

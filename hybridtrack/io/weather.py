@@ -169,6 +169,19 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
     return (one_typical_year(path, index, table.lines, report) if "year" in mapping else index), keep
 
 
+def _without_cut_last(table: Table, report: dict) -> Table:
+    """`table` without its last row when that row alone has fewer fields than the header
+    (`Table.cut_short`: a logger that lost power mid-line), counted as ``truncated``: its last
+    field may be a number cut short, and ``...,812.4,64`` (DNI 645.3) had been read as a DNI of
+    64 W/m², the missing fields as NaN, and nothing said."""
+    if not table.cut_short:
+        return table
+    line = int(table.lines[-1])
+    report["truncated"] = {"count": 1, "lines": [line],
+                           "why": f"the last line is cut short ({table.cut_short} of {len(table.headers)} fields)"}
+    return dataclasses.replace(table, rows=table.rows[:-1], lines=table.lines[:-1])
+
+
 def _without_empty_columns(table: Table, report: dict) -> Table:
     """`table` without its columns that have no name and no value in any row: Excel's "Save as
     CSV" pads rows to the sheet's used range (``time;ghi;dni;dhi;;``), and the two unnamed columns
@@ -241,6 +254,7 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
                   decimal=table.decimal,
                   skipped={k: v for k, v in table.skipped.items() if v},
                   columns={k: v for k, v in mapping.items() if k in WEATHER_COLUMNS})
+    table = _without_cut_last(table, report)
     if not {"time", "date", "year"} & set(mapping):
         raise HybridtrackError(f"{path}: no time column found; name it with columns={{'time': ...}} "
                                f"(--map time=COLUMN, or --map time= for an unnamed first column); columns are "
