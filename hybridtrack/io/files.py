@@ -53,7 +53,7 @@ def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
         try:
             with zipfile.ZipFile(io.BytesIO(raw)) as archive:
                 members = [m for m in archive.infolist() if not m.is_dir() and not m.filename.startswith("__MACOSX")]
-                _refuse_office(path, [m.filename for m in members])
+                _refuse_office(path, archive, [m.filename for m in members])
                 weather = [m for m in members if m.filename.lower().endswith(WEATHER_SUFFIXES)]
                 if len(members) > 1 and len(weather) == 1:  # EnergyPlus zips: .epw with .stat and .ddy
                     members = weather
@@ -66,12 +66,21 @@ def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
     return raw, None
 
 
-def _refuse_office(path: Path, names: list[str]) -> None:
-    """Refuse an Office file (a zip with ``[Content_Types].xml``): an Excel workbook had been told
-    that a zip archive must hold one file, naming its XML parts."""
+#: The ``mimetype`` an OpenDocument spreadsheet (LibreOffice Calc's ``.ods``) starts with.
+_ODS_MIMETYPE = b"application/vnd.oasis.opendocument.spreadsheet"
+
+
+def _refuse_office(path: Path, archive: zipfile.ZipFile, names: list[str]) -> None:
+    """Refuse an Office file (a zip with ``[Content_Types].xml``) or an OpenDocument one (a zip
+    with a ``mimetype`` and ``content.xml``): an Excel workbook, and later a LibreOffice one, had
+    been told that a zip archive must hold one file, naming its XML parts."""
     if "[Content_Types].xml" in names:
         kind = ("an Excel workbook: save it as CSV (File > Save As > CSV)" if "xl/workbook.xml" in names
                 else "an Office document, not a table")
+        raise HybridtrackError(f"{path}: {kind}")
+    if {"mimetype", "content.xml"} <= set(names):
+        kind = ("an OpenDocument spreadsheet: save it as CSV (File > Save As > Text CSV)"
+                if archive.read("mimetype").startswith(_ODS_MIMETYPE) else "an OpenDocument file, not a table")
         raise HybridtrackError(f"{path}: {kind}")
 
 
