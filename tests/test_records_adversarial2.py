@@ -42,3 +42,24 @@ def test_a_short_row_inside_the_file_keeps_its_values(tmp_path):
     frame = read_weather(path)
     assert len(frame) == 3 and frame["dni"].iloc[1] == 642.7 and np.isnan(frame["dhi"].iloc[1])
     assert "truncated" not in frame.attrs["validation"] and frame.attrs["validation"]["nan"] == {"dhi": 1}
+
+
+@pytest.mark.parametrize("units, values, name, given", [
+    ("kW/m2,kW/m2,kW/m2,C", ("812.4", "640.1", "150.2", "25.0"), "ghi", "kW/m2"),
+    ("W/m2,W/m2,W/m2,K", ("812.4", "640.1", "150.2", "25.0"), "temp_air", "K"),
+])
+def test_a_units_row_that_mislabels_a_column_is_the_unit_named(tmp_path, units, values, name, given):
+    """A units row saying kW/m² over W/m² values (812.4 kW/m² is 812,400 W/m²), or K over °C
+    (25 K is -248.15 °C), had been refused with a hint to look for kJ/m² sums, or to give the
+    very unit the row gave (--units temp_air=K)."""
+    stamps = [f"2021-06-21T04:{minute:02d}:00Z" for minute in range(0, 60, 10)]
+    path = tmp_path / "units.csv"
+    path.write_text("time,ghi,dni,dhi,temp_air\n," + units + "\n" + "\n".join(f"{t}," + ",".join(values)
+                                                                             for t in stamps) + "\n")
+    with pytest.raises(HybridtrackError) as refused:
+        read_weather(path)
+    message = str(refused.value)
+    assert f"column '{name}'" in message and f"read in {given} and converted" in message
+    assert f"--units {name}={given}" not in message and "kJ/m²" not in message
+    frame = read_weather(path, units={"ghi": "W/m2", "dni": "W/m2", "dhi": "W/m2", "temp_air": "C"})
+    assert frame["ghi"].iloc[0] == 812.4 and frame["temp_air"].iloc[0] == 25.0
