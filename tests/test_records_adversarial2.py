@@ -63,3 +63,31 @@ def test_a_units_row_that_mislabels_a_column_is_the_unit_named(tmp_path, units, 
     assert f"--units {name}={given}" not in message and "kJ/m²" not in message
     frame = read_weather(path, units={"ghi": "W/m2", "dni": "W/m2", "dhi": "W/m2", "temp_air": "C"})
     assert frame["ghi"].iloc[0] == 812.4 and frame["temp_air"].iloc[0] == 25.0
+
+
+TOA5_HEADER = ['"TOA5","Roof","CR1000","4321","CR1000.Std.32","CPU:sun.CR1","17071","Ten"',
+               '"TIMESTAMP","RECORD","GHI_Avg","DNI_Avg","DHI_Avg"',
+               '"TS","RN","W/m^2","W/m^2","W/m^2"',
+               '"","","Avg","Avg","Avg"']
+
+
+def test_daily_toa5_files_joined_with_cat_are_read_as_one(tmp_path):
+    """``cat day1.dat day2.dat`` repeats the four TOA5 header lines: the environment line had been
+    refused as a row longer than the header (8 fields, the header naming 5)."""
+    day1 = ['"2021-06-21 12:00:00",0,812.4,640.1,150.2', '"2021-06-21 12:10:00",1,815,642.7,150.9']
+    day2 = ['"2021-06-22 12:00:00",2,790.5,600.3,160.4', '"2021-06-22 12:10:00",3,"NAN",610.0,161.0']
+    path = tmp_path / "joined.dat"
+    path.write_text("\n".join(TOA5_HEADER + day1 + TOA5_HEADER + day2) + "\n")
+    frame = read_weather(path, tz="Etc/GMT-8")
+    assert list(frame["dni"]) == [640.1, 642.7, 600.3, 610.0] and np.isnan(frame["ghi"].iloc[3])
+    assert str(frame.index[2]) == "2021-06-22 12:00:00+08:00"
+    assert frame.attrs["validation"]["skipped"]["repeated header lines"] == [7, 8, 9, 10]
+
+
+def test_a_repeated_units_row_is_skipped_with_its_header(tmp_path):
+    path = tmp_path / "joined.csv"
+    block = ["time,ghi,dni,dhi", ",W/m2,W/m2,W/m2"]
+    path.write_text("\n".join(block + ROWS[:2] + block + ROWS[2:]) + "\n")
+    frame = read_weather(path)
+    assert list(frame["dni"]) == [640.1, 642.7, 644.0]
+    assert frame.attrs["validation"]["skipped"]["repeated header lines"] == [5, 6]

@@ -159,11 +159,13 @@ def _header_after_hint(path: Path, kept: list[tuple[int, str]], sep: str) -> tup
     return 0, sep, f"table with Excel's 'sep={sep}' line"
 
 
-def _without_repeated_header(rows: list[list[str]], numbers: list[int], headers: list[str],
+def _without_repeated_header(rows: list[list[str]], numbers: list[int], preamble: list[list[str]],
                              skipped: dict) -> tuple[list[list[str]], list[int]]:
-    """`rows` without the lines that repeat the header (a logger restarted, daily files joined with
-    ``cat``), which are skipped and listed: such a line had been refused as a time stamp."""
-    again = [i for i, fields in enumerate(rows) if [f.strip() for f in fields] == headers]
+    """`rows` without the lines that repeat the header or a line above or below it (`preamble`: a
+    TOA5 file's environment line, units and processing rows; a logger restarted, daily files
+    joined with ``cat``), which are skipped and listed: such a header had been refused as a time
+    stamp, and a TOA5 environment line as a row longer than the header."""
+    again = [i for i, fields in enumerate(rows) if [f.strip() for f in fields] in preamble]
     if not again:
         return rows, numbers
     skipped["repeated header lines"] = [numbers[i] for i in again]
@@ -173,10 +175,10 @@ def _without_repeated_header(rows: list[list[str]], numbers: list[int], headers:
 
 
 def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str], header_line: int,
-          skipped: dict) -> tuple[list[list[str]], list[int], int]:
-    """The rows' fields, each as long as `headers`, and their file lines; empty rows and repeated
-    headers skipped, long rows refused; and the field count of a last row cut short
-    (`Table.cut_short`, else 0)."""
+          skipped: dict, preamble: list[list[str]]) -> tuple[list[list[str]], list[int], int]:
+    """The rows' fields, each as long as `headers`, and their file lines; empty rows and lines
+    repeating the `preamble` (the header and the lines about it, each as stripped fields) skipped,
+    long rows refused; and the field count of a last row cut short (`Table.cut_short`, else 0)."""
     width = len(headers)
     empty = [not line.strip(sep + ' \t"') for _, line in body]  # ';;;;': a row the logger left empty
     if any(empty):
@@ -186,7 +188,7 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
     numbers = [number for number, _ in body]
     if len(rows) != len(numbers):
         _refuse_open_quote(path, body)
-    rows, numbers = _without_repeated_header(rows, numbers, headers, skipped)
+    rows, numbers = _without_repeated_header(rows, numbers, preamble, skipped)
     short = [len(fields) < width for fields in rows]
     cut_short = len(rows[-1]) if len(rows) > 2 and short[-1] and not any(short[:-1]) else 0
     for i, fields in enumerate(rows):
@@ -250,7 +252,9 @@ def locate_table(path: Path, text: str) -> Table:
         body = body[1:]
     if not body or not rows_with_values(body, sep):
         raise HybridtrackError(f"{path}: the table has a header but no rows")
-    rows, numbers, cut_short = _rows(path, body, sep, headers, kept[position][0], skipped)
+    preamble = [[f.strip() for f in fields] for fields in (*(_split(line, sep) for _, line in kept[:position]),
+                                                          headers, *meta)]
+    rows, numbers, cut_short = _rows(path, body, sep, headers, kept[position][0], skipped, preamble)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
     units.update({h: site[f"{h} Units"] for h in headers if site.get(f"{h} Units")})  # NSRDB: 'GHI Units'
     decimal = _decimal(sep, rows)
