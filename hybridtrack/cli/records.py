@@ -13,6 +13,7 @@ from .base import (
     add_site_arguments,
     add_synthetic_arguments,
     command,
+    flag_named,
     read_record,
     site_from_arguments,
     synthetic_frame,
@@ -35,6 +36,11 @@ def _check(args: argparse.Namespace) -> int:
     from ..io import validation_report
 
     site = site_from_arguments(args, clock_required=False)
+    if args.freq is not None:
+        from ..times import parse_freq
+
+        with flag_named("--freq"):  # before the file is read; the refusal names the flag
+            parse_freq(args.freq)
     if args.out:  # before the file is read, not after its report: an --out there already had been refused last
         _refuse_other_formats(args.out)
         claim([args.out])

@@ -14,6 +14,7 @@ from .base import (
     add_site_arguments,
     collector_from_arguments,
     command,
+    flag_named,
     site_from_arguments,
 )
 
@@ -48,10 +49,14 @@ def _fastest_rate(rate: pd.Series) -> str:
 def _sun(args: argparse.Namespace) -> int:
     from ..collectors import Collector
     from ..sun import solar_position
-    from ..times import local_range
+    from ..times import local_range, parse_clock, parse_date, parse_freq
 
     site = site_from_arguments(args)
     collector: Collector = collector_from_arguments(args)
+    for flag, parse, value in (("--date", parse_date, args.date), ("--start", parse_clock, args.start),
+                               ("--end", parse_clock, args.end), ("--freq", parse_freq, args.freq)):
+        with flag_named(flag):  # the refusal names the flag: '--end: clock time '25:00' is not HH:MM'
+            parse(value)
     times = local_range(args.date, site.tz, start=args.start, end=args.end, freq=args.freq)
     position = solar_position(times, site, args.model, declination=args.declination, equation_of_time=args.eot)
     angles = collector.angles(position["altitude"], position["azimuth"])
