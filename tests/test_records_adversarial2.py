@@ -91,3 +91,30 @@ def test_a_repeated_units_row_is_skipped_with_its_header(tmp_path):
     frame = read_weather(path)
     assert list(frame["dni"]) == [640.1, 642.7, 644.0]
     assert frame.attrs["validation"]["skipped"]["repeated header lines"] == [5, 6]
+
+
+def _hourly(path, clocks, days=("6/21/2021", "6/22/2021")):
+    path.write_text("time,ghi,dni,dhi\n" + "\n".join(f"{day} {clock},{100 + i},{50 + i},{60 + i}" for day in days
+                                                     for i, clock in enumerate(clocks)) + "\n")
+    return path
+
+
+def test_a_twelve_hour_clock_without_am_or_pm_is_refused(tmp_path):
+    """'6/21/2021 1:00:00' for 1 AM and 1 PM alike: each afternoon had been dropped as repeated
+    stamps (144 of 288 rows), the hour after midnight read as noon, and the file called usable.
+    The clock goes back from 12:00 (midnight, line 2) to 1:00 on line 3."""
+    twelve = [f"{hour}:00:00" for hour in [12, *range(1, 12)] * 2]  # 12, 1 ... 11 (AM), then again (PM)
+    path = _hourly(tmp_path / "h12.csv", twelve)
+    with pytest.raises(HybridtrackError, match=r"line 3, column 'time': '6/21/2021 1:00:00' goes back from 12 to "
+                                               r"1 o'clock within a date.*12-hour clock without AM or PM"):
+        read_weather(path, tz="UTC")
+
+
+@pytest.mark.parametrize("clocks", [
+    [f"{hour}:00" for hour in range(6, 13)],  # mornings only on a 24-hour clock: 12:00, then the next day's 6:00
+    [f"{hour % 12 or 12}:00 {'AM' if hour < 12 else 'PM'}" for hour in range(24)],  # with AM and PM
+])
+def test_mornings_only_and_am_pm_stamps_are_read(tmp_path, clocks):
+    frame = read_weather(_hourly(tmp_path / "h.csv", clocks), tz="UTC")
+    assert len(frame) == 2 * len(clocks) and frame.index.is_unique
+    assert frame.index[len(clocks) - 1].hour == (12 if len(clocks) == 7 else 23)

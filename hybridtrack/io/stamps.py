@@ -370,6 +370,22 @@ def _end_of_day(iso: pd.Series) -> tuple[pd.Series, np.ndarray]:
     return iso.str.replace(r"([ T])24:00((?::00)?)$", r"\g<1>00:00\g<2>", regex=True), midnight
 
 
+def _refuse_twelve_hour_clock(column: _Column, index: pd.DatetimeIndex) -> None:
+    """Refuse stamps of a 12-hour clock written without AM or PM (``6/21/2021 1:00:00`` for both
+    1 AM and 1 PM): every hour is 1 to 12, and the clock goes back from 12 to 1 within a date,
+    which a 24-hour clock never does. Read as a 24-hour clock, each afternoon had been dropped as
+    repeated stamps, the night's first hour read as noon, and the file called usable."""
+    hours = np.asarray(index.hour)
+    if len(hours) < 2 or not ((hours >= 1) & (hours <= 12)).all():
+        return
+    days = np.asarray(index.normalize().asi8)
+    back = np.flatnonzero((hours[:-1] == 12) & (hours[1:] == 1) & (days[:-1] == days[1:]))
+    if len(back):
+        column.refuse(int(back[0]) + 1, "goes back from 12 to 1 o'clock within a date, and no stamp is before 1:00 "
+                                        "or after 12:59: a 12-hour clock without AM or PM? write the stamps with "
+                                        "AM/PM, or on a 24-hour clock")
+
+
 def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dict, zone_from: str):
     """`parse_stamps` on a column whose stamps are whole."""
     path, header, lines = column.path, column.header, column.lines
@@ -395,6 +411,7 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
                          "remove it and give the zone (--tz)")
     if midnight.any():
         index = index + pd.to_timedelta(midnight.astype(int), unit="D")
+    _refuse_twelve_hour_clock(column, index)
     if has_offset.any():
         return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)
     if tz is not None:
