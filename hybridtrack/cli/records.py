@@ -67,8 +67,18 @@ def _refuse_other_formats(path: str) -> None:
 
 
 def write_frame(frame: pd.DataFrame, path: str) -> None:
-    """A weather frame as Parquet (a ``.parquet`` name, its tz-aware index kept: what a streamed
-    replay reads fastest) or CSV (ISO stamps with their UTC offset, which `read_weather` reads back)."""
+    """Write a weather frame as Parquet or CSV.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A weather frame on a tz-aware index.
+    path : str
+        A ``.parquet`` name: Parquet, its tz-aware index kept (what a streamed replay reads
+        fastest); any other: CSV of ISO stamps with their UTC offset, which `read_weather` reads
+        back, with microseconds where a stamp has a fraction of a second (written to the whole
+        second, half-second stamps had read back as repeated ones, half the rows dropped).
+    """
     from pathlib import Path
 
     from ..errors import HybridtrackError
@@ -82,7 +92,9 @@ def write_frame(frame: pd.DataFrame, path: str) -> None:
         write(target, lambda file: frame.rename_axis("time").to_parquet(file))
         return
     out = frame.copy()
-    out.index = out.index.strftime("%Y-%m-%dT%H:%M:%S%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2", regex=True)
+    fraction = ".%f" if (out.index.as_unit("ns").asi8 % 1_000_000_000).any() else ""
+    out.index = out.index.strftime(f"%Y-%m-%dT%H:%M:%S{fraction}%z").str.replace(r"(\d{2})(\d{2})$", r"\1:\2",
+                                                                                 regex=True)
     write(target, lambda file: out.to_csv(file, index_label="time", float_format="%.6g"))
 
 
