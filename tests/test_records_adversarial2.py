@@ -118,3 +118,24 @@ def test_mornings_only_and_am_pm_stamps_are_read(tmp_path, clocks):
     frame = read_weather(_hourly(tmp_path / "h.csv", clocks), tz="UTC")
     assert len(frame) == 2 * len(clocks) and frame.index.is_unique
     assert frame.index[len(clocks) - 1].hour == (12 if len(clocks) == 7 else 23)
+
+
+@pytest.mark.parametrize("header, first", [
+    ("Time UTC-5", "2021-06-21 12:00:00-05:00"),  # had been read as UTC: 5 h off, "as the column's name says"
+    ("Time (UTC+8)", "2021-06-21 12:00:00+08:00"),  # these three had been read as naive: refused without a site,
+    ("TIMESTAMP UTC+01:00", "2021-06-21 12:00:00+01:00"),  # and with one read as its local time
+    ("Date Time, GMT+08:00", "2021-06-21 12:00:00+08:00"),  # Onset HOBO's export
+    ("time_utc", "2021-06-21 12:00:00+00:00"),
+])
+def test_an_offset_the_time_columns_name_writes_is_the_stamps_zone(tmp_path, header, first):
+    path = tmp_path / "named.csv"
+    path.write_text(f'"{header}",ghi,dni,dhi\n2021-06-21 12:00,812.4,640.1,150.2\n2021-06-21 12:10,815.0,642.7,150.9\n')
+    frame = read_weather(path, columns={"time": header})
+    assert str(frame.index[0]) == first and frame.attrs["validation"]["time"].endswith("column's name says")
+
+
+def test_an_offset_beyond_fourteen_hours_in_the_name_is_refused_naming_the_column(tmp_path):
+    path = tmp_path / "named.csv"
+    path.write_text("Time UTC+15,ghi,dni,dhi\n2021-06-21 12:00,812.4,640.1,150.2\n2021-06-21 12:10,815.0,642.7,150.9\n")
+    with pytest.raises(HybridtrackError, match=r"named.csv: column 'Time UTC\+15': UTC offset '\+15:00' is not a real"):
+        read_weather(path, columns={"time": "Time UTC+15"})

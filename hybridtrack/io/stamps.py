@@ -31,7 +31,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 
-__all__ = ["parse_stamps", "fixed_zone", "CLOCK_ZONES"]
+__all__ = ["parse_stamps", "fixed_zone", "offset_in_name", "CLOCK_ZONES"]
 
 #: Zones named by a clock column's header: US standard times (no daylight saving), as MIDC writes.
 CLOCK_ZONES = {"mst": "-07:00", "pst": "-08:00", "cst": "-06:00", "est": "-05:00", "ast": "-04:00", "hst": "-10:00",
@@ -56,6 +56,8 @@ _OFFSET = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?\s*(?:[+-]\d{2}(?::?\d{2}
 #: An offset written after ``UTC`` or ``GMT`` (``UTC+8``, ``GMT+8``, ``UTC+08:00``), as loggers write
 #: it: pandas reads ``UTC+8`` with the POSIX sign, 16 h off, and a traceback followed.
 _NAMED_OFFSET = re.compile(r"\s*(?:UTC|GMT)\s*([+-])(\d{1,2})(?::?(\d{2}))?$")
+#: The same in a column's name, anywhere in it, in any case (``Time UTC-5``, ``Date Time, GMT+08:00``).
+_OFFSET_IN_NAME = re.compile(r"(?:UTC|GMT)\s*([+-])(\d{1,2})(?::?(\d{2}))?(?!\d)", re.I)
 #: A zone's abbreviation in brackets after a numeric offset (``+0800 (CST)``, as ``date`` writes it).
 _ZONE_NOTE = re.compile(r"([+-]\d{2}:?\d{2})\s*\([A-Za-z]{2,5}\)$")
 #: A stamp written ``yyyymmddHH`` (hourly exports): ten digits, like epoch seconds of 2030-2033.
@@ -341,6 +343,14 @@ def _iso_offset(match: re.Match) -> str:
     return f"{match[1]}{int(match[2]):02d}:{match[3] or '00'}"
 
 
+def offset_in_name(name: str) -> str | None:
+    """The ISO UTC offset a column's name writes after ``UTC`` or ``GMT`` (``'Time UTC-5'`` ->
+    ``'-05:00'``, ``'Date Time, GMT+08:00'`` -> ``'+08:00'``, east of Greenwich plus as the stamps'
+    own are read), or None."""
+    match = _OFFSET_IN_NAME.search(name)
+    return _iso_offset(match) if match else None
+
+
 def _written_offsets(iso: pd.Series, report: dict) -> pd.Series:
     """Offsets written ``UTC``, ``UTC+8``, ``GMT+8``, ``UTC+08:00`` or ``+0800 (CST)`` as ISO
     offsets (``+00:00``, ``+08:00``, ``+0800``), with the ISO sign: east of Greenwich is plus, as a
@@ -417,7 +427,10 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
     if tz is not None:
         return _localise(column, index, tz, f"naive stamps localised to {tz}", report)
     if clock_zone is not None:
-        zone = fixed_zone(clock_zone)
+        try:
+            zone = fixed_zone(clock_zone)
+        except HybridtrackError as exc:  # 'Time UTC+15': named by the file and column
+            raise HybridtrackError(f"{path}: column {header!r}: {exc}, as {zone_from} says") from None
         report["time"] = f"naive stamps in UTC{clock_zone}, as {zone_from} says"
         return index.tz_localize(zone), np.ones(len(index), bool)
     if site_tz is not None:

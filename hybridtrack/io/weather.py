@@ -25,7 +25,7 @@ from .files import file_text
 from .formats import PVLIB_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
 from .resample import resample
-from .stamps import CLOCK_ZONES, parse_stamps
+from .stamps import CLOCK_ZONES, offset_in_name, parse_stamps
 from .suncheck import meta_name
 from .tables import COMMA_GROUPED, MISSING, Table, locate_table
 from .units import looks_like_unit, spellings, to_frame_units
@@ -220,7 +220,13 @@ def _missing_markers(table: Table, name: str, values: np.ndarray, report: dict) 
 
 def _zone_in_name(header: str) -> str | None:
     """The UTC offset a time or clock column's name gives (`CLOCK_ZONES`: MIDC's ``MST``,
-    ``time_utc``, ``Time (UTC)``): a time column so named had been read as the site's local time."""
+    ``time_utc``, ``Time (UTC)``): a time column so named had been read as the site's local time.
+    An offset written after UTC or GMT (``Time UTC-5``, ``Time (UTC+8)``, HOBO's ``Date Time,
+    GMT+08:00``) is that offset: ``Time UTC-5`` had been read as UTC, and the others' offsets
+    ignored."""
+    written = offset_in_name(header)
+    if written is not None:
+        return written
     name, _, note = split_header(header)
     words = [name, *re.split(r"[\s_/-]+", name), *(word.lower() for word in re.split(r"[\s;]+", note or ""))]
     return next((CLOCK_ZONES[word] for word in words if word in CLOCK_ZONES), None)
