@@ -139,3 +139,15 @@ def test_an_offset_beyond_fourteen_hours_in_the_name_is_refused_naming_the_colum
     path.write_text("Time UTC+15,ghi,dni,dhi\n2021-06-21 12:00,812.4,640.1,150.2\n2021-06-21 12:10,815.0,642.7,150.9\n")
     with pytest.raises(HybridtrackError, match=r"named.csv: column 'Time UTC\+15': UTC offset '\+15:00' is not a real"):
         read_weather(path, columns={"time": "Time UTC+15"})
+
+
+def test_epoch_milliseconds_are_read_as_such(tmp_path):
+    """Thirteen-digit stamps (JavaScript, Grafana and InfluxDB exports) had been refused as no
+    time stamp. 1624233600 s is 2021-06-21 00:00 UTC (18,799 days of 86,400 s since 1970)."""
+    path = tmp_path / "grafana.csv"
+    rows = [f"{(1624233600 + 4 * 3600) * 1000 + 600_000 * i + 123},{800 + i},{640 + i},{150 + i}" for i in range(3)]
+    path.write_text("Time,ghi,dni,dhi\n" + "\n".join(rows) + "\n")
+    frame = read_weather(path)
+    assert [str(t) for t in frame.index] == ["2021-06-21 04:00:00.123000+00:00", "2021-06-21 04:10:00.123000+00:00",
+                                             "2021-06-21 04:20:00.123000+00:00"]
+    assert frame.attrs["validation"]["time"] == "epoch milliseconds (since 1970-01-01 UTC)"

@@ -12,7 +12,8 @@ Decided for the whole column, never cell by cell:
   the user asked (``dayfirst=True``/``False``, ``--dayfirst``/``--monthfirst``, or four-digit
   years). Dotted dates (``05.06.2021``) are never month-first. Dates after their clock
   (``12:00 05/06/2021``) and six-digit dates (``210605``) are decided so too.
-* **Epoch seconds**: a column of 9- or 10-digit numbers is seconds since 1970-01-01 UTC.
+* **Epoch seconds**: a column of 9- or 10-digit numbers is seconds since 1970-01-01 UTC, and a
+  column of 13-digit numbers milliseconds (as JavaScript, Grafana and InfluxDB write them).
 * **Stamps without a date** (``12:00``) are refused: the date cannot be guessed.
 * **The file's zone**: stamps with UTC offsets (``+08:00``, ``Z``, `` UTC``) keep them, or are
   converted to `tz`; naive stamps are in `tz`, or in the zone a clock column's name gives
@@ -50,6 +51,8 @@ _CLOCK_FIRST = r"^(\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?)[ ,]+(\d{1,2}[./-]\d{1,2}[
 _SIX_DIGITS = r"^(\d{2})(\d{2})(\d{2})($|[ T].*)$"
 _CLOCK_ONLY = re.compile(r"^\d{1,2}:\d{2}(:\d{2}(\.\d+)?)?$")
 _EPOCH = re.compile(r"^\d{9,10}(\.\d+)?$")
+#: Epoch milliseconds (2001-09-09 to 2286): thirteen digits, refused as no time stamp before.
+_EPOCH_MS = re.compile(r"^\d{13}$")
 #: A UTC offset after a clock time: ``+08:00``, ``+0800``, ``Z``, and the hour alone (``+08``, as
 #: PostgreSQL writes a timestamptz), which pandas reads as an offset too (and a traceback followed).
 _OFFSET = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?\s*(?:[+-]\d{2}(?::?\d{2})?|Z)$")
@@ -239,9 +242,10 @@ def _parse(column: _Column, text: pd.Series, utc: bool) -> pd.DatetimeIndex:
     return index
 
 
-def _epoch(column: _Column, report: dict) -> pd.DatetimeIndex:
-    report["time"] = "epoch seconds (since 1970-01-01 UTC)"
-    return pd.DatetimeIndex(pd.to_datetime(column.text.astype(float), unit="s", utc=True))
+def _epoch(column: _Column, report: dict, unit: str = "s") -> pd.DatetimeIndex:
+    report["time"] = f"epoch {'milliseconds' if unit == 'ms' else 'seconds'} (since 1970-01-01 UTC)"
+    values = column.text.astype("int64" if unit == "ms" else float)  # 13 digits: exact as integers
+    return pd.DatetimeIndex(pd.to_datetime(values, unit=unit, utc=True))
 
 
 def _with_offsets(column: _Column, index: pd.DatetimeIndex, text: pd.Series, has_offset: pd.Series, tz: str | None,
@@ -405,9 +409,10 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
     if column.text.str.fullmatch(_COMPACT_HOURS).all():
         report["date_order"] = "written yyyymmddHH"
         column.text = column.text.str.replace(r"^(\d{4})(\d{2})(\d{2})(\d{2})$", r"\1-\2-\3 \4:00", regex=True)
-    if column.text.str.fullmatch(_EPOCH).all():
-        index = _epoch(column, report)
-        return (index.tz_convert(tz) if tz else index), np.ones(len(index), bool)
+    for pattern, unit in ((_EPOCH, "s"), (_EPOCH_MS, "ms")):
+        if column.text.str.fullmatch(pattern).all():
+            index = _epoch(column, report, unit)
+            return (index.tz_convert(tz) if tz else index), np.ones(len(index), bool)
     clock_only = np.flatnonzero(column.text.str.fullmatch(_CLOCK_ONLY).to_numpy())
     if len(clock_only):
         column.refuse(int(clock_only[0]), "has no date; stamps need the date (add a date column, or write "
