@@ -151,3 +151,24 @@ def test_epoch_milliseconds_are_read_as_such(tmp_path):
     assert [str(t) for t in frame.index] == ["2021-06-21 04:00:00.123000+00:00", "2021-06-21 04:10:00.123000+00:00",
                                              "2021-06-21 04:20:00.123000+00:00"]
     assert frame.attrs["validation"]["time"] == "epoch milliseconds (since 1970-01-01 UTC)"
+
+
+@pytest.mark.parametrize("zone, first", [("UTC", "2021-06-21 04:00:00+00:00"), ("UTC+8", "2021-06-21 04:00:00+08:00"),
+                                         ("[GMT-05:00]", "2021-06-21 04:00:00-05:00")])
+def test_the_zone_a_units_row_writes_for_the_time_column_is_the_stamps(tmp_path, zone, first):
+    """A units row's 'UTC' had been ignored (UTC stamps read as the site's local time), and its
+    'UTC+8' refused as a time stamp (the row taken for data)."""
+    path = tmp_path / "units.csv"
+    stamps = ["2021-06-21 04:00", "2021-06-21 04:10", "2021-06-21 04:20"]
+    path.write_text(f"time,ghi,dni,dhi\n{zone},W/m2,W/m2,W/m2\n" + "\n".join(f"{t},812.4,640.1,150.2" for t in stamps))
+    frame = read_weather(path)
+    assert str(frame.index[0]) == first and frame.attrs["validation"]["time"].endswith("as the units row (line 2) says")
+
+
+def test_a_zones_abbreviation_in_a_units_row_is_not_read(tmp_path):
+    """'CST' is China's +08:00 or the US's -06:00: the stamps stay naive, to be given a zone."""
+    path = tmp_path / "units.csv"
+    path.write_text("time,ghi,dni,dhi\nCST,W/m2,W/m2,W/m2\n2021-06-21 04:00,812.4,640.1,150.2\n"
+                    "2021-06-21 04:10,815.0,642.7,150.9\n")
+    with pytest.raises(HybridtrackError, match="line 3, column 'time': naive time stamps"):
+        read_weather(path)

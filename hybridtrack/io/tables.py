@@ -32,7 +32,7 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .files import file_text
 
-__all__ = ["Table", "locate_table", "read_table", "numeric_columns", "table_row", "MISSING"]
+__all__ = ["Table", "locate_table", "read_table", "numeric_columns", "table_row", "MISSING", "UNITS_ROW_ZONE"]
 
 #: Cell texts that mean "no value" (Campbell writes NAN, spreadsheets #N/A).
 MISSING = ("", "nan", "na", "n/a", "#n/a", "-", "null", "none", "--")
@@ -110,10 +110,17 @@ def _is_number(cell: str) -> bool:
     return bool(_NUMBER.fullmatch(cell.strip()))
 
 
+#: A units row's cell for the time column that is a UTC offset (``UTC+8``, ``[GMT-05:00]``): its
+#: digits are no stamp's.
+UNITS_ROW_ZONE = re.compile(r"[\[(]?\s*(?:UTC|GMT)\s*(?:[+-]\d{1,2}(?::?\d{2})?)?\s*[\])]?", re.I)
+
+
 def _meta_row(fields: list[str]) -> bool:
-    """A units or processing row: no cell is a number and the first cell has no digit (no stamp)."""
+    """A units or processing row: no cell is a number and the first cell has no digit (no stamp)
+    unless it is a UTC offset (`UNITS_ROW_ZONE`: such a row had been refused as a time stamp)."""
     cells = [f.strip() for f in fields]
-    return not any(_is_number(c) for c in cells if c) and not re.search(r"\d", cells[0] if cells else "")
+    first = cells[0] if cells and not UNITS_ROW_ZONE.fullmatch(cells[0]) else ""
+    return not any(_is_number(c) for c in cells if c) and not re.search(r"\d", first)
 
 
 def _named(field: str) -> bool:

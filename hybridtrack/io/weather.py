@@ -27,7 +27,7 @@ from .gapfill import fill_components
 from .resample import resample
 from .stamps import CLOCK_ZONES, offset_in_name, parse_stamps
 from .suncheck import meta_name
-from .tables import COMMA_GROUPED, MISSING, Table, locate_table
+from .tables import COMMA_GROUPED, MISSING, UNITS_ROW_ZONE, Table, locate_table
 from .units import looks_like_unit, spellings, to_frame_units
 
 __all__ = ["read_weather"]
@@ -150,7 +150,8 @@ def _stamp_from_parts(mapping: dict, cells) -> tuple[pd.Series, str]:
 def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, report, file_zone=None):
     """The stamps as a tz-aware index and the rows kept (`stamps.parse_stamps`), from a time
     column, a date and a clock column, or year, month, day and hour columns; naive ones in
-    `file_zone` (a UTC offset an NSRDB file's site lines give), else a zone the clock's name gives."""
+    `file_zone` (a UTC offset an NSRDB file's site lines give), else a zone the clock's name gives,
+    else one its units row gives (`_zone_in_units_row`)."""
     if "year" in mapping:
         (text, header), zone = _stamp_from_parts(mapping, cells), None
     elif "date" in mapping:
@@ -164,9 +165,23 @@ def _stamps(path: Path, table: Table, mapping: dict, cells, tz, site, dayfirst, 
         text, header = pd.Series(cells(mapping["time"])), mapping["time"]
         zone = _zone_in_name(header)
     zone_from = {"zone_from": f"the file's Time Zone (line {table.site_line})"} if file_zone else {}
+    if not file_zone and zone is None and "year" not in mapping:
+        zone, zone_from = _zone_in_units_row(table, mapping.get("clock", header))
     index, keep = parse_stamps(path, header, text, table.lines, tz=tz, site_tz=site.tz if site is not None else None,
                                clock_zone=file_zone or zone, dayfirst=dayfirst, report=report, **zone_from)
     return (one_typical_year(path, index, table.lines, report) if "year" in mapping else index), keep
+
+
+def _zone_in_units_row(table: Table, header: str) -> tuple[str | None, dict]:
+    """The UTC offset the units row writes for the time or clock column (``UTC``, ``UTC+8``,
+    ``[GMT-05:00]``: `tables.UNITS_ROW_ZONE`), and where it comes from for the report; a zone's
+    abbreviation (``CST``: China's or the US's?) is not read. Such a row had been skipped and its
+    zone ignored: UTC stamps read as the site's local time."""
+    written = table.units.get(header, "")
+    if not UNITS_ROW_ZONE.fullmatch(written):
+        return None, {}
+    line = table.skipped.get("units and processing rows", ["?"])[0]
+    return offset_in_name(written) or "+00:00", {"zone_from": f"the units row (line {line})"}
 
 
 def _without_cut_last(table: Table, report: dict) -> Table:
