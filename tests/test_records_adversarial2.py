@@ -172,3 +172,11 @@ def test_a_zones_abbreviation_in_a_units_row_is_not_read(tmp_path):
                     "2021-06-21 04:10,815.0,642.7,150.9\n")
     with pytest.raises(HybridtrackError, match="line 3, column 'time': naive time stamps"):
         read_weather(path)
+
+
+def test_a_format_the_file_is_not_is_named_as_such(tmp_path):
+    """--format epw on a CSV table had been refused with pvlib's "KeyError: 'altitude'" alone."""
+    path = _write(tmp_path / "table.csv", ROWS)
+    with pytest.raises(HybridtrackError, match="its first lines are a table's, not those of the EPW format: leave "
+                                               "--format out"):
+        read_weather(path, format="epw")

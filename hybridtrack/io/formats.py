@@ -36,6 +36,8 @@ __all__ = ["PVLIB_FORMATS", "TYPICAL_YEAR", "detect_format", "read_pvlib", "head
 PVLIB_FORMATS = {"epw": "read_epw", "tmy3": "read_tmy3", "tmy2": "read_tmy2", "midc": "read_midc",
                  "srml": "read_srml", "bsrn": "read_bsrn", "surfrad": "read_surfrad", "crn": "read_crn",
                  "solrad": "read_solrad"}
+#: The formats `detect_format` recognises by their first lines (the others read as tables).
+RECOGNISED_FORMATS = ("epw", "tmy3", "tmy2", "srml", "surfrad", "bsrn")
 #: Typical-year formats: their months come from different years, so one year is coerced.
 TYPICAL_YEAR_FORMATS = ("epw", "tmy3", "tmy2")
 TYPICAL_YEAR = 2019  # any year that is not a leap year

@@ -22,7 +22,7 @@ from .closure import closure_check
 from .columns import (IRRADIANCE, LABEL_COLUMN, STAMP_PARTS, WEATHER_COLUMNS, check_names, resolve_columns,
                       split_header)
 from .files import file_text
-from .formats import PVLIB_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
+from .formats import PVLIB_FORMATS, RECOGNISED_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
 from .resample import resample
 from .stamps import CLOCK_ZONES, offset_in_name, parse_stamps
@@ -315,6 +315,20 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
     return frame[keep], meta
 
 
+def _read_pvlib_as_told(path: Path, fmt: str, tz, report: dict, text: str, encoding: str):
+    """`read_pvlib`, whose refusal of a file given a format its first lines are not (``--format
+    epw`` on a CSV table) says so: pvlib's own word alone had been ``KeyError: 'altitude'``."""
+    try:
+        return read_pvlib(path, fmt, tz, report, text, encoding)
+    except HybridtrackError as exc:
+        detected = detect_format(text)
+        if fmt not in RECOGNISED_FORMATS or detected == fmt:
+            raise
+        looks = "a table" if detected == "csv" else f"a {detected.upper()} file"
+        raise HybridtrackError(f"{exc}; its first lines are {looks}'s, not those of the {fmt.upper()} format: "
+                               "leave --format out (format=None) to read it as what it is") from None
+
+
 def _site_from_meta(meta: dict):
     from ..sites import custom
 
@@ -403,7 +417,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         if columns or units:
             raise HybridtrackError(f"{path}: --map and --units apply to tables; a {fmt.upper()} file names its own "
                                    "columns and units")
-        frame, meta = read_pvlib(path, fmt, tz, report, text, encoding)
+        frame, meta = _read_pvlib_as_told(path, fmt, tz, report, text, encoding)
         report["rows_read"] = int(len(frame))
     else:
         raise HybridtrackError(f"unknown format {format!r}; choose csv, {', '.join(PVLIB_FORMATS)}")
