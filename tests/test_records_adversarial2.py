@@ -180,3 +180,17 @@ def test_a_format_the_file_is_not_is_named_as_such(tmp_path):
     with pytest.raises(HybridtrackError, match="its first lines are a table's, not those of the EPW format: leave "
                                                "--format out"):
         read_weather(path, format="epw")
+
+
+@pytest.mark.parametrize("written", ["{a} {d:02d}/06/2021 12:00", "{a}, {d:02d}.06.2021 12:00", "{A} {d}/6/2021 12:00"])
+def test_dates_after_a_weekdays_name_are_decided_for_the_whole_column(tmp_path, written):
+    """'Thu 10/06/2021 12:00' had been read one stamp at a time, month-first where it could: 10, 11
+    and 12 June as 6 October, November and December (dotted dates too), 13 and 14 June as June,
+    and the file called usable. 10 June 2021 was a Thursday."""
+    names = ["Thursday", "Friday", "Saturday", "Sunday", "Monday"]
+    stamps = [written.format(a=name[:3], A=name, d=day) for name, day in zip(names, range(10, 15))]
+    path = tmp_path / "weekdays.csv"
+    path.write_text("time,ghi,dni,dhi\n" + "\n".join(f'"{t}",812.4,640.1,150.2' for t in stamps) + "\n")
+    frame = read_weather(path, tz="UTC")
+    assert [str(t.date()) for t in frame.index] == [f"2021-06-{day}" for day in range(10, 15)]
+    assert frame.attrs["validation"]["date_order"].startswith("day-first")

@@ -49,6 +49,9 @@ _CLOCK_FIRST = r"^(\d{1,2}:\d{2}(?::\d{2}(?:\.\d+)?)?)[ ,]+(\d{1,2}[./-]\d{1,2}[
 #: A date of six digits (``210622``: yymmdd, ddmmyy or mmddyy), alone or before its clock: pandas
 #: read ``210622`` as 21 June 2022, day-first, without a word.
 _SIX_DIGITS = r"^(\d{2})(\d{2})(\d{2})($|[ T].*)$"
+#: A weekday's name before a date (``Thu 10/06/2021 00:00``, ``Thursday, 10.06.2021``): pandas read
+#: such stamps one at a time, month-first where it could, 10 June as 6 October, dotted dates too.
+_WEEKDAY = r"^(?:[Mm]on|[Tt]ue|[Ww]ed|[Tt]hu|[Ff]ri|[Ss]at|[Ss]un)[A-Za-z]*\.?,?\s+"
 _CLOCK_ONLY = re.compile(r"^\d{1,2}:\d{2}(:\d{2}(\.\d+)?)?$")
 _EPOCH = re.compile(r"^\d{9,10}(\.\d+)?$")
 #: Epoch milliseconds (2001-09-09 to 2286): thirteen digits, refused as no time stamp before.
@@ -189,11 +192,12 @@ def _date_reading(column: _Column, parts: pd.DataFrame, dayfirst: bool | None) -
 
 
 def _date_before_clock(text: pd.Series) -> pd.Series:
-    """Dates written after their clock, or as six digits, rewritten as ``a-b-c clock``, so that
-    their order is decided for the whole column as any other's is."""
-    if not text.str.match(f"(?:{_CLOCK_FIRST})|(?:{_SIX_DIGITS})").any():
+    """Dates written after their clock, or as six digits, rewritten as ``a-b-c clock``, and dates
+    after a weekday's name without it, so that their order is decided for the whole column as any
+    other's is."""
+    if not text.str.match(f"(?:{_CLOCK_FIRST})|(?:{_SIX_DIGITS})|(?:{_WEEKDAY})").any():
         return text  # as nearly every file: a look costs a tenth of rewriting
-    for pattern, written in ((_CLOCK_FIRST, r"\2 \1"), (_SIX_DIGITS, r"\1-\2-\3\4")):
+    for pattern, written in ((_WEEKDAY, ""), (_CLOCK_FIRST, r"\2 \1"), (_SIX_DIGITS, r"\1-\2-\3\4")):
         text = text.str.replace(pattern, written, regex=True)
     return text
 
