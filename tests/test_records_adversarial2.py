@@ -194,3 +194,12 @@ def test_dates_after_a_weekdays_name_are_decided_for_the_whole_column(tmp_path, 
     frame = read_weather(path, tz="UTC")
     assert [str(t.date()) for t in frame.index] == [f"2021-06-{day}" for day in range(10, 15)]
     assert frame.attrs["validation"]["date_order"].startswith("day-first")
+
+
+def test_a_dash_between_date_and_clock_keeps_the_date_decided_for_the_whole_column(tmp_path):
+    """'10/06/2021-12:00' had been read one stamp at a time, 10-12 June as 6 October to December."""
+    path = tmp_path / "dash.csv"
+    path.write_text("time,ghi,dni,dhi\n" + "\n".join(f"{day}/06/2021-12:00,812.4,640.1,150.2"
+                                                     for day in range(10, 15)) + "\n")
+    frame = read_weather(path, tz="UTC")
+    assert [str(t) for t in frame.index] == [f"2021-06-{day} 12:00:00+00:00" for day in range(10, 15)]

@@ -39,9 +39,9 @@ CLOCK_ZONES = {"mst": "-07:00", "pst": "-08:00", "cst": "-06:00", "est": "-05:00
                "akst": "-09:00", "utc": "+00:00", "gmt": "+00:00"}
 
 #: A day-and-month date, its year, and the clock after it (after a space, a T, or a comma, as
-#: ``toLocaleString('en-GB')`` writes ``10/06/2021, 00:00:00``: such stamps had been read by
-#: pandas one at a time, 10-12 June as 6 October, November and December).
-_DMY = re.compile(r"^(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?=$|[ T,])(.*)$")
+#: ``toLocaleString('en-GB')`` writes ``10/06/2021, 00:00:00``, or a dash, ``10/06/2021-00:00``:
+#: such stamps had been read by pandas one at a time, 10-12 June as 6 October, November and December).
+_DMY = re.compile(r"^(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?=$|[ T,]|-\d)(.*)$")
 #: A date after its clock (``12:00 05/06/2021``): pandas read such stamps one at a time,
 #: month-first, and ``12:00 21-06-22`` as 21 June 2022, without a word.
 #: (Both written as pyarrow's regular expressions read them, without look-ahead: Python's took seconds.)
@@ -216,7 +216,7 @@ def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
                                                         f"({column.text.iloc[int(np.flatnonzero(matched)[0])]!r})")
     reading, report["date_order"] = _date_reading(column, parts, dayfirst)
     day, month, year = (parts[i] for i in _READINGS[reading])
-    clock = parts[4].str.replace(r"^,\s*", " ", regex=True)
+    clock = parts[4].str.replace(r"^(?:,\s*|-)", " ", regex=True)  # '10/06/2021-12:00' as a space
     return (year.map(_two_digit_year).astype(str) + "-" + month.str.zfill(2) + "-" + day.str.zfill(2) + clock).str.strip()
 
 
