@@ -203,3 +203,15 @@ def test_a_dash_between_date_and_clock_keeps_the_date_decided_for_the_whole_colu
                                                      for day in range(10, 15)) + "\n")
     frame = read_weather(path, tz="UTC")
     assert [str(t) for t in frame.index] == [f"2021-06-{day} 12:00:00+00:00" for day in range(10, 15)]
+
+
+@pytest.mark.parametrize("stamp", ["@ {d}/06/2021 12:00", "{d}/06/2021_12:00", "Date: {d}.06.2021 12:00"])
+def test_a_day_and_month_in_a_form_not_decided_for_the_column_is_refused(tmp_path, stamp):
+    """Such stamps had been read one at a time (or by a form of their own), month-first where
+    they could be: 10-12 June as 6 October to December, or refused as no time stamp alike."""
+    path = tmp_path / "loose.csv"
+    path.write_text("time,ghi,dni,dhi\n" + "\n".join(f"{stamp.format(d=day)},812.4,640.1,150.2"
+                                                     for day in range(10, 15)) + "\n")
+    with pytest.raises(HybridtrackError, match=r"line 2, column 'time': .* writes its day and month in a form whose "
+                                               r"order cannot be decided for the whole column"):
+        read_weather(path, tz="UTC")

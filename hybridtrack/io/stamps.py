@@ -202,14 +202,31 @@ def _date_before_clock(text: pd.Series) -> pd.Series:
     return text
 
 
+#: A day and month written with a year anywhere in a stamp (``@ 10/06/2021 12:00``), not at its start.
+_LOOSE_DMY = r"(?:^|[^\d./-])\d{1,2}[./-]\d{1,2}[./-]\d{2,4}(?:[^\d./-]|$)"
+
+
+def _refuse_undecided_form(column: _Column, text: pd.Series) -> None:
+    """Refuse a column whose ``a/b/c`` dates are written in a form whose order is not decided for
+    the whole column (`_DMY`): the parser would read them one at a time, month-first where it
+    could (``Thu 10/06/2021`` had been 6 October), without a word."""
+    loose = np.flatnonzero(text.str.contains(_LOOSE_DMY, regex=True).to_numpy())
+    if len(loose):
+        column.refuse(int(loose[0]), "writes its day and month in a form whose order cannot be decided for the "
+                                     "whole column; write the stamps as yyyy-mm-dd HH:MM, or as dd/mm/yyyy HH:MM "
+                                     "(or mm/dd/yyyy HH:MM)")
+
+
 def _to_iso(column: _Column, dayfirst: bool | None, report: dict) -> pd.Series:
     """Dates in ``d/m/y``, ``m/d/y`` or ``yy/m/d`` form rewritten as ``yyyy-mm-dd``, decided for the whole column."""
     text = _date_before_clock(column.text)
     if not text.str.contains(r"^\d{1,2}[./-]\d{1,2}[./-]\d", regex=True).any():
+        _refuse_undecided_form(column, text)
         return column.text  # year first (ISO) or another form the parser reads whole
     parts = text.str.extract(_DMY)
     matched = parts[0].notna().to_numpy()
     if not matched.any():
+        _refuse_undecided_form(column, text)
         return column.text
     if not matched.all():
         column.refuse(int(np.flatnonzero(~matched)[0]), f"is not written like the column's other dates "
