@@ -56,9 +56,22 @@ class AblationPlan:
     policies: tuple[str, ...] = STRATEGIES
 
     def __post_init__(self) -> None:
+        from . import params
+        from . import sites as known_sites
         from .collectors import KINDS
         from .sky import DAY_TYPES
 
+        for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
+            values = getattr(self, name)
+            if isinstance(values, (str, bytes)):  # a text had been run a letter a value ("unknown site 'l'")
+                raise HybridtrackError(f"ablate: {name} must be a list, such as ({values!r},), got {values!r:.60}")
+            object.__setattr__(self, name, tuple(values))
+            if not getattr(self, name):
+                raise HybridtrackError(f"ablate: no {name} to run")
+        # a built-in site by its own name: 'Nanjing' had taken the days of 2021, 'nanjing' those of 2013
+        object.__setattr__(self, "sites", tuple(site if isinstance(site, known_sites.Site) else
+                                                known_sites.get(site).name for site in self.sites))
+        object.__setattr__(self, "seeds", tuple(params.seed(seed, "ablate: seed") for seed in self.seeds))
         checks = [("season", self.seasons, tuple(SEASONS)), ("weather", self.weather, (*DAY_TYPES, "mixed")),
                   ("collector", self.collectors, KINDS), ("policy", self.policies, STRATEGIES)]
         for what, values, known in checks:
@@ -66,16 +79,15 @@ class AblationPlan:
                 if value not in known:
                     raise HybridtrackError(f"ablate: unknown {what} {value!r}; choose from {', '.join(known)}")
         for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
-            if not getattr(self, name):
-                raise HybridtrackError(f"ablate: no {name} to run")
+            values = getattr(self, name)
+            twice = next((value for k, value in enumerate(values) if value in values[:k]), None)
+            if twice is not None:  # the same days run twice, and counted twice in the table's means
+                raise HybridtrackError(f"ablate: {name} names {twice!r} twice")
 
     def days(self) -> list[dict]:
         """One dict per day: site, date, weather, seed, collector."""
-        from . import sites as known_sites
-
         out = []
         for site in self.sites:
-            known_sites.get(site)
             year = SITE_YEARS.get(site, 2021)
             for season in self.seasons:
                 for weather in self.weather:
