@@ -3,7 +3,13 @@
 import pytest
 
 from hybridtrack.ablation import AblationPlan
+from hybridtrack.cli import main
 from hybridtrack.errors import HybridtrackError
+
+#: One day, one policy: a plan that would run in seconds, were it run.
+SMALL = ["ablate", "--sites", "lanzhou", "--seasons", "summer", "--collectors", "trough-ns", "--seeds", "1",
+         "--policies", "hybrid"]
+
 
 @pytest.mark.parametrize("field, values, named", [
     ("sites", ("lanzhou", "nanjing", "lanzhou"), "'lanzhou'"),
@@ -43,3 +49,29 @@ def test_a_site_written_in_capitals_takes_its_own_year():
 def test_an_unknown_site_is_refused_when_the_plan_is_made():
     with pytest.raises(HybridtrackError, match="unknown site 'mars'"):
         AblationPlan(sites=("lanzhou", "mars"))
+
+
+@pytest.mark.parametrize("flags, named", [(["--deadbands", "0.2"], "--deadbands goes with --tradeoff"),
+                                          (["--periods", "5min"], "--periods goes with --tradeoff"),
+                                          (["--periods", "5min", "--deadbands", "0.2"],
+                                           "--deadbands and --periods go with --tradeoff")])
+def test_tradeoff_flags_without_tradeoff_are_refused(flags, named, capsys):
+    # they had been dropped without a word: every policy ran at the config's deadband and 1 min
+    assert main([*SMALL, *flags]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and named in err
+
+
+@pytest.mark.parametrize("tradeoff", [[], ["--tradeoff"]])
+def test_an_empty_config_path_is_refused_not_read_as_the_defaults(tradeoff, capsys):
+    # --config "$CONFIG" with the variable unset had run the defaults without a word
+    assert main([*SMALL, *tradeoff, "--config", ""]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "a config file must be a path, got ''" in err
+
+
+def test_the_help_names_the_tradeoff_defaults(capsys):
+    with pytest.raises(SystemExit):
+        main(["ablate", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "(default 0.1,0.2,0.4,0.8)" in help_text and "(default 1min;" in help_text

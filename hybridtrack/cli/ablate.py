@@ -12,6 +12,10 @@ from ..outputs import claim, write
 from .base import add_force_argument, command, leaving_out, real_number, whole_number
 
 
+#: ``--deadbands`` and ``--periods`` when not given (with ``--tradeoff``).
+DEADBANDS, PERIODS = "0.1,0.2,0.4,0.8", "1min"
+
+
 def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
     from ..ablation import SEASONS
     from ..control import STRATEGIES
@@ -31,10 +35,10 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tradeoff", action="store_true",
                         help="instead of every policy: one policy over a grid of drive deadbands and scan periods, "
                              "pointing error against moves a day")
-    parser.add_argument("--deadbands", default="0.1,0.2,0.4,0.8",
-                        help="with --tradeoff: deadbands, degrees, comma-separated (default 0.1,0.2,0.4,0.8)")
-    parser.add_argument("--periods", default="1min",
-                        help="with --tradeoff: scan periods, comma-separated (default 1min; e.g. 1min,2min,5min)")
+    parser.add_argument("--deadbands", help=f"with --tradeoff: deadbands, degrees, comma-separated (default "
+                                            f"{DEADBANDS})")
+    parser.add_argument("--periods", help=f"with --tradeoff: scan periods, comma-separated (default {PERIODS}; e.g. "
+                                          "1min,2min,5min)")
     add_force_argument(parser)
 
 
@@ -43,18 +47,21 @@ def _ablate_arguments(parser: argparse.ArgumentParser) -> None:
 def _ablate(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from ..ablation import AblationPlan, ablate
+    from ..ablation import ablate
     from ..control import STRATEGIES
-    from ..simulation import SimulationConfig
 
     if not 1 <= args.seeds <= 1000:
         raise HybridtrackError(f"--seeds must be between 1 and 1000, got {args.seeds}")
     params.whole(args.workers, "--workers", 1, 64)
     if args.tradeoff:
         return _tradeoff(args)
-    plan = AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
-                        tuple(args.collectors), tuple(args.policies or STRATEGIES))
-    config = SimulationConfig.from_toml(args.config) if args.config else None
+    given = [flag for flag in ("--deadbands", "--periods") if getattr(args, flag[2:]) is not None]
+    if given:  # they had been dropped without a word, and every policy run at the config's drive and 1 min
+        raise HybridtrackError(f"{' and '.join(given)} {'go' if len(given) > 1 else 'goes'} with --tradeoff, which "
+                               "runs one policy over deadbands and scan periods; give --tradeoff, or leave "
+                               f"{'them' if len(given) > 1 else 'it'} out")
+    plan = _plan(args, tuple(args.policies or STRATEGIES))
+    config = _config(args)
     files = _files(args.out, "ablation.png")
     claim(files)  # before the runs, not after them
     days = len(plan.days())
@@ -68,6 +75,22 @@ def _ablate(args: argparse.Namespace) -> int:
         if args.out:
             _write(files, result)
     return 0
+
+
+def _plan(args: argparse.Namespace, policies: tuple[str, ...]):
+    """The `AblationPlan` of the days the flags ask for, with `policies`."""
+    from ..ablation import AblationPlan
+
+    return AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
+                        tuple(args.collectors), policies)
+
+
+def _config(args: argparse.Namespace):
+    """The ``--config`` file's run config, or None (the defaults) without one. An empty path
+    (``--config "$CONFIG"`` with the variable unset) is refused as no file, not read as none."""
+    from ..simulation import SimulationConfig
+
+    return SimulationConfig.from_toml(args.config) if args.config is not None else None
 
 
 def _files(out: str | None, picture: str) -> list:
@@ -108,13 +131,14 @@ def _tradeoff(args: argparse.Namespace) -> int:
     """``ablate --tradeoff``: one policy over deadbands and scan periods."""
     from tqdm import tqdm
 
-    from ..simulation import SimulationConfig
     from ..tradeoff import TradeoffPlan, tradeoff
 
-    plan = TradeoffPlan(_deadbands(args.deadbands), tuple(p.strip() for p in args.periods.split(",")),
-                        tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
-                        tuple(args.collectors), (args.policies or ["hybrid"])[0])
-    config = SimulationConfig.from_toml(args.config) if args.config else None
+    deadbands = DEADBANDS if args.deadbands is None else args.deadbands  # "" is refused, not the default
+    periods = PERIODS if args.periods is None else args.periods
+    days = _plan(args, ((args.policies or ["hybrid"])[0],))  # its sites by their own names (SITE_YEARS)
+    plan = TradeoffPlan(_deadbands(deadbands), tuple(p.strip() for p in periods.split(",")), days.sites, days.seasons,
+                        days.weather, days.seeds, days.collectors, days.policies[0])
+    config = _config(args)
     files = _files(args.out, "tradeoff.png")
     claim(files)  # before the runs, not after them
     with _leaving_out_the_other_picture(args, "ablation.png", "--tradeoff"):
