@@ -31,6 +31,9 @@ __all__ = ["Term", "Variable", "Rule", "Methods", "FuzzyConfig", "SHAPES", "LABE
 #: The weather labels the controller understands, in score order.
 LABELS = ("overcast", "cloudy", "sunny")
 
+#: The keys of a rule in the TOML layout besides its variables' names.
+RULE_KEYS = ("weight", "connection")
+
 #: The inference options of a Mamdani system and the choices of each.
 METHOD_CHOICES = {"and_method": ("min", "prod"), "or_method": ("max", "probor"), "implication": ("min", "prod"),
                   "aggregation": ("max", "sum", "probor"),
@@ -362,6 +365,7 @@ class FuzzyConfig:
         self.output.check(f"output.{self.output.name}")
         if len(set(self.input_names)) != 2 or self.output.name in self.input_names:
             raise HybridtrackError(f"variable names must differ, got {list(self.input_names)} and {self.output.name!r}")
+        self._validate_names()
         if not self.rules:
             raise HybridtrackError("the rule table is empty")
         for number, rule in enumerate(self.rules, start=1):
@@ -389,6 +393,21 @@ class FuzzyConfig:
                 len(self.labelled_range) != len(self.inputs)
                 or not all(math.isfinite(lo) and math.isfinite(hi) and lo <= hi for lo, hi in self.labelled_range)):
             raise HybridtrackError(f"labelled_range needs a finite [low, high] for each input, got {self.labelled_range}")
+
+    def _validate_names(self) -> None:
+        """Refuse the names a TOML rule table would read as something else, so that every config
+        `to_toml` writes `from_toml` reads back: a variable named like a rule's own keys
+        (`RULE_KEYS`), and an input term whose name reads as a negation (``not ...``) or loses its
+        blanks when a negation is read."""
+        for var in (*self.inputs, self.output):
+            if var.name in RULE_KEYS:
+                raise HybridtrackError(f"{'output' if var is self.output else 'inputs'}.{var.name}: a variable "
+                                       f"cannot be named {var.name!r}, a rule's own key in the TOML layout")
+        for var in self.inputs:
+            for term in var.term_names:
+                if term.lower().startswith("not ") or term != term.strip():
+                    raise HybridtrackError(f"inputs.{var.name}.terms.{term}: a term name {term!r} would read as "
+                                           "another in a rule (a rule's 'not TERM' negates TERM); rename it")
 
     def _validate_bands(self) -> None:
         if not self.bands:

@@ -1,0 +1,63 @@
+"""Fuzzy configs a user or a converted file could make: every one that is made round-trips
+through TOML; the ones a TOML rule table would read as another are refused, naming the key."""
+
+import dataclasses
+
+import pytest
+
+from hybridtrack.errors import HybridtrackError
+from hybridtrack.fuzzy import FuzzyConfig
+from hybridtrack.fuzzy.config import Rule
+
+DEFAULT = FuzzyConfig.default()
+
+
+def _renamed_input(name: str) -> FuzzyConfig:
+    """The published system with its intensity input called `name` (in its rules too)."""
+    intensity, variation = DEFAULT.inputs
+    rules = tuple(Rule({name if k == "intensity" else k: t for k, t in r.conditions.items()}, r.then)
+                  for r in DEFAULT.rules)
+    return DEFAULT.replace(inputs=(dataclasses.replace(intensity, name=name), variation), rules=rules)
+
+
+def _renamed_term(name: str, *, negated: bool = False) -> FuzzyConfig:
+    """The published system with the intensity term 'weak' called `name` (in its rules too)."""
+    intensity, variation = DEFAULT.inputs
+    terms = tuple(dataclasses.replace(t, name=name) if t.name == "weak" else t for t in intensity.terms)
+    rules = tuple(Rule({k: name if t == "weak" else t for k, t in r.conditions.items()}, r.then,
+                       negated=("intensity",) if negated and r.conditions["intensity"] == "weak" else ())
+                  for r in DEFAULT.rules)
+    return DEFAULT.replace(inputs=(dataclasses.replace(intensity, terms=terms), variation), rules=rules)
+
+
+@pytest.mark.parametrize("name", ["weight", "connection"])
+def test_an_input_named_like_a_rule_key_is_refused(name):
+    # to_toml wrote it; from_toml read the rule's 'weight = "strong"' as its weight and refused its own file
+    with pytest.raises(HybridtrackError, match=f"inputs.{name}: a variable cannot be named '{name}'"):
+        _renamed_input(name)
+
+
+@pytest.mark.parametrize("name", ["weight", "connection"])
+def test_an_output_named_like_a_rule_key_is_refused(name):
+    with pytest.raises(HybridtrackError, match=f"output.{name}: a variable cannot be named '{name}'"):
+        DEFAULT.replace(output=dataclasses.replace(DEFAULT.output, name=name))
+
+
+@pytest.mark.parametrize("name, negated", [("not weak", False), ("Not weak", False), (" weak", True)])
+def test_an_input_term_a_rule_would_read_as_another_is_refused(name, negated):
+    # 'not weak' was read back as the negation of a term 'weak'; ' weak' negated lost its blank
+    with pytest.raises(HybridtrackError, match="would read as another in a rule"):
+        _renamed_term(name, negated=negated)
+
+
+@pytest.mark.parametrize("config", [
+    _renamed_input("name"),  # a key of the file's top level, not of a rule
+    _renamed_term("nothing"),  # begins with 'not', but not with 'not '
+    _renamed_term("très faible ☁", negated=True),
+    DEFAULT.replace(name="晴天 \"quoted\" \\ back\nslash", output=dataclasses.replace(DEFAULT.output, name="out put")),
+    DEFAULT.replace(bands=(("阴", 0.0, 10.0), ("", 10.0, 20.0), ("a.b", 20.0, 30.0))),
+    DEFAULT.replace(rules=tuple(dataclasses.replace(r, weight=0.1 + 0.2, connection="or") for r in DEFAULT.rules)),
+    DEFAULT.replace(labelled_range=((-0.0, 300.0), (0.0, 180.0))),
+], ids=["input-name", "term-nothing", "unicode-negated-term", "unicode-names", "odd-bands", "weights-or", "labelled"])
+def test_a_config_made_round_trips_through_toml(config, tmp_path):
+    assert FuzzyConfig.from_toml(config.to_toml(tmp_path / "fuzzy.toml")) == config
