@@ -352,7 +352,11 @@ def run_scenario(name: str, site: str | None = None) -> ScenarioResult:
     from .simulation import SimulationConfig, simulate
 
     if name not in SCENARIOS:
-        raise HybridtrackError(f"unknown fault scenario {name!r}; `hybridtrack faults list` shows them")
+        import difflib
+
+        near = difflib.get_close_matches(str(name).lower(), SCENARIOS, n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise HybridtrackError(f"unknown fault scenario {name!r}; {hint}`hybridtrack faults list` shows them")
     scenario = SCENARIOS[name]
     place = site or scenario.site
     frame, faults, changes, onset = scenario.build(place)

@@ -23,6 +23,11 @@ def _faults(args: argparse.Namespace) -> int:
     from ..faults import SCENARIOS, run_scenario
 
     if args.action == "list":
+        given = [what for what, value in ((f"a scenario's name ({args.name!r})", args.name), ("--site", args.site),
+                                          ("--markdown", args.markdown)) if value not in (None, False)]
+        if given:  # they had been dropped without a word
+            raise HybridtrackError(f"{' and '.join(given)} {'goes' if len(given) == 1 else 'go'} with faults run, "
+                                   "not faults list")
         for scenario in SCENARIOS.values():
             print(f"{scenario.name:24s} {scenario.description}")
         return 0
