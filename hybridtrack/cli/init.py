@@ -110,6 +110,9 @@ def _init_arguments(parser: argparse.ArgumentParser) -> None:
 @command("init", "write a commented run config, a fuzzy config and an example rule table to start from",
          _init_arguments)
 def _init(args: argparse.Namespace) -> int:
+    if not args.dir.strip():  # Path("") is here: ``init "$DIR"`` with DIR unset had written into the current folder
+        raise HybridtrackError("DIR is empty: give a folder to write into, or leave it out to write here "
+                               "(an unset shell variable?)")
     folder = Path(args.dir)
     files = {RUN: commented_run_config(), FUZZY: commented_fuzzy_config(), RULES: example_rule_table()}
     if folder.exists() and not folder.is_dir():
