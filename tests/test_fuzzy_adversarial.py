@@ -61,3 +61,16 @@ def test_an_input_term_a_rule_would_read_as_another_is_refused(name, negated):
 ], ids=["input-name", "term-nothing", "unicode-negated-term", "unicode-names", "odd-bands", "weights-or", "labelled"])
 def test_a_config_made_round_trips_through_toml(config, tmp_path):
     assert FuzzyConfig.from_toml(config.to_toml(tmp_path / "fuzzy.toml")) == config
+
+
+@pytest.mark.parametrize("values, named", [(["intensity=-5", "variation=50"], "input 'intensity' must be 0 or more"),
+                                           (["intensity=200", "variation=-0.1"], "input 'variation' must be 0 or more")])
+def test_fuzzy_eval_of_a_classifier_refuses_a_reading_below_zero_as_classify_does(values, named, tmp_path, capsys):
+    # -5 mA had been clipped onto the raw range and scored overcast; classify and rules refuse it
+    from hybridtrack.cli import main
+
+    source = DEFAULT.to_toml(tmp_path / "fuzzy.toml")
+    assert main(["fuzzy", "eval", str(source), *values]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and named in err
+    assert main(["classify", "--config", str(source), "--intensity", values[0][10:], "--variation", values[1][10:]]) == 2

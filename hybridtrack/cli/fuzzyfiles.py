@@ -58,6 +58,12 @@ def _evaluate(system, args: argparse.Namespace) -> int:
     for name, value in zip(system.input_names, x[0]):
         if not np.isfinite(value):
             raise HybridtrackError(f"input {name!r} must be a finite number, got {value}")
+    if str(args.source).lower().endswith(".toml"):  # a classifier's readings: refused below zero, as classify does
+        from ..fuzzy.classifier import NEVER_NEGATIVE
+
+        for name, value, why in zip(system.input_names, x[0], NEVER_NEGATIVE.values()):
+            if value < 0.0:
+                raise HybridtrackError(f"input {name!r} must be 0 or more ({why}), got {value:g}")
     x = np.array([[var.to_universe(value) for var, value in zip(system.inputs, x[0])]])  # a .toml's raw_range
     if args.engine == "skfuzzy":
         values = [evaluate_skfuzzy(system, x, output=o)[0] for o in range(len(system.outputs))]
