@@ -4,6 +4,7 @@ through TOML; the ones a TOML rule table would read as another are refused, nami
 import dataclasses
 
 import pytest
+import tomli_w
 
 from hybridtrack.errors import HybridtrackError
 from hybridtrack.fuzzy import FuzzyConfig
@@ -74,3 +75,61 @@ def test_fuzzy_eval_of_a_classifier_refuses_a_reading_below_zero_as_classify_doe
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and named in err
     assert main(["classify", "--config", str(source), "--intensity", values[0][10:], "--variation", values[1][10:]]) == 2
+
+
+#: The published checks of the classifier (docs/physics.md §4): readings (mA) and their labels.
+PUBLISHED_CHECKS = ((246.0, 27.0, "sunny"), (200.1, 84.6, "cloudy"), (143.4, 45.0, "overcast"))
+
+
+def test_a_config_whose_name_is_no_fcl_identifier_is_written_as_fcl_under_a_plain_name(tmp_path):
+    # a tuned config is named 'published-tuned': writing it as FCL had failed, after the fit
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+
+    path = DEFAULT.replace(name="published-tuned").to_fcl(tmp_path / "tuned.fcl")
+    assert path.read_text().splitlines()[0] == "FUNCTION_BLOCK published_tuned"
+    read = FuzzyWeatherClassifier(FuzzyConfig.from_fcl(path))
+    assert [read.classify(i, v) for i, v, _ in PUBLISHED_CHECKS] == [label for _, _, label in PUBLISHED_CHECKS]
+
+
+@pytest.mark.parametrize("name, block", [("9 lives", "_9_lives"), ("", "_"), ("晴 x", "__x")])
+def test_an_fcl_block_name_starts_as_an_identifier_must(name, block, tmp_path):
+    path = DEFAULT.replace(name=name).to_fcl(tmp_path / "x.fcl")
+    assert path.read_text().splitlines()[0] == f"FUNCTION_BLOCK {block}"
+    assert FuzzyConfig.from_fcl(path).name == block
+
+
+def _labels(tmp_path):
+    path = tmp_path / "labels.csv"
+    path.write_text("intensity,variation,weather\n" + "".join(f"{i},{v},{w}\n" for i, v, w in PUBLISHED_CHECKS)
+                    + "280,5,sunny\n60,10,overcast\n220,120,cloudy\n")
+    return path
+
+
+def test_tune_writes_fcl_as_fcl(tmp_path, capsys):
+    # --out tuned.fcl had been written as TOML, which no reader then took
+    from hybridtrack.cli import main
+
+    out = tmp_path / "tuned.fcl"
+    assert main(["tune", str(_labels(tmp_path)), "--out", str(out), "--method", "local", "--folds", "0",
+                 "--seeds", "1"]) == 0
+    assert out.read_text().startswith("FUNCTION_BLOCK ") and FuzzyConfig.from_fcl(out).input_names == (
+        "intensity", "variation")
+    assert "a .fcl file cannot keep the labelled range" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", ["tuned.json", "tuned"])
+def test_tune_refuses_an_out_of_no_fuzzy_format_before_the_fit(name, tmp_path, capsys):
+    from hybridtrack.cli import main
+
+    assert main(["tune", str(_labels(tmp_path)), "--out", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown fuzzy system format" in err and not (tmp_path / name).exists()
+
+
+def test_a_toml_file_read_as_fcl_is_refused_in_a_short_line(tmp_path):
+    # the statement left unclosed had been quoted whole: the entire TOML file as one line
+    path = tmp_path / "fake.fcl"
+    path.write_text(tomli_w.dumps(DEFAULT.to_dict()))
+    with pytest.raises(HybridtrackError, match="statement without a closing ';'") as caught:
+        FuzzyConfig.from_fcl(path)
+    assert len(str(caught.value)) < 200

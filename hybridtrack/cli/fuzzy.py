@@ -112,7 +112,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
 def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("labels", help="CSV (or TOML [[case]]) of intensity, variation and weather and/or score")
     parser.add_argument("--config", help="starting config (.toml or .fis); the published one by default")
-    parser.add_argument("--out", required=True, help="where to write the tuned config (.toml or .fis)")
+    parser.add_argument("--out", required=True, help="where to write the tuned config (.toml, .fis or .fcl)")
     parser.add_argument("--method", choices=("global", "local"), default="global",
                         help="global: population search then Powell (default); local: Powell only")
     parser.add_argument("--margin", type=real_number, default=0.5,
@@ -131,8 +131,10 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
 def _tune(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from ..fuzzy.files import file_format
     from ..fuzzy.tuning import check_folds, check_margin, check_seed, check_seeds, read_samples, tune
 
+    suffix = file_format(args.out)  # tuned.fcl had been written as TOML, which no reader then took
     check_seed(args.seed, "--seed")
     check_seeds(args.seeds, "--seeds")  # these checks before the progress bar
     start = load_fuzzy_config(args.config)
@@ -148,12 +150,12 @@ def _tune(args: argparse.Namespace) -> int:
     with tqdm(total=fits, unit="fit", desc="tuning", disable=fits < 2, leave=False, file=sys.stderr) as bar:
         tuned, report = tune(start, samples, method=args.method, margin=args.margin, seed=args.seed,
                              folds=args.folds, seeds=args.seeds, progress=bar.update)
-    out = tuned.to_fis(args.out) if args.out.lower().endswith(".fis") else tuned.to_toml(args.out)
+    out = {".fis": tuned.to_fis, ".fcl": tuned.to_fcl, ".toml": tuned.to_toml}[suffix](args.out)
     print(report)
     for name, change in report.changed.items():
         print(f"  {name}: {change['before']} -> {change['after']}")
-    print(f"wrote {out}" + (" (a .fis file cannot keep the labelled range; use .toml to keep the warning)"
-                            if str(out).lower().endswith(".fis") else ""))
+    print(f"wrote {out}" + (f" (a {suffix} file cannot keep the labelled range; use .toml to keep the warning)"
+                            if suffix != ".toml" else ""))
     if args.report:
         from ..report import plot_confusion, plot_tuning, save_figure
 

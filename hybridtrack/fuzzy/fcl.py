@@ -70,6 +70,14 @@ def _name(text: str, what: str) -> str:
     return text
 
 
+def _block_name(text: str) -> str:
+    """`text` as the function block's identifier, each character FCL does not take an underscore:
+    the block's name is a label no rule refers to, and a tuned system's ('published-tuned') had
+    made every tuned classifier unwritable as FCL (after its fit)."""
+    name = re.sub(r"[^A-Za-z0-9_]", "_", text)
+    return name if _IDENTIFIER.match(name) else f"_{name}"
+
+
 def _points(term: Term) -> str:
     p = [format_number(v) for v in term.params]
     ys = ("0", "1", "0") if term.shape == "trimf" else ("0", "1", "1", "0")
@@ -89,7 +97,7 @@ def _key(table: dict[str, str], value: str) -> str:
 def fcl_text(system: MamdaniSystem) -> str:
     """The system as an IEC 61131-7 function block."""
     methods = system.methods
-    lines = [f"FUNCTION_BLOCK {_name(system.name, 'system name')}", "", "VAR_INPUT"]
+    lines = [f"FUNCTION_BLOCK {_block_name(system.name)}", "", "VAR_INPUT"]
     lines += [f"    {_name(var.name, 'input')} : REAL;" for var in system.inputs]
     lines += ["END_VAR", "", "VAR_OUTPUT"]
     lines += [f"    {_name(var.name, 'output')} : REAL;" for var in system.outputs]
@@ -158,7 +166,8 @@ def _statements(path: Path, text: str) -> list[tuple[int, str]]:
                 out.append((start, " ".join(statement.split())))
             start = number
     if buffer.strip():
-        raise HybridtrackError(f"{path}:{start}: statement without a closing ';': {buffer.strip()!r}")
+        raise HybridtrackError(f"{path}:{start}: statement without a closing ';': "  # its start: a TOML file
+                               f"{' '.join(buffer.split())!r:.80}")  # had been printed whole, as one line
     return out
 
 

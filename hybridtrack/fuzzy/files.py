@@ -7,14 +7,16 @@ from pathlib import Path
 from ..errors import HybridtrackError
 from .system import MamdaniSystem
 
-__all__ = ["FORMATS", "read_system", "write_system"]
+__all__ = ["FORMATS", "read_system", "write_system", "file_format"]
 
 #: File suffixes and what they hold.
 FORMATS = {".fis": "MATLAB Fuzzy Logic Toolbox v2", ".fcl": "IEC 61131-7 Fuzzy Control Language",
            ".toml": "hybridtrack sky classifier config"}
 
 
-def _suffix(path: Path) -> str:
+def file_format(path) -> str:
+    """The suffix of a fuzzy system file, lower case, one of `FORMATS`; else `HybridtrackError`."""
+    path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise HybridtrackError(f"{path}: unknown fuzzy system format {path.suffix or '(no suffix)'!r}; "
@@ -27,7 +29,7 @@ def read_system(path, *, resolution=None) -> MamdaniSystem:
     from ..io.files import input_path
 
     path = input_path(path, "fuzzy system file")
-    suffix = _suffix(path)
+    suffix = file_format(path)
     if suffix == ".fis":
         from .fis import read_fis_system
 
@@ -47,7 +49,7 @@ def write_system(system: MamdaniSystem, path) -> Path:
     from ..outputs import output_path
 
     path = output_path(path)
-    suffix = _suffix(path)
+    suffix = file_format(path)
     if suffix == ".fis":
         from .fis import write_fis
 
