@@ -21,3 +21,27 @@ def test_init_without_a_folder_still_writes_here(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["init"]) == 0
     assert sorted(os.listdir(tmp_path)) == ["fuzzy.toml", "run.toml", "test_site.rules.csv"]
+
+
+def _options(name, parser):
+    """Every option of `parser` and its sub-commands' parsers, with the command it belongs to."""
+    import argparse
+
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child, sub in action.choices.items():
+                yield from _options(f"{name} {child}", sub)
+        else:
+            yield name, action
+
+
+def test_every_option_with_a_default_says_it_in_its_help():
+    # tune --margin, classify --engine and --intensity-col had defaults their help did not name
+    import argparse
+
+    from hybridtrack.cli import build_parser
+
+    silent = [f"{command} {'/'.join(action.option_strings) or action.dest}"
+              for command, action in _options("hybridtrack", build_parser())
+              if action.default not in (None, False, argparse.SUPPRESS) and "default" not in (action.help or "")]
+    assert silent == []

@@ -64,12 +64,15 @@ def _classify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config",
                         help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by default")
     parser.add_argument("--json", action="store_true", help="print JSON: score, weather and each rule's firing")
-    parser.add_argument("--intensity-col", default="intensity", help="file: column of the photocurrent (mA)")
-    parser.add_argument("--variation-col", default="variation", help="file: column of the variation (mA)")
+    parser.add_argument("--intensity-col", default="intensity",
+                        help="file: column of the photocurrent, mA (default intensity)")
+    parser.add_argument("--variation-col", default="variation",
+                        help="file: column of the variation, mA (default variation)")
     parser.add_argument("--out", help="file: write the readings with sky_score and sky columns here")
     add_force_argument(parser)
     parser.add_argument("--engine", choices=("fast", "numba", "numpy", "skfuzzy"), default="fast",
-                        help="inference engine: fast (numba, or numpy without it), numba, numpy or skfuzzy")
+                        help="inference engine: fast (numba, or numpy without it; the default), numba, numpy or "
+                             "skfuzzy")
 
 
 @command("classify", "classify sky readings with the fuzzy classifier", _classify_arguments)
@@ -111,12 +114,13 @@ def _classify_readings(args: argparse.Namespace) -> int:
 
 def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("labels", help="CSV (or TOML [[case]]) of intensity, variation and weather and/or score")
-    parser.add_argument("--config", help="starting config (.toml or .fis); the published one by default")
+    parser.add_argument("--config", help="starting config (.toml, MATLAB .fis or FCL .fcl); the published one by "
+                                         "default")
     parser.add_argument("--out", required=True, help="where to write the tuned config (.toml, .fis or .fcl)")
     parser.add_argument("--method", choices=("global", "local"), default="global",
                         help="global: population search then Powell (default); local: Powell only")
     parser.add_argument("--margin", type=real_number, default=0.5,
-                        help="how far inside its band a label's score should sit")
+                        help="how far inside its band a label's score should sit, score units (default 0.5)")
     parser.add_argument("--seed", type=whole_number, default=0, help="seed for reproducible fits (default 0)")
     parser.add_argument("--folds", type=whole_number, default=5,
                         help="k of the k-fold cross-validated accuracy (default 5; 0 skips it)")
@@ -168,7 +172,8 @@ def _tune(args: argparse.Namespace) -> int:
 
 
 def _surface_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--config", help="classifier config (.toml or .fis); the published one by default")
+    parser.add_argument("--config", help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by "
+                                         "default")
     parser.add_argument("--out", default="surface.png", help="image to write (default surface.png)")
     add_force_argument(parser)
     parser.add_argument("--points", type=whole_number, default=121, help="grid points along each input (default 121)")

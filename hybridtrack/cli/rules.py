@@ -11,7 +11,8 @@ from .fuzzy import check_reading, load_fuzzy_config, tuned_config_warnings
 def _rules_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--intensity", type=real_number, required=True, help="sensor photocurrent, mA")
     parser.add_argument("--variation", type=real_number, required=True, help="its variation over the window, mA")
-    parser.add_argument("--config", help="classifier config (.toml or MATLAB .fis); the published one by default")
+    parser.add_argument("--config", help="classifier config (.toml, MATLAB .fis or FCL .fcl); the published one by "
+                                         "default")
     parser.add_argument("--plot", metavar="FILE", help="also draw the rule viewer (PNG, SVG or PDF)")
     add_force_argument(parser)
 
