@@ -64,8 +64,7 @@ def from_matlab(shape: str, values) -> tuple[float, ...]:
 
 
 def _sigmoid(x, centre_, slope):
-    with np.errstate(over="ignore"):
-        return 1.0 / (1.0 + np.exp(-slope * (x - centre_)))
+    return 1.0 / (1.0 + np.exp(-slope * (x - centre_)))
 
 
 def _s_curve(x, a, b):
@@ -76,15 +75,40 @@ def _s_curve(x, a, b):
     return np.where(x <= a, 0.0, np.where(x <= mid, rise, np.where(x <= b, top, 1.0)))
 
 
+def _gaussian(x, mean, sigma):
+    """``exp(-(x - mean)² / 2σ²)``, written so that no σ a term takes over- or underflows it: σ²
+    of 1e200 had raised OverflowError, of 1e-200 divided by zero (NaN at the mean)."""
+    return np.exp(-0.5 * ((x - mean) / sigma) ** 2)
+
+
 def membership(shape: str, params, x) -> np.ndarray:
-    """The membership of the points `x` in a term of type `shape` with `params`."""
-    p = [float(v) for v in params]
-    x = np.asarray(x, float)
+    """The membership of the points `x` in a term of type `shape` with `params`.
+
+    Parameters
+    ----------
+    shape : str
+        One of `SHAPES`.
+    params : sequence of float
+        The shape's parameters, in scikit-fuzzy's order (`check_params` holds them valid).
+    x : array_like
+        Points of the universe.
+
+    Returns
+    -------
+    numpy.ndarray
+        Memberships in [0, 1]; a steep or far term's values past float's range are read as
+        their limits (0 or 1), without a warning.
+    """
+    with np.errstate(over="ignore", under="ignore"):  # an exponent or a slope past float's range: 0 or 1
+        return _membership(shape, [float(v) for v in params], np.asarray(x, float))
+
+
+def _membership(shape: str, p: list, x: np.ndarray) -> np.ndarray:
     if shape == "gaussmf":
-        return np.exp(-((x - p[0]) ** 2) / (2.0 * p[1] ** 2))
+        return _gaussian(x, p[0], p[1])
     if shape == "gauss2mf":
-        left = np.exp(-((x - p[0]) ** 2) / (2.0 * p[1] ** 2))
-        right = np.exp(-((x - p[2]) ** 2) / (2.0 * p[3] ** 2))
+        left = _gaussian(x, p[0], p[1])
+        right = _gaussian(x, p[2], p[3])
         return np.where(x <= p[0], left, np.where(x > p[2], right, 1.0))
     if shape == "gbellmf":
         return 1.0 / (1.0 + np.abs((x - p[2]) / p[0]) ** (2.0 * p[1]))
