@@ -133,3 +133,70 @@ def test_a_toml_file_read_as_fcl_is_refused_in_a_short_line(tmp_path):
     with pytest.raises(HybridtrackError, match="statement without a closing ';'") as caught:
         FuzzyConfig.from_fcl(path)
     assert len(str(caught.value)) < 200
+
+
+@pytest.mark.parametrize("shape, params, x, expected", [
+    # exp(-(x - m)² / 2σ²) by hand: 1 at the mean, 0 a finite distance from a mean of σ → 0, 1 for σ → ∞
+    ("gaussmf", (5.0, 1e-300), [5.0, 5.1], [1.0, 0.0]),
+    ("gaussmf", (5.0, 1e300), [0.0, 10.0], [1.0, 1.0]),
+    ("gauss2mf", (4.0, 1e-300, 6.0, 1e300), [3.9, 5.0, 10.0], [0.0, 1.0, 1.0]),
+    ("gaussmf", (5.0, 2.0), [5.0, 7.0], [1.0, 0.6065306597126334]),  # exp(-1/2)
+])
+def test_a_gaussian_of_any_valid_sigma_is_evaluated_without_overflow(shape, params, x, expected):
+    # σ = 1e300 had raised OverflowError (σ² past float), σ = 1e-300 divided by zero: NaN at the mean
+    import warnings
+
+    import numpy as np
+
+    from hybridtrack.fuzzy.membership import membership
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.allclose(membership(shape, params, np.array(x)), expected, rtol=1e-15, atol=0)
+
+
+def test_a_config_of_inputs_written_variation_first_reads_them_by_name(tmp_path):
+    # [inputs.variation] above [inputs.intensity] had fed the photocurrent to the variation's terms:
+    # the published sunny check (246 mA, 27 mA) came out cloudy
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+
+    data = DEFAULT.to_dict()
+    data["inputs"] = {"variation": data["inputs"]["variation"], "intensity": data["inputs"]["intensity"]}
+    data["labelled_range"] = {"variation": [0.0, 100.0], "intensity": [50.0, 250.0]}
+    path = tmp_path / "fuzzy.toml"
+    path.write_text(tomli_w.dumps(data))
+    config = FuzzyConfig.from_toml(path)
+    assert config.input_names == ("intensity", "variation")
+    assert config.labelled_range == ((50.0, 250.0), (0.0, 100.0))
+    assert FuzzyWeatherClassifier(config).classify(246.0, 27.0) == "sunny"
+
+
+def test_a_config_of_inputs_given_variation_first_is_refused():
+    with pytest.raises(HybridtrackError, match="inputs: intensity must come first, then variation"):
+        DEFAULT.replace(inputs=DEFAULT.inputs[::-1])
+
+
+@pytest.mark.parametrize("variable, term, params, named", [
+    ("intensity", "weak", (100.0, 1.5), "inputs.intensity.terms.weak: gaussmf [100.0, 1.5] is 0 at every one of "
+                                        "the 1,001 samples of the universe 0-10"),
+    ("weather", "sunny", (40.0, 45.0, 50.0), "output.weather.terms.sunny: trimf [40.0, 45.0, 50.0] is 0 at every one "
+                                              "of the 3,001 samples of the universe 0-30"),
+    ("weather", "cloudy", (15.001, 15.002, 15.003), "output.weather.terms.cloudy"),  # between two samples
+])
+def test_a_term_that_overlaps_no_sample_of_its_universe_is_refused(variable, term, params, named):
+    # a classifier of such terms had called every reading unknown without a word
+    with pytest.raises(HybridtrackError) as caught:
+        DEFAULT.with_params(variable, term, params)
+    assert named in str(caught.value) and "no rule on it could fire" in str(caught.value)
+
+
+def test_a_term_on_a_single_sample_of_its_universe_is_kept():
+    # 15 is a sample of 0-30 at 3,001 samples (every 0.01)
+    assert DEFAULT.with_params("weather", "cloudy", (14.999, 15.0, 15.001)).output.term("cloudy").params[1] == 15.0
+
+
+@pytest.mark.parametrize("resolution", [(10**9, 3001), (1001, 10_002), (2, 3001)])
+def test_a_resolution_past_the_limits_is_refused_before_any_sampling(resolution):
+    # 10**9 samples had filled the memory until the system killed the command
+    with pytest.raises(HybridtrackError, match="resolution needs two sample counts from 3 to 10,001"):
+        DEFAULT.replace(resolution=resolution)

@@ -24,9 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import HybridtrackError
-from .membership import SHAPES, centre, check_params
+from .membership import SHAPES, centre, check_params, membership
 
 __all__ = ["Term", "Variable", "Rule", "Methods", "FuzzyConfig", "SHAPES", "LABELS", "METHOD_CHOICES"]
+
+#: The classifier's inputs, in the order it takes a reading's values.
+INPUT_NAMES = ("intensity", "variation")
 
 #: The weather labels the controller understands, in score order.
 LABELS = ("overcast", "cloudy", "sunny")
@@ -356,13 +359,20 @@ class FuzzyConfig:
 
     def validate(self) -> None:
         """Raise `HybridtrackError` naming the first problem found."""
+        from .system import check_resolution
+
+        check_resolution(self.resolution)  # first: the terms' reach is checked on these samples
         if len(self.inputs) != 2:
             raise HybridtrackError(f"config needs two inputs (intensity, variation), got {len(self.inputs)}")
+        if self.input_names == INPUT_NAMES[::-1]:  # the photocurrent had been scored as the variation
+            raise HybridtrackError("inputs: intensity must come first, then variation (the classifier takes a "
+                                   f"reading's intensity and variation in that order), got {list(self.input_names)}")
         for var in self.inputs:
             var.check(f"inputs.{var.name}")
             if var.raw_range is None:
                 raise HybridtrackError(f"inputs.{var.name}: raw_range is missing")
         self.output.check(f"output.{self.output.name}")
+        self._validate_reach()
         if len(set(self.input_names)) != 2 or self.output.name in self.input_names:
             raise HybridtrackError(f"variable names must differ, got {list(self.input_names)} and {self.output.name!r}")
         self._validate_names()
@@ -387,12 +397,23 @@ class FuzzyConfig:
             raise HybridtrackError("the rule table has two rules with the same conditions")
         self.methods.check()
         self._validate_bands()
-        if any(r < 3 for r in self.resolution) or len(self.resolution) != 2:
-            raise HybridtrackError(f"resolution needs two sample counts of at least 3, got {list(self.resolution)}")
         if self.labelled_range is not None and (
                 len(self.labelled_range) != len(self.inputs)
                 or not all(math.isfinite(lo) and math.isfinite(hi) and lo <= hi for lo, hi in self.labelled_range)):
             raise HybridtrackError(f"labelled_range needs a finite [low, high] for each input, got {self.labelled_range}")
+
+    def _validate_reach(self) -> None:
+        """Refuse a term that is 0 at every sample of its universe (one beyond it, or narrower than
+        a sample's spacing off the samples): no rule on it could fire, and a classifier of such
+        terms had called every reading unknown without a word."""
+        for var, samples, where in [*((v, self.resolution[0], "inputs") for v in self.inputs),
+                                    (self.output, self.resolution[1], "output")]:
+            grid = np.linspace(*var.universe, samples)
+            for term in var.terms:
+                if not membership(term.shape, term.params, grid).max() > 0.0:
+                    raise HybridtrackError(f"{where}.{var.name}.terms.{term.name}: {term.shape} {list(term.params)} "
+                                           f"is 0 at every one of the {samples:,} samples of the universe "
+                                           f"{var.universe[0]:g}-{var.universe[1]:g}; no rule on it could fire")
 
     def _validate_names(self) -> None:
         """Refuse the names a TOML rule table would read as something else, so that every config
@@ -468,6 +489,8 @@ class FuzzyConfig:
             reader.variable(name, spec, f"inputs.{name}", is_input=True)
             for name, spec in reader.table(data.get("inputs"), "inputs").items()
         ) if "inputs" in data else default.inputs
+        if tuple(var.name for var in inputs) == INPUT_NAMES[::-1]:  # by name, not by where a table stands
+            inputs = inputs[::-1]
         output_spec = reader.table(data.get("output", {}), "output", {"name", "universe", "terms"})
         output = reader.variable(output_spec.get("name", "weather"), output_spec, "output", is_input=False) \
             if "output" in data else default.output

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 from ..errors import HybridtrackError
 from .config import FuzzyConfig, Methods, Rule, Variable
 
-__all__ = ["MamdaniSystem", "SystemRule", "system_of", "config_from_system", "format_number"]
+__all__ = ["MamdaniSystem", "SystemRule", "system_of", "config_from_system", "format_number", "check_resolution",
+           "MAX_RESOLUTION"]
 
 
 def format_number(value: float) -> str:
@@ -104,8 +105,7 @@ class MamdaniSystem:
             raise HybridtrackError(f"defaults: one per output ({len(self.outputs)}), got {len(self.defaults)}")
         if any(d is not None and d != d for d in self.defaults):
             raise HybridtrackError("defaults must be numbers")
-        if len(self.resolution) != 2 or any(r < 3 for r in self.resolution):
-            raise HybridtrackError(f"resolution needs two sample counts of at least 3, got {list(self.resolution)}")
+        check_resolution(self.resolution)
 
     def _check_rule(self, rule: SystemRule, where: str) -> None:
         if len(rule.antecedent) != len(self.inputs) or len(rule.consequent) != len(self.outputs):
@@ -147,6 +147,25 @@ def system_of(config: FuzzyConfig) -> MamdaniSystem:
         consequent = (config.output.term_names.index(rule.then) + 1,)
         rules.append(SystemRule(tuple(antecedent), consequent, rule.weight, rule.connection))
     return MamdaniSystem(config.inputs, (config.output,), tuple(rules), config.methods, config.resolution, config.name)
+
+
+#: The most samples across a universe, ten times the default's across an input: the dense
+#: defuzzifications (mom, som, lom, bisector) hold a chunk of readings by samples, 1.5 GB at this
+#: many; 10**9 (a slip of a few digits) had filled the memory until the system killed the command.
+MAX_RESOLUTION = 10_001
+
+
+def check_resolution(resolution) -> None:
+    """Refuse a `resolution` that is not two sample counts from 3 to `MAX_RESOLUTION`.
+
+    Parameters
+    ----------
+    resolution : tuple of int
+        Samples across (input universes, output universe).
+    """
+    if len(resolution) != 2 or any(not 3 <= r <= MAX_RESOLUTION for r in resolution):
+        raise HybridtrackError(f"resolution needs two sample counts from 3 to {MAX_RESOLUTION:,}, got "
+                               f"{list(resolution)}")
 
 
 def config_from_system(system: MamdaniSystem, *, raw_ranges=None, units=None, bands=None, resolution=None,
