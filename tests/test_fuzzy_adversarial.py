@@ -200,3 +200,12 @@ def test_a_resolution_past_the_limits_is_refused_before_any_sampling(resolution)
     # 10**9 samples had filled the memory until the system killed the command
     with pytest.raises(HybridtrackError, match="resolution needs two sample counts from 3 to 10,001"):
         DEFAULT.replace(resolution=resolution)
+
+
+def test_a_run_config_given_as_a_fuzzy_config_is_named_so(tmp_path):
+    # it had been refused for its first key ("unknown key 'controller'"), not for being the other kind
+    from hybridtrack.simulation import SimulationConfig
+
+    path = SimulationConfig().to_toml(tmp_path / "run.toml")
+    with pytest.raises(HybridtrackError, match="run.toml: a run config .* not a fuzzy classifier config"):
+        FuzzyConfig.from_toml(path)

@@ -483,6 +483,9 @@ class FuzzyConfig:
     def from_dict(cls, data: Mapping, *, source: str = "config") -> FuzzyConfig:
         """Build and validate a config from the TOML layout; unknown keys are refused."""
         reader = _Reader(source)
+        if isinstance(data, Mapping) and {"controller", "imperfections", "drive"} & set(data):
+            reader.fail("", "a run config (controller, imperfections, drive, ...), not a fuzzy classifier config; "
+                            "give a fuzzy config, such as the fuzzy.toml hybridtrack init writes")
         data = reader.table(data, "", {"name", "resolution", "inputs", "output", "bands", "rules", "labelled_range", "methods"})
         default = cls()
         inputs = tuple(
