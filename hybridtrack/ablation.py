@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,7 +64,8 @@ class AblationPlan:
 
         for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
             values = getattr(self, name)
-            if isinstance(values, (str, bytes)):  # a text had been run a letter a value ("unknown site 'l'")
+            # a text had been run a letter a value ("unknown site 'l'"); a number raised TypeError
+            if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
                 raise HybridtrackError(f"ablate: {name} must be a list, such as ({values!r},), got {values!r:.60}")
             object.__setattr__(self, name, tuple(values))
             if not getattr(self, name):

@@ -26,7 +26,8 @@ def test_a_plan_naming_a_value_twice_is_refused(field, values, named):
         AblationPlan(**{field: values})
 
 
-@pytest.mark.parametrize("field, value", [("sites", "lanzhou"), ("policies", "hybrid"), ("weather", "sunny")])
+@pytest.mark.parametrize("field, value", [("sites", "lanzhou"), ("policies", "hybrid"), ("weather", "sunny"),
+                                          ("seeds", 5)])
 def test_a_plan_given_a_text_for_a_list_is_refused_as_such(field, value):
     # it had been read a letter at a time: "unknown site 'l'"
     with pytest.raises(HybridtrackError, match=f"ablate: {field} must be a list"):
