@@ -45,3 +45,13 @@ def test_every_option_with_a_default_says_it_in_its_help():
               for command, action in _options("hybridtrack", build_parser())
               if action.default not in (None, False, argparse.SUPPRESS) and "default" not in (action.help or "")]
     assert silent == []
+
+
+def test_init_suggests_a_command_that_pastes_whole_into_a_shell(tmp_path, capsys):
+    # a folder with a blank had been printed bare: pasted, --config took only its first word
+    import shlex
+
+    folder = tmp_path / "my runs"
+    assert main(["init", str(folder)]) == 0
+    suggested = capsys.readouterr().out.splitlines()[-1].removeprefix("try: ")
+    assert shlex.split(suggested)[-2:] == ["--config", str(folder / "run.toml")]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import re
+import shlex
 from pathlib import Path
 
 from ..errors import HybridtrackError
@@ -121,5 +122,5 @@ def _init(args: argparse.Namespace) -> int:
     for name, text in files.items():
         write(folder / name, lambda file, text=text: file.write_text(text, encoding="utf-8"))
     print(f"wrote {', '.join(str(folder / name) for name in files)}")
-    print(f"try: hybridtrack simulate --site lanzhou --date 2021-06-21 --config {folder / RUN}")
+    print(f"try: hybridtrack simulate --site lanzhou --date 2021-06-21 --config {shlex.quote(str(folder / RUN))}")
     return 0
