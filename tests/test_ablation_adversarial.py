@@ -68,7 +68,7 @@ def test_an_empty_config_path_is_refused_not_read_as_the_defaults(tradeoff, caps
     # --config "$CONFIG" with the variable unset had run the defaults without a word
     assert main([*SMALL, *tradeoff, "--config", ""]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "a config file must be a path, got ''" in err
+    assert err.count("\n") == 1 and "--config is empty: give a file to read" in err
 
 
 def test_the_help_names_the_tradeoff_defaults(capsys):

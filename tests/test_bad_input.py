@@ -532,3 +532,17 @@ def test_a_refusal_without_any_of_the_values_is_blamed_on_none():
         raise HybridtrackError("the file is bad")
 
     assert blamed(refused_always, {"a": 1, "b": 2}, "the file is bad") == []
+
+
+@pytest.mark.parametrize("argv", [
+    ["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--config", ""],  # had run the defaults, seed 0
+    ["compare", "--site", "lanzhou", "--date", "2021-06-21", "--config", " "],
+    ["classify", "--intensity", "200", "--variation", "50", "--config", ""],
+    ["field", "heliostat", "--site", "lanzhou", "--date", "2021-06-21", "--positions", ""],
+])
+def test_an_empty_path_to_read_is_refused_by_its_flag(argv, capsys):
+    """``--config "$CONFIG"`` with the variable unset is no file: refused, not read as no option."""
+    assert main(argv) == 2
+    flag = argv[argv.index("") - 1] if "" in argv else "--config"
+    assert capsys.readouterr().err == f"hybridtrack: error: {flag} is empty: give a file to read, or leave {flag} out " \
+                                      "(an unset shell variable?)\n"

@@ -143,6 +143,9 @@ def _tell(line: str) -> None:
 _OUTPUT_OPTIONS = ("out", "csv", "plot", "report", "json")
 #: Every option and argument that names a file or folder, to write or to read.
 _PATH_OPTIONS = (*_OUTPUT_OPTIONS, "target", "dir", "file", "config", "positions", "source", "labels", "classifier")
+#: The options among them that name a file to read: an empty one is no file (the positional
+#: arguments are refused as paths that are not there, and init's DIR by init).
+_INPUT_OPTIONS = ("config", "positions", "labels", "classifier")
 
 
 def _refuse_empty_paths(args) -> None:
@@ -156,6 +159,9 @@ def _refuse_empty_paths(args) -> None:
             continue
         if name in _OUTPUT_OPTIONS and not value.strip():
             raise HybridtrackError(f"--{name} is empty: give a file or folder to write (an unset shell variable?)")
+        if name in _INPUT_OPTIONS and not value.strip():  # --config '' had run the defaults, seed 0, without a word
+            raise HybridtrackError(f"--{name} is empty: give a file to read, or leave --{name} out (an unset shell "
+                                   "variable?)")
         setattr(args, name, os.path.expanduser(value))
 
 
