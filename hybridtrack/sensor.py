@@ -63,6 +63,10 @@ RECORDED_COLUMN = "photocurrent"
 RECORDED_POINTING = ("pointing", "pointing_2")
 
 
+#: The least responsivity a sun sensor can have, mA per W/m² (`SensorModel.responsivity`).
+MIN_RESPONSIVITY = 0.001
+
+
 @dataclass(frozen=True)
 class SensorModel:
     """Parameters of the photoelectric sun sensor.
@@ -72,7 +76,9 @@ class SensorModel:
     dark_current : float
         Photocurrent with no light, mA.
     responsivity : float
-        mA per W/m² of light on the cells.
+        mA per W/m² of light on the cells, from `MIN_RESPONSIVITY` to 10: below that the full
+        sun's photocurrent (1 mA at 1000 W/m²) is within twice the default noise, no signal to
+        track or classify by (1e-300 had broken the mount fit's numbers mid-run).
     diffuse_share : float
         Share of the diffuse irradiance the cells see (0-1).
     window : str
@@ -121,7 +127,8 @@ class SensorModel:
 
     def __post_init__(self) -> None:
         # (name, low, high, low excluded): mA, mA per W/m², shares, W/m², degrees
-        ranges = [("dark_current", 0, 1000, False), ("responsivity", 0, 10, True), ("diffuse_share", 0, 1, False),
+        ranges = [("dark_current", 0, 1000, False), ("responsivity", MIN_RESPONSIVITY, 10, False),
+                  ("diffuse_share", 0, 1, False),
                   ("current_noise", 0, 100, False), ("direct_threshold", 0, 1500, True),
                   ("field_of_view", 0, 90, True), ("coarse_field_of_view", self.field_of_view, 90, False),
                   ("coarse_accuracy", 0, 45, False), ("noise", 0, 5, False), ("bias", -5, 5, False),

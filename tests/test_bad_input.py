@@ -546,3 +546,17 @@ def test_an_empty_path_to_read_is_refused_by_its_flag(argv, capsys):
     flag = argv[argv.index("") - 1] if "" in argv else "--config"
     assert capsys.readouterr().err == f"hybridtrack: error: {flag} is empty: give a file to read, or leave {flag} out " \
                                       "(an unset shell variable?)\n"
+
+
+def test_a_sensor_too_dull_to_see_the_sun_is_refused_and_the_dullest_taken_runs():
+    """A responsivity of 1e-300 mA per W/m² had been taken, and broke the mount fit's SVD mid-run
+    (a traceback from astronomical-commissioned and hybrid-oracle); the least taken runs."""
+    from hybridtrack.sensor import MIN_RESPONSIVITY, SensorModel
+    from hybridtrack.sky import synthetic
+
+    with pytest.raises(HybridtrackError, match=r"^sensor: responsivity = 1e-300 is outside \[0.001, 10\]$"):
+        SensorModel(responsivity=1e-300)
+    frame = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=1, freq="5min")
+    config = SimulationConfig(sensor=SensorModel(responsivity=MIN_RESPONSIVITY))
+    for strategy in ("astronomical-commissioned", "hybrid-oracle"):
+        assert simulate(frame, "lanzhou", strategy=strategy, config=config).summary["tracking_error_deg"]["rms"] < 1.0
