@@ -7,6 +7,7 @@ and checks both say the same thing.
 
 import dataclasses
 import math
+import os
 
 import pandas as pd
 import pytest
@@ -560,3 +561,21 @@ def test_a_sensor_too_dull_to_see_the_sun_is_refused_and_the_dullest_taken_runs(
     config = SimulationConfig(sensor=SensorModel(responsivity=MIN_RESPONSIVITY))
     for strategy in ("astronomical-commissioned", "hybrid-oracle"):
         assert simulate(frame, "lanzhou", strategy=strategy, config=config).summary["tracking_error_deg"]["rms"] < 1.0
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero here")
+def test_a_config_that_never_ends_is_refused_at_its_limit(capsys):
+    """``--config /dev/zero`` had been read until the memory ran out (a MemoryError traceback)."""
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--config", "/dev/zero"]) == 2
+    assert capsys.readouterr().err == ("hybridtrack: error: /dev/zero: larger than 16 MiB, more than a config file "
+                                       "can be (a device that never ends?)\n")
+
+
+def test_a_file_is_read_whole_up_to_its_limit_and_refused_one_byte_past_it(tmp_path):
+    from hybridtrack.io.files import read_bytes
+
+    path = tmp_path / "f.bin"
+    path.write_bytes(b"x" * 1000)
+    assert read_bytes(path, limit=1000) == b"x" * 1000
+    with pytest.raises(HybridtrackError, match=r"f\.bin: larger than 0 MiB, more than a file can be"):
+        read_bytes(path, limit=999)

@@ -27,11 +27,26 @@ def input_path(value, what: str = "file") -> Path:
     return params.path(value, f"a {what}")
 
 
-def read_bytes(path: Path, what: str = "file") -> bytes:
-    """The raw bytes of `path`, or one clear error: missing, a folder, not readable."""
+#: The largest config file read, bytes: a run's, a fuzzy system's or a sweep's TOML is a few kB;
+#: ``--config /dev/zero`` had been read until the memory ran out.
+MAX_CONFIG_BYTES = 16 * 2**20
+
+
+def read_bytes(path: Path, what: str = "file", limit: int | None = None) -> bytes:
+    """The raw bytes of `path`, or one clear error: missing, a folder, not readable, or more than
+    `limit` bytes (by default the memory budget, `hybridtrack.budget.memory_budget`): a device
+    that never ends (``/dev/zero``) is refused at the limit, not read until the memory runs out."""
+    from ..budget import memory_budget
+
     path = input_path(path, what)
+    limit = memory_budget() if limit is None else int(limit)
     try:
-        return path.read_bytes()
+        with open(path, "rb") as stream:
+            raw = stream.read(limit + 1)
+        if len(raw) > limit:
+            raise HybridtrackError(f"{path}: larger than {limit / 2**20:,.0f} MiB, more than a {what} can be "
+                                   f"(a device that never ends?)")
+        return raw
     except FileNotFoundError:
         raise HybridtrackError(f"{path}: no such {what}") from None
     except IsADirectoryError:
@@ -186,7 +201,7 @@ def read_toml(path, what: str = "config") -> dict:
     """A TOML file as a dict, or one clear error naming the file (missing, not UTF-8, bad TOML)."""
     tomllib = _tomllib()
     path = input_path(path, f"{what} file")
-    raw = read_bytes(path, f"{what} file")
+    raw = read_bytes(path, f"{what} file", MAX_CONFIG_BYTES)
     mark = 3 if raw.startswith(b"\xef\xbb\xbf") else 0  # a byte-order mark, as Windows editors save UTF-8
     try:
         text = raw[mark:].decode("utf-8")
