@@ -42,8 +42,8 @@ def read_bytes(path: Path, what: str = "file", limit: int | None = None) -> byte
     limit = memory_budget() if limit is None else int(limit)
     try:
         with open(path, "rb") as stream:
-            raw = stream.read(limit + 1)
-        if len(raw) > limit:
+            raw = _read_up_to(stream, limit)
+        if raw is None:
             raise HybridtrackError(f"{path}: larger than {limit / 2**20:,.0f} MiB, more than a {what} can be "
                                    f"(a device that never ends?)")
         return raw
@@ -55,6 +55,25 @@ def read_bytes(path: Path, what: str = "file", limit: int | None = None) -> byte
         raise HybridtrackError(f"{path}: not readable (permission denied)") from None
     except OSError as exc:
         raise HybridtrackError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+
+
+def _read_up_to(stream, limit: int) -> bytes | None:
+    """All of `stream`, or None past `limit` bytes: a regular file of that size at once, anything
+    else (a pipe, a device) in pieces, so that no buffer of the limit's size is asked for."""
+    import os
+    import stat
+
+    status = os.fstat(stream.fileno())
+    if stat.S_ISREG(status.st_mode) and status.st_size <= limit:
+        return stream.read()
+    pieces, size = [], 0
+    while size <= limit:
+        piece = stream.read(min(2**24, limit + 1 - size))
+        if not piece:
+            return b"".join(pieces)
+        pieces.append(piece)
+        size += len(piece)
+    return None
 
 
 def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
