@@ -93,7 +93,9 @@ class TradeoffPlan:
                 raise HybridtrackError(f"tradeoff: deadband {deadband!r} is given twice")
         if not self.deadbands or not self.periods:
             raise HybridtrackError("tradeoff: no deadbands or periods to run")
-        AblationPlan(self.sites, self.seasons, self.weather, self.seeds, self.collectors, (self.policy,))
+        days = AblationPlan(self.sites, self.seasons, self.weather, self.seeds, self.collectors, (self.policy,))
+        for name in ("sites", "seasons", "weather", "seeds", "collectors"):  # as the plan names them: 'Nanjing'
+            object.__setattr__(self, name, getattr(days, name))  # had taken 2021's days, not SITE_YEARS' 2013
 
     def days(self) -> list[dict]:
         """One dict per day and period: site, date, weather, seed, collector, period."""

@@ -76,3 +76,11 @@ def test_the_help_names_the_tradeoff_defaults(capsys):
         main(["ablate", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
     assert "(default 0.1,0.2,0.4,0.8)" in help_text and "(default 1min;" in help_text
+
+
+def test_a_tradeoff_plan_takes_a_built_in_sites_days_whatever_its_names_case():
+    """TradeoffPlan(sites=("Nanjing",)) had taken 2021's days; Nanjing's typical days are 2013's."""
+    from hybridtrack.tradeoff import TradeoffPlan
+
+    plan = TradeoffPlan(sites=("Nanjing",), seasons=("summer",))
+    assert plan.sites == ("nanjing",) and {day["date"] for day in plan.days()} == {"2013-06-21"}
