@@ -129,8 +129,10 @@ def claim(paths: Iterable, *, folders: Iterable = (), earlier: Iterable = ()) ->
     existing = [path for path in (*paths, *folders) if path.exists()]
     refused = existing + earlier_files(earlier)
     if refused and not _FORCE.get():
-        raise HybridtrackError(f"would replace {len(refused)} existing file{'s' if len(refused) > 1 else ''}: "
-                               f"{', '.join(map(str, refused))}; give --force to replace them, or write elsewhere")
+        some = len(refused) > 1
+        raise HybridtrackError(f"would replace {len(refused)} existing file{'s' if some else ''}: "
+                               f"{', '.join(map(str, refused))}; give --force to replace {'them' if some else 'it'}, "
+                               "or write elsewhere")
     replaced = _REPLACED.get()  # the command line names what it removes itself (`cli.base.leaving_out`)
     if replaced is not None:
         replaced.extend(p for p in existing if p not in replaced)

@@ -252,7 +252,7 @@ MATRIX = [
      "out is a symbolic link; results are never written through one"),
     ("an existing output without --force", existing_files("run.toml"),
      lambda p: refusing(lambda: SimulationConfig().to_toml(p / "run.toml")), lambda p: ["init", str(p)],
-     "run.toml; give --force to replace them"),
+     "run.toml; give --force to replace it"),
     ("a full disk", lambda tmp: None, lambda p: SimulationConfig().to_toml("/dev/full"),
      lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--csv", "/dev/full", "--force"],
      "/dev/full: cannot write (No space left on device)"),

@@ -115,7 +115,7 @@ def test_existing_results_are_refused_without_force_and_named(tmp_path, capsys):
     assert main(SHORT + ["--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err == (f"hybridtrack: error: would replace 1 existing file: {out / 'summary.json'}; give --force to "
-                   "replace them, or write elsewhere\n")
+                   "replace it, or write elsewhere\n")
     assert (out / "summary.json").read_text() == "the user's own\n" and not (out / "log.parquet").exists()
 
 
