@@ -143,7 +143,7 @@ MATRIX = [
      "imperfections.clock_error: must be a number"),
     ("latitude beyond 90", lambda tmp: None, lambda p: sites.custom(95.0, 10.0, "UTC"),
      lambda p: ["sun", "--lat", "95", "--lon", "10", "--tz", "UTC", "--date", "2021-06-21"],
-     "latitude 95.0 is outside [-90, 90]"),
+     "95.0 is outside [-90, 90]"),  # the API names latitude, the command line --lat
     ("site with unknown time zone", lambda tmp: None, lambda p: sites.custom(30.0, 10.0, "Nowhere/Land"),
      lambda p: ["simulate", "--lat", "30", "--lon", "10", "--tz", "Nowhere/Land", "--date", "2021-06-21"],
      "unknown time zone 'Nowhere/Land'"),
@@ -579,3 +579,15 @@ def test_a_file_is_read_whole_up_to_its_limit_and_refused_one_byte_past_it(tmp_p
     assert read_bytes(path, limit=1000) == b"x" * 1000
     with pytest.raises(HybridtrackError, match=r"f\.bin: larger than 0 MiB, more than a file can be"):
         read_bytes(path, limit=999)
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--lat", "95", "--lon", "100", "--tz", "UTC"], "--lat 95.0 is outside [-90, 90] degrees"),
+    (["--lat", "30", "--lon", "200", "--tz", "UTC"], "--lon 200.0 is outside [-180, 180] degrees"),
+    (["--lat", "30", "--lon", "100", "--tz", "UTC", "--altitude", "-9000"], "--altitude -9000.0 m is outside"),
+    (["--lat", "30", "--lon", "100", "--tz", "Mars/X"], "--tz: unknown time zone 'Mars/X'"),
+])
+def test_a_site_by_coordinates_is_refused_by_its_flag(flags, message, capsys):
+    """It had said "site 'custom': latitude 95.0 is outside ...", naming a site the user never named."""
+    assert main(["simulate", "--date", "2021-06-21", *flags]) == 2
+    assert capsys.readouterr().err.startswith(f"hybridtrack: error: {message}")

@@ -29,7 +29,7 @@ def test_sun_at_coordinates_with_fresnel_geometry(capsys):
 @pytest.mark.parametrize("args, message", [
     (["--site", "mars", "--date", "2013-06-21"], "unknown site 'mars'"),
     (["--date", "2013-02-30"], "date '2013-02-30' does not exist"),
-    (["--lat", "95", "--lon", "0", "--tz", "UTC", "--date", "2013-06-21"], "latitude 95.0 is outside"),
+    (["--lat", "95", "--lon", "0", "--tz", "UTC", "--date", "2013-06-21"], "--lat 95.0 is outside"),
     (["--lat", "30", "--date", "2013-06-21"], "--lat, --lon and --tz go together"),
     (["--date", "2013-06-21", "--freq", "fast"], "step 'fast' is not a duration"),
     (["--date", "2013-06-21", "--start", "25:00"], "clock time '25:00' is not HH:MM"),
