@@ -591,3 +591,8 @@ def test_a_site_by_coordinates_is_refused_by_its_flag(flags, message, capsys):
     """It had said "site 'custom': latitude 95.0 is outside ...", naming a site the user never named."""
     assert main(["simulate", "--date", "2021-06-21", *flags]) == 2
     assert capsys.readouterr().err.startswith(f"hybridtrack: error: {message}")
+
+
+def test_replays_step_is_refused_by_its_flag_before_the_file_is_read(capsys):
+    assert main(["replay", "no-such-file.csv", "--site", "lanzhou", "--step", "0min"]) == 2
+    assert capsys.readouterr().err == "hybridtrack: error: --step: step '0min' must be positive\n"

@@ -19,6 +19,7 @@ from .base import (
     add_synthetic_arguments,
     collector_from_arguments,
     command,
+    flag_named,
     leaving_out,
     read_record,
     simulation_config,
@@ -186,6 +187,11 @@ def _replay_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _replay_frame(args: argparse.Namespace):
+    if args.step is not None:
+        from ..times import parse_freq
+
+        with flag_named("--step"):  # before the file is read; 'step '0min' must be positive' had named no flag
+            parse_freq(args.step)
     site = site_from_arguments(args)
     frame = read_record(args, args.file, site=site, freq=args.step or "1min")
     from ..io import validation_report
