@@ -70,8 +70,10 @@ _ZONE_NOTE = re.compile(r"([+-]\d{2}:?\d{2})\s*\([A-Za-z]{2,5}\)$")
 _COMPACT_HOURS = re.compile(r"^(?:19|20)\d{2}(?:0[1-9]|1[0-2])(?:0[1-9]|[12]\d|3[01])(?:[01]\d|2[0-3])$")
 #: A stamp written ``yymmddHHMM`` (a logger's compact minutes): ten digits, read as epoch seconds
 #: they had been 2001-2052 without a word (1306211200, Nanjing's 21 June 2013 at noon, as 24 May
-#: 2011). A column of epoch seconds is never all of this form: within three rows at any step of a
-#: minute or more its last digits pass 59 or its hours 23.
+#: 2011). A column of epoch seconds of `COMPACT_MINUTES_ROWS` rows is never all of this form at a
+#: logger's steps (1, 2, 5, 10, 15, 30 min, 1 h, 1 day): its last two digits pass 59, or the two
+#: before them 23, within eight rows (5-min steps add 3 to those two digits a row).
+COMPACT_MINUTES_ROWS = 12
 _COMPACT_MINUTES = re.compile(r"^\d{2}(?:0[1-9]|1[0-2])(?:0[1-9]|[12]\d|3[01])(?:[01]\d|2[0-3])[0-5]\d$")
 
 
@@ -435,7 +437,7 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
     if column.text.str.fullmatch(_COMPACT_HOURS).all():
         report["date_order"] = "written yyyymmddHH"
         column.text = column.text.str.replace(r"^(\d{4})(\d{2})(\d{2})(\d{2})$", r"\1-\2-\3 \4:00", regex=True)
-    elif len(column.text) >= 3 and column.text.str.fullmatch(_COMPACT_MINUTES).all():
+    elif len(column.text) >= COMPACT_MINUTES_ROWS and column.text.str.fullmatch(_COMPACT_MINUTES).all():
         report["date_order"] = "written yymmddHHMM (20yy)"
         column.text = column.text.str.replace(r"^(\d{2})(\d{2})(\d{2})(\d{2})(\d{2})$", r"20\1-\2-\3 \4:\5",
                                               regex=True)
