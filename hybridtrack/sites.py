@@ -15,7 +15,7 @@ import numpy as np
 from .errors import HybridtrackError
 from .times import check_tz
 
-__all__ = ["Site", "get", "names", "custom", "BUILTIN"]
+__all__ = ["Site", "get", "names", "custom", "check_place", "BUILTIN"]
 
 
 @dataclass(frozen=True)
@@ -45,26 +45,34 @@ class Site:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
             raise HybridtrackError(f"a site's name must be a non-empty text, got {self.name!r:.60}")
-        for field in ("latitude", "longitude", "altitude"):
-            value = getattr(self, field)  # numpy's scalars are numbers too; True is not a latitude
-            if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)) or value != value:
-                raise HybridtrackError(f"site {self.name!r}: {field} must be a number, got {value!r:.60}")
-        if not -90.0 <= self.latitude <= 90.0:
-            raise HybridtrackError(
-                f"site {self.name!r}: latitude {_brief(self.latitude)} is outside [-90, 90] degrees"
-            )
-        if not -180.0 <= self.longitude <= 180.0:
-            raise HybridtrackError(
-                f"site {self.name!r}: longitude {_brief(self.longitude)} is outside [-180, 180] degrees"
-            )
-        if not -500.0 <= self.altitude <= 9000.0:
-            raise HybridtrackError(
-                f"site {self.name!r}: altitude {_brief(self.altitude)} m is outside [-500, 9000] m"
-            )
+        names = {field: f"site {self.name!r}: {field}" for field in _RANGES}
         # a zone object (ZoneInfo, pytz) is kept by its name: a Site's zone is written into files
-        object.__setattr__(self, "tz", check_tz(self.tz, f"site {self.name!r}: "))
+        object.__setattr__(self, "tz", check_place(self.latitude, self.longitude, self.altitude, self.tz,
+                                                   {**names, "tz": f"site {self.name!r}: "}))
         for field in ("latitude", "longitude", "altitude"):  # within range: floats (np.float32 is no JSON)
             object.__setattr__(self, field, float(getattr(self, field)))
+
+
+#: Where on earth a site may be: each coordinate's range and its unit (as the messages write it).
+_RANGES = {"latitude": (-90.0, 90.0, "", "degrees"), "longitude": (-180.0, 180.0, "", "degrees"),
+           "altitude": (-500.0, 9000.0, " m", "m")}
+
+
+def check_place(latitude, longitude, altitude, tz, names: dict) -> str:
+    """Refuse coordinates that are no place on earth, or a zone that is none; return the zone's name.
+
+    Each refusal names what was wrong by ``names[field]`` (``latitude``, ``longitude``,
+    ``altitude``; ``tz`` is a prefix): a site's ``site 'x': latitude``, the command line's ``--lat``.
+    """
+    coordinates = {"latitude": latitude, "longitude": longitude, "altitude": altitude}
+    for field, value in coordinates.items():  # numpy's scalars are numbers too; True is not a latitude
+        if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)) or value != value:
+            raise HybridtrackError(f"{names[field]} must be a number, got {value!r:.60}")
+    for field, value in coordinates.items():
+        low, high, unit, units = _RANGES[field]
+        if not low <= value <= high:
+            raise HybridtrackError(f"{names[field]} {_brief(value)}{unit} is outside [{low:g}, {high:g}] {units}")
+    return check_tz(tz, names["tz"])
 
 
 def _brief(value) -> str:

@@ -80,19 +80,6 @@ def add_site_arguments(parser: argparse.ArgumentParser, *, default: str | None =
     parser.set_defaults(_default_site=default, _record_site=record)
 
 
-#: The words of a site's refusal (`sites.custom`) and the flags that gave them.
-_SITE_FLAGS = {"latitude ": "--lat ", "longitude ": "--lon ", "altitude ": "--altitude ", "unknown time zone": "{zone}: unknown time zone"}
-
-
-def _by_flag(message: str, zone: str) -> str:
-    """A site's refusal in the command line's terms: the flag, not the site 'custom' it made."""
-    message = message.removeprefix("site 'custom': ")
-    for word, flag in _SITE_FLAGS.items():
-        if message.startswith(word):
-            return flag.format(zone=zone) + message[len(word):]
-    return message
-
-
 def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True) -> sites.Site | None:
     """The site the user named, or the one given by coordinates.
 
@@ -114,10 +101,12 @@ def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True
         if clock is None and (clock_required or not record):
             raise HybridtrackError("--lat and --lon need the site's clock: --tz ZONE" + (" (or --site-tz)" if record
                                                                                           else ""))
-        try:
-            return sites.custom(args.lat, args.lon, clock or "UTC", 0.0 if args.altitude is None else args.altitude)
-        except HybridtrackError as exc:  # 'site 'custom': latitude 95.0 is outside ...' had named no flag
-            raise HybridtrackError(_by_flag(str(exc), "--site-tz" if site_tz else "--tz")) from None
+        altitude = 0.0 if args.altitude is None else args.altitude
+        # refused by its flag: 'site 'custom': latitude 95.0 is outside ...' had named a site nobody named
+        sites.check_place(args.lat, args.lon, altitude, clock or "UTC", {
+            "latitude": "--lat", "longitude": "--lon", "altitude": "--altitude",
+            "tz": f"{'--site-tz' if site_tz else '--tz'}: "})
+        return sites.custom(args.lat, args.lon, clock or "UTC", altitude)
     if args.lat is not None or args.lon is not None or (args.tz is not None and not record):
         together = "--lat, --lon" + ("" if record else " and --tz")
         raise HybridtrackError(f"{together} go together; one of them is missing")
