@@ -82,9 +82,9 @@ def _found(frame: pd.DataFrame, site) -> tuple:
     return index, step, instants, owner, down, _nights(owner, down, step)
 
 
-def _between_readings(nights: np.ndarray, rows: int) -> int:
-    """How many of `nights` lie between two readings (not the first day's start or the last's end)."""
-    return int(((nights >= 0) & (nights < rows)).sum())
+def _between_readings(nights: np.ndarray, rows: int) -> np.ndarray:
+    """The `nights` that lie between two readings (not the first day's start or the last's end)."""
+    return nights[(nights >= 0) & (nights < rows)]
 
 
 def night_gaps(frame: pd.DataFrame, site) -> int:
@@ -95,7 +95,7 @@ def night_gaps(frame: pd.DataFrame, site) -> int:
     counted; `fill_nights` fills it all the same."""
     site = sites.get(site)
     index, *_, nights = _found(frame, site)
-    inner = nights[(nights >= 0) & (nights < len(index) - 1)]
+    inner = _between_readings(nights, len(index))
     return int((~_sun_down(index[inner + 1], site)).sum()) if len(inner) else 0
 
 
@@ -147,7 +147,7 @@ def fill_nights(frame: pd.DataFrame, site) -> pd.DataFrame:
             values = values.mask(dark & new, 0.0)
         through = values.interpolate(method="time", limit_area="inside").ffill().bfill()  # the edges: held
         filled[column] = values.where(~new, through)
-    inner = _between_readings(nights, len(index))
+    inner = len(_between_readings(nights, len(index)))
     attrs = {**frame.attrs, "validation": dict(frame.attrs.get("validation", {}))}
     attrs["validation"]["nights_filled"] = {
         "nights": inner, "ends of the first and last days": int(len(nights) - inner), "rows": int(len(added)),
