@@ -523,14 +523,11 @@ def warn_of_nights_left_out(frame: pd.DataFrame, site) -> None:
 
     from .io.nights import night_gaps
 
-    index = frame.index if isinstance(frame, pd.DataFrame) else None
-    if (not isinstance(index, pd.DatetimeIndex) or index.tz is None or len(index) < 2
-            or not index.is_monotonic_increasing or index.has_duplicates
-            or "nights_left_out" in frame.attrs.get("validation", {})):
+    if not isinstance(frame, pd.DataFrame) or "nights_left_out" in frame.attrs.get("validation", {}):
         return
     try:
         left_out = night_gaps(frame, site)
-    except HybridtrackError:  # a site, or stamps, the run refuses with its own words
+    except HybridtrackError:  # a site, an index or stamps the run refuses with its own words
         return
     if left_out:
         warnings.warn(f"the frame leaves out {left_out} night{'s' if left_out > 1 else ''} (no rows from a night "
