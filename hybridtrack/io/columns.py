@@ -19,7 +19,7 @@ from ..errors import HybridtrackError
 from .units import any_known_unit
 
 __all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "STAMP_PARTS", "split_header",
-           "resolve_columns", "check_names"]
+           "resolve_columns", "check_names", "not_read"]
 
 #: The columns of a weather frame, in order.
 WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent", "pointing", "pointing_2")
@@ -147,6 +147,20 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
     if "time" not in mapping or split_header(mapping["time"])[0] in ALIASES["clock"] and "time" not in columns:
         _date_and_clock(headers, taken, mapping)
     return mapping
+
+
+def not_read(headers: list[str], mapping: Mapping[str, str]) -> list[str]:
+    """The named columns no quantity was read from, each with the quantity its name looks like
+    when it has one (``'ghi' (looks like ghi)``: a ``--map ghi=OTHER`` left the file's own ghi
+    unread), for the report: a column the reading passes over is said, not dropped unseen."""
+    taken = set(mapping.values())
+    shown = []
+    for header in headers:
+        if header in taken or not header.strip() or split_header(header)[0] == LABEL_COLUMN:
+            continue
+        like = next((name for name in WEATHER_COLUMNS if _matches(header, name)), None)
+        shown.append(repr(header) + (f" (looks like {like})" if like else ""))
+    return shown
 
 
 def _stamp_parts(headers: list[str], taken: set, mapping: dict[str, str]) -> bool:

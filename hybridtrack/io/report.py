@@ -57,6 +57,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
             lines.append(f"  skipped {what}: {len(numbers)} line{'s' if len(numbers) > 1 else ''} "
                          f"({_describe(numbers[:5])}{', ...' if len(numbers) > 5 else ''})")
     lines.append("  columns: " + ", ".join(f"{k} <- {v!r}" for k, v in report.get("columns", {}).items()))
+    if report.get("not_read"):
+        lines.append(f"  not read: {_describe(report['not_read'])}")
     if report.get("empty_columns"):
         lines.append(f"  skipped {report['empty_columns']} empty column(s) without a name (a spreadsheet's padding)")
     if "header_notes" in report:

@@ -19,7 +19,7 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .checks import check_frame, check_magnitude, refuse_repairs
 from .closure import closure_check
-from .columns import (IRRADIANCE, LABEL_COLUMN, STAMP_PARTS, WEATHER_COLUMNS, check_names, resolve_columns,
+from .columns import (IRRADIANCE, LABEL_COLUMN, STAMP_PARTS, WEATHER_COLUMNS, check_names, not_read, resolve_columns,
                       split_header)
 from .files import file_text
 from .formats import PVLIB_FORMATS, RECOGNISED_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
@@ -275,6 +275,9 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
                   decimal=table.decimal,
                   skipped={k: v for k, v in table.skipped.items() if v},
                   columns={k: v for k, v in mapping.items() if k in WEATHER_COLUMNS})
+    unread = not_read(table.headers, mapping)
+    if unread:
+        report["not_read"] = unread
     table = _without_cut_last(table, report)
     if not {"time", "date", "year"} & set(mapping):
         raise HybridtrackError(f"{path}: no time column found; name it with columns={{'time': ...}} "
