@@ -48,6 +48,16 @@ MAX_TRAVEL = 720.0
 #: Degrees per minute a drive may turn at most: a full turn a minute, six times the fastest
 #: stow move of the collectors modelled here (60°/min).
 MAX_SPEED = 360.0
+#: Degrees per minute the sun's hour angle turns (the earth's rotation, 360° in 24 h): a drive
+#: slower than this falls behind the sun on every axis and never catches up.
+SUN_RATE = 0.25
+
+
+def _speed(value, name: str) -> float:
+    """A drive speed in degrees per minute, refused when slower than the sun (`SUN_RATE`): at
+    1e-300 °/min a collector had run a whole day 46° off its target without a word."""
+    return number(value, f"drive: {name} (degrees per minute; the sun turns {SUN_RATE:g}, a slower axis never "
+                         "keeps up)", SUN_RATE, MAX_SPEED)
 
 
 @dataclass(frozen=True)
@@ -84,8 +94,7 @@ class Drive:
         # kept as Python's numbers: numpy's are taken, and TOML cannot write them
         object.__setattr__(self, "deadband", number(self.deadband, "drive: deadband (degrees)", 0, 10))
         for name in ("speed", "stow_speed"):
-            object.__setattr__(self, name, number(getattr(self, name), f"drive: {name} (degrees per minute)", 0,
-                                                  MAX_SPEED, above=True))
+            object.__setattr__(self, name, _speed(getattr(self, name), name))
         object.__setattr__(self, "stow", number(self.stow, "drive: stow (degrees)", *self.limits))
         object.__setattr__(self, "encoder_bits", whole(self.encoder_bits, "drive: encoder_bits", 8, 24))
 

@@ -629,3 +629,14 @@ def test_a_heliostat_whose_elevation_axis_stands_past_the_zenith_is_scored():
     config = SimulationConfig(imperfections=Imperfections(encoder_offset=-0.05))
     result = simulate(day, "lanzhou", collector="heliostat", config=config)
     assert result.log["angle"].max() > 90.0 and 0 < result.summary["tracking_error_deg"]["rms"] < 0.5
+
+
+@pytest.mark.parametrize("name", ["speed", "stow_speed"])
+def test_a_drive_slower_than_the_sun_is_refused_with_the_suns_rate(name):
+    # the hour angle turns 360° in 1,440 minutes: 0.25° a minute, the least speed that keeps up
+    from hybridtrack.drive import Drive
+
+    assert getattr(Drive(**{name: 360.0 / 1440.0}), name) == 0.25
+    with pytest.raises(HybridtrackError, match=rf"drive: {name} \(degrees per minute; the sun turns 0.25.*= 0.2 is "
+                                               r"outside \[0.25, 360\]"):
+        Drive(**{name: 0.2})
