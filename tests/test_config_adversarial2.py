@@ -4,6 +4,8 @@ import os
 
 import pytest
 
+from hybridtrack import HybridtrackError
+from hybridtrack.simulation import SimulationConfig
 from hybridtrack.cli import main
 
 
@@ -55,3 +57,23 @@ def test_init_suggests_a_command_that_pastes_whole_into_a_shell(tmp_path, capsys
     assert main(["init", str(folder)]) == 0
     suggested = capsys.readouterr().out.splitlines()[-1].removeprefix("try: ")
     assert shlex.split(suggested)[-2:] == ["--config", str(folder / "run.toml")]
+
+
+@pytest.mark.parametrize("text", ["", "\n  \n", "\ufeff"])
+def test_an_empty_config_file_is_refused_not_run_as_the_defaults(text, tmp_path, capsys):
+    """A 0-byte run.toml (a write cut short, `> run.toml` by mistake) had run the defaults unsaid."""
+    path = tmp_path / "run.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(HybridtrackError, match=r"run.toml: the config file is empty; leave it out for the defaults"):
+        SimulationConfig.from_toml(path)
+    assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--config", str(path),
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the config file is empty" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_config_of_comments_alone_is_read_as_the_defaults(tmp_path):
+    path = tmp_path / "run.toml"
+    path.write_text("# every setting at its default\n")
+    assert SimulationConfig.from_toml(path) == SimulationConfig()

@@ -217,7 +217,8 @@ def _tomllib():
 
 
 def read_toml(path, what: str = "config") -> dict:
-    """A TOML file as a dict, or one clear error naming the file (missing, not UTF-8, bad TOML)."""
+    """A TOML file as a dict, or one clear error naming the file (missing, empty, not UTF-8, bad
+    TOML). A file of comments alone is read, as an empty table: someone wrote it."""
     tomllib = _tomllib()
     path = input_path(path, f"{what} file")
     raw = read_bytes(path, f"{what} file", MAX_CONFIG_BYTES)
@@ -226,6 +227,8 @@ def read_toml(path, what: str = "config") -> dict:
         text = raw[mark:].decode("utf-8")
     except UnicodeDecodeError as exc:
         raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start + mark})") from None
+    if not text.strip():  # a write cut short, or `> run.toml` by mistake: it had run the defaults unsaid
+        raise HybridtrackError(f"{path}: the {what} file is empty; leave it out for the defaults")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
