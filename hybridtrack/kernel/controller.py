@@ -541,15 +541,31 @@ def _start_day(state):
     state.calibration[:, OFFSET] = 0.0
 
 
-@kernel(allocates=True)
+@kernel
+def _forget_scale(p, m, factor, prior):
+    """MountEstimator.forget's scale of parameter `m`: sqrt(min(1, prior / (p[m, m] / factor))),
+    NaN through as numpy's minimum passes it."""
+    ratio = prior / (p[m, m] / factor)
+    return math.sqrt(ratio if not ratio >= 1.0 else 1.0)
+
+
+@kernel
 def fit_forget(p, information, evidence, memory, prior, dt):
-    """MountEstimator.forget (in place on `p`, `information` and `evidence`)."""
+    """MountEstimator.forget (in place on `p`, `information` and `evidence`): each element the
+    reference's p / factor times its outer product of scales, the off-diagonal ones first, while
+    the diagonal the scales come from is still the old one; no array is made."""
     factor = math.exp(-dt / memory)
-    grown = p / factor
-    scale = np.sqrt(np.minimum(1.0, prior / np.diag(grown)))
-    p[:, :] = grown * np.outer(scale, scale)
-    information[:, :] = information * factor
-    evidence[:] = evidence * factor
+    n = p.shape[0]
+    for i in range(n):
+        for j in range(n):
+            if i != j:
+                p[i, j] = p[i, j] / factor * (_forget_scale(p, i, factor, prior) * _forget_scale(p, j, factor, prior))
+    for i in range(n):
+        scale = _forget_scale(p, i, factor, prior)
+        p[i, i] = p[i, i] / factor * (scale * scale)
+        for j in range(n):
+            information[i, j] = information[i, j] * factor
+        evidence[i] = evidence[i] * factor
 
 
 @kernel(allocates=True)
@@ -589,37 +605,63 @@ def fit_check(theta, p, information, evidence, prior, frozen):
 @kernel(allocates=True)
 def fit_update(theta, p, information, evidence, r, clip, frozen, derivatives, weight, residual):
     """MountEstimator.update of the row `derivatives` · `weight` (Joseph form; frozen pedestal
-    terms as consider parameters), in place on `theta`, `p`, `information` and `evidence`."""
-    row = derivatives * weight
-    n = row.shape[0]
-    information[:, :] = information + np.outer(row, row) / r
-    evidence[:] = evidence + row * residual / r
-    pr = np.empty(n)
+    terms as consider parameters), in place on `theta`, `p`, `information` and `evidence`: each
+    number the reference's, summed in its order, with the Joseph form's A = I − g·rowᵀ taken
+    element by element (`_joseph`) and two arrays made where the reference made eleven."""
+    n = derivatives.shape[0]
+    for i in range(n):
+        for j in range(n):
+            information[i, j] = information[i, j] + derivatives[i] * weight * (derivatives[j] * weight) / r
+        evidence[i] = evidence[i] + derivatives[i] * weight * residual / r
+    gain = np.empty(n)
     for m in range(n):
-        pr[m] = ordered_dot(p[m], row)
-    s = r + ordered_dot(row, pr)
-    gain = pr / s
-    if frozen:
-        gain[:2] = 0.0
+        total = p[m, 0] * (derivatives[0] * weight)
+        for k in range(1, n):
+            total = total + p[m, k] * (derivatives[k] * weight)
+        gain[m] = total
+    s = r + _row_dot(derivatives, weight, gain)
+    for m in range(n):
+        gain[m] = 0.0 if frozen and m < 2 else gain[m] / s
     bound = clip * math.sqrt(s)
-    innovation = residual - ordered_dot(row, theta)
+    innovation = residual - _row_dot(derivatives, weight, theta)
     error = max(-bound, min(bound, innovation))
-    theta[:] = theta + gain * error
-    a = np.eye(n) - np.outer(gain, row)
-    p[:, :] = _ordered_matmul(_ordered_matmul(a, p), a.T) + r * np.outer(gain, gain)
+    for m in range(n):
+        theta[m] = theta[m] + gain[m] * error
+    _joseph(p, gain, derivatives, weight, r)
+
+
+@kernel
+def _row_dot(derivatives, weight, y):
+    """ordered_dot(row, y) of the row `derivatives` · `weight`."""
+    total = derivatives[0] * weight * y[0]
+    for k in range(1, y.shape[0]):
+        total = total + derivatives[k] * weight * y[k]
+    return total
+
+
+@kernel
+def _joseph_a(gain, derivatives, weight, i, k):
+    """Element (i, k) of the Joseph form's A = I − g·rowᵀ, as np.eye − np.outer gives it."""
+    return (1.0 if i == k else 0.0) - gain[i] * (derivatives[k] * weight)
 
 
 @kernel(allocates=True)
-def _ordered_matmul(a, b):
-    """mountfit.ordered_matmul: Σₖ a[i, k] · b[k, j] added in turn."""
-    out = np.empty((a.shape[0], b.shape[1]))
-    for i in range(a.shape[0]):
-        for j in range(b.shape[1]):
-            total = a[i, 0] * b[0, j]
-            for k in range(1, a.shape[1]):
-                total = total + a[i, k] * b[k, j]
-            out[i, j] = total
-    return out
+def _joseph(p, gain, derivatives, weight, r):
+    """P ← A P Aᵀ + r g gᵀ in place, each product summed in turn as `mountfit.ordered_matmul`."""
+    n = p.shape[0]
+    ap = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = _joseph_a(gain, derivatives, weight, i, 0) * p[0, j]
+            for k in range(1, n):
+                total = total + _joseph_a(gain, derivatives, weight, i, k) * p[k, j]
+            ap[i, j] = total
+    for i in range(n):
+        for j in range(n):
+            total = ap[i, 0] * _joseph_a(gain, derivatives, weight, j, 0)
+            for k in range(1, n):
+                total = total + ap[i, k] * _joseph_a(gain, derivatives, weight, j, k)
+            p[i, j] = total + r * (gain[i] * gain[j])
 
 
 @kernel
