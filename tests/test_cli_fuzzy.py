@@ -1,5 +1,6 @@
 import json
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -7,18 +8,55 @@ from hybridtrack.cli import main
 from hybridtrack.fuzzy import FuzzyConfig
 
 
+def published_score_by_skfuzzy(intensity_ma, variation_ma):
+    """The published classifier written out afresh in scikit-fuzzy's control API (not through
+    hybridtrack's own translation): Gaussian inputs on 0-10 (σ 1.5 and 2.5, the documented
+    choice of hybridtrack.fuzzy.config), triangular outputs on 0-30, the four published rules,
+    the published linear maps 30-300 mA and 0-180 mA onto 0-10, and the same sampling (1001 and
+    3001 points) so that scikit-fuzzy's discrete centroid is the same integral."""
+    import skfuzzy as fuzz
+    from skfuzzy import control as ctrl
+
+    i = ctrl.Antecedent(np.linspace(0, 10, 1001), "intensity")
+    v = ctrl.Antecedent(np.linspace(0, 10, 1001), "variation")
+    w = ctrl.Consequent(np.linspace(0, 30, 3001), "weather")
+    for name, mean in (("weak", 0.0), ("medium", 5.0), ("strong", 10.0)):
+        i[name] = fuzz.gaussmf(i.universe, mean, 1.5)
+    v["small"], v["large"] = fuzz.gaussmf(v.universe, 0.0, 2.5), fuzz.gaussmf(v.universe, 10.0, 2.5)
+    for name, abc in (("overcast", [0, 5, 10]), ("cloudy", [10, 15, 20]), ("sunny", [20, 25, 30])):
+        w[name] = fuzz.trimf(w.universe, abc)
+    rules = [ctrl.Rule(i["strong"] & v["small"], w["sunny"]), ctrl.Rule(i["strong"] & v["large"], w["cloudy"]),
+             ctrl.Rule(i["medium"] & v["large"], w["cloudy"]), ctrl.Rule(i["weak"] & v["small"], w["overcast"])]
+    sim = ctrl.ControlSystemSimulation(ctrl.ControlSystem(rules))
+    sim.input["intensity"] = (intensity_ma - 30.0) / 270.0 * 10.0
+    sim.input["variation"] = variation_ma / 180.0 * 10.0
+    sim.compute()
+    return float(sim.output["weather"])
+
+
 def test_classify_one_reading_prints_score_label_and_rules(capsys):
+    """The published cloudy reading (200.1 mA, 84.6 mA); the score is scikit-fuzzy's, the firing by hand."""
     assert main(["classify", "--intensity", "200.1", "--variation", "84.6"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("score 18.163 -> cloudy")
-    assert "rule 3: intensity is medium AND variation is large -> cloudy  fires 0.106" in out
+    score = published_score_by_skfuzzy(200.1, 84.6)
+    assert 10.0 <= score < 20.0  # the published label, cloudy, by the reference alone
+    assert out.startswith(f"score {score:.3f} -> cloudy")
+    # by hand: intensity (200.1 - 30)/27 = 6.3, variation 84.6/18 = 4.7;
+    # medium(6.3) = exp(-1.3²/4.5) = 0.687, large(4.7) = exp(-5.3²/12.5) = 0.1057; rule 3 fires min = 0.106
+    firing = min(np.exp(-(6.3 - 5.0) ** 2 / 4.5), np.exp(-(4.7 - 10.0) ** 2 / 12.5))
+    assert f"{firing:.3f}" == "0.106"
+    assert f"rule 3: intensity is medium AND variation is large -> cloudy  fires {firing:.3f}" in out
 
 
 def test_classify_json(capsys):
+    """The published sunny reading (246 mA, 27 mA) against scikit-fuzzy and a hand-computed firing."""
     assert main(["classify", "--intensity", "246", "--variation", "27", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["weather"] == "sunny" and data["score"] == pytest.approx(24.9064, abs=1e-4)
-    assert [r["firing"] for r in data["rules"]][0] == pytest.approx(0.411, abs=1e-3)
+    assert data["weather"] == "sunny"
+    assert data["score"] == pytest.approx(published_score_by_skfuzzy(246.0, 27.0), abs=1e-6)
+    # by hand: intensity (246 - 30)/27 = 8.0, variation 27/18 = 1.5;
+    # strong(8) = exp(-2²/4.5) = 0.4111, small(1.5) = exp(-1.5²/12.5) = 0.835; rule 1 fires min = 0.4111
+    assert data["rules"][0]["firing"] == pytest.approx(np.exp(-4.0 / 4.5), rel=1e-9)
 
 
 def test_classify_a_file_with_named_columns(tmp_path, capsys):
