@@ -52,9 +52,10 @@ def test_replay_a_shipped_record(tmp_path, capsys):
     out = tmp_path / "replay"
     assert main(["replay", "data/nanjing-2013-cloudy.csv", "--site", "nanjing", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "data/nanjing-2013-cloudy.csv: 3604 rows read" in printed and "replay of" in printed
+    rows = len(pd.read_csv("data/nanjing-2013-cloudy.csv"))  # the file itself: four days of 05:00-20:00 at 1 min, 4 × 901
+    assert f"data/nanjing-2013-cloudy.csv: {rows} rows read" in printed and "replay of" in printed
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["steps"] == 3604 and summary["sky_share"]["cloudy"] > 0.3
+    assert summary["steps"] == rows and summary["sky_share"]["cloudy"] > 0.3
 
 
 def test_replay_a_messy_logger_file_by_coordinates(tmp_path, capsys):
@@ -68,7 +69,7 @@ def test_replay_a_messy_logger_file_by_coordinates(tmp_path, capsys):
                  "--map", "wind_speed=Wind", "--collector", "trough-ns", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "resampled: linear in time from 5min to 1min" in printed
-    assert json.loads((out / "summary.json").read_text())["steps"] == 781
+    assert json.loads((out / "summary.json").read_text())["steps"] == 13 * 60 + 1  # 06:00-19:00 at 1 min, both ends
 
 
 def test_compare_runs_every_strategy_side_by_side(tmp_path, capsys):
