@@ -240,6 +240,27 @@ def test_knowing_the_true_sky_does_no_worse_than_trusting_the_sensor_always_on_a
     assert oracle["energy_capture"] >= always["energy_capture"]
 
 
+@pytest.mark.parametrize("zone", ["UTC", "America/Denver"])
+def test_a_run_is_the_same_whatever_zone_its_frames_stamps_are_written_in(zone):
+    """The same instants written in another zone are the same weather: the controller's clock is
+    the site's (Beijing time), so every logged value, every event and every score must be the
+    same; only how the start and end are written may differ. (The run's own test of this had
+    checked the step count alone.)"""
+    local = synthetic("lanzhou", "2021-06-21", weather="mixed", seed=2, gusts_per_day=2.0)
+    here = simulate(local, "lanzhou")
+    there = simulate(local.tz_convert(zone), "lanzhou")
+    assert str(there.log.index.tz) == zone
+    pd.testing.assert_frame_equal(there.log.set_axis(there.log.index.tz_convert("Asia/Shanghai")), here.log,
+                                  check_freq=False)
+    assert (there.events["time"].dt.tz_convert("Asia/Shanghai") == here.events["time"]).all()
+    pd.testing.assert_frame_equal(there.events.drop(columns="time"), here.events.drop(columns="time"))
+    assert len(here.events) > 2 and here.summary["stow_events"] >= 1  # a day with something to get wrong
+    differ = {k for k in here.summary if here.summary[k] != there.summary[k]}
+    assert differ <= {"start", "end"}
+    for key in differ:
+        assert pd.Timestamp(here.summary[key]) == pd.Timestamp(there.summary[key])
+
+
 def test_the_clear_sky_the_controller_expects_comes_from_its_own_sun_model():
     """Given a sun position, `clear_sky` uses it; SPA's gives pvlib's own clear sky, and the PLC
     model's (what the controller has) is within a watt or two of it while the sun is up."""
