@@ -656,7 +656,7 @@ def test_a_path_from_the_home_folder_is_read_and_written_there(tmp_path, monkeyp
     SimulationConfig(seed=5).to_toml("~/config.toml")
     assert SimulationConfig.from_toml("~/config.toml").seed == 5
     assert main(["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "1h", "--csv=~/sun.csv"]) == 0
-    assert f"wrote 16 rows to {tmp_path / 'home' / 'sun.csv'}" in capsys.readouterr().out
+    assert f"wrote {20 - 5 + 1} rows to {tmp_path / 'home' / 'sun.csv'}" in capsys.readouterr().out  # 05:00-20:00 hourly
     assert sorted(p.name for p in (tmp_path / "home").iterdir()) == ["config.toml", "sun.csv"]
     assert not (tmp_path / "~").exists()
 
