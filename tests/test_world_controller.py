@@ -97,7 +97,9 @@ def scene(weather, seed=2, site="lanzhou", date="2021-06-21"):
 def test_a_bright_patch_appears_only_where_the_frames_own_light_says_cloud():
     frame, position, light = scene("overcast")
     up = position["altitude"].to_numpy() > 10
-    assert np.all(light.patch[up] <= light.aureole[up] * 1e9)  # defined everywhere
+    # defined everywhere and never negative (it had been checked as patch <= 1e9 × aureole, which
+    # only a NaN could fail, and which a zero aureole beside a lit patch would have failed wrongly)
+    assert np.isfinite(light.patch[up]).all() and (light.patch[up] >= 0).all()
     frame, position, clear = scene("sunny")
     cloud_light = np.clip(frame["dhi"] - frame["dhi_clear"], 0, None).to_numpy()
     assert np.all(clear.patch[cloud_light == 0] == 0)
