@@ -87,3 +87,27 @@ def test_an_index_not_ascending_is_left_to_pandas():
 def test_unknown_engine_is_refused():
     with pytest.raises(HybridtrackError, match="unknown engine 'fast'"):
         trailing_range(_series(0, n=10), "20min", engine="fast")
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("window", [1.0, 3.0, 20.0])
+def test_the_controllers_own_trailing_range_and_mean_are_pandas(seed, window):
+    """The reference controller's sky watch keeps its own windows (`control.skywatch.TrailingRange`,
+    `TrailingMean`, scan by scan in minutes); the compiled kernel is tested against them, and they
+    against pandas' rolling max − min and mean over (t − window, t] here. Stamps are whole and
+    half minutes, exact in binary, so no window edge is a matter of rounding."""
+    from hybridtrack.control.skywatch import TrailingMean, TrailingRange
+
+    rng = np.random.default_rng(seed)
+    minutes = np.cumsum(rng.choice([0.5, 1.0, 1.0, 1.5, 2.0, 30.0], size=600))
+    values = np.round(rng.normal(100.0, 30.0, 600), 1)  # rounded: ties
+    values[rng.random(600) < 0.15] = np.nan
+    values[100:140] = np.nan  # a run longer than every window: empty windows
+    spread, mean = TrailingRange(window), TrailingMean(window)
+    got_range = np.array([spread.add(t, v) for t, v in zip(minutes, values)])
+    got_mean = np.array([mean.add(t, v) for t, v in zip(minutes, values)])
+    series = pd.Series(values, index=pd.Timestamp("2021-06-21") + pd.to_timedelta(minutes, unit="min"))
+    rolling = series.rolling(pd.Timedelta(minutes=window), min_periods=1)
+    np.testing.assert_array_equal(got_range, (rolling.max() - rolling.min()).to_numpy())
+    np.testing.assert_allclose(got_mean, rolling.mean().to_numpy(), rtol=1e-12, atol=1e-9)
+    assert np.isnan(got_range).any() and not np.isnan(got_range).all()
