@@ -490,7 +490,7 @@ def test_an_api_save_refused_after_claiming_its_folder_leaves_no_folder(tmp_path
         run.save(tmp_path / "run")
     assert list(tmp_path.iterdir()) == []  # nor the folder above the one asked for
     (tmp_path / "mine").mkdir()
-    with pytest.raises(HybridtrackError):
+    with pytest.raises(HybridtrackError, match="No space left on device"):  # the same full disk, not another refusal
         run.save(tmp_path / "mine")
     assert (tmp_path / "mine").is_dir()  # a folder that was there before stays
 
