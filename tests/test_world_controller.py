@@ -263,6 +263,20 @@ def test_a_run_is_the_same_whatever_zone_its_frames_stamps_are_written_in(zone):
         assert pd.Timestamp(here.summary[key]) == pd.Timestamp(there.summary[key])
 
 
+@pytest.mark.parametrize("strategy", ["hybrid", "sensor"])
+def test_the_reference_loop_runs_the_same_with_nights_in_bulk_or_scan_by_scan(strategy):
+    """Nights in bulk are a fast path of both engines; the compiled one is held to its scans in
+    tests/test_kernel.py, and the simulator's own test runs whichever engine 'auto' picks (the
+    kernel wherever it is compiled or cached). Here the reference loop, named."""
+    frame = synthetic("nanjing", "2013-06-20", "2013-06-21", weather="mixed", seed=4, gusts_per_day=1.0)
+    config = SimulationConfig(engine="reference")
+    bulk = simulate(frame, "nanjing", strategy=strategy, config=config, bulk_nights=True)
+    scans = simulate(frame, "nanjing", strategy=strategy, config=config, bulk_nights=False)
+    pd.testing.assert_frame_equal(bulk.log, scans.log)
+    pd.testing.assert_frame_equal(bulk.events, scans.events)
+    assert bulk.summary == scans.summary and bulk.summary["mode_share"]["stow_night"] > 0.3
+
+
 def test_the_clear_sky_the_controller_expects_comes_from_its_own_sun_model():
     """Given a sun position, `clear_sky` uses it; SPA's gives pvlib's own clear sky, and the PLC
     model's (what the controller has) is within a watt or two of it while the sun is up."""
