@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from hybridtrack import HybridtrackError
+from hybridtrack.fuzzy import FuzzyWeatherClassifier
 from hybridtrack.testing import RuleCaseFailure, load_cases, rule_table_cases
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,6 +32,8 @@ def test_a_failing_row_shows_memberships_and_firings(tmp_path):
     assert result.returncode == 1
     out = result.stdout
     assert "expected overcast, got sunny for intensity 246 mA, variation 27 mA" in out
+    # by hand: 246 mA is (246 - 30)/27 = 8.0 on the universe; weak exp(-64/4.5) = 7e-7, medium
+    # exp(-9/4.5) = 0.1353, strong exp(-4/4.5) = 0.4111; 27 mA is 1.5, small exp(-2.25/12.5) = 0.835
     assert "intensity: weak 0.000, medium 0.135, strong 0.411" in out
     assert "rule 1: intensity is strong AND variation is small -> sunny  fires 0.411" in out
 
@@ -53,7 +56,10 @@ def test_check_raises_a_rule_case_failure_with_the_explanation():
     case = rule_table_cases(ROOT / "examples" / "rule_tables" / "commissioning.csv")[0].values[0]
     case.check()
     wrong = type(case)(case.intensity, case.variation, "cloudy", score=20.0, tolerance=0.1)
-    with pytest.raises(RuleCaseFailure, match=r"expected cloudy, got sunny; expected score 20 ± 0.1, got 24.9064"):
+    # the score the message gives is scikit-fuzzy's for the published sunny reading (246 mA, 27 mA)
+    score = FuzzyWeatherClassifier().score(246.0, 27.0, engine="skfuzzy")
+    assert (case.intensity, case.variation) == (246.0, 27.0)
+    with pytest.raises(RuleCaseFailure, match=rf"expected cloudy, got sunny; expected score 20 ± 0.1, got {score:.4f}"):
         wrong.check()
 
 
