@@ -90,7 +90,9 @@ def test_a_utc_logger_replays_at_a_built_in_site_with_tz_utc(tmp_path, capsys):
                  "--site-tz", "Asia/Shanghai", "--perfect", "--out", str(by_coordinates)]) == 0
     capsys.readouterr()
     again = json.loads((by_coordinates / "summary.json").read_text())
-    assert again["energy_capture"] == pytest.approx(summary["energy_capture"], abs=1e-3)
+    # the same coordinates, zone and file are the same run, whatever the site is called (the energy
+    # had been compared to within 1e-3 only, room for a different run to pass)
+    assert again["site"] == "custom" and {**again, "site": "lanzhou"} == summary
 
 
 def test_check_writes_parquet_for_a_parquet_name_and_a_streamed_replay_reads_it(tmp_path, capsys):
