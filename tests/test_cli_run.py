@@ -52,7 +52,8 @@ def test_replay_a_shipped_record(tmp_path, capsys):
     out = tmp_path / "replay"
     assert main(["replay", "data/nanjing-2013-cloudy.csv", "--site", "nanjing", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    rows = len(pd.read_csv("data/nanjing-2013-cloudy.csv"))  # the file itself: four days of 05:00-20:00 at 1 min, 4 × 901
+    # the file itself: four days of 05:00-20:00 at 1 min, 4 × 901
+    rows = len(pd.read_csv("data/nanjing-2013-cloudy.csv"))
     assert f"data/nanjing-2013-cloudy.csv: {rows} rows read" in printed and "replay of" in printed
     summary = json.loads((out / "summary.json").read_text())
     assert summary["steps"] == rows and summary["sky_share"]["cloudy"] > 0.3

@@ -303,7 +303,8 @@ def test_the_budget_is_half_the_available_memory_up_to_16_gib(monkeypatch):
 
 def test_a_refusal_names_a_coarser_step_and_a_shorter_span(monkeypatch):
     # budget 1e9 bytes = 500,000 steps of 2,000 bytes; ten days at 1 s are 864,000 steps (1.728e9 bytes).
-    # At 2 s they are 864,000 / 2 = 432,000 steps, 0 to 863,998 s (0.864e9 bytes): they fit. At 1 s, 499,999 s = 5.787 days fit.
+    # At 2 s they are 864,000 / 2 = 432,000 steps, 0 to 863,998 s (0.864e9 bytes): they fit.
+    # At 1 s, 499,999 s = 5.787 days fit.
     monkeypatch.setattr(budget, "available_memory", lambda: 2_000_000_000)
     first = pd.Timestamp("2021-06-21", tz="UTC")
     last = first + pd.Timedelta(days=10) - pd.Timedelta(seconds=1)

@@ -59,7 +59,8 @@ def test_check_raises_a_rule_case_failure_with_the_explanation():
     # the score the message gives is scikit-fuzzy's for the published sunny reading (246 mA, 27 mA)
     score = FuzzyWeatherClassifier().score(246.0, 27.0, engine="skfuzzy")
     assert (case.intensity, case.variation) == (246.0, 27.0)
-    with pytest.raises(RuleCaseFailure, match=rf"expected cloudy, got sunny; expected score 20 ± 0.1, got {score:.4f}"):
+    expected = rf"expected cloudy, got sunny; expected score 20 ± 0.1, got {score:.4f}"
+    with pytest.raises(RuleCaseFailure, match=expected):
         wrong.check()
 
 
