@@ -205,6 +205,27 @@ def test_a_streamed_run_against_one_simulate_on_the_same_weather(tmp_path):
     assert streamed_run.summary["moves"] == pytest.approx(mono[0].summary["moves"], rel=0.05)
 
 
+def test_one_day_streamed_is_the_same_run_as_one_simulate(tmp_path):
+    """With a single segment nothing is restarted or redrawn (the first day's noise is the run's
+    seed's): the streamed run is the in-memory one, its log bit for bit, its events and every key
+    of its summary the same, the p95 within half a bin of the running histogram it is read from."""
+    (_, frame), = synthetic_days(SITE, "2021-03-10", "2021-03-10", weather="climate", freq="1min", seed=3,
+                                 gusts_per_day=2.0)
+    streamed = stream(frame_days(frame, SITE), tmp_path, strategy="hybrid")
+    mono = simulate(frame, SITE, strategy="hybrid")
+    pd.testing.assert_frame_equal(streamed.log(), mono.log, check_freq=False)
+    events = streamed.events()
+    assert len(events) == len(mono.events) > 2
+    assert list(events["reason"]) == list(mono.events["reason"]) and (events["time"] == mono.events["time"]).all()
+    for key, value in mono.summary.items():
+        if key == "tracking_error_deg":
+            for name in ("rms", "max", "mean"):
+                assert streamed.summary[key][name] == value[name], name
+            assert abs(streamed.summary[key]["p95"] - value["p95"]) <= HISTOGRAM_RESOLUTION / 2 + 1e-5
+        else:
+            assert streamed.summary[key] == value, key
+
+
 def test_a_recorded_parquet_or_csv_frame_streams_in_chunks(tmp_path):
     from hybridtrack.sky import synthetic
 
