@@ -136,7 +136,7 @@ def _metrics(result) -> dict:
                         ACCEPTANCE_HALF_ANGLE[result.collector.kind])
     lost_energy = beam * (1.0 - gained) * np.isin(mode, ["sensor", "astronomical", "search"])
     total = lost_energy.sum()
-    hours = np.diff(log.index.asi8).mean() / 3.6e12 if len(log) > 1 else 0.0
+    hours = np.diff(log.index.as_unit("ns").asi8).mean() / 3.6e12 if len(log) > 1 else 0.0
 
     def share(mask):
         return float(lost_energy[mask].sum() / total) if total > 0 else float("nan")

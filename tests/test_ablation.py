@@ -14,7 +14,8 @@ from hybridtrack.ablation import AblationPlan, AblationResult, _metrics, ablate
 from hybridtrack.collectors import Collector
 
 
-def test_the_lost_energy_is_put_down_to_pull_or_to_a_lost_sun_by_hand():
+@pytest.mark.parametrize("unit", ["ns", "us", "s"])
+def test_the_lost_energy_is_put_down_to_pull_or_to_a_lost_sun_by_hand(unit):
     # a north-south trough (θ½ = 1°), 1-minute steps; η(e) = 1 / (1 + e⁴)
     #   step mode          status        DNI  error  lost = DNI (1 − η)         counted as
     #   0    sensor        ok            800  1.0    800 · 1/2      = 400       pull (followed)
@@ -24,10 +25,9 @@ def test_the_lost_energy_is_put_down_to_pull_or_to_a_lost_sun_by_hand():
     #   4    astronomical  not read      300  1.0    300 · 1/2      = 150       neither
     #   5    stow_wind     not read      900  30.0   not tracking   = 0
     # total 1764.706; pull (400 + 564.706) / total = 0.54667; lost sun (250 + 400) / total = 0.36833
-    # nanosecond stamps, as the ablation's synthetic days have (`_metrics` reads the step from
-    # `index.asi8` as nanoseconds: a µs index, pandas 3's default for
-    # date_range and read_weather's, would give lost_kwh 1000 times too small)
-    index = pd.date_range("2021-06-21 12:00", periods=6, freq="1min", tz="Asia/Shanghai", unit="ns")
+    # any resolution of the stamps (a µs index, pandas 3's default for date_range and
+    # read_weather's, had given lost_kwh 1000 times too small)
+    index = pd.date_range("2021-06-21 12:00", periods=6, freq="1min", tz="Asia/Shanghai", unit=unit)
     log = pd.DataFrame({"dni": [800.0, 600.0, 500.0, 400.0, 300.0, 900.0],
                         "mode": ["sensor", "sensor", "sensor", "search", "astronomical", "stow_wind"],
                         "sensor_status": ["ok", "outlier", "low light", "not read", "not read", "not read"],
