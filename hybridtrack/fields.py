@@ -467,12 +467,13 @@ class HeliostatField:
         placed, ring = [], 0
         while sum(len(p) for p in placed) < count:
             radius = first_radius + ring * spacing
-            places = max(int(2 * np.pi * radius / spacing), 1)
+            places = _ring_places(radius, spacing)
             angle = 2 * np.pi * (np.arange(places) + 0.5 * (ring % 2)) / places
             placed.append(np.column_stack([radius * np.sin(angle), radius * np.cos(angle)]))
             ring += 1
         spread = spread if spread is not None else ImperfectionSpread()
-        return cls(positions=np.concatenate(placed)[:count], aim=aim, spread=spread)
+        positions = np.round(np.concatenate(placed)[:count], 9) + 0.0  # no 1e-15 m east of a mirror due south
+        return cls(positions=positions, aim=aim, spread=spread)
 
     @property
     def names(self) -> list[str]:
@@ -498,6 +499,16 @@ class HeliostatField:
     def targets(self, altitude, azimuth) -> np.ndarray:
         """Every mirror's nominal normal azimuth and elevation (T, N, 2), degrees."""
         return np.stack(normal_angles(self.normals(altitude, azimuth)), axis=-1)
+
+
+def _ring_places(radius: float, spacing: float) -> int:
+    """The most mirrors a ring of `radius` holds with neighbours' centres `spacing` metres apart
+    in a straight line (the chord, ``2 r sin(π / n)``), at least one. Counted along the arc
+    (``2 π r / spacing``), a ring of 11.46 m had put mirrors of a 12 m spacing 11.46 m apart, and
+    one of 0.95 m at the least spacing, 1 m, had its own mirrors refused as overlapping."""
+    if spacing > 2.0 * radius:  # not even two fit across
+        return 1
+    return max(int(np.pi / np.arcsin(spacing / (2.0 * radius)) + 1e-9), 1)  # 1e-9: a hexagon of 1 m sides is 6
 
 
 def _by_name(positions):
