@@ -210,17 +210,41 @@ def _alike(value):
 
 
 def _refuse_repeats(key: str, values: list, source: str) -> None:
-    """Refuse a grid value given twice: every combination with it would run twice, two rows alike
-    in all but their number, and a mean over them counted double."""
+    """Refuse a grid value given twice, or two that its runs read alike (`_run_reading`): every
+    combination with it would run twice, two rows alike in all but their number, and a mean over
+    them counted double."""
     seen: dict = {}
+    check = _key_checks().get(key)
     for number, value in enumerate(values, 1):
         try:
-            first = seen.setdefault(_alike(value), number)
+            first = seen.setdefault(_run_reading(key, value, check), number)
         except TypeError:  # unhashable in a way TOML does not make: judged by its run
             continue
-        if first != number:
+        if first != number and _alike(values[first - 1]) == _alike(value):
             raise HybridtrackError(f"{source}: grid.{key}: {_shown(value)} is given twice (values {first} and "
                                    f"{number}); each value makes its runs once")
+        if first != number:
+            raise HybridtrackError(f"{source}: grid.{key}: {_shown(value)} is {_shown(values[first - 1])} again "
+                                   f"(values {first} and {number}): their runs are the same; each value makes its "
+                                   "runs once")
+
+
+def _run_reading(key: str, value, check):
+    """What a run makes of a grid value of `key`, to tell repeats by: a run key's value as its
+    `check` (`_key_checks`) reads it (a date and its text, '60min' and '1h', 'Lanzhou' and
+    'lanzhou', 'sunny' and ['sunny'] had each made the same runs twice); any other value, or one
+    its run refuses (which fails each of its runs on its own), by `_alike`."""
+    try:
+        read = check(value) if check is not None else None
+    except HybridtrackError:
+        read = None
+    if read is None:
+        return _alike(value)
+    if key == "freq":  # the step, not its text
+        from .times import parse_freq
+
+        read = parse_freq(read)
+    return key, tuple(read) if isinstance(read, list) else read
 
 
 def _known_keys() -> list[str]:

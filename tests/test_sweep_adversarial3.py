@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import datetime as dt
+
 import pytest
 
 from hybridtrack import HybridtrackError
@@ -21,3 +23,23 @@ def test_an_hourly_step_is_taken_and_a_longer_grid_step_fails_its_run_only():
     Sweep.from_dict({"base": {"freq": "1h"}, "grid": {"seed": [0]}}, source="s.toml")
     row = run_one({"config": {}}, {"run": 3, "freq": "2h"}, "s.toml")
     assert row["error"].startswith("HybridtrackError: grid.freq = '2h': freq '2h' is longer than")
+
+
+@pytest.mark.parametrize("key, values, message", [
+    ("start", [dt.date(2021, 6, 21), "2021-06-21"], "grid.start: '2021-06-21' is 2021-06-21 again .values 1 and 2."),
+    ("freq", ["30min", "60min", "1h"], "grid.freq: '1h' is '60min' again .values 2 and 3."),
+    ("site", ["lanzhou", "nanjing", "Lanzhou"], "grid.site: 'Lanzhou' is 'lanzhou' again .values 1 and 3."),
+    ("weather", ["sunny", ["sunny"]], r"grid.weather: \['sunny'\] is 'sunny' again .values 1 and 2."),
+    ("weather", ["sunny,cloudy", ["sunny", "cloudy"]], r"grid.weather: \['sunny', 'cloudy'\] is 'sunny,cloudy' again .values 1 and 2."),
+])
+def test_two_grid_values_a_run_reads_alike_are_refused_as_repeats(key, values, message):
+    """A date and its text, '60min' and '1h', a site's name in capitals had each made the same
+    runs twice: two rows alike in all but their number, a mean over them counted double."""
+    with pytest.raises(HybridtrackError, match=message + ": their runs are the same; each value makes its runs once"):
+        Sweep.from_dict({"base": {"days": 2}, "grid": {key: values}}, source="s.toml")
+
+
+def test_values_that_read_differently_or_that_their_runs_refuse_are_not_repeats():
+    grid = {"freq": ["30min", "30s"], "site": ["lanzhou", "nanjing"], "seed": [1, True],
+            "start": ["2021-06-21", "2021-6-21x"]}
+    assert len(Sweep.from_dict({"grid": grid}, source="s.toml").runs()) == 16
