@@ -325,6 +325,7 @@ def safety_breaches(result) -> list[str]:
     if late.any():
         breaches.append(f"no stow at a gust ({log.index[np.flatnonzero(late)[0]]})")
     angle = log["angle"].to_numpy()
+    stowed_at = _true_stow(result)
     for start in np.flatnonzero((mode == "stow_wind") & (np.roll(mode, 1) != "stow_wind")):
         end = start
         while end + 1 < len(mode) and mode[end + 1] == "stow_wind":
@@ -332,6 +333,9 @@ def safety_breaches(result) -> list[str]:
         settled = start + 5  # at stow speed a stow (or a timed stow move) ends within a few scans
         if end > settled and np.ptp(angle[settled:end + 1]) > 0:
             breaches.append(f"moved while stowed for wind ({log.index[settled]})")
+        if end > settled and not abs(angle[end] - stowed_at[0]) <= stowed_at[1]:
+            breaches.append(f"stowed for wind but {angle[end]:.2f}° where the stow is {stowed_at[0]:.2f}° "
+                            f"({log.index[end]})")
     status = log["sensor_status"].astype(str).to_numpy()
     faulty_tracked = (mode == "sensor") & np.isin(status, FAULTY) & np.roll(np.isin(status, FAULTY), 1)
     if faulty_tracked.any():
@@ -345,6 +349,14 @@ def safety_breaches(result) -> list[str]:
             breaches.append(f"stayed on an invalid sensor past the loss time ({log.index[i]})")
             break
     return breaches
+
+
+def _true_stow(result) -> tuple[float, float]:
+    """Where the logged axis truly stands when stowed (its encoder's stow less the encoder's zero
+    error), and how far from it a stowed axis may stand: the deadband and one count."""
+    drive = result.config.drive if result.collector.single_axis else result.config.heliostat_drive
+    stow = drive.stow if result.collector.single_axis else 90.0  # a heliostat's logged axis: elevation
+    return stow - result.config.imperfections.encoder_offset, drive.deadband + drive.resolution + 1e-9
 
 
 def run_scenario(name: str, site: str | None = None) -> ScenarioResult:

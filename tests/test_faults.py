@@ -257,7 +257,7 @@ def test_a_gust_while_the_encoder_is_judged_frozen_stows_by_a_timed_move_and_is_
     reason = events.loc[events["to"] == "stow_wind", "reason"].iloc[0]
     assert "29.0 m/s" in reason and "timed stow move" in reason
     stowed = log["angle"].iloc[first + 3]
-    assert abs(stowed - 90.0) < 3.0  # a timed move from the last trusted reading: near stow, no encoder
+    assert abs(stowed - 90.0) < 3.0  # a timed move from the reckoned position: near stow, no encoder
     released = events[(events["from"] == "stow_wind") & (events["to"] == "fault")]
     assert len(released) == 1 and "encoder still judged frozen" in released["reason"].iloc[0]
 

@@ -358,9 +358,9 @@ class Controller:
 
     def _read_encoders(self, i: int, t: float, obs: Observation) -> list[float]:
         reading = []
-        blind = self.mode == FAULT or self.blind_stow is not None
+        reckoned = self.mode == FAULT or self.blind_stow is not None
         for a, monitor in enumerate(self.encoders):
-            value, note, frozen = monitor.read(obs.encoder[a], blind)
+            value, note, frozen = monitor.read(obs.encoder[a], reckoned)
             if frozen and self.mode != FAULT:
                 self._switch(i, FAULT, note, t)
             elif note:
@@ -373,9 +373,9 @@ class Controller:
         resume = SENSOR if config.sensor_only else ASTRONOMICAL
         if gusty and mode != STOW_WIND:  # wind first, from every mode
             reason = "wind reading missing" if math.isnan(wind) else f"wind {wind:.1f} m/s > {config.wind_stow}"
-            if mode == FAULT:  # the position is unknown: a timed move from the last trusted reading
+            if mode == FAULT:  # the encoder is not believed: a timed move from the reckoned position
                 self.blind_stow = [d.stow - m.believed for d, m in zip(self.drives, self.encoders)]
-                reason += "; encoder judged frozen: timed stow move from the last trusted reading"
+                reason += "; encoder judged frozen: timed stow move from the position reckoned from the moves commanded"
             self._switch(i, STOW_WIND, reason, t)
         elif mode == STOW_WIND and not gusty and self.wind.released(t):
             released = f"wind at or below {config.wind_release} m/s for {config.wind_hold}"
@@ -706,6 +706,7 @@ class Controller:
                 left = self.blind_stow[a]
                 step = max(-drive.stow_speed * dt, min(drive.stow_speed * dt, left))
                 self.blind_stow[a] = left - step
+                monitor.commanded = step  # the encoder is not believed: the position is reckoned from it
                 self.travel[a] += abs(step)
                 self.moves[a] += 1 if step else 0
                 targets.append(drive.stow)

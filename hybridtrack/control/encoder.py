@@ -12,7 +12,11 @@ class EncoderMonitor:
 
     A reading that jumps away from the expected position is a glitch: ignored for that scan,
     believed only once it has persisted for `confirm` scans. A reading that does not change
-    although the drive was commanded to move is a frozen encoder.
+    although the drive was commanded to move is a frozen encoder: the drive moved, its encoder
+    did not count, so the axis is where the move should have left it, and from then on (while
+    the controller does not believe the encoder) where the moves commanded since have taken it.
+    A timed stow move is measured from there: taken from the frozen reading, it had left a trough
+    frozen on its first move of the morning (30° off stow) where it stood through a gale.
     """
 
     __slots__ = ("resolution", "confirm", "believed", "last", "jumped", "commanded")
@@ -25,17 +29,21 @@ class EncoderMonitor:
         self.jumped = 0
         self.commanded = 0.0
 
-    def read(self, value: float, trust_blindly: bool) -> tuple[float, str | None, bool]:
-        """The reading to use, an alarm text or None, and whether the encoder looks frozen."""
+    def read(self, value: float, reckoned: bool) -> tuple[float, str | None, bool]:
+        """The position to use, an alarm text or None, and whether the encoder looks frozen;
+        `reckoned`: the encoder is not believed (judged frozen), the position is dead reckoned."""
         previous, self.last = self.last, value
-        if math.isnan(self.believed) or trust_blindly:
+        if math.isnan(self.believed):
             self.believed = value
             return value, None, False
         expected = self.believed + self.commanded
+        if reckoned:
+            self.believed = expected
+            return expected, None, False
         tolerance = 2.0 * self.resolution + 1e-9
         if self.commanded and abs(value - previous) < 0.5 * self.resolution and abs(self.commanded) > tolerance:
-            self.believed = value
-            return value, f"encoder frozen: commanded {self.commanded:+.2f}°, reading unchanged; drive halted", True
+            self.believed = expected
+            return expected, f"encoder frozen: commanded {self.commanded:+.2f}°, reading unchanged; drive halted", True
         if abs(value - expected) <= tolerance:
             self.jumped = 0
             self.believed = value

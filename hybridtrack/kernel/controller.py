@@ -204,21 +204,24 @@ def _night_target(cfg, state, a):
 # -- the encoder monitor --------------------------------------------------------------------------
 
 @kernel
-def encoder_read(cfg, state, a, value, trust_blindly):
-    """EncoderMonitor.read: (reading, event code or 0, value, other, frozen)."""
+def encoder_read(cfg, state, a, value, reckoned):
+    """EncoderMonitor.read: (position, event code or 0, value, other, frozen)."""
     e = state.encoder
     previous = e[a, LAST]
     e[a, LAST] = value
-    if math.isnan(e[a, BELIEVED]) or trust_blindly:
+    if math.isnan(e[a, BELIEVED]):
         e[a, BELIEVED] = value
         return value, 0, 0.0, 0.0, False
     resolution = cfg.resolution[a]
     commanded = e[a, COMMANDED]
     expected = e[a, BELIEVED] + commanded
+    if reckoned:
+        e[a, BELIEVED] = expected
+        return expected, 0, 0.0, 0.0, False
     tolerance = 2.0 * resolution + 1e-9
     if commanded != 0.0 and abs(value - previous) < 0.5 * resolution and abs(commanded) > tolerance:
-        e[a, BELIEVED] = value
-        return value, ev.ENCODER_FROZEN, commanded, 0.0, True
+        e[a, BELIEVED] = expected
+        return expected, ev.ENCODER_FROZEN, commanded, 0.0, True
     if abs(value - expected) <= tolerance:
         state.jumped[a] = 0
         e[a, BELIEVED] = value
@@ -1113,9 +1116,9 @@ def _daylight(cfg, state, t, intensity):
 
 @kernel
 def _read_encoders(cfg, state, log, i, t, obs_axes, reading):
-    blind = state.k[MODE] == FAULT or state.k[BLIND_STOW] != 0
+    reckoned = state.k[MODE] == FAULT or state.k[BLIND_STOW] != 0
     for a in range(reading.shape[0]):
-        value, code, number, other, frozen = encoder_read(cfg, state, a, obs_axes[a, 0], blind)
+        value, code, number, other, frozen = encoder_read(cfg, state, a, obs_axes[a, 0], reckoned)
         if frozen and state.k[MODE] != FAULT:
             _switch(i, FAULT, code, number, t, state, log)
         elif code:
@@ -1223,6 +1226,7 @@ def _command(cfg, plan, state, awake_plan, i, t, dt, reading, valid, obs_axes, t
             limit = cfg.stow_speed[a] * dt
             step = max(-limit, min(limit, left))
             state.blind_stow[a] = left - step
+            state.encoder[a, COMMANDED] = step
             state.travel[a] += abs(step)
             state.moves[a] += 1 if step else 0
             targets[a] = cfg.stow[a]

@@ -16,7 +16,7 @@ __all__ = ["wording"]
  WIND_MISSING, WIND_HIGH, WIND_RELEASED, WIND_RELEASED_FROZEN, NEW_DAY_PROBE, NIGHT, WAKE, SENSOR_LOST, SKY_NOT_SUNNY,
  TRUE_SKY_NOT_SUNNY, SENSOR_TRUSTED, SKY_SUNNY, SUN_BACK, OUT_OF_FINE_VIEW, DISAGREEMENT, CLOCK_OFF,
  CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED, HELD_OFF, NIGHT_GAP) = range(1, 28)
-#: A flag added to the wind codes when the stow is a timed move from the last trusted reading.
+#: A flag added to the wind codes when the stow is a timed move from the reckoned position.
 BLIND = 100
 
 
@@ -75,7 +75,7 @@ def wording(config, plan_alarms: dict):
     def reason(code: int, value: float, other: float, scan: int, third: float = 0.0) -> str:
         if code >= BLIND:  # a wind stow from fault: a timed move
             return texts[code - BLIND](value, other, scan, third) + \
-                "; encoder judged frozen: timed stow move from the last trusted reading"
+                "; encoder judged frozen: timed stow move from the position reckoned from the moves commanded"
         return texts[code](value, other, scan, third)
 
     return reason
