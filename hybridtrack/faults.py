@@ -7,9 +7,12 @@ pattern after the fault began), how long that took, the worst true pointing erro
 undetected, the final mode, and every breach of the safety check:
 
 * the true angle stays within the hard stops and every target within the software limits;
-* a stow begins within one scan of every gust, in every mode;
+* a stow begins within one scan of every gust, in every mode, and of every wind reading that is
+  missing or no anemometer's (`hybridtrack.control.wind.READABLE`) unless the run tracks through
+  missing wind;
 * once stowed for wind, the collector does not move until the mode ends (a timed stow move with
-  the encoder judged frozen is allowed to finish);
+  the encoder judged frozen is allowed to finish), and stands at the true stow (the drive's, less
+  the encoder's zero error) within the deadband and a count;
 * no step is tracked on a sensor judged faulty (stuck, implausible or an invalid reading), and
   no step stays in sensor mode on a sensor invalid for longer than the allowed loss;
 * no tracking mode while the collector cannot move (the encoder judged frozen is ``fault``).
@@ -172,6 +175,8 @@ def _wind(kind, start="11:00"):
             wind[at] = 0.0
         elif kind == "offset":
             wind = np.clip(wind - 0.6, -0.04, None)  # a calm anemometer reading a little below zero
+        elif kind == "broken":
+            wind[_between(frame, start, start[:3] + "30")] = -5.0  # an open 4-20 mA loop: below any calm
         elif kind == "sunrise":
             wind[_between(frame, "05:10", "05:20")] = 21.0
         onset = {"sunrise": "05:10", "storm": "00:00"}.get(kind, start)
@@ -184,6 +189,13 @@ def _frozen_and_gust(site):
     wind = _calm(frame)
     wind[_between(frame, "14:00", "14:20")] = 29.0
     return frame.assign(wind_speed=wind), {"encoder_frozen": _between(frame, "12:00", "18:00")}, {}, "12:00"
+
+
+def _frozen_overnight_and_gust(site):
+    frame = _day(site)
+    wind = _calm(frame)
+    wind[_between(frame, "11:00", "11:20")] = 25.0
+    return frame.assign(wind_speed=wind), {"encoder_frozen": _between(frame, "05:00", "23:59")}, {}, "05:00"
 
 
 def _stuck_then_gust(site):
@@ -244,6 +256,8 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
     Scenario("encoder-frozen", "the encoder freezes 12:00-18:00", _mask("encoder_frozen", "12:00", "18:00"),
              r"encoder frozen"),
     Scenario("encoder-frozen-gust", "frozen encoder, then 29 m/s at 14:00", _frozen_and_gust, r"encoder frozen"),
+    Scenario("encoder-frozen-overnight-gust", "the encoder freezes at stow overnight, misses the first move, "
+             "then 25 m/s at 11:00", _frozen_overnight_and_gust, r"encoder frozen"),
     Scenario("clock-step-forward", "the clock jumps 10 min forward at noon", _clock("step", 600.0),
              r"clock stepped"),
     Scenario("clock-step-back", "the clock jumps 10 min back at noon", _clock("step", -600.0), r"clock stepped"),
@@ -256,6 +270,8 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
     Scenario("wind-hover", "wind hovering around the 17.2 m/s threshold from 11:00", _wind("hover"),
              r"wind .* m/s >"),
     Scenario("wind-nan", "the anemometer gives no number 11:00-11:30", _wind("nan"), r"wind reading missing"),
+    Scenario("wind-broken", "the anemometer reads -5 m/s 11:00-11:30 (an open signal loop)", _wind("broken"),
+             r"no wind \(an anemometer reads"),
     Scenario("wind-stuck", "the anemometer sticks at 0.0 from 11:00", _wind("stuck"), r"anemometer stuck"),
     Scenario("wind-negative-calm", "a calm anemometer reading -0.04 m/s at times (a zero offset)",
              _wind("offset"), None),
@@ -308,6 +324,7 @@ class ScenarioResult:
 
 def safety_breaches(result) -> list[str]:
     """Every way a run broke the shared safety check (empty: safe)."""
+    from .control.wind import READABLE
     from .world import HARD_STOP_MARGIN
 
     log, breaches = result.log, []
@@ -318,9 +335,11 @@ def safety_breaches(result) -> list[str]:
     if not log["target"].between(low - 1e-9, high + 1e-9).all():
         breaches.append("target beyond the limits")
     mode = log["mode"].astype(str).to_numpy()
-    gust = ~(log["wind_speed"].to_numpy(float) <= result.config.controller.wind_stow)
+    wind = log["wind_speed"].to_numpy(float)
+    missing = ~((wind >= READABLE[0]) & (wind <= READABLE[1]))  # NaN, or no anemometer's reading
+    gust = missing | (wind > result.config.controller.wind_stow)
     if result.config.controller.wind_missing == "track":
-        gust &= np.isfinite(log["wind_speed"].to_numpy(float))
+        gust &= ~missing
     late = gust & (mode != "stow_wind")
     if late.any():
         breaches.append(f"no stow at a gust ({log.index[np.flatnonzero(late)[0]]})")

@@ -48,3 +48,32 @@ def test_an_encoder_frozen_before_the_first_move_still_stows_for_a_gust(engine):
     true_stow = config.drive.stow - config.imperfections.encoder_offset
     stowed = log.loc[pd.Timestamp("2021-06-21 11:05", tz=TZ):pd.Timestamp("2021-06-21 11:20", tz=TZ), "angle"]
     assert np.allclose(stowed, true_stow, atol=config.drive.resolution)
+
+
+@pytest.mark.parametrize("reading", [-5.0, -np.inf, 1e300, np.inf])
+def test_an_anemometer_reading_no_anemometer_gives_stows_and_says_so(reading):
+    """A cup anemometer reads no less than its zero offset (a few tenths below 0 in calm air) and no
+    more than the strongest gust on record (113 m/s): -5 m/s is an open 4-20 mA loop, not calm, and
+    1e300 m/s no wind. Both are missing readings: stow (the live controller's policy), in the same
+    scan, with a reason that names the reading; -5 m/s and -inf had been tracked through as calm."""
+    frame = morning("09:00", "11:40")
+    wind = frame["wind_speed"].to_numpy().copy()
+    bad = at(frame, "11:00", "11:10")
+    wind[bad] = reading
+    result = simulate(frame.assign(wind_speed=wind), "lanzhou", config=SimulationConfig(engine="reference"))
+    assert not safety_breaches(result), safety_breaches(result)
+    modes = result.log["mode"].to_numpy()
+    assert (modes[bad] == "stow_wind").all()
+    stow = result.events[result.events["to"] == "stow_wind"]
+    assert len(stow) == 1 and stow["time"].iloc[0] == frame.index[bad][0]
+    assert stow["reason"].iloc[0] == (f"wind reading {reading:.3g} m/s is no wind (an anemometer reads -0.5 to 120 m/s): "
+                                      "the instrument or its signal failed; counted as missing")
+
+
+def test_a_calm_anemometers_zero_offset_is_calm():
+    """-0.4 m/s is within a working anemometer's zero offset: calm, no stow, no event."""
+    frame = morning("09:00", "11:40")
+    result = simulate(frame.assign(wind_speed=-0.4), "lanzhou", config=SimulationConfig(engine="reference"))
+    assert not safety_breaches(result)
+    assert not (result.log["mode"] == "stow_wind").any()
+    assert not result.events["reason"].str.contains("wind").any()

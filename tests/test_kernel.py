@@ -119,6 +119,19 @@ def test_fault_scenarios_run_the_same_compiled(name):
     assert_same_run(*scenario_runs(name))
 
 
+@pytest.mark.parametrize("reading", [-5.0, np.inf])
+def test_an_unreadable_wind_and_a_timed_stow_from_a_reckoned_position_run_the_same_compiled(mixed_day, reading):
+    """A wind reading no anemometer gives stows with its own reason; an encoder frozen overnight
+    misses the morning's first move, and a gust's timed stow is measured from where that move left it."""
+    n = len(mixed_day)
+    wind = np.clip(mixed_day["wind_speed"].to_numpy(), 0.0, 11.0)
+    wind[600:610] = reading
+    wind[700:720] = 25.0
+    frozen = (np.arange(n) >= 180) & (np.arange(n) < 1380)
+    assert_same_run(*both(mixed_day.assign(wind_speed=wind), "lanzhou", faults={"encoder_frozen": frozen}))
+    assert_same_run(*both(mixed_day.assign(wind_speed=wind), "lanzhou"))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(SCENARIOS))
 def test_every_fault_scenario_runs_the_same_compiled(name):

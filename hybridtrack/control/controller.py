@@ -29,7 +29,7 @@ from .observation import Observation
 from .plan import ControllerPlan
 from .sensing import SensorGate
 from .skywatch import ClassifierTable, SkyWatch
-from .wind import WindGuard
+from .wind import WindGuard, unreadable, unreadable_reason
 
 __all__ = ["Controller", "ControllerOutputs"]
 
@@ -311,7 +311,7 @@ class Controller:
             return [0.0] * self.axes
         if self.slept[i]:
             self._night_in_gap(i, t, dt)
-        self._day_and_wind(i, t, awake, gusty, wind)
+        self._day_and_wind(i, t, awake, gusty, wind, obs.wind)
         if self.was_awake and not awake:  # the day's end
             self._judge_clock(i)
         if awake and not self.was_awake:  # a new day: the residual offsets were the evening sky's
@@ -368,11 +368,16 @@ class Controller:
             reading.append(value)
         return reading
 
-    def _day_and_wind(self, i: int, t: float, awake: bool, gusty: bool, wind: float) -> None:
+    def _day_and_wind(self, i: int, t: float, awake: bool, gusty: bool, wind: float, read: float) -> None:
+        """The wind guard's stow and release, then the day's; `wind` as the guard counts the
+        anemometer's reading `read`."""
         mode, config = self.mode, self.config
         resume = SENSOR if config.sensor_only else ASTRONOMICAL
         if gusty and mode != STOW_WIND:  # wind first, from every mode
-            reason = "wind reading missing" if math.isnan(wind) else f"wind {wind:.1f} m/s > {config.wind_stow}"
+            if unreadable(read):
+                reason = unreadable_reason(read)
+            else:
+                reason = "wind reading missing" if math.isnan(wind) else f"wind {wind:.1f} m/s > {config.wind_stow}"
             if mode == FAULT:  # the encoder is not believed: a timed move from the reckoned position
                 self.blind_stow = [d.stow - m.believed for d, m in zip(self.drives, self.encoders)]
                 reason += "; encoder judged frozen: timed stow move from the position reckoned from the moves commanded"

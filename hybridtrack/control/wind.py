@@ -4,13 +4,31 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["WindGuard", "STUCK_HOURS", "STUCK_SPREAD"]
+__all__ = ["WindGuard", "STUCK_HOURS", "STUCK_SPREAD", "READABLE", "unreadable", "unreadable_reason"]
 
 #: Hours of daylight readings within `STUCK_SPREAD` of each other that mark an anemometer stuck:
 #: the wind by day moves more than that within minutes (a calm night may read 0 for hours).
 STUCK_HOURS = 3.0
 #: m/s: the spread a working cup anemometer's readings exceed within `STUCK_HOURS` of daylight.
 STUCK_SPREAD = 0.05
+#: m/s: the readings an anemometer can give. Below: a working one reads a few tenths below zero in
+#: calm air (its zero offset; the WMO asks ±0.5 m/s at low speeds, and the file reader clips as
+#: much to calm), so a lower reading is a failed instrument or signal (an open 4-20 mA loop reads
+#: below 4 mA, a negative speed), never calm: -5 m/s, or -inf, had been taken as calm and the
+#: collector tracked through whatever blew. Above: the strongest gust on record is 113 m/s
+#: (Barrow Island, 1996, WMO); 1e300 is no wind.
+READABLE = (-0.5, 120.0)
+
+
+def unreadable(wind: float) -> bool:
+    """Whether a reading is outside what an anemometer can give (`READABLE`); NaN is missing, not this."""
+    return wind < READABLE[0] or wind > READABLE[1]
+
+
+def unreadable_reason(wind: float) -> str:
+    """The stow's reason for a reading outside `READABLE`."""
+    return (f"wind reading {wind:.3g} m/s is no wind (an anemometer reads {READABLE[0]:g} to {READABLE[1]:g} m/s): "
+            "the instrument or its signal failed; counted as missing")
 
 
 class WindGuard:
@@ -19,7 +37,8 @@ class WindGuard:
     A reading that is not a number is missing wind data, never calm: with ``missing="stow"``
     (a live controller's default) it counts as a gust; with ``missing="track"`` (replaying a
     file that has no wind at all) it counts as no gust, and the run says the wind was missing.
-    A reading stuck within `STUCK_SPREAD` for `STUCK_HOURS` of daylight is missing too.
+    A reading outside what an anemometer reads (`READABLE`), or stuck within `STUCK_SPREAD` for
+    `STUCK_HOURS` of daylight, is missing too.
     """
 
     __slots__ = ("stow_above", "release_at", "hold", "calm_since", "stow_when_missing", "flat_value", "flat_since",
@@ -43,7 +62,7 @@ class WindGuard:
 
     def watch(self, t: float, wind: float, daylight: bool) -> str | None:
         """Watch for a stuck anemometer; return an alarm text when it sticks or comes back."""
-        if math.isnan(wind) or not daylight:
+        if math.isnan(wind) or unreadable(wind) or not daylight:
             self.flat_value = math.nan  # the flat spell must be daylight without a break
             return None
         if math.isnan(self.flat_value) or abs(wind - self.flat_value) > STUCK_SPREAD:
@@ -59,8 +78,9 @@ class WindGuard:
         return None
 
     def heard(self, wind: float) -> float:
-        """The reading as the guard counts it: NaN (missing) while the anemometer is stuck at it."""
-        if self.stuck and not math.isnan(wind) and abs(wind - self.flat_value) <= STUCK_SPREAD:
+        """The reading as the guard counts it: NaN (missing) outside `READABLE`, or while the
+        anemometer is stuck at it."""
+        if unreadable(wind) or self.stuck and not math.isnan(wind) and abs(wind - self.flat_value) <= STUCK_SPREAD:
             return math.nan
         return wind
 

@@ -41,7 +41,7 @@ from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGH
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
 from ..control.mountfit import HORIZON, LEVEL_READINGS, LIGHT_TOLERANCE, MAX_CONDITION
 from ..control.mountfit import spd_inverse as reference_spd_inverse  # compiled below
-from ..control.wind import STUCK_HOURS, STUCK_SPREAD
+from ..control.wind import READABLE, STUCK_HOURS, STUCK_SPREAD
 from . import events as ev
 from .jit import kernel
 
@@ -239,6 +239,15 @@ def encoder_read(cfg, state, a, value, reckoned):
 
 # -- the wind guard -------------------------------------------------------------------------------
 
+LEAST_WIND, MOST_WIND = READABLE
+
+
+@kernel
+def _unreadable(wind):
+    """wind.unreadable."""
+    return wind < LEAST_WIND or wind > MOST_WIND
+
+
 @kernel
 def _gusty(cfg, wind):
     if math.isnan(wind):
@@ -250,7 +259,7 @@ def _gusty(cfg, wind):
 def wind_watch(state, t, wind, daylight):
     """WindGuard.watch: (event code or 0, value)."""
     s, k = state.s, state.k
-    if math.isnan(wind) or not daylight:
+    if math.isnan(wind) or _unreadable(wind) or not daylight:
         s[FLAT_VALUE] = math.nan
         return 0, 0.0
     if math.isnan(s[FLAT_VALUE]) or abs(wind - s[FLAT_VALUE]) > STUCK_SPREAD:
@@ -268,8 +277,9 @@ def wind_watch(state, t, wind, daylight):
 
 @kernel
 def wind_heard(state, wind):
-    """WindGuard.heard: the reading, NaN while the anemometer is stuck at it."""
-    if state.k[WIND_STUCK] and not math.isnan(wind) and abs(wind - state.s[FLAT_VALUE]) <= STUCK_SPREAD:
+    """WindGuard.heard: the reading, NaN outside `READABLE` or while the anemometer is stuck at it."""
+    if _unreadable(wind) or state.k[WIND_STUCK] and not math.isnan(wind) \
+            and abs(wind - state.s[FLAT_VALUE]) <= STUCK_SPREAD:
         return math.nan
     return wind
 
@@ -1140,11 +1150,14 @@ def _night_in_gap(cfg, state, log, i, t, minutes):
 
 
 @kernel
-def _day_and_wind(cfg, state, log, i, t, awake, gusty, wind):
+def _day_and_wind(cfg, state, log, i, t, awake, gusty, wind, read):
     mode = state.k[MODE]
     resume = SENSOR if cfg.sensor_only else ASTRONOMICAL
     if gusty and mode != STOW_WIND:
-        code = ev.WIND_MISSING if math.isnan(wind) else ev.WIND_HIGH
+        if _unreadable(read):
+            code, wind = ev.WIND_UNREADABLE, read
+        else:
+            code = ev.WIND_MISSING if math.isnan(wind) else ev.WIND_HIGH
         if mode == FAULT:
             for a in range(state.blind_stow.shape[0]):
                 state.blind_stow[a] = cfg.stow[a] - state.encoder[a, BELIEVED]
@@ -1280,7 +1293,7 @@ def controller_step(cfg, plan, state, out, log, i, obs, obs_axes, moves, reading
         return
     if plan.slept[i]:
         _night_in_gap(cfg, state, log, i, t, dt)
-    _day_and_wind(cfg, state, log, i, t, awake, gusty, wind)
+    _day_and_wind(cfg, state, log, i, t, awake, gusty, wind, obs[1])
     if k[WAS_AWAKE] and not awake and cfg.has_fit:  # the day's end: judge the clock
         clock_verdict(cfg, state, log, i)
     if awake and not k[WAS_AWAKE]:  # a new day: the residual offsets were the evening sky's

@@ -8,14 +8,14 @@ mode, code, value, value, value); `wording` words it exactly as the reference co
 from __future__ import annotations
 
 from ..control.modes import SENSOR_STATUS, SKY_CODES
-from ..control.wind import STUCK_HOURS
+from ..control.wind import STUCK_HOURS, unreadable_reason
 
 __all__ = ["wording"]
 
 (PLAN_ALARM, CLOCK_STEPPED, ENCODER_FROZEN, ENCODER_BELIEVED, ENCODER_GLITCH, ANEMOMETER_MOVING, ANEMOMETER_STUCK,
  WIND_MISSING, WIND_HIGH, WIND_RELEASED, WIND_RELEASED_FROZEN, NEW_DAY_PROBE, NIGHT, WAKE, SENSOR_LOST, SKY_NOT_SUNNY,
  TRUE_SKY_NOT_SUNNY, SENSOR_TRUSTED, SKY_SUNNY, SUN_BACK, OUT_OF_FINE_VIEW, DISAGREEMENT, CLOCK_OFF,
- CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED, HELD_OFF, NIGHT_GAP) = range(1, 28)
+ CLOCK_DRIFTING, DISAGREEMENT_FOLLOWED, HELD_OFF, NIGHT_GAP, WIND_UNREADABLE) = range(1, 29)
 #: A flag added to the wind codes when the stow is a timed move from the reckoned position.
 BLIND = 100
 
@@ -40,6 +40,7 @@ def wording(config, plan_alarms: dict):
                                                       "daylight; its readings count as missing"),
         WIND_MISSING: lambda value, other, scan, third: "wind reading missing",
         WIND_HIGH: lambda value, other, scan, third: f"wind {value:.1f} m/s > {config.wind_stow}",
+        WIND_UNREADABLE: lambda value, other, scan, third: unreadable_reason(value),
         WIND_RELEASED: lambda value, other, scan, third: released,
         WIND_RELEASED_FROZEN: lambda value, other, scan, third: released + "; encoder still judged frozen: drive halted",
         NEW_DAY_PROBE: lambda value, other, scan, third: "a new day: probing the encoder again",
