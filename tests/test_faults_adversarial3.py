@@ -77,3 +77,20 @@ def test_a_calm_anemometers_zero_offset_is_calm():
     assert not safety_breaches(result)
     assert not (result.log["mode"] == "stow_wind").any()
     assert not result.events["reason"].str.contains("wind").any()
+
+
+def test_a_recorded_photocurrent_with_a_gap_leaves_the_mount_fit_whole():
+    """The hybrid-always policy trusts the sensor whatever the sky, so it fits the mount through a
+    gap in a recorded photocurrent, where the light in view (which weighs each fit reading) has no
+    number. The reading is taken at the least light the sensor sees the sun in: the mount fit
+    stays finite. The NaN had reached the fit's matrix and LAPACK's SVD failed mid-run
+    (numpy.linalg.LinAlgError)."""
+    frame = morning("09:00", "12:30")
+    config = SimulationConfig(engine="reference")
+    current = simulate(frame, "lanzhou", config=config).log["intensity_ma"].to_numpy().copy()
+    current[at(frame, "11:00", "11:30")] = np.nan
+    result = simulate(frame.assign(photocurrent=current), "lanzhou", strategy="hybrid-always", config=config)
+    assert not safety_breaches(result), safety_breaches(result)
+    fit = result.log.filter(like="fit_")
+    assert fit.notna().all().all() and np.isfinite(fit.to_numpy()).all()
+    assert (result.log.loc[at(frame, "11:00", "11:30"), "mode"] == "sensor").all()  # the pointing was valid

@@ -262,6 +262,13 @@ def test_a_recorded_photocurrent_and_a_frame_without_wind_or_diffuse_run_the_sam
         assert_same_run(*both(recorded, "lanzhou", config=config, strategy=strategy))
 
 
+def test_a_recorded_photocurrent_with_gaps_fits_the_mount_the_same_compiled(mixed_day):
+    """hybrid-always fits the mount through the gaps, each reading weighed as at the sun threshold."""
+    current = mixed_day.assign(photocurrent=simulate(mixed_day, "lanzhou").log["intensity_ma"].to_numpy())
+    current.iloc[600:660, current.columns.get_loc("photocurrent")] = np.nan
+    assert_same_run(*both(current, "lanzhou", strategy="hybrid-always"))
+
+
 @pytest.mark.parametrize("policy,distrust", [("sensor", "60min"), ("model", "25min")])
 def test_either_disagreement_policy_runs_the_same_compiled(policy, distrust):
     scenario = SCENARIOS["encoder-step"]

@@ -570,10 +570,15 @@ class Controller:
         `REFERENCE_LIGHT` in view, grown as the light falls, (σ · 1000 / L)², as the sensor's
         amplifier noise does against a smaller signal (`hybridtrack.sensor`). L is the light the
         cells see, from the photocurrent above dark over the `responsivity`, at least the sensor's
-        sun threshold (below it the sensor reports no sun). Without a responsivity, σ² as stated."""
+        sun threshold (below it the sensor reports no sun), and the threshold where the photocurrent
+        has no number (a recorded one with a gap): the sensor said it saw the sun, so its reading
+        is taken as no better than at the least light it sees it in. A NaN here had made the mount
+        fit's matrix NaN, and LAPACK's SVD failed mid-run. Without a responsivity, σ² as stated."""
         if self.responsivity is None:
             return self.fit.r
-        light = max((self.out["intensity"][i] - self.sky.dark) / self.responsivity, self.sun_threshold)
+        light = (self.out["intensity"][i] - self.sky.dark) / self.responsivity
+        if not light >= self.sun_threshold:  # NaN too
+            light = self.sun_threshold
         ratio = REFERENCE_LIGHT / light
         return self.fit.r * ratio * ratio  # not ** 2: libm's pow and a product may differ in the last bit
 

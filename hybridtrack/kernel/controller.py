@@ -787,7 +787,9 @@ def _reading_variance(cfg, intensity):
     stated where the responsivity is not known, 0 here)."""
     if cfg.responsivity <= 0.0:
         return cfg.fit_r
-    light = max((intensity - cfg.dark) / cfg.responsivity, cfg.sun_threshold)
+    light = (intensity - cfg.dark) / cfg.responsivity
+    if not light >= cfg.sun_threshold:  # NaN too
+        light = cfg.sun_threshold
     ratio = REFERENCE_LIGHT / light
     return cfg.fit_r * ratio * ratio
 
