@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 __all__ = ["WindGuard", "STUCK_HOURS", "STUCK_SPREAD", "READABLE", "unreadable", "unreadable_reason"]
 
 #: Hours of daylight readings within `STUCK_SPREAD` of each other that mark an anemometer stuck:
@@ -76,6 +78,14 @@ class WindGuard:
             return (f"anemometer stuck at {self.flat_value:.2f} m/s for {STUCK_HOURS:g} h of daylight; "
                     "its readings count as missing")
         return None
+
+    def gusts(self, readings: np.ndarray) -> np.ndarray:
+        """Per reading, whether `update` takes it for a gust once `heard`, a stuck spell aside
+        (which needs daylight): the scans a night asleep in bulk must not pass over."""
+        readings = np.asarray(readings, float)
+        with np.errstate(invalid="ignore"):
+            missing = np.isnan(readings) | (readings < READABLE[0]) | (readings > READABLE[1])
+            return np.where(missing, self.stow_when_missing, readings > self.stow_above)
 
     def heard(self, wind: float) -> float:
         """The reading as the guard counts it: NaN (missing) outside `READABLE`, or while the

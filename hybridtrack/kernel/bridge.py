@@ -259,9 +259,7 @@ def run_compiled(world: World, controller: Controller, progress, bulk_nights: bo
     state = _state(controller, arrays.minutes)
     out = _record(n, axes, len(state.theta))
     events = _events(1024 + EVENTS_PER_SCAN)
-    guard = controller.wind
-    gusts = (world.wind > guard.stow_above) | (np.isnan(world.wind) & guard.stow_when_missing)
-    wind_ok = np.concatenate([[0], np.cumsum(gusts)])
+    wind_ok = np.concatenate([[0], np.cumsum(controller.wind.gusts(world.wind))])
     obs, obs_axes, moves = np.zeros(5), np.zeros((axes, 3)), np.zeros(axes)
     i = 0
     while i < n and not (stop is not None and stop.is_set()):
