@@ -6,7 +6,8 @@ reports whether the controller detected it (the first event whose reason matches
 pattern after the fault began), how long that took, the worst true pointing error while it was
 undetected, the final mode, and every breach of the safety check:
 
-* the true angle stays within the hard stops and every target within the software limits;
+* the true angle stays short of the hard stops (the world holds an axis driven into one there)
+  and every target within the software limits;
 * a stow begins within one scan of every gust, in every mode, and of every wind reading that is
   missing or no anemometer's (`hybridtrack.control.wind.READABLE`) unless the run tracks through
   missing wind;
@@ -330,8 +331,10 @@ def safety_breaches(result) -> list[str]:
     log, breaches = result.log, []
     single = result.collector.single_axis
     low, high = result.config.drive.limits if single else (0.0, 90.0)
-    if not log["angle"].between(low - HARD_STOP_MARGIN - 1e-9, high + HARD_STOP_MARGIN + 1e-9).all():
-        breaches.append("angle beyond the hard stops")
+    stops = log["angle"].to_numpy(float)  # the world holds the axis at its hard stop: a collector driven into it
+    hit = ~((stops > low - HARD_STOP_MARGIN + 1e-9) & (stops < high + HARD_STOP_MARGIN - 1e-9))
+    if hit.any():
+        breaches.append(f"driven into a hard stop ({log.index[np.flatnonzero(hit)[0]]})")
     if not log["target"].between(low - 1e-9, high + 1e-9).all():
         breaches.append("target beyond the limits")
     mode = log["mode"].astype(str).to_numpy()

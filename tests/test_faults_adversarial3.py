@@ -152,3 +152,17 @@ def test_a_wind_reading_no_anemometer_gives_stows_a_night_asleep_in_bulk(engine)
     wind[at(frame, "05:10", "05:11")] = -5.0
     result = simulate(frame.assign(wind_speed=wind), "lanzhou", config=SimulationConfig(engine=engine))
     assert result.log["mode"].iloc[frame.index.get_loc(pd.Timestamp("2021-06-21 05:10", tz=TZ))] == "stow_wind"
+
+
+def test_an_encoder_reading_more_than_the_stop_margin_drives_the_axis_into_its_hard_stop_and_the_check_says_so():
+    """The software limits are in encoder terms; the hard stops lie 1° beyond them. An encoder that
+    reads 3° more than the axis (a slipped coupling, or a slow creep over a night) sends the
+    morning's first target, the 0° limit, to -3.26° true: the axis meets its stop at -1° and stays
+    there, which the controller takes for a frozen encoder. A limit of one encoder (docs/robustness.md);
+    the safety check names it: a world that holds the axis at its stop had passed it as 'within the stops'."""
+    frame = morning("04:00", "06:30")
+    result = simulate(frame, "lanzhou", config=SimulationConfig(engine="reference"),
+                      faults={"encoder": np.where(at(frame, "04:30", "23:00"), 3.0, 0.0)})
+    assert result.log["angle"].min() == pytest.approx(-1.0)
+    assert safety_breaches(result) == ["driven into a hard stop (2021-06-21 05:27:00+08:00)"]
+    assert result.events["reason"].str.startswith("encoder frozen").any()
