@@ -30,3 +30,12 @@ def test_list_refuses_what_only_run_takes(extra, named, capsys):
     assert main(["faults", "list", *extra]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"{named} with faults run, not faults list" in err
+
+
+def test_the_list_sets_every_description_apart_from_its_name_in_one_column(capsys):
+    from hybridtrack.faults import SCENARIOS
+
+    assert main(["faults", "list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    starts = {line.index(scenario.description) for line, scenario in zip(lines, SCENARIOS.values())}
+    assert len(starts) == 1 and all(line.startswith(name + "  ") for line, name in zip(lines, SCENARIOS))

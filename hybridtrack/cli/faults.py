@@ -28,8 +28,9 @@ def _faults(args: argparse.Namespace) -> int:
         if given:  # they had been dropped without a word
             raise HybridtrackError(f"{' and '.join(given)} {'goes' if len(given) == 1 else 'go'} with faults run, "
                                    "not faults list")
+        width = max(map(len, SCENARIOS))  # 'encoder-frozen-overnight-gust' had run into its description
         for scenario in SCENARIOS.values():
-            print(f"{scenario.name:24s} {scenario.description}")
+            print(f"{scenario.name:{width}s}  {scenario.description}")
         return 0
     if not args.name:
         raise HybridtrackError("faults run needs a scenario's name, or 'all'")
