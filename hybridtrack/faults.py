@@ -15,7 +15,8 @@ undetected, the final mode, and every breach of the safety check:
   the encoder judged frozen is allowed to finish), and stands at the true stow (the drive's, less
   the encoder's zero error) within the deadband and a count;
 * no step is tracked on a sensor judged faulty (stuck, implausible or an invalid reading), and
-  no step stays in sensor mode on a sensor invalid for longer than the allowed loss;
+  no step stays in sensor mode on a sensor invalid for longer than the allowed loss (but for the
+  sensor-only tracker, which has no computed sun to hand over to and holds where it is);
 * no tracking mode while the collector cannot move (the encoder judged frozen is ``fault``).
 
 ``hybridtrack faults list`` and ``hybridtrack faults run NAME`` are the command line.
@@ -362,6 +363,8 @@ def safety_breaches(result) -> list[str]:
     faulty_tracked = (mode == "sensor") & np.isin(status, FAULTY) & np.roll(np.isin(status, FAULTY), 1)
     if faulty_tracked.any():
         breaches.append(f"tracked a sensor judged faulty ({log.index[np.flatnonzero(faulty_tracked)[0]]})")
+    if result.config.controller.sensor_only:  # no computed sun to hand over to: it holds, by design
+        return breaches
     loss = int(result.config.controller.minutes("sensor_loss"))
     run = 0
     invalid = np.isin(status, INVALID)
