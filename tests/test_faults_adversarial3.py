@@ -179,3 +179,15 @@ def test_the_safety_check_lets_the_sensor_only_tracker_hold_through_a_low_sun():
     held = (log["mode"] == "sensor") & (log["sensor_status"] == "low light")
     assert held.sum() > 4  # past the 3-min loss time: what the hybrid would be held to
     assert not safety_breaches(result)
+
+
+def test_a_heliostats_encoder_events_name_their_axis():
+    """A heliostat's two encoders had given the same text ("encoder frozen: commanded -30.00°" twice):
+    each event now names its axis; a single-axis collector's text is as before."""
+    frame = synthetic("delingha", "2021-06-21", weather="sunny", seed=1)
+    frame = frame.loc[pd.Timestamp("2021-06-21 04:00", tz=TZ):pd.Timestamp("2021-06-21 07:00", tz=TZ)]
+    frozen = np.asarray(frame.index >= pd.Timestamp("2021-06-21 05:00", tz=TZ))
+    result = simulate(frame, "delingha", collector="heliostat", config=SimulationConfig(engine="reference"),
+                      faults={"encoder_frozen": frozen})
+    reasons = [r for r in result.events["reason"] if "encoder frozen" in r]
+    assert [r.split(":")[0] for r in reasons] == ["azimuth encoder frozen", "elevation encoder frozen"]

@@ -21,7 +21,7 @@ from .calibration import Calibrator
 from .clockwatch import ClockWatch
 from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
-from .encoder import EncoderMonitor
+from .encoder import AXIS_NAMES, EncoderMonitor
 from .mountfit import MountEstimator, ordered_dot, pull_spread
 from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR,
                     SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
@@ -133,7 +133,8 @@ class Controller:
         self.plan_alarms = plan.alarms
         resolution = [d.resolution for d in drives]
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
-        self.encoders = [EncoderMonitor(r, config.encoder_confirm) for r in resolution]
+        self.encoders = [EncoderMonitor(r, config.encoder_confirm, name)
+                         for r, name in zip(resolution, AXIS_NAMES[self.axes])]
         self.wind = WindGuard(config.wind_stow, config.wind_release, config.minutes("wind_hold"), config.wind_missing)
         self.sky = SkyWatch(ClassifierTable(classifier), sky_inputs, dark_current)
         variance = [config.sensor_noise**2 + r * r / 12.0 for r in resolution]

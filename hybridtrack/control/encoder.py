@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["EncoderMonitor"]
+__all__ = ["EncoderMonitor", "AXIS_NAMES"]
+
+#: What an encoder's events call it, by the collector's number of axes: a heliostat's two encoders
+#: had given the same text, and a field engineer could not tell which had frozen.
+AXIS_NAMES = {1: ("",), 2: ("azimuth ", "elevation ")}
 
 
 class EncoderMonitor:
@@ -19,9 +23,10 @@ class EncoderMonitor:
     frozen on its first move of the morning (30° off stow) where it stood through a gale.
     """
 
-    __slots__ = ("resolution", "confirm", "believed", "last", "jumped", "commanded")
+    __slots__ = ("resolution", "confirm", "believed", "last", "jumped", "commanded", "name")
 
-    def __init__(self, resolution: float, confirm: int):
+    def __init__(self, resolution: float, confirm: int, name: str = ""):
+        self.name = name  # "", or the axis and a space (`AXIS_NAMES`)
         self.resolution = resolution
         self.confirm = confirm
         self.believed = math.nan
@@ -43,7 +48,7 @@ class EncoderMonitor:
         tolerance = 2.0 * self.resolution + 1e-9
         if self.commanded and abs(value - previous) < 0.5 * self.resolution and abs(self.commanded) > tolerance:
             self.believed = expected
-            return expected, f"encoder frozen: commanded {self.commanded:+.2f}°, reading unchanged; drive halted", True
+            return expected, f"{self.name}encoder frozen: commanded {self.commanded:+.2f}°, reading unchanged; drive halted", True
         if abs(value - expected) <= tolerance:
             self.jumped = 0
             self.believed = value
@@ -52,7 +57,7 @@ class EncoderMonitor:
         if self.jumped >= self.confirm:
             self.jumped = 0
             self.believed = value
-            return value, f"encoder reading {value:.3f}° held for {self.confirm} scans; believed", False
+            return value, f"{self.name}encoder reading {value:.3f}° held for {self.confirm} scans; believed", False
         self.believed = expected
-        note = f"encoder glitch: read {value:.3f}°, expected {expected:.3f}°; ignored" if self.jumped == 1 else None
+        note = f"{self.name}encoder glitch: read {value:.3f}°, expected {expected:.3f}°; ignored" if self.jumped == 1 else None
         return expected, note, False

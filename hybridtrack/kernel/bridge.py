@@ -211,7 +211,7 @@ def _grown(events: kc.EventLog) -> kc.EventLog:
 
 
 def _worded(controller: Controller, events: kc.EventLog, count: int) -> list:
-    worded, reason = [], wording(controller.config, controller.plan_alarms)
+    worded, reason = [], wording(controller.config, controller.plan_alarms, controller.axes)
     for i, before, after, code, (value, other, third) in zip(events.scan[:count].tolist(), events.before[:count].tolist(),
                                                      events.after[:count].tolist(), events.code[:count].tolist(),
                                                      events.value[:count].tolist()):

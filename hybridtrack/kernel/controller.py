@@ -1133,8 +1133,9 @@ def _read_encoders(cfg, state, log, i, t, obs_axes, reading):
         value, code, number, other, frozen = encoder_read(cfg, state, a, obs_axes[a, 0], reckoned)
         if frozen and state.k[MODE] != FAULT:
             _switch(i, FAULT, code, number, t, state, log)
+            log.value[state.k[EVENTS] - 1, 2] = a  # the axis, for its name
         elif code:
-            _alarm(i, code, number, other, state, log)
+            _alarm3(i, code, number, other, float(a), state, log)
         reading[a] = value
 
 

@@ -7,6 +7,7 @@ mode, code, value, value, value); `wording` words it exactly as the reference co
 
 from __future__ import annotations
 
+from ..control.encoder import AXIS_NAMES
 from ..control.modes import SENSOR_STATUS, SKY_CODES
 from ..control.wind import STUCK_HOURS, unreadable_reason
 
@@ -20,9 +21,11 @@ __all__ = ["wording"]
 BLIND = 100
 
 
-def wording(config, plan_alarms: dict):
+def wording(config, plan_alarms: dict, axes: int):
     """`reason(code, value, other, scan, third)`: the reference controller's text for an event, for a
-    run of controller `config` whose plan raised `plan_alarms` (by scan)."""
+    run of controller `config` on `axes` axes whose plan raised `plan_alarms` (by scan); an
+    encoder's events carry its axis in `third`."""
+    names = AXIS_NAMES[axes]
     distrust = config.minutes("distrust")
     released = f"wind at or below {config.wind_release} m/s for {config.wind_hold}"
     texts = {
@@ -30,11 +33,11 @@ def wording(config, plan_alarms: dict):
         CLOCK_STEPPED: lambda value, other, scan, third:
             f"controller clock stepped by {value:+.0f} s against the scan timer; clock re-based",
         ENCODER_FROZEN: lambda value, other, scan, third:
-            f"encoder frozen: commanded {value:+.2f}°, reading unchanged; drive halted",
+            f"{names[int(third)]}encoder frozen: commanded {value:+.2f}°, reading unchanged; drive halted",
         ENCODER_BELIEVED: lambda value, other, scan, third:
-            f"encoder reading {value:.3f}° held for {int(other)} scans; believed",
+            f"{names[int(third)]}encoder reading {value:.3f}° held for {int(other)} scans; believed",
         ENCODER_GLITCH: lambda value, other, scan, third:
-            f"encoder glitch: read {value:.3f}°, expected {other:.3f}°; ignored",
+            f"{names[int(third)]}encoder glitch: read {value:.3f}°, expected {other:.3f}°; ignored",
         ANEMOMETER_MOVING: lambda value, other, scan, third: f"anemometer moving again ({value:.1f} m/s)",
         ANEMOMETER_STUCK: lambda value, other, scan, third: (f"anemometer stuck at {value:.2f} m/s for {STUCK_HOURS:g} h of "
                                                       "daylight; its readings count as missing"),
