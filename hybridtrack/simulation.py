@@ -921,8 +921,7 @@ def _run(world: World, controller: Controller, progress, bulk_nights: bool) -> N
     n = world.n
     obs = Observation(world.axes)
     guard = controller.wind
-    gusts = (world.wind > guard.stow_above) | (np.isnan(world.wind) & guard.stow_when_missing)
-    wind_ok = np.concatenate([[0], np.cumsum(gusts)])
+    wind_ok = np.concatenate([[0], np.cumsum(guard.gusts(world.wind))])  # the kernel's mask (`bridge`)
     i = reported = 0
     while i < n:
         if progress is not None and i - reported >= 8192:

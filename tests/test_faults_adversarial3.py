@@ -140,9 +140,7 @@ def test_a_wind_reading_gone_bad_stows_from_every_mode_in_the_same_scan(mode, re
 
 
 @pytest.mark.parametrize("engine", [
-    pytest.param("reference", marks=pytest.mark.xfail(strict=True, reason=(
-        "simulation._run counts a night's gusts as wind > stow or NaN, not by WindGuard.gusts: a reading "
-        "no anemometer gives is passed over in a night asleep in bulk"))),
+    "reference",
     pytest.param("compiled", marks=pytest.mark.slow)])
 def test_a_wind_reading_no_anemometer_gives_stows_a_night_asleep_in_bulk(engine):
     """A night asleep in bulk passes over its scans only where no reading demands a stow: -5 m/s
