@@ -326,7 +326,7 @@ class ScenarioResult:
 
 def safety_breaches(result) -> list[str]:
     """Every way a run broke the shared safety check (empty: safe)."""
-    from .control.wind import READABLE
+    from .control.wind import WindGuard
     from .world import HARD_STOP_MARGIN
 
     log, breaches = result.log, []
@@ -339,12 +339,10 @@ def safety_breaches(result) -> list[str]:
     if not log["target"].between(low - 1e-9, high + 1e-9).all():
         breaches.append("target beyond the limits")
     mode = log["mode"].astype(str).to_numpy()
-    wind = log["wind_speed"].to_numpy(float)
-    missing = ~((wind >= READABLE[0]) & (wind <= READABLE[1]))  # NaN, or no anemometer's reading
-    gust = missing | (wind > result.config.controller.wind_stow)
-    if result.config.controller.wind_missing == "track":
-        gust &= ~missing
-    late = gust & (mode != "stow_wind")
+    controller = result.config.controller  # a gust as the wind guard judges one: missing or unreadable wind too
+    guard = WindGuard(controller.wind_stow, controller.wind_release, controller.minutes("wind_hold"),
+                      controller.wind_missing)
+    late = guard.gusts(log["wind_speed"].to_numpy(float)) & (mode != "stow_wind")
     if late.any():
         breaches.append(f"no stow at a gust ({log.index[np.flatnonzero(late)[0]]})")
     angle = log["angle"].to_numpy()
