@@ -628,10 +628,7 @@ def fit_update(theta, p, information, evidence, r, clip, frozen, derivatives, we
         evidence[i] = evidence[i] + derivatives[i] * weight * residual / r
     gain = np.empty(n)
     for m in range(n):
-        total = p[m, 0] * (derivatives[0] * weight)
-        for k in range(1, n):
-            total = total + p[m, k] * (derivatives[k] * weight)
-        gain[m] = total
+        gain[m] = _row_dot(derivatives, weight, p[m])  # P·row, before it is scaled to the gain
     s = r + _row_dot(derivatives, weight, gain)
     for m in range(n):
         gain[m] = 0.0 if frozen and m < 2 else gain[m] / s
