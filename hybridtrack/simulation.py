@@ -942,6 +942,9 @@ def _run(world: World, controller: Controller, progress, bulk_nights: bool) -> N
 
 
 def _check_faults(faults: dict, n: int, axes: int) -> dict:
+    if not isinstance(faults, Mapping):
+        raise HybridtrackError(f"faults must be a dict of fault name to values per step (see FAULTS), "
+                               f"got {type(faults).__name__}")
     unknown = sorted(set(faults) - set(FAULTS))
     if unknown:
         raise HybridtrackError(f"unknown fault {unknown[0]!r}; known: {', '.join(FAULTS)}")
@@ -957,16 +960,21 @@ def _check_faults(faults: dict, n: int, axes: int) -> dict:
 
 
 def _fault_array(faults: dict, name: str, kind) -> np.ndarray:
-    """A fault's values as an array of `kind`, refused unless they are numbers (True/False for a
-    mask: not text, not NaN, which `bool` would read as True)."""
+    """A fault's values as an array of `kind`, refused unless they are real numbers (not text,
+    complex numbers or durations) and, for a mask, True/False or 0/1 (not NaN or 0.5, which `bool`
+    would read as True)."""
     values = np.asarray(faults[name])
+    real = values.dtype == bool or (np.issubdtype(values.dtype, np.number)
+                                    and not np.issubdtype(values.dtype, np.complexfloating)
+                                    and not np.issubdtype(values.dtype, np.timedelta64))
     if kind is bool:
-        if values.dtype != bool and not (np.issubdtype(values.dtype, np.number) and np.isfinite(values).all()):
-            raise HybridtrackError(f"fault {name!r} needs True/False per step, got dtype {values.dtype}"
-                                   f"{' with NaN' if np.issubdtype(values.dtype, np.floating) else ''}")
+        if not real or (values.dtype != bool and not np.isin(values, (0, 1)).all()):
+            nan = real and np.issubdtype(values.dtype, np.floating) and np.isnan(values).any()
+            raise HybridtrackError(f"fault {name!r} needs True/False (or 1/0) per step, got dtype {values.dtype}"
+                                   f"{' with NaN' if nan else ''}")
         return values.astype(bool)
-    if not (np.issubdtype(values.dtype, np.number) or values.dtype == bool):
-        raise HybridtrackError(f"fault {name!r} needs numbers, got dtype {values.dtype}")
+    if not real:
+        raise HybridtrackError(f"fault {name!r} needs real numbers, got dtype {values.dtype}")
     values = values.astype(float)
     beyond = np.argwhere(np.abs(values) > FAULT_LIMITS[name])  # inf too; NaN is "no fault here"
     if len(beyond):

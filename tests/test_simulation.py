@@ -363,10 +363,19 @@ def test_bad_frames_are_refused(frame, message):
 @pytest.mark.parametrize("change, message", [
     (lambda f, n: dict(faults={"clock": np.full(n, np.inf)}), r"fault 'clock' at step 0: inf is beyond ±3\.1536e\+07"),
     (lambda f, n: dict(faults={"clock": np.full(n, 1e12)}), "fault 'clock' at step 0: 1e\\+12 is beyond"),
-    (lambda f, n: dict(faults={"sensor_drift": ["a"] * n}), "fault 'sensor_drift' needs numbers"),
-    (lambda f, n: dict(faults={"sensor_dropout": ["no"] * n}), "fault 'sensor_dropout' needs True/False per step"),
-    (lambda f, n: dict(faults={"sensor_dropout": np.full(n, np.nan)}), "needs True/False per step, got dtype float64 "
-                                                                        "with NaN"),  # bool(nan) is True: dropout on
+    (lambda f, n: dict(faults={"sensor_drift": ["a"] * n}), "fault 'sensor_drift' needs real numbers"),
+    (lambda f, n: dict(faults={"sensor_dropout": ["no"] * n}), r"fault 'sensor_dropout' needs True/False \(or 1/0\)"),
+    (lambda f, n: dict(faults={"sensor_dropout": np.full(n, np.nan)}), r"needs True/False \(or 1/0\) per step, got "
+                                                                        "dtype float64 with NaN"),  # bool(nan) is True
+    # each was read as something else: a list of faults raised a TypeError, 0.5 was a dropout, a
+    # complex drift lost its imaginary part with a ComplexWarning, a duration was read as a number
+    (lambda f, n: dict(faults=[("sensor_drift", np.zeros(n))]), "faults must be a dict of fault name to values"),
+    (lambda f, n: dict(faults={"sensor_dropout": np.full(n, 0.5)}), r"'sensor_dropout' needs True/False \(or 1/0\)"),
+    (lambda f, n: dict(faults={"sensor_drift": np.full(n, 1 + 2j)}), "'sensor_drift' needs real numbers, got dtype "
+                                                                      "complex128"),
+    (lambda f, n: dict(faults={"clock": np.full(n, np.timedelta64(5, "s"))}), "'clock' needs real numbers, got dtype "
+                                                                              "timedelta64"),
+    (lambda f, n: dict(faults={"encoder_frozen": np.full(n, 1 + 0j)}), "'encoder_frozen' needs True/False"),
     (lambda f, n: dict(config={"seed": 1}), "config must be a SimulationConfig"),
     (lambda f, n: dict(frame=f.assign(dni=f["dni"].astype(object).where(f.index != f.index[100], "abc"))),
      "column 'dni' must hold numbers"),
