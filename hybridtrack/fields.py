@@ -422,7 +422,8 @@ class HeliostatField:
         given = _aims_by_name(self.aims)
         if self.aim is not None and self.aims is not None and not _aim_of(self.aim, given):
             raise HybridtrackError("heliostat field: give aim (one point for every heliostat) or aims (one each), "
-                                   "not both")
+                                   "not both; a field's aim is its aims' mean, so to give a field new aims with "
+                                   "dataclasses.replace, give aim=None beside them")
         if self.aims is None:
             aim = _as_numbers(DEFAULT_AIM if self.aim is None else self.aim)
             if aim is None or aim.shape != (3,):

@@ -106,6 +106,12 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
     own = HeliostatField(positions=[[0, -100], [80, -60]], aims=[[0, 0, 100], [3, 0, 95]])
     with pytest.raises(HybridtrackError, match="not both"):  # which of the two would be used?
         dataclasses.replace(own, aim=(0.0, 0.0, 80.0))
+    # new aims for a field: its aim is the old aims' mean, so the refusal says to give aim=None
+    with pytest.raises(HybridtrackError, match="give aim=None beside them"):
+        dataclasses.replace(own, aims=[[0, 0, 90], [2, 0, 90]])
+    spread = dataclasses.replace(field, aim=None, aims=[[0, 0, 90], [2, 0, 90]])
+    assert spread.aim == (1.0, 0.0, 90.0)  # their mean, by hand
+    np.testing.assert_array_equal(spread.relative_aims, [[0, 100, 90], [-78, 60, 90]])
 
 
 @pytest.mark.parametrize("make, message", [
