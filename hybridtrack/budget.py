@@ -21,7 +21,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["BYTES_PER_STEP", "MAX_BUDGET", "available_memory", "memory_budget", "check_steps"]
+__all__ = ["BYTES_PER_STEP", "MAX_BUDGET", "available_memory", "memory_budget", "check_steps", "readable_size"]
 
 #: Peak bytes one step of a run takes (measured; see the module's notes).
 BYTES_PER_STEP = 2_000
@@ -53,7 +53,8 @@ def memory_budget() -> int:
     return int(min(BUDGET_SHARE * available_memory(), MAX_BUDGET))
 
 
-def _gigabytes(size: float) -> str:
+def readable_size(size: float) -> str:
+    """Bytes as a person reads them: GB from 100 MB, MB from 1 MB, kB below."""
     if size >= 1e8:
         return f"{size / 1e9:,.1f} GB"
     return f"{size / 1e6:,.0f} MB" if size >= 1e6 else f"{size / 1e3:,.0f} kB"
@@ -106,5 +107,5 @@ def check_steps(first, last, step, *, bytes_per_step: int = BYTES_PER_STEP, what
         streamed = ("; or stream it to disk a day at a time, in bounded memory (hybridtrack simulate --stream, "
                     "hybridtrack.streaming.stream)")
     raise HybridtrackError(f"{what}: {steps:,} steps of {duration(step)} would need about "
-                           f"{_gigabytes(steps * per_step)} of memory, over the {_gigabytes(budget)} a run may use; "
+                           f"{readable_size(steps * per_step)} of memory, over the {readable_size(budget)} a run may use; "
                            f"use {coarser} or a span of {at_most} at this step{streamed}")

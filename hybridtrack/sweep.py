@@ -556,7 +556,9 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         Address of a running Dask scheduler (``tcp://host:8786``); by default a local cluster.
     workers : int, optional
         Worker processes of the local cluster, one thread each; the machine's cores by default.
-        Never more than the sweep has runs.
+        Never more than the sweep has runs, nor (by default) than can hold the sweep's longest
+        run each at once in the memory budget (`hybridtrack.budget`); more than that, asked for,
+        is refused.
     progress : bool
         A progress bar over runs on stderr.
     started : callable, optional
@@ -572,7 +574,8 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     runs = sweep.runs()
     check_where(scheduler, workers)
     if scheduler is None:  # a local cluster starts no worker without a run to do (64 for 2 runs had)
-        workers = min(cores() if workers is None else workers, len(runs))
+        workers = _workers_that_fit(sweep, runs, min(cores() if workers is None else workers, len(runs)),
+                                    chosen=workers is not None)
     client, cluster = dask_client(scheduler, workers, what="sweeps")
     rows = []
     stop = None
@@ -661,6 +664,30 @@ def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:
             keep.append(index)
             best = value
     return ok.loc[keep]
+
+
+def _workers_that_fit(sweep: Sweep, runs: list[dict], workers: int, *, chosen: bool) -> int:
+    """The local cluster's workers whose runs fit in memory together: each worker holds one run
+    at a time, so `workers` of the sweep's longest run must fit the memory budget at once (each
+    run alone is checked as it is read). Fewer than `workers` where the default does not fit;
+    refused, naming the longest run, where the user `chosen` them."""
+    from .budget import BYTES_PER_STEP, readable_size, memory_budget
+    from .times import parse_freq
+
+    def steps(run: dict) -> tuple[int, int, str]:
+        spec = _spec(sweep.base, run)
+        days, freq = _whole_days(spec["days"]), _step(spec["freq"])
+        return days * pd.Timedelta(days=1) // parse_freq(freq), days, freq
+
+    count, days, freq = max(steps(run) for run in runs)
+    size, budget = count * BYTES_PER_STEP, memory_budget()
+    fitting = max(1, min(workers, budget // max(size, 1)))
+    if chosen and fitting < workers:
+        raise HybridtrackError(f"{workers} workers would each hold a run of up to {days} days at {freq} "
+                               f"(about {readable_size(size)}), {readable_size(size * workers)} together, over the "
+                               f"{readable_size(budget)} the runs may use; {fitting} fit: use --workers {fitting} "
+                               "(workers= from Python)")
+    return fitting
 
 
 def _check_columns(table, names: list, what: str, *, numbers: bool = False) -> None:

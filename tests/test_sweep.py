@@ -746,3 +746,23 @@ def test_a_sweep_without_a_point_to_plot_says_so_not_pandas_empty_frame(tmp_path
     printed = capsys.readouterr().out
     assert "Empty DataFrame" not in printed and "Index: []" not in printed
     assert "Pareto front of moves against rms: no run has both (2 runs failed)\n" in printed
+
+
+def test_a_local_cluster_takes_no_more_workers_than_the_longest_runs_fit_in_memory(monkeypatch):
+    """Each run was checked against the memory budget alone, so two workers could each hold a run
+    that fit only once. Here a 1-minute day is 1,440 steps of `BYTES_PER_STEP` (2.9 MB) and a
+    2-day run 5.8 MB; the budget is set to 12 MB, which holds two of the longest but not three."""
+    import hybridtrack.budget as budget
+    import hybridtrack.sweep as sweeps
+
+    monkeypatch.setattr(budget, "memory_budget", lambda: 12_000_000)
+    sweep = Sweep.from_dict({"base": {"freq": "1min"}, "grid": {"days": [1, 2], "seed": [0, 1, 2]}})
+    runs = sweep.runs()
+    assert 2 * 2880 * budget.BYTES_PER_STEP <= 12_000_000 < 3 * 2880 * budget.BYTES_PER_STEP
+    assert sweeps._workers_that_fit(sweep, runs, 4, chosen=False) == 2
+    assert sweeps._workers_that_fit(sweep, runs, 2, chosen=True) == 2
+    with pytest.raises(HybridtrackError, match=r"3 workers would each hold a run of up to 2 days at 1min \(about "
+                                               r"6 MB\), 17 MB together, over the 12 MB the runs may use; 2 fit"):
+        sweeps._workers_that_fit(sweep, runs, 3, chosen=True)
+    monkeypatch.setattr(budget, "memory_budget", lambda: 1_000_000)  # not one: each run's own check says so
+    assert sweeps._workers_that_fit(sweep, runs, 2, chosen=False) == 1
