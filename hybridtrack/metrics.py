@@ -32,7 +32,8 @@ from .errors import HybridtrackError
 from .times import check_tz
 
 __all__ = ["summarize", "score", "RunningSummary", "offered_light", "daily", "shares", "share_counts", "event_counts", "moved_axes",
-           "weighted_quantile", "acceptance", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES", "HISTOGRAM_RESOLUTION"]
+           "weighted_quantile", "acceptance", "held_error", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES",
+           "HISTOGRAM_RESOLUTION"]
 
 TRACKING_MODES = ("sensor", "astronomical", "search")
 ACCEPTANCE_HALF_ANGLE = {"trough-ns": 1.0, "trough-ew": 1.0, "trough": 1.0, "fresnel": 0.8, "heliostat": 0.25}
@@ -124,6 +125,40 @@ def moved_axes(log: pd.DataFrame) -> np.ndarray:
                 change = np.minimum(change, 360.0 - change)
             moved += (change > 1e-9).astype(int)
     return moved
+
+
+def held_error(log: pd.DataFrame) -> pd.Series:
+    """The pointing error just before each next scan, degrees: the collector where this scan's
+    move left it (``angle``, and a heliostat's ``angle_azimuth``) against the true target where
+    the next scan finds the sun (``target_true``, ``target_true_azimuth``). NaN at the last scan
+    and wherever either target is NaN.
+
+    The run's ``error`` (and every score built on it) is taken at each scan after its move: the
+    error of a drive that keeps up with the sun between scans, as a PLC scanning every few
+    seconds does. A run at coarse steps (30 minutes) models such a PLC coarsely; were the drive
+    to move only at the run's scans, its error would grow over each step from ``error`` to this.
+    The gap between the two is what the coarse step leaves unscored (``docs/robustness.md``,
+    "Coarse steps"). A single axis' error is signed (angle less target, within ±180°, as
+    ``error`` is); a heliostat's is the angle between its mirror normal and the one it needs.
+    """
+    missing = [c for c in ("angle", "target_true") if c not in log.columns]
+    if missing:
+        raise HybridtrackError(f"held_error: the log has no {', '.join(map(repr, missing))} column; a run's log has "
+                               "angle and target_true")
+    angle = log["angle"].to_numpy(float)
+    wanted = np.append(log["target_true"].to_numpy(float)[1:], np.nan)
+    if "target_true_azimuth" not in log.columns:  # one axis
+        with np.errstate(invalid="ignore"):
+            error = (angle - wanted + 180.0) % 360.0 - 180.0
+        return pd.Series(error, index=log.index, name="held_error")
+    azimuth = np.radians(log["angle_azimuth"].to_numpy(float))
+    wanted_azimuth = np.radians(np.append(log["target_true_azimuth"].to_numpy(float)[1:], np.nan))
+    e, w = np.radians(angle), np.radians(wanted)
+    # the angle between two directions given as (elevation, azimuth): the haversine form keeps
+    # its precision at small angles, where the arccos of a dot product loses it
+    half = np.sin((w - e) / 2.0) ** 2 + np.cos(e) * np.cos(w) * np.sin((wanted_azimuth - azimuth) / 2.0) ** 2
+    error = np.degrees(2.0 * np.arcsin(np.sqrt(np.clip(half, 0.0, 1.0))))
+    return pd.Series(error, index=log.index, name="held_error")
 
 
 def _error_sums(steps: pd.DataFrame) -> dict:
