@@ -9,8 +9,9 @@ gate is: its Kalman filter coasts through the zenith pass, where the mirror norm
 150° from its prediction then passes the 4σ gate and the update turns the whole swing into a rate
 (1.18°/min instead of the sun's 0.11), and in sensor mode the next scan's rejected reading leaves
 the drive on the filter's coasted angle, 68° of azimuth off (``docs/robustness.md``, "Coarse
-steps"). The fix is in the controller and its kernel, which this branch may not change; the tests
-that need it are strict xfails, and pass once it is made.
+steps"). The fix is in the controller and its kernel: a filter coasted until it knows its angle
+worse than the calibrated model restarts at a reading the model vouches for, and sensor mode
+leaves a coasted filter that strayed beyond the plausibility bound for the computed target.
 
 Every bound here is computed by hand from the world's imperfections and the drive's datasheet, not
 from an earlier run.
@@ -69,9 +70,6 @@ def test_an_open_loop_heliostat_points_within_its_budget_at_any_step(freq):
     assert _scored(result)["error"].max() <= OPEN_LOOP_BUDGET
 
 
-@pytest.mark.xfail(strict=True, reason="controller: the sensor gate's Kalman filter learns a rate from the zenith "
-                                       "pass's swing across a 30/60-minute gap, and sensor mode follows its coasted "
-                                       "angle (18.4° at 15:30, 39.7° at 16:00); the fix needs the kernel too")
 @pytest.mark.parametrize("freq", ["30min", "60min"])
 def test_a_hybrid_heliostat_on_a_sunny_day_points_within_the_open_loop_budget_at_coarse_steps(freq):
     """A hybrid tracker with a sensor in clear sun is never worse than its own open loop's budget."""
@@ -80,8 +78,6 @@ def test_a_hybrid_heliostat_on_a_sunny_day_points_within_the_open_loop_budget_at
     assert _scored(result)["error"].max() <= OPEN_LOOP_BUDGET
 
 
-@pytest.mark.xfail(strict=True, reason="controller: a filter coasted for 90 minutes takes a reading 150° from its "
-                                       "prediction as an update, and its rate jumps to the swing over the gap")
 def test_a_filter_coasted_across_a_long_gap_restarts_at_the_reading_with_the_suns_rate():
     """After 90 minutes without a reading the filter's own angle is uncertain by tens of degrees
     (P00 grows as P11·dt²: 0.1 (°/min)² over 90 min is 810 deg²), far more than the calibrated

@@ -680,9 +680,11 @@ class Controller:
             return self._night_target(a)
         if mode == SENSOR:
             coasting = not valid and t - self.invalid_since <= self.coast_for
-            if gate.ready and (valid or not self.config.sensor_only or coasting):
+            if not (gate.ready and (valid or not self.config.sensor_only or coasting)):
+                return reading  # hold
+            if valid or not self._strayed(i, a, gate.filter.angle):
                 return gate.filter.angle + (_lead(gate.filter.rate, dt, drive.deadband) if lead else 0.0)
-            return reading  # hold
+            # a filter coasted beyond the plausibility bound of the calibrated model: the computed target
         if mode == SEARCH:
             rough = obs.coarse[a]  # the drive's speed limits the step; a scan later the cells look again
             return reading if math.isnan(rough) else reading + rough
@@ -699,6 +701,15 @@ class Controller:
             if not low <= target <= high:
                 target += 360.0 if target < low else -360.0
         return target
+
+    def _strayed(self, i: int, a: int, angle: float) -> bool:
+        """Whether a filtered angle on axis `a` lies further from the calibrated model than the
+        plausibility bound: a filter that coasted there (a rate learned across a gap) is no target
+        while the model is at hand (never without one)."""
+        m = self.model[a][i]
+        if not self.config.uses_model or math.isnan(m):
+            return False
+        return abs(self._turn(a, angle - m - self._correction(i, a))) > self._plausibility_bound(i, a)
 
     def _command(self, i: int, t: float, dt: float, reading: list, valid: list,
                  obs: Observation) -> tuple[list, list]:

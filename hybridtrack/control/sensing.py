@@ -6,11 +6,14 @@ sensor's datasheet σ while the expected offset, from the computed sun or the fi
 the encoder, moved ten times that: the sun and the drive never both stand still, so a sensor
 whose answer does is stuck, noise or no noise), when it is further from the calibrated model
 than the plausibility bound, or when it fails the Kalman filter's innovation gate. After
-`reacquire` gated readings in a row the filter restarts from the latest reading at the rate it
-is given (the computed sun's, where there is one): a filter that drifted away from the sun must
-not go on rejecting it, nor restart with the rate that drifted (a heliostat's azimuth near the
-zenith speeds up faster than the filter's process noise allows, and a filter that kept its own
-rate there was rejected again at once and coasted the drive away).
+`reacquire` gated readings in a row, or at once when the filter has coasted so long that its
+predicted angle is less certain than the plausibility bound and the calibrated model vouches for
+the reading, the filter restarts from the latest reading at the rate it is given (the computed
+sun's, where there is one): a filter that drifted away from the sun must not go on rejecting it,
+nor restart with the rate that drifted (a heliostat's azimuth near the zenith speeds up faster
+than the filter's process noise allows, and a filter that kept its own rate there was rejected
+again at once and coasted the drive away), nor, coasted across a gap, take the gap's swing for a
+rate (a heliostat's zenith pass between 30-minute scans had taught it 1.2°/min).
 """
 
 from __future__ import annotations
@@ -70,6 +73,10 @@ class SensorGate:
             return OK
         kf.predict(dt)
         y, s = kf.innovation(z)
+        if s > bound * bound and not math.isnan(miss):  # coasted until it knows the angle worse than the model
+            kf.reset(z, rate)  # that vouches for this reading: an update's rate gain would take the gap's swing
+            self.rejected = 0  # for a rate (a heliostat's zenith pass across 30-minute scans: 1.2°/min)
+            return OK
         if y * y > self.gate2 * s:
             self.rejected += 1
             if self.rejected < self.reacquire:

@@ -516,6 +516,10 @@ def gate_take(cfg, state, a, z, dt, miss, bound, rate):
         return OK
     kalman_predict(cfg, state, a, dt)
     y, s = z - state.kf[a, X0], state.kf[a, P00] + cfg.r[a]
+    if s > bound * bound and not math.isnan(miss):
+        kalman_reset(state, a, z, rate)
+        gate[a, REJECTED] = 0
+        return OK
     if y * y > cfg.gate2 * s:
         gate[a, REJECTED] += 1
         if gate[a, REJECTED] < cfg.reacquire:
@@ -1195,6 +1199,16 @@ def _watch_sky(cfg, plan, state, out, i, t, intensity):
 
 
 @kernel
+def _strayed(cfg, plan, state, i, a, angle):
+    """Controller._strayed."""
+    m = plan.model[i, a]
+    if not cfg.uses_model or math.isnan(m):
+        return False
+    bound = _plausibility_bound(cfg, plan, i, a, state.kf.shape[0])
+    return abs(_turn(cfg, a, angle - m - _correction(cfg, plan, state, i, a))) > bound
+
+
+@kernel
 def _target(cfg, plan, state, i, a, t, dt, reading, valid, coarse):
     mode = state.k[MODE]
     deadband = cfg.deadband[a]
@@ -1204,9 +1218,10 @@ def _target(cfg, plan, state, i, a, t, dt, reading, valid, coarse):
         return _night_target(cfg, state, a)
     if mode == SENSOR:
         coasting = not valid and t - state.s[INVALID_SINCE] <= cfg.coast_for
-        if state.gate[a, READY] and (valid or not cfg.sensor_only or coasting):
+        if not (state.gate[a, READY] and (valid or not cfg.sensor_only or coasting)):
+            return reading
+        if valid or not _strayed(cfg, plan, state, i, a, state.kf[a, X0]):
             return state.kf[a, X0] + (_lead(state.kf[a, X1], dt, deadband) if cfg.lead else 0.0)
-        return reading
     if mode == SEARCH:
         return reading if math.isnan(coarse) else reading + coarse
     m = plan.model[i, a]
