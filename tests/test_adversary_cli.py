@@ -34,3 +34,41 @@ def test_a_stamp_of_millions_of_characters_is_refused_at_once_and_quoted_cut(tmp
     message = refused(path, {"tz": "UTC"}, ["--tz", "UTC"], capsys)
     assert message == (f"{path}: line 7, column 'time': '99999999999999999999'... (5,000,000 characters) is not a "
                        "time stamp (longer than 80 characters)")
+
+
+@pytest.mark.parametrize("argv, message", [
+    # --tz "$TZ" with TZ unset: sun had run in UTC without a word
+    (["sun", "--lat", "10", "--lon", "10", "--tz", "", "--date", "2021-06-21"],
+     "--tz is empty: give an IANA time zone such as Asia/Shanghai, or leave --tz out (an unset shell variable?)"),
+    # and the site's clock had been dropped for the file's
+    (["check", "f.csv", "--lat", "36", "--lon", "103", "--tz", "UTC", "--site-tz", " "],
+     "--site-tz is empty: give an IANA time zone such as Asia/Shanghai, or leave --site-tz out (an unset shell "
+     "variable?)"),
+    # a file's zone no one knows had been refused without naming the flag
+    (["check", "f.csv", "--tz", "Mars/Olympus"],
+     "--tz: unknown time zone 'Mars/Olympus' (use an IANA name such as 'Asia/Shanghai')"),
+    (["replay", "f.csv", "--site", "lanzhou", "--tz", "Asia/Shanghia"],
+     "--tz: unknown time zone 'Asia/Shanghia' (use an IANA name such as 'Asia/Shanghai')"),
+    # pandas reads a bare number as nanoseconds: refused as 5.4e12 steps needing 10,800,000 GB
+    (["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "10"],
+     "--freq: step '10' has no unit; write it with one, such as '10min' or '10s'"),
+    (["check", "f.csv", "--freq", "1.5"], "--freq: step '1.5' has no unit; write it with one, such as '1.5min' or "
+                                          "'1.5s'"),
+    # argparse took -1e9 for an option: '--altitude: expected one argument'; now the range names it
+    (["sun", "--lat", "10", "--lon", "10", "--tz", "UTC", "--altitude", "-1e9", "--date", "2021-06-21"],
+     "--altitude -1000000000.0 m is outside [-500, 9000] m"),
+    (["sun", "--lat", "-inf", "--lon", "10", "--tz", "UTC", "--date", "2021-06-21"],
+     "--lat -inf is outside [-90, 90] degrees"),
+])
+def test_a_zone_or_step_flag_is_refused_by_its_flag(argv, message, capsys):
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"hybridtrack: error: {message}\n"
+    assert captured.out == ""
+
+
+def test_a_negative_number_in_exponent_form_is_read_as_a_value(capsys):
+    # -1e2 is the longitude -100, as -100 is: argparse had refused it as an option
+    assert main(["sun", "--lat", "40", "--lon", "-1e2", "--tz", "America/Denver", "--date", "2021-06-21",
+                 "--freq", "6h"]) == 0
+    assert "custom (40.0000°, -100.0000°)" in capsys.readouterr().out
