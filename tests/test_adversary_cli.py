@@ -72,3 +72,15 @@ def test_a_negative_number_in_exponent_form_is_read_as_a_value(capsys):
     assert main(["sun", "--lat", "40", "--lon", "-1e2", "--tz", "America/Denver", "--date", "2021-06-21",
                  "--freq", "6h"]) == 0
     assert "custom (40.0000°, -100.0000°)" in capsys.readouterr().out
+
+
+def test_stamps_of_24_00_read_as_the_next_midnight_are_said_in_the_report(tmp_path, capsys):
+    # a reading of the file, not written down: 'changes: none', and the time line said nothing
+    path = tmp_path / "h24.csv"
+    path.write_text("time,ghi,dni,dhi\n2021-06-05 22:00,0,0,0\n2021-06-05 23:00,0,0,0\n2021-06-05 24:00,0,0,0\n"
+                    "2021-06-06 01:00,0,0,0\n2021-06-06 24:00,0,0,0\n")
+    frame = read_weather(path, tz="UTC")
+    assert list(frame.index.strftime("%d %H")) == ["05 22", "05 23", "06 00", "06 01", "07 00"]
+    assert main(["check", str(path), "--tz", "UTC"]) == 0
+    time_line = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("  time:"))
+    assert time_line.endswith("; 2 stamps of 24:00 read as 00:00 of the next day (lines 4, 6)")

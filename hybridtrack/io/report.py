@@ -64,7 +64,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
     if "header_notes" in report:
         lines.append(f"  header notes (not units, ignored): {_describe(report['header_notes'])}")
     lines.append(f"  time: {report.get('time', '?')}" + "".join(f"; {prefix}{report[key]}" for key, prefix in
-                                                            (("offset_written", ""), ("date_order", "dates "))
+                                                            (("offset_written", ""), ("date_order", "dates "),
+                                                             ("end_of_day", ""))
                                                             if key in report))
     if "site" in report:
         lines.append(f"  site: {report['site']}")

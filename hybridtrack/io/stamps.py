@@ -473,6 +473,10 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
                          "remove it and give the zone (--tz)")
     if midnight.any():
         index = index + pd.to_timedelta(midnight.astype(int), unit="D")
+        at = np.flatnonzero(midnight)
+        lines_at = ", ".join(str(int(v)) for v in column.lines[at[:5]]) + (", ..." if len(at) > 5 else "")
+        report["end_of_day"] = (f"{len(at)} stamp{'s' if len(at) > 1 else ''} of 24:00 read as 00:00 of the next day "
+                                f"(line{'s' if len(at) > 1 else ''} {lines_at})")
     _refuse_twelve_hour_clock(column, index)
     if has_offset.any():
         return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)
