@@ -84,3 +84,29 @@ def test_stamps_of_24_00_read_as_the_next_midnight_are_said_in_the_report(tmp_pa
     assert main(["check", str(path), "--tz", "UTC"]) == 0
     time_line = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("  time:"))
     assert time_line.endswith("; 2 stamps of 24:00 read as 00:00 of the next day (lines 4, 6)")
+
+
+def test_a_line_short_of_fields_mid_file_is_counted_and_refused_when_strict(tmp_path, capsys):
+    # a logger that lost power mid-line and wrote on in a new line: '...,06:00,64' had been read
+    # as a GHI of 64 W/m² and its missing cells as NaN, with 'changes: none'
+    path = tmp_path / "cut.csv"
+    lines = ROWS.splitlines()
+    lines[1] = "2021-06-05 09:00,60"  # file line 3: 2 of 5 fields
+    path.write_text(HEADER + "\n".join(lines) + "\n")
+    frame = read_weather(path, tz="UTC")
+    assert frame.attrs["validation"]["short_rows"]["lines"] == [3]
+    assert frame.loc["2021-06-05 09:00", "ghi"].item() == 60 and frame.loc["2021-06-05 09:00", ["dni", "dhi"]].isna().all()
+    assert main(["check", str(path), "--tz", "UTC"]) == 0
+    out = capsys.readouterr().out
+    assert "  changes: 1\n    padded with NaN (lines short of fields): count 1, lines 3, why fewer fields than the header's 5" in out
+    assert "verdict: clean" not in out
+    message = refused(path, {"tz": "UTC", "strict": True}, ["--tz", "UTC", "--strict"], capsys)
+    assert message == f"{path}: line 3: a line with fewer fields than the header (strict)"
+
+
+def test_rows_that_leave_out_only_a_trailing_column_not_read_are_not_short(tmp_path):
+    path = tmp_path / "notes.csv"
+    rows = ROWS.replace(",2.0\n", ",2.0,ok\n").splitlines()
+    rows[2] = rows[2].removesuffix(",ok")  # file line 4 leaves the note out
+    path.write_text("time,ghi,dni,dhi,wind_speed,note\n" + "\n".join(rows) + "\n")
+    assert "short_rows" not in read_weather(path, tz="UTC").attrs["validation"]
