@@ -110,3 +110,32 @@ def test_rows_that_leave_out_only_a_trailing_column_not_read_are_not_short(tmp_p
     rows[2] = rows[2].removesuffix(",ok")  # file line 4 leaves the note out
     path.write_text("time,ghi,dni,dhi,wind_speed,note\n" + "\n".join(rows) + "\n")
     assert "short_rows" not in read_weather(path, tz="UTC").attrs["validation"]
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/dev/zero"), reason="needs /dev/zero and /dev/urandom")
+@pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
+def test_a_device_of_binary_data_is_refused_at_its_first_piece(device, monkeypatch, capsys):
+    # it had been read to the memory limit (12 GB, 45 s for /dev/zero) and refused as too large;
+    # with the limit at 64 MiB that is the message the old reader gives
+    monkeypatch.setattr("hybridtrack.budget.memory_budget", lambda: 64 * 2**20)
+    message = refused(device, {"tz": "UTC"}, ["--tz", "UTC"], capsys)
+    assert message == f"{device}: looks binary, not a text file (a device or a stream of binary data?)"
+
+
+def test_a_stream_of_text_with_nul_padding_after_it_is_still_read(tmp_path):
+    import os
+    import threading
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    text = (HEADER + ROWS).encode() + b"\0" * 5000
+
+    def feed():
+        with open(fifo, "wb") as stream:
+            stream.write(text)
+
+    writer = threading.Thread(target=feed)
+    writer.start()
+    frame = read_weather(fifo, tz="UTC")
+    writer.join()
+    assert len(frame) == 5 and frame.attrs["validation"]["padding"]["count"] == 5000
