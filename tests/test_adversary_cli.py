@@ -139,3 +139,19 @@ def test_a_stream_of_text_with_nul_padding_after_it_is_still_read(tmp_path):
     frame = read_weather(fifo, tz="UTC")
     writer.join()
     assert len(frame) == 5 and frame.attrs["validation"]["padding"]["count"] == 5000
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--workers", "0"], "--workers must be a whole number within [1, 1,024], got 0"),
+    (["--workers", "-3"], "--workers must be a whole number within [1, 1,024], got -3"),
+    (["--scheduler", ""], "--scheduler must be an address such as 'tcp://host:8786', got ''; leave it out for a "
+                          "local cluster (an unset shell variable?)"),
+])
+def test_a_sweeps_where_flags_are_refused_by_their_flag(tmp_path, capsys, flags, message):
+    # 'workers must be ...' and 'scheduler must be ...' had named no flag, unlike field's
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('[base]\nsite = "lanzhou"\nstart = 2021-06-19\ndays = 1\nfreq = "30min"\n[grid]\nseed = [0, 1]\n')
+    assert main(["sweep", str(sweep), "--out", str(tmp_path / "out"), *flags]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"hybridtrack: error: {message}\n" and captured.out == ""
+    assert not (tmp_path / "out").exists()

@@ -320,8 +320,8 @@ def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, fla
     (["--scheduler", "nonsense://x"], "cannot reach the Dask scheduler at nonsense://x: unknown address scheme"),
     (["--scheduler", "tcp://"], "cannot reach the Dask scheduler at tcp://: "),
     (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "give either --scheduler or --workers, not both"),
-    (["--workers", "0"], "workers must be a whole number within [1, 1,024], got 0"),
-    (["--scheduler", ""], "scheduler must be an address such as 'tcp://host:8786', got ''"),
+    (["--workers", "0"], "--workers must be a whole number within [1, 1,024], got 0"),
+    (["--scheduler", ""], "--scheduler must be an address such as 'tcp://host:8786', got ''"),
 ])
 def test_where_the_runs_go_is_checked_before_anything_is_printed(tmp_path, capsys, flags, message):
     """The run count ("s.toml: 2 runs over seed") had been printed above the refusal."""
