@@ -155,3 +155,16 @@ def test_a_sweeps_where_flags_are_refused_by_their_flag(tmp_path, capsys, flags,
     captured = capsys.readouterr()
     assert captured.err == f"hybridtrack: error: {message}\n" and captured.out == ""
     assert not (tmp_path / "out").exists()
+
+
+def test_a_column_name_of_a_million_characters_is_not_matched_and_is_quoted_cut(tmp_path, capsys):
+    # matched against every alias (3 s a million characters) and printed whole in 'not read'
+    path = tmp_path / "long.csv"
+    path.write_text(HEADER.rstrip("\n") + ",x" + "h" * 999_999 + "\n" + ROWS.replace("\n", ",1\n"))
+    frame = read_weather(path, tz="UTC")
+    assert frame.attrs["validation"]["not_read"] == ["'xhhhhhhhhhhhhhhhhhhh'... (1,000,000 characters)"]
+    assert main(["check", str(path), "--tz", "UTC"]) == 0
+    assert "  not read: 'xhhhhhhhhhhhhhhhhhhh'... (1,000,000 characters)\n" in capsys.readouterr().out
+    path.write_text("y" * 500_000 + ",ghi\n1,2\n3,4\n")
+    message = refused(path, {"tz": "UTC"}, ["--tz", "UTC"], capsys)
+    assert message.endswith("; columns are 'yyyyyyyyyyyyyyyyyyyy'... (500,000 characters), ghi")

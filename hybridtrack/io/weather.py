@@ -19,8 +19,8 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .checks import check_frame, check_magnitude, refuse_repairs
 from .closure import closure_check
-from .columns import (IRRADIANCE, LABEL_COLUMN, STAMP_PARTS, WEATHER_COLUMNS, check_names, not_read, resolve_columns,
-                      split_header)
+from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, name_shown,
+                      not_read, resolve_columns, split_header)
 from .files import file_text
 from .formats import PVLIB_FORMATS, RECOGNISED_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
@@ -300,10 +300,11 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
     if not {"time", "date", "year"} & set(mapping):
         raise HybridtrackError(f"{path}: no time column found; name it with columns={{'time': ...}} "
                                f"(--map time=COLUMN, or --map time= for an unnamed first column); columns are "
-                               f"{', '.join(repr(h) if not h else h for h in table.headers)}")
+                               f"{', '.join(name_shown(h) if not h or len(h) > LONGEST_NAME else h for h in table.headers)}")
     if not any(name in mapping for name in (*IRRADIANCE, "photocurrent")):
         raise HybridtrackError(f"{path}: no irradiance column found (ghi, dni, dhi); map one, e.g. --map "
-                               f"dni=COLUMN; columns are {', '.join(table.headers)}")
+                               f"dni=COLUMN; columns are "
+                               f"{', '.join(name_shown(h) if len(h) > LONGEST_NAME else h for h in table.headers)}")
     meta = header_site(path, table) if table.site else {}
     index, keep = _stamps(path, table, mapping, cells, tz, site, dayfirst, report, meta.get("zone"))
     frame = pd.DataFrame(index=index)
