@@ -15,7 +15,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
-from ..errors import HybridtrackError
+from ..errors import HybridtrackError, quoted_cut
 from .units import any_known_unit
 
 __all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "STAMP_PARTS", "split_header",
@@ -113,7 +113,7 @@ LONGEST_NAME = 256
 
 def name_shown(header: str) -> str:
     """A column's name as a message or the report quotes it: a long one cut, with its length."""
-    return repr(header) if len(header) <= LONGEST_NAME else f"{header[:20]!r}... ({len(header):,} characters)"
+    return quoted_cut(header, LONGEST_NAME)
 
 
 def _matches(header: str, name: str) -> bool:

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import HybridtrackError
+from ..errors import HybridtrackError, quoted_cut
 
 __all__ = ["parse_stamps", "fixed_zone", "offset_in_name", "CLOCK_ZONES"]
 
@@ -106,8 +106,7 @@ LONGEST_STAMP = 80
 
 def shown(cell: str) -> str:
     """A cell as a message quotes it: a long one cut, with its length."""
-    cell = str(cell)
-    return repr(cell) if len(cell) <= LONGEST_STAMP else f"{cell[:20]!r}... ({len(cell):,} characters)"
+    return quoted_cut(str(cell), LONGEST_STAMP)
 
 
 #: The readings of an ``a/b/c`` date: which of its numbers (groups 0, 2 and 3 of `_DMY`) is the
