@@ -182,6 +182,7 @@ def _check_zones_and_steps(args) -> None:
     knows was refused without naming ``--tz``. A step of a bare number (``--freq 10``) is read by
     pandas as nanoseconds, and had been refused as a step of 10ns needing 10,800,000 GB.
     """
+    from ..params import refuse_unitless
     from ..times import check_tz
 
     for name in _ZONE_OPTIONS:
@@ -194,9 +195,8 @@ def _check_zones_and_steps(args) -> None:
                                    "out (an unset shell variable?)")
         check_tz(value, f"{flag}: ")
     freq = getattr(args, "freq", None)
-    if isinstance(freq, str) and re.fullmatch(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*", freq):
-        raise HybridtrackError(f"--freq: step {freq!r} has no unit; write it with one, such as '{freq.strip()}min' or "
-                               f"'{freq.strip()}s'")
+    if isinstance(freq, str):
+        refuse_unitless(freq, "--freq: step")
 
 
 if __name__ == "__main__":  # pragma: no cover
