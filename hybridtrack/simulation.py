@@ -36,6 +36,7 @@ from .errors import HybridtrackError
 from .outputs import claim, output_folder, remove_earlier, removing_empty_folders, strict_json, together, write
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
+from .fuzzy.classifier import READING_LIMIT
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import score, summarize
 from .mountreport import FIT_PREFIX
@@ -412,7 +413,7 @@ def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.n
 #: perihelion: 1408 W/m²; a photocurrent of 10 A where the reader's limit is 10,000 mA). A reading
 #: past it is a unit mixed up (kW/m² read as W/m², ×1000) or garbage (1e200 W/m² failed deep in the
 #: mount fit with numpy's LinAlgError); a spike below it is a sensor's fault to survive.
-NOT_LIGHT = {"dni": 14_080.0, "dhi": 14_080.0, "photocurrent": 100_000.0}
+NOT_LIGHT = {"dni": 14_080.0, "dhi": 14_080.0, "photocurrent": READING_LIMIT}
 _UNITS = {"dni": "W/m²", "dhi": "W/m²", "photocurrent": "mA"}
 
 

@@ -120,10 +120,16 @@ def test_classify_file_missing_column(tmp_path, capsys):
     assert "no column 'intensity'; columns are a, b" in capsys.readouterr().err
 
 
-def test_an_absurd_reading_is_clipped_to_its_range_not_overflowed(capsys):
-    assert main(["rules", "--intensity", "1e308", "--variation", "0"]) == 0
-    captured = capsys.readouterr()
-    assert "-> sunny" in captured.out and "overflow" not in captured.err  # the strongest light: sunny
+def test_an_absurd_reading_is_clipped_to_its_range_not_overflowed():
+    """From Python a reading past the input's range is clipped onto it (a run survives a logger's
+    spike); the command line refuses it (`test_a_reading_no_sensor_gives_is_refused_in_one_line`)."""
+    import warnings
+
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow
+        assert FuzzyWeatherClassifier().explain(1e308, 0.0).weather == "sunny"  # the strongest light
 
 
 def test_a_warning_that_is_not_a_tuning_one_is_shown_once(monkeypatch):
@@ -195,11 +201,14 @@ def test_tune_refuses_an_empty_score_cell(tmp_path, capsys):
 
 @pytest.mark.parametrize("command", ["classify", "rules"])
 @pytest.mark.parametrize("intensity, variation, message", [
-    ("-500", "20", "--intensity must be 0 or more (a photocurrent in mA is never below zero), got -500"),
-    ("100", "-20", "--variation must be 0 or more (a variation is a range, max - min, never below zero), got -20"),
+    ("-500", "20", "--intensity -500 is no reading: a photocurrent in mA is never below zero"),
+    ("100", "-20", "--variation -20 is no reading: a variation is a range, max - min, never below zero"),
+    ("1e308", "20", "--intensity 1e+308 is no reading: over 100,000 mA, which no sun sensor gives (a unit mixed up?)"),
+    ("100", "200000", "--variation 200000 is no reading: over 100,000 mA, which no sun sensor gives (a unit mixed up?)"),
 ])
-def test_a_negative_reading_is_refused_in_one_line(capsys, command, intensity, variation, message):
-    # 'classify --intensity -500 --variation -20' had printed 'score 5.007 -> overcast', status 0
+def test_a_reading_no_sensor_gives_is_refused_in_one_line(capsys, command, intensity, variation, message):
+    # 'classify --intensity -500 --variation -20' had printed 'score 5.007 -> overcast', status 0,
+    # and --intensity 1e308 'score 24.993 -> sunny'
     assert main([command, f"--intensity={intensity}", f"--variation={variation}"]) == 2
     assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
 
@@ -213,6 +222,18 @@ def test_a_negative_cell_is_refused_by_row_and_column(tmp_path, capsys, command)
     assert main([command, str(src), *extra]) == 2
     assert capsys.readouterr().err == (f"hybridtrack: error: {src}: row 3, column 'variation': -3 is no reading; "
                                        "a variation is a range, max - min, never below zero\n")
+
+
+@pytest.mark.parametrize("command", ["classify", "tune"])
+def test_the_earliest_cell_no_sensor_gives_is_refused_by_row_and_column(tmp_path, capsys, command):
+    # a label of 1e308 mA had been fitted as the brightest sun; and a negative intensity two rows
+    # below a negative variation had been named first (the columns were looked at one by one)
+    src = tmp_path / "labels.csv"
+    src.write_text("intensity,variation,weather\n246,27,sunny\n1e308,3,sunny\n-60,-3,overcast\n")
+    extra = ["--out", str(tmp_path / "t.toml"), "--folds", "0", "--seeds", "1"] if command == "tune" else []
+    assert main([command, str(src), *extra]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {src}: row 3, column 'intensity': 1e+308 is no reading; "
+                                       "over 100,000 mA, which no sun sensor gives (a unit mixed up?)\n")
     assert not (tmp_path / "t.toml").exists()
 
 

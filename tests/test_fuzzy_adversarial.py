@@ -64,8 +64,9 @@ def test_a_config_made_round_trips_through_toml(config, tmp_path):
     assert FuzzyConfig.from_toml(config.to_toml(tmp_path / "fuzzy.toml")) == config
 
 
-@pytest.mark.parametrize("values, named", [(["intensity=-5", "variation=50"], "input 'intensity' must be 0 or more"),
-                                           (["intensity=200", "variation=-0.1"], "input 'variation' must be 0 or more")])
+@pytest.mark.parametrize("values, named", [(["intensity=-5", "variation=50"], "input 'intensity' -5 is no reading"),
+                                           (["intensity=200", "variation=-0.1"], "input 'variation' -0.1 is no reading"),
+                                           (["intensity=1e308", "variation=5"], "input 'intensity' 1e+308 is no reading")])
 def test_fuzzy_eval_of_a_classifier_refuses_a_reading_below_zero_as_classify_does(values, named, tmp_path, capsys):
     # -5 mA had been clipped onto the raw range and scored overcast; classify and rules refuse it
     from hybridtrack.cli import main

@@ -45,16 +45,17 @@ def load_fuzzy_config(path):
 
 def check_reading(args: argparse.Namespace) -> None:
     """Refuse an ``--intensity`` or ``--variation`` that is not a finite number (NaN fires no
-    rule; an infinite one would be clipped to the end of its range) or is below zero (no reading:
-    ``--intensity -500 --variation -20`` had been classified overcast)."""
-    from ..fuzzy.classifier import NEVER_NEGATIVE
+    rule; an infinite one would be clipped to the end of its range) or no sensor gives (below zero:
+    ``--intensity -500 --variation -20`` had been classified overcast; 1e308 mA sunny)."""
+    from ..fuzzy.classifier import impossible_reading
 
     for name in ("intensity", "variation"):
         value = getattr(args, name)
         if value is not None and not math.isfinite(value):
             raise HybridtrackError(f"--{name} must be a finite number, got {value}")
-        if value is not None and value < 0.0:
-            raise HybridtrackError(f"--{name} must be 0 or more ({NEVER_NEGATIVE[name]}), got {value:g}")
+        why = None if value is None else impossible_reading(value, name)
+        if why:
+            raise HybridtrackError(f"--{name} {value:g} is no reading: {why}")
 
 
 def _classify_arguments(parser: argparse.ArgumentParser) -> None:
@@ -83,7 +84,7 @@ def _classify(args: argparse.Namespace) -> int:
 
 def _classify_readings(args: argparse.Namespace) -> int:
     from ..fuzzy import FuzzyWeatherClassifier
-    from ..fuzzy.classifier import refuse_negative_readings
+    from ..fuzzy.classifier import refuse_impossible_readings
 
     clf = FuzzyWeatherClassifier(load_fuzzy_config(args.config))
     if args.file is None:
@@ -101,7 +102,7 @@ def _classify_readings(args: argparse.Namespace) -> int:
         if column not in table.columns:
             raise HybridtrackError(f"{args.file}: no column {column!r}; columns are {', '.join(table.columns)}")
     readings = numeric_columns(table[wanted], wanted, str(args.file))
-    refuse_negative_readings(readings, wanted, str(args.file))
+    refuse_impossible_readings(readings, wanted, str(args.file))
     table["sky_score"] = clf.score(readings[wanted[0]].to_numpy(), readings[wanted[1]].to_numpy(), engine=args.engine)
     table["sky"] = clf.label(table["sky_score"].to_numpy())
     if args.out:

@@ -58,12 +58,13 @@ def _evaluate(system, args: argparse.Namespace) -> int:
     for name, value in zip(system.input_names, x[0]):
         if not np.isfinite(value):
             raise HybridtrackError(f"input {name!r} must be a finite number, got {value}")
-    if str(args.source).lower().endswith(".toml"):  # a classifier's readings: refused below zero, as classify does
-        from ..fuzzy.classifier import NEVER_NEGATIVE
+    if str(args.source).lower().endswith(".toml"):  # a classifier's readings: refused as classify refuses them
+        from ..fuzzy.classifier import NEVER_NEGATIVE, impossible_reading
 
-        for name, value, why in zip(system.input_names, x[0], NEVER_NEGATIVE.values()):
-            if value < 0.0:
-                raise HybridtrackError(f"input {name!r} must be 0 or more ({why}), got {value:g}")
+        for name, value, reading in zip(system.input_names, x[0], NEVER_NEGATIVE):
+            why = impossible_reading(value, reading)
+            if why:
+                raise HybridtrackError(f"input {name!r} {value:g} is no reading: {why}")
     x = np.array([[var.to_universe(value) for var, value in zip(system.inputs, x[0])]])  # a .toml's raw_range
     if args.engine == "skfuzzy":
         values = [evaluate_skfuzzy(system, x, output=o)[0] for o in range(len(system.outputs))]

@@ -13,7 +13,7 @@ from .config import FuzzyConfig
 from .engine import CompiledSystem, evaluate_fast, evaluate_skfuzzy
 
 __all__ = ["FuzzyWeatherClassifier", "Explanation", "UNKNOWN", "ENGINES", "NEVER_NEGATIVE",
-           "refuse_negative_readings"]
+           "refuse_impossible_readings", "impossible_reading", "READING_LIMIT"]
 
 #: The label given when no rule fires or an input is missing.
 UNKNOWN = "unknown"
@@ -56,28 +56,45 @@ class Explanation:
 #: Why a raw reading is never below zero, by input.
 NEVER_NEGATIVE = {"intensity": "a photocurrent in mA is never below zero",
                   "variation": "a variation is a range, max - min, never below zero"}
+#: mA: more than any sun sensor's photocurrent, or its range, can be: ten times a 10,000 mA
+#: reader's limit. A reading past it is a unit mixed up (µA read as mA) or garbage (1e308 mA
+#: had been taken as the brightest sun); a weather frame's photocurrent is held to it too.
+READING_LIMIT = 100_000.0
 
 
-def refuse_negative_readings(frame: pd.DataFrame, columns, where: str) -> None:
-    """Refuse a table's first raw reading below zero in `columns`, by its row and column.
+def impossible_reading(value: float, name: str) -> str | None:
+    """Why a raw reading of input `name` (``intensity`` or ``variation``) is none a sensor gives,
+    or None for a possible one (NaN, no reading, included)."""
+    if value < 0.0:
+        return NEVER_NEGATIVE[name]
+    if value > READING_LIMIT:
+        return f"over {READING_LIMIT:,.0f} mA, which no sun sensor gives (a unit mixed up?)"
+    return None
+
+
+def refuse_impossible_readings(frame: pd.DataFrame, columns, where: str) -> None:
+    """Refuse a table's first raw reading no sensor gives (`impossible_reading`), by its row and
+    column: the earliest row, intensity before variation within it.
 
     Parameters
     ----------
     frame : pandas.DataFrame
         Readings as numbers (`hybridtrack.io.numeric_columns`).
-    columns : iterable of str
+    columns : sequence of str
         The intensity and variation columns, in that order.
     where : str
         The file, for the message.
     """
     from ..io import table_row
 
-    for column, name in zip(columns, NEVER_NEGATIVE):
-        negative = frame[column].to_numpy(float) < 0.0
-        if negative.any():
-            row = int(np.flatnonzero(negative)[0])
-            raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {column!r}: "
-                                   f"{frame[column].iloc[row]:g} is no reading; {NEVER_NEGATIVE[name]}")
+    columns = list(columns)
+    values = frame[columns].to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        bad = np.argwhere((values < 0.0) | (values > READING_LIMIT))
+    if len(bad):
+        row, k = (int(i) for i in bad[0])
+        raise HybridtrackError(f"{where}: row {table_row(frame, row)}, column {columns[k]!r}: {values[row, k]:g} is "
+                               f"no reading; {impossible_reading(values[row, k], list(NEVER_NEGATIVE)[k])}")
 
 
 def _readings(values, name: str) -> np.ndarray:
@@ -85,7 +102,7 @@ def _readings(values, name: str) -> np.ndarray:
     ('246'), True and an infinite reading had been taken (inf mA as the brightest sun). A reading
     below zero is clipped onto the input's range, as any reading past it: a recorded photocurrent
     below zero is a logger's offset a run survives (`hybridtrack.faults`); the command line, where
-    a person types or files readings, refuses it (`refuse_negative_readings`)."""
+    a person types or files readings, refuses it (`refuse_impossible_readings`)."""
     return finite_array(values, not_numbers=f"{name} must be numbers (NaN where there is no reading)",
                         infinite=f"{name} must be finite (NaN where there is no reading)")
 

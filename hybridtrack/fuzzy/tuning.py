@@ -41,7 +41,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from ..params import number, whole
-from .classifier import FuzzyWeatherClassifier, refuse_negative_readings
+from .classifier import FuzzyWeatherClassifier, refuse_impossible_readings
 from .config import FuzzyConfig, Term
 
 __all__ = ["tune", "check_margin", "check_folds", "check_seeds", "check_seed", "TuningReport", "read_samples", "evaluate",
@@ -169,7 +169,7 @@ def read_samples(source, config: FuzzyConfig | None = None) -> pd.DataFrame:
 
     frame = numeric_columns(frame, ("intensity", "variation", "score", "tolerance"), where,
                             required=("intensity", "variation", "score"))
-    refuse_negative_readings(frame, ("intensity", "variation"), where)
+    refuse_impossible_readings(frame, ("intensity", "variation"), where)
     if config is not None and "weather" in frame.columns:
         _refuse_unknown_labels(frame, config, where)
     return frame
