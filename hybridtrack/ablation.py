@@ -57,34 +57,8 @@ class AblationPlan:
     policies: tuple[str, ...] = STRATEGIES
 
     def __post_init__(self) -> None:
-        from . import params
-        from . import sites as known_sites
-        from .collectors import KINDS
-        from .sky import DAY_TYPES
-
-        for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
-            values = getattr(self, name)
-            # a text had been run a letter a value ("unknown site 'l'"); a number raised TypeError
-            if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
-                raise HybridtrackError(f"ablate: {name} must be a list, such as ({values!r},), got {values!r:.60}")
-            object.__setattr__(self, name, tuple(values))
-            if not getattr(self, name):
-                raise HybridtrackError(f"ablate: no {name} to run")
-        # a built-in site by its own name: 'Nanjing' had taken the days of 2021, 'nanjing' those of 2013
-        object.__setattr__(self, "sites", tuple(site if isinstance(site, known_sites.Site) else
-                                                known_sites.get(site).name for site in self.sites))
-        object.__setattr__(self, "seeds", tuple(params.seed(seed, "ablate: seed") for seed in self.seeds))
-        checks = [("season", self.seasons, tuple(SEASONS)), ("weather", self.weather, (*DAY_TYPES, "mixed")),
-                  ("collector", self.collectors, KINDS), ("policy", self.policies, STRATEGIES)]
-        for what, values, known in checks:
-            for value in values:
-                if value not in known:
-                    raise HybridtrackError(f"ablate: unknown {what} {value!r}; choose from {', '.join(known)}")
-        for name in ("sites", "seasons", "weather", "seeds", "collectors", "policies"):
-            values = getattr(self, name)
-            twice = next((value for k, value in enumerate(values) if value in values[:k]), None)
-            if twice is not None:  # the same days run twice, and counted twice in the table's means
-                raise HybridtrackError(f"ablate: {name} names {twice!r} twice")
+        for name in PLAN_FIELDS:
+            object.__setattr__(self, name, checked_values(name, getattr(self, name), "ablate"))
 
     def days(self) -> list[dict]:
         """One dict per day: site, date, weather, seed, collector."""
@@ -98,6 +72,45 @@ class AblationPlan:
                             out.append({"site": site, "season": season, "date": f"{year}-{SEASONS[season]}",
                                         "weather": weather, "seed": int(seed), "collector": collector})
         return out
+
+
+#: The fields of an `AblationPlan` that list what to run.
+PLAN_FIELDS = ("sites", "seasons", "weather", "seeds", "collectors", "policies")
+
+
+def checked_values(name: str, values, label: str) -> tuple:
+    """An `AblationPlan` field (`PLAN_FIELDS`) as the plan keeps it: a tuple of known values,
+    none twice, the built-in sites by their own names; refused with `label` first (``ablate``
+    from Python, the flag on the command line)."""
+    from . import params
+    from . import sites as known_sites
+    from .collectors import KINDS
+    from .sky import DAY_TYPES
+
+    # a text had been run a letter a value ("unknown site 'l'"); a number raised TypeError
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        raise HybridtrackError(f"{label}: {name} must be a list, such as ({values!r},), got {values!r:.60}")
+    values = tuple(values)
+    if not values:
+        raise HybridtrackError(f"{label}: no {name} to run")
+    if name == "sites":  # a built-in site by its own name: 'Nanjing' had taken the days of 2021, 'nanjing' 2013
+        try:
+            values = tuple(site if isinstance(site, known_sites.Site) else known_sites.get(site).name
+                           for site in values)
+        except HybridtrackError as exc:
+            raise HybridtrackError(f"{label}: {exc}") from None
+    elif name == "seeds":
+        values = tuple(params.seed(seed, f"{label}: seed") for seed in values)
+    else:
+        what, known = {"seasons": ("season", tuple(SEASONS)), "weather": ("weather", (*DAY_TYPES, "mixed")),
+                       "collectors": ("collector", KINDS), "policies": ("policy", STRATEGIES)}[name]
+        unknown = next((value for value in values if value not in known), None)
+        if unknown is not None:
+            raise HybridtrackError(f"{label}: unknown {what} {unknown!r}; choose from {', '.join(known)}")
+    twice = next((value for k, value in enumerate(values) if value in values[:k]), None)
+    if twice is not None:  # the same days run twice, and counted twice in the table's means
+        raise HybridtrackError(f"{label}: {name} names {twice!r} twice")
+    return values
 
 
 def _day(day: dict, policies: tuple[str, ...], config) -> list[dict]:

@@ -84,3 +84,18 @@ def test_a_tradeoff_plan_takes_a_built_in_sites_days_whatever_its_names_case():
 
     plan = TradeoffPlan(sites=("Nanjing",), seasons=("summer",))
     assert plan.sites == ("nanjing",) and {day["date"] for day in plan.days()} == {"2013-06-21"}
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--sites", "atlantis"], "--sites: unknown site 'atlantis'; known sites: "),
+    (["--weather", "foggy"], "--weather: unknown weather 'foggy'; choose from sunny, cloudy, overcast, mixed"),
+    (["--collectors", "tower"], "--collectors: unknown collector 'tower'; choose from "),
+    (["--sites", "lanzhou", "Lanzhou"], "--sites: sites names 'lanzhou' twice"),
+])
+def test_an_ablate_flag_naming_nothing_known_is_refused_naming_the_flag(flags, message, capsys):
+    """'unknown site 'atlantis'' and 'ablate: unknown weather 'foggy'' had named no flag."""
+    from hybridtrack.cli import main
+
+    assert main(["ablate", *flags]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"hybridtrack: error: {message}") and err.count("\n") == 1

@@ -79,8 +79,10 @@ def _ablate(args: argparse.Namespace) -> int:
 
 def _plan(args: argparse.Namespace, policies: tuple[str, ...]):
     """The `AblationPlan` of the days the flags ask for, with `policies`."""
-    from ..ablation import AblationPlan
+    from ..ablation import AblationPlan, checked_values
 
+    for name in ("sites", "weather", "collectors"):  # refused naming the flag ('unknown site' had named none)
+        checked_values(name, getattr(args, name), f"--{name}")
     return AblationPlan(tuple(args.sites), tuple(args.seasons), tuple(args.weather), tuple(range(1, args.seeds + 1)),
                         tuple(args.collectors), policies)
 
