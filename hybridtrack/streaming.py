@@ -796,15 +796,11 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
     run = _PartialRun(files)
     memory: bool | dict = warm_start
     start = None
-    whole = False
     wind, cycle, last = set(), [], None
     try:
-        for day, frame in source:
+        for day, frame in _read_to_a_whole_day(source, site):
             begin = frame.index[0]
             start = begin if start is None else start
-            midnight, next_midnight = (local_midnight(d, site.tz) for d in (day, day + dt.timedelta(days=1)))
-            step = frame.index[1] - begin if len(frame) > 1 else pd.Timedelta(0)
-            whole = whole or (begin <= midnight and frame.index[-1] + step >= next_midnight)
             age = (begin - start) / pd.Timedelta(days=1)
             setup = dataclasses.replace(config, imperfections=dataclasses.replace(
                 config.imperfections, commissioned_days_ago=config.imperfections.commissioned_days_ago + age),
@@ -820,12 +816,10 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
             memory = result.memory
             last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"]}
             del result, frame  # nothing of a segment outlives it but its memory and the running sums
-        if run.segments == 0 or not whole:
-            raise HybridtrackError(f"{source.describe}: holds no time steps" if run.segments == 0 else
-                                   f"a streamed run needs at least one whole local day at {site.name}; this span has "
-                                   "none (run it without --stream; hybridtrack.simulate from Python)")
+        if run.segments == 0:
+            raise HybridtrackError(f"{source.describe}: holds no time steps")
     except BaseException:
-        run.abandon(keep=whole)  # a span refused for holding no whole day keeps nothing
+        run.abandon(keep=True)  # the segments done, if any: a span with no whole day is refused before any runs
         raise
     run.finish()
     summary = running.summary()
@@ -837,6 +831,33 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
                            "p95_resolution_deg": running.resolution, "weather": source.describe}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
     return StreamResult(summary, files, site, collector, config, memory)
+
+
+def _read_to_a_whole_day(source: DaySource, site) -> Iterator[tuple[dt.date, pd.DataFrame]]:
+    """The days of `source`, read ahead to its first whole local day before the first is given
+    (two days at most: a part day, then a whole one or the end): a span with no whole day is
+    refused before any of it runs (a two-row file had run, then been refused)."""
+    days = iter(source)
+    ahead = []
+    for day, frame in days:
+        ahead.append((day, frame))
+        if _whole(day, frame, site):
+            break
+    else:
+        if ahead:
+            raise HybridtrackError(f"a streamed run needs at least one whole local day at {site.name}; this span has "
+                                   "none (run it without --stream; hybridtrack.simulate from Python)")
+    yield from ahead
+    del ahead
+    yield from days
+
+
+def _whole(day: dt.date, frame: pd.DataFrame, site) -> bool:
+    """Whether `frame` covers the whole local `day` at `site`, its last step running to midnight."""
+    begin = frame.index[0]
+    midnight, next_midnight = (local_midnight(d, site.tz) for d in (day, day + dt.timedelta(days=1)))
+    step = frame.index[1] - begin if len(frame) > 1 else pd.Timedelta(0)
+    return begin <= midnight and frame.index[-1] + step >= next_midnight
 
 
 def progress_bar(source: DaySource, *, label: str = "", file=None):

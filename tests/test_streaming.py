@@ -642,3 +642,19 @@ def test_a_frame_out_of_order_is_refused_as_such(order):
     frame = synthetic("lanzhou", "2021-06-20", "2021-06-21", weather="sunny", freq="10min", seed=1)
     with pytest.raises(HybridtrackError, match="the weather frame's time goes back at row [0-9]+ .2021-06-2"):
         frame_days(frame.iloc[order], "lanzhou")
+
+
+def test_a_span_with_no_whole_day_is_refused_before_any_of_it_runs(tmp_path, monkeypatch):
+    """A recorded file of an evening and the next morning (no whole local day) had run both
+    segments, then been refused; now it is refused before the first runs."""
+    import hybridtrack.simulation as simulation
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-03-10", "2021-03-11", weather="sunny", freq="10min")
+    evening_and_morning = frame.loc["2021-03-10 18:00":"2021-03-11 09:00"]
+    evening_and_morning.to_parquet(tmp_path / "part.parquet")
+    ran = []
+    monkeypatch.setattr(simulation, "simulate", lambda *a, **k: ran.append(1))
+    with pytest.raises(HybridtrackError, match="needs at least one whole local day"):
+        stream(recorded_days(tmp_path / "part.parquet", SITE), tmp_path / "part")
+    assert ran == [] and not (tmp_path / "part").exists()
