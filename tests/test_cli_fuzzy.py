@@ -214,26 +214,20 @@ def test_a_reading_no_sensor_gives_is_refused_in_one_line(capsys, command, inten
 
 
 @pytest.mark.parametrize("command", ["classify", "tune"])
-def test_a_negative_cell_is_refused_by_row_and_column(tmp_path, capsys, command):
+@pytest.mark.parametrize("rows, refused", [
     # negative labels had been fitted, and negative cells classified
+    ("60,-3,overcast\n", "row 3, column 'variation': -3 is no reading; a variation is a range, max - min, never "
+                         "below zero"),
+    # a label of 1e308 mA had been fitted as the brightest sun; the earliest bad row is named
+    ("1e308,3,sunny\n-60,-3,overcast\n", "row 3, column 'intensity': 1e+308 is no reading; over 100,000 mA, which "
+                                         "no sun sensor gives (a unit mixed up?)"),
+])
+def test_a_cell_no_sensor_gives_is_refused_by_row_and_column(tmp_path, capsys, command, rows, refused):
     src = tmp_path / "labels.csv"
-    src.write_text("intensity,variation,weather\n246,27,sunny\n60,-3,overcast\n")
+    src.write_text("intensity,variation,weather\n246,27,sunny\n" + rows)
     extra = ["--out", str(tmp_path / "t.toml"), "--folds", "0", "--seeds", "1"] if command == "tune" else []
     assert main([command, str(src), *extra]) == 2
-    assert capsys.readouterr().err == (f"hybridtrack: error: {src}: row 3, column 'variation': -3 is no reading; "
-                                       "a variation is a range, max - min, never below zero\n")
-
-
-@pytest.mark.parametrize("command", ["classify", "tune"])
-def test_the_earliest_cell_no_sensor_gives_is_refused_by_row_and_column(tmp_path, capsys, command):
-    # a label of 1e308 mA had been fitted as the brightest sun; and a negative intensity two rows
-    # below a negative variation had been named first (the columns were looked at one by one)
-    src = tmp_path / "labels.csv"
-    src.write_text("intensity,variation,weather\n246,27,sunny\n1e308,3,sunny\n-60,-3,overcast\n")
-    extra = ["--out", str(tmp_path / "t.toml"), "--folds", "0", "--seeds", "1"] if command == "tune" else []
-    assert main([command, str(src), *extra]) == 2
-    assert capsys.readouterr().err == (f"hybridtrack: error: {src}: row 3, column 'intensity': 1e+308 is no reading; "
-                                       "over 100,000 mA, which no sun sensor gives (a unit mixed up?)\n")
+    assert capsys.readouterr().err == f"hybridtrack: error: {src}: {refused}\n"
     assert not (tmp_path / "t.toml").exists()
 
 
