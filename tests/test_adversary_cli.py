@@ -190,3 +190,13 @@ def test_a_streamed_replay_of_a_file_shorter_than_a_day_is_refused_before_its_ba
                             "span has none (run it without --stream; hybridtrack.simulate from Python)\n")
     assert not out.exists()
 
+
+@pytest.mark.parametrize("argv", [["simulate", "--site", "atlantis", "--date", "2021-06-21"],
+                                  ["sun", "--site", "atlantis", "--date", "2021-06-21"],
+                                  ["check", "f.csv", "--site", "atlantis"],
+                                  ["replay", "f.csv", "--site", "atlantis"]])
+def test_an_unknown_site_is_refused_naming_the_flag(argv, capsys):
+    # 'unknown site 'atlantis'' had named no flag, as ablate's --sites had not
+    assert main(argv) == 2
+    assert capsys.readouterr().err == ("hybridtrack: error: --site: unknown site 'atlantis'; known sites: delingha, "
+                                       "kunming, lanzhou, nanjing\n")
