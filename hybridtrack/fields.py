@@ -689,9 +689,22 @@ class FieldResult:
             write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
             write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
             if self.dataset is not None:
-                write(written["log"], lambda path: self.dataset.to_netcdf(path, engine="scipy"))
+                write(written["log"], lambda path: _netcdf(self.dataset, path))
         remove_earlier(earlier)
         return written
+
+
+def _netcdf(dataset, path: Path) -> None:
+    """`dataset` to netCDF at `path`, with Dask's scheduler pinned to ``synchronous`` for the
+    write: its arrays are numpy's, nothing for Dask to compute, but xarray's writer asks Dask's
+    global scheduler for a lock, and one set to ``dask.distributed`` with no client open (a
+    ``scheduler: distributed`` in dask.yaml or ``DASK_SCHEDULER``, a default client of one's own
+    not closed) had made the save fail: 'Requested dask.distributed scheduler but no Client
+    active'. The setting is the caller's again after the write."""
+    import dask
+
+    with dask.config.set(scheduler="synchronous"):
+        dataset.to_netcdf(path, engine="scipy")
 
 
 #: The field figures `FieldResult` shows, by their summary keys (the command line's table too).

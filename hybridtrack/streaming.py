@@ -100,8 +100,28 @@ class DaySource:
     #: through, as `hybridtrack replay` does with a file in memory); None where not judged.
     wind_measured: bool | None = None
 
+    #: Whether `check_span` found a whole local day.
+    _spans_a_day: bool = field(default=False, repr=False)
+
     def __iter__(self) -> Iterator[tuple[dt.date, pd.DataFrame]]:
         return self._days()
+
+    def check_span(self) -> None:
+        """Refuse a span with no whole local day before anything runs (`stream` calls it, and the
+        command line before its progress bar): the weather is read up to its first whole day and
+        let go, a day or two of a recorded file, once per source. Read ahead and held instead, the
+        days of a logger that records only by day had been held in memory to the file's end."""
+        if self._spans_a_day:
+            return
+        days = 0
+        for day, frame in self:
+            if _whole(day, frame, self.site):
+                self._spans_a_day = True
+                return
+            days += 1
+        raise HybridtrackError(f"{self.describe}: holds no time steps" if days == 0 else
+                               f"a streamed run needs at least one whole local day at {self.site.name}; this span "
+                               "has none (run it without --stream; hybridtrack.simulate from Python)")
 
 
 def _dates(start, end) -> tuple[dt.date, dt.date]:
@@ -688,10 +708,10 @@ class _PartialRun:
         write_in_place(self.files["events"], lambda target: os.replace(self.partial["events"], target))
         shutil.rmtree(self.partial["log"], ignore_errors=True)
 
-    def abandon(self, keep: bool) -> None:
-        """After a failure: if `keep`, keep the segments done (whole, readable with `read_log`)
-        under their partial names; remove them if not, or if there are none."""
-        if not (keep and self.segments):
+    def abandon(self) -> None:
+        """After a failure: keep the segments done (whole, readable with `read_log`) under their
+        partial names; remove the partial files if there are none."""
+        if not self.segments:
             shutil.rmtree(self.partial["log"], ignore_errors=True)
             self.partial["events"].unlink(missing_ok=True)
 
@@ -724,7 +744,8 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     ----------
     source : DaySource
         The weather, a day at a time (`synthetic_days`, `recorded_days`, `frame_days`). The span
-        must hold at least one whole local day; a part day at either end runs as a short segment.
+        must hold at least one whole local day (`DaySource.check_span`, before anything runs);
+        a part day at either end runs as a short segment.
     out : str or Path
         Folder for ``log.parquet``, ``events.csv`` and ``summary.json``, claimed before the run
         (`hybridtrack.outputs.claim`: no symbolic links; existing files only under ``replacing``).
@@ -780,6 +801,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
         config = dataclasses.replace(config, engine="compiled")
     running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                              resolution=resolution)  # checks `resolution` before anything is written
+    source.check_span()
     files = stream_files(out)
     partial = partial_files(files)
     claim([*files.values(), partial["events"]], folders=[partial["log"]])  # the log's segments: a folder
@@ -798,7 +820,7 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
     start = None
     wind, cycle, last = set(), [], None
     try:
-        for day, frame in _read_to_a_whole_day(source, site):
+        for day, frame in source:
             begin = frame.index[0]
             start = begin if start is None else start
             age = (begin - start) / pd.Timedelta(days=1)
@@ -816,10 +838,8 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
             memory = result.memory
             last = {"calibration": result.summary["calibration"], "clock": result.summary["clock"]}
             del result, frame  # nothing of a segment outlives it but its memory and the running sums
-        if run.segments == 0:
-            raise HybridtrackError(f"{source.describe}: holds no time steps")
     except BaseException:
-        run.abandon(keep=True)  # the segments done, if any: a span with no whole day is refused before any runs
+        run.abandon()
         raise
     run.finish()
     summary = running.summary()
@@ -831,25 +851,6 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
                            "p95_resolution_deg": running.resolution, "weather": source.describe}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
     return StreamResult(summary, files, site, collector, config, memory)
-
-
-def _read_to_a_whole_day(source: DaySource, site) -> Iterator[tuple[dt.date, pd.DataFrame]]:
-    """The days of `source`, read ahead to its first whole local day before the first is given
-    (two days at most: a part day, then a whole one or the end): a span with no whole day is
-    refused before any of it runs (a two-row file had run, then been refused)."""
-    days = iter(source)
-    ahead = []
-    for day, frame in days:
-        ahead.append((day, frame))
-        if _whole(day, frame, site):
-            break
-    else:
-        if ahead:
-            raise HybridtrackError(f"a streamed run needs at least one whole local day at {site.name}; this span has "
-                                   "none (run it without --stream; hybridtrack.simulate from Python)")
-    yield from ahead
-    del ahead
-    yield from days
 
 
 def _whole(day: dt.date, frame: pd.DataFrame, site) -> bool:

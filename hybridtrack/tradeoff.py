@@ -61,38 +61,9 @@ class TradeoffPlan:
 
     def __post_init__(self) -> None:
         from .ablation import AblationPlan
-        from .drive import Drive
 
-        from .times import parse_freq
-
-        # a text was run a letter a period, a number raised TypeError: each is a list of values
-        for name, example in (("deadbands", "of degrees such as (0.1, 0.4)"), ("periods", "of steps such as ('1min', "
-                                                                                         "'5min')")):
-            values = getattr(self, name)
-            if not isinstance(values, (tuple, list)):
-                raise HybridtrackError(f"tradeoff: {name} must be a list {example}, got {values!r:.60}")
-            object.__setattr__(self, name, tuple(values))
-        for deadband in self.deadbands:
-            Drive(deadband=deadband)  # refuses a deadband outside 0-10°
-        steps = {}
-        for period in self.periods:
-            if not isinstance(period, str):  # a number would be nanoseconds to pandas
-                raise HybridtrackError(f"tradeoff: period {period!r:.60} is not a step such as '1min' or '10s'")
-            try:
-                step = parse_freq(period)  # as the synthetic sky reads it
-            except HybridtrackError:
-                raise HybridtrackError(f"tradeoff: period {period!r} is not a step such as '1min' or '10s'") from None
-            if not pd.Timedelta(seconds=10) <= step <= pd.Timedelta(minutes=30):
-                raise HybridtrackError(f"tradeoff: period {period!r} is outside 10 s to 30 min")
-            if step in steps:  # the same days run twice, and counted twice in the table's means
-                raise HybridtrackError(f"tradeoff: period {period!r} is given twice (as {steps[step]!r} and "
-                                       f"{period!r})")
-            steps[step] = period
-        for k, deadband in enumerate(self.deadbands):
-            if deadband in self.deadbands[:k]:
-                raise HybridtrackError(f"tradeoff: deadband {deadband!r} is given twice")
-        if not self.deadbands or not self.periods:
-            raise HybridtrackError("tradeoff: no deadbands or periods to run")
+        for name in ("deadbands", "periods"):
+            object.__setattr__(self, name, checked_grid(name, getattr(self, name), "tradeoff"))
         days = AblationPlan(self.sites, self.seasons, self.weather, self.seeds, self.collectors, (self.policy,))
         for name in ("sites", "seasons", "weather", "seeds", "collectors"):  # as the plan names them: 'Nanjing'
             object.__setattr__(self, name, getattr(days, name))  # had taken 2021's days, not SITE_YEARS' 2013
@@ -103,6 +74,46 @@ class TradeoffPlan:
                  "seed": int(seed), "collector": collector, "period": period}
                 for site in self.sites for season in self.seasons for weather in self.weather for seed in self.seeds
                 for collector in self.collectors for period in self.periods]
+
+
+def checked_grid(name: str, values, label: str) -> tuple:
+    """A `TradeoffPlan` grid field, ``deadbands`` or ``periods``, as the plan keeps it: a tuple
+    of distinct deadbands the drive takes (0-10°) or scan periods of 10 s to 30 min; refused with
+    `label` first (``tradeoff`` from Python, the flag on the command line, which had named none:
+    ``tradeoff: period '0' is not a step``)."""
+    from .drive import Drive
+    from .times import parse_freq
+
+    example = "of degrees such as (0.1, 0.4)" if name == "deadbands" else "of steps such as ('1min', '5min')"
+    # a text was run a letter a period, a number raised TypeError: each is a list of values
+    if not isinstance(values, (tuple, list)):
+        raise HybridtrackError(f"{label}: {name} must be a list {example}, got {values!r:.60}")
+    values = tuple(values)
+    if not values:
+        raise HybridtrackError(f"{label}: no {name} to run")
+    if name == "deadbands":
+        for k, deadband in enumerate(values):
+            try:
+                Drive(deadband=deadband)  # refuses a deadband outside 0-10°
+            except HybridtrackError as exc:
+                raise HybridtrackError(f"{label}: {exc}") from None
+            if deadband in values[:k]:  # the same days run twice, and counted twice in the table's means
+                raise HybridtrackError(f"{label}: deadband {deadband!r} is given twice")
+        return values
+    steps = {}
+    for period in values:
+        if not isinstance(period, str):  # a number would be nanoseconds to pandas
+            raise HybridtrackError(f"{label}: period {period!r:.60} is not a step such as '1min' or '10s'")
+        try:
+            step = parse_freq(period)  # as the synthetic sky reads it
+        except HybridtrackError:
+            raise HybridtrackError(f"{label}: period {period!r} is not a step such as '1min' or '10s'") from None
+        if not pd.Timedelta(seconds=10) <= step <= pd.Timedelta(minutes=30):
+            raise HybridtrackError(f"{label}: period {period!r} is outside 10 s to 30 min")
+        if step in steps:  # the same days run twice, and counted twice in the table's means
+            raise HybridtrackError(f"{label}: period {period!r} is given twice (as {steps[step]!r} and {period!r})")
+        steps[step] = period
+    return values
 
 
 def _day(day: dict, plan: TradeoffPlan, config) -> list[dict]:

@@ -99,3 +99,17 @@ def test_an_ablate_flag_naming_nothing_known_is_refused_naming_the_flag(flags, m
     assert main(["ablate", *flags]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"hybridtrack: error: {message}") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--periods", "0"], "--periods: period '0' is not a step such as '1min' or '10s'"),
+    (["--periods", "1min,60s"], "--periods: period '60s' is given twice (as '1min' and '60s')"),
+    (["--deadbands", "-1"], "--deadbands: drive: deadband (degrees) = -1.0 is outside [0, 10]"),
+    (["--deadbands", "0.1,0.4,0.10"], "--deadbands: deadband 0.1 is given twice"),
+])
+def test_a_tradeoff_grid_flag_is_refused_naming_the_flag(flags, message, capsys):
+    """'tradeoff: period '0' is not a step' and 'drive: deadband (degrees) = -1.0' had named no flag."""
+    from hybridtrack.cli import main
+
+    assert main(["ablate", "--tradeoff", *flags]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"

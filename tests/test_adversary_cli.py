@@ -168,3 +168,35 @@ def test_a_column_name_of_a_million_characters_is_not_matched_and_is_quoted_cut(
     path.write_text("y" * 500_000 + ",ghi\n1,2\n3,4\n")
     message = refused(path, {"tz": "UTC"}, ["--tz", "UTC"], capsys)
     assert message.endswith("; columns are 'yyyyyyyyyyyyyyyyyyyy'... (500,000 characters), ghi")
+
+
+def test_a_streamed_replay_of_a_file_shorter_than_a_day_is_refused_before_its_bar_and_notes(tmp_path, monkeypatch,
+                                                                                             capsys):
+    # a file of 06:00 to 18:00 had been simulated to its end, then refused for holding no whole
+    # local day; read ahead in the run, it was refused after the wind's note and the progress bar
+    import hybridtrack.simulation
+
+    def ran(*args, **kwargs):
+        raise AssertionError("a segment was simulated")
+
+    monkeypatch.setattr(hybridtrack.simulation, "simulate", ran)
+    path = tmp_path / "half-day.csv"
+    path.write_text("time,dni\n" + "".join(f"2021-06-05T{h:02d}:00:00+08:00,500\n" for h in range(6, 19)))
+    out = tmp_path / "run"
+    assert main(["replay", str(path), "--site", "nanjing", "--stream", "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == ("hybridtrack: error: a streamed run needs at least one whole local day at nanjing; this "
+                            "span has none (run it without --stream; hybridtrack.simulate from Python)\n")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv", [["simulate", "--site", "atlantis", "--date", "2021-06-21"],
+                                  ["sun", "--site", "atlantis", "--date", "2021-06-21"],
+                                  ["check", "f.csv", "--site", "atlantis"],
+                                  ["replay", "f.csv", "--site", "atlantis"]])
+def test_an_unknown_site_is_refused_naming_the_flag(argv, capsys):
+    # 'unknown site 'atlantis'' had named no flag, as ablate's --sites had not
+    assert main(argv) == 2
+    assert capsys.readouterr().err == ("hybridtrack: error: --site: unknown site 'atlantis'; known sites: delingha, "
+                                       "kunming, lanzhou, nanjing\n")

@@ -231,6 +231,18 @@ MATRIX = [
         "[inputs.variation]\nraw_range = [0, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n"),
      lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
      "inputs.intensity: raw_range must be two finite numbers [low, high] with low < high, got [30.0, inf]"),
+    # it had mapped every reading a sensor gives onto the universe's floor: each day overcast
+    ("fuzzy config: a raw_range past any reading", config_file(
+        "[inputs.intensity]\nraw_range = [30, 1e308]\nterms.weak = {shape='gaussmf', params=[0, 1]}\n"
+        "[inputs.variation]\nraw_range = [0, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
+     "inputs.intensity: raw_range [30.0, 1e+308]: 1e+308 is no reading; over 100,000 mA, which no sun sensor gives"),
+    ("fuzzy config: a raw_range below zero", config_file(
+        "[inputs.intensity]\nraw_range = [30, 300]\nterms.weak = {shape='gaussmf', params=[0, 1]}\n"
+        "[inputs.variation]\nraw_range = [-20, 180]\nterms.small = {shape='gaussmf', params=[0, 1]}\n"),
+     lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],
+     "inputs.variation: raw_range [-20.0, 180.0]: -20 is no reading; a variation is a range, max - min, never "
+     "below zero"),
     ("fuzzy config: NaN membership parameter", config_file(
         "[output]\nterms.overcast = {shape='trimf', params=[0, nan, 10]}\n"),
      lambda p: FuzzyConfig.from_toml(p), lambda p: CLASSIFY + ["--config", str(p)],

@@ -669,3 +669,19 @@ def test_a_trough_loop_of_collectors_too_short_to_stand_apart_is_refused():
     with pytest.raises(HybridtrackError, match="got 0.5"):
         TroughLoop(count=2, collector_length=0.5)
     np.testing.assert_array_equal(TroughLoop(count=2, collector_length=1.0).positions, [[0, 0, 0], [0, 1, 0]])
+
+
+def test_a_field_saves_its_log_whatever_dasks_global_scheduler_says(day, tmp_path):
+    """A Dask scheduler set to dask.distributed with no client open (a dask.yaml, DASK_SCHEDULER,
+    a default client left unclosed; our sweep's clients had set it, the flaky order test_sweep.py
+    then test_cli_field.py) had failed the save in xarray's netCDF writer: 'Requested
+    dask.distributed scheduler but no Client active'. The log holds numpy arrays: no Dask at all."""
+    import dask
+    import xarray as xr
+
+    result = simulate_field(day.iloc[600:660], "lanzhou", TroughLoop(count=2))
+    with dask.config.set(scheduler="dask.distributed"):
+        written = result.save(tmp_path / "field")
+        assert dask.config.get("scheduler") == "dask.distributed"  # the caller's setting, as it was
+    with xr.open_dataset(written["log"], engine="scipy") as saved:
+        assert dict(saved.sizes) == {"collector": 2, "time": 60}

@@ -658,3 +658,32 @@ def test_a_span_with_no_whole_day_is_refused_before_any_of_it_runs(tmp_path, mon
     with pytest.raises(HybridtrackError, match="needs at least one whole local day"):
         stream(recorded_days(tmp_path / "part.parquet", SITE), tmp_path / "part")
     assert ran == [] and not (tmp_path / "part").exists()
+
+
+def test_a_span_of_part_days_is_refused_holding_one_day_at_a_time(tmp_path):
+    """A logger that records only by day gives a part day each day: the span is refused, its days
+    read one at a time and let go (read ahead and held, every day had been in memory at once)."""
+    import gc
+    import weakref
+
+    from hybridtrack import sites
+    from hybridtrack.sky import synthetic
+    from hybridtrack.streaming import DaySource
+
+    alive = []
+
+    def days():
+        for k in range(5):
+            date = pd.Timestamp("2021-03-10") + pd.Timedelta(days=k)
+            day = synthetic(SITE, date, weather="sunny", freq="10min").between_time("06:00", "18:00")
+            gc.collect()
+            alive.append(sum(ref() is not None for ref in refs))  # the days before this one still held
+            refs.append(weakref.ref(day))
+            yield date.date(), day
+
+    refs = []
+    source = DaySource(sites.get(SITE), "daytime only", None, None, days)
+    with pytest.raises(HybridtrackError, match="needs at least one whole local day"):
+        stream(source, tmp_path / "run")
+    assert len(alive) == 5 and max(alive) <= 1, alive  # the day before at most, while the next is read
+    assert not (tmp_path / "run").exists()

@@ -133,13 +133,16 @@ def _tradeoff(args: argparse.Namespace) -> int:
     """``ablate --tradeoff``: one policy over deadbands and scan periods."""
     from tqdm import tqdm
 
-    from ..tradeoff import TradeoffPlan, tradeoff
+    from ..tradeoff import TradeoffPlan, checked_grid, tradeoff
 
     deadbands = DEADBANDS if args.deadbands is None else args.deadbands  # "" is refused, not the default
     periods = PERIODS if args.periods is None else args.periods
     days = _plan(args, ((args.policies or ["hybrid"])[0],))  # its sites by their own names (SITE_YEARS)
-    plan = TradeoffPlan(_deadbands(deadbands), tuple(p.strip() for p in periods.split(",")), days.sites, days.seasons,
-                        days.weather, days.seeds, days.collectors, days.policies[0])
+    # refused naming the flag ('tradeoff: period '0' is not a step' and 'drive: deadband' had named none)
+    grid = {name: checked_grid(name, values, f"--{name}") for name, values in
+            (("deadbands", _deadbands(deadbands)), ("periods", tuple(p.strip() for p in periods.split(","))))}
+    plan = TradeoffPlan(grid["deadbands"], grid["periods"], days.sites, days.seasons, days.weather, days.seeds,
+                        days.collectors, days.policies[0])
     config = _config(args)
     files = _files(args.out, "tradeoff.png")
     claim(files)  # before the runs, not after them

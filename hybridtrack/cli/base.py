@@ -95,7 +95,8 @@ def site_from_arguments(args: argparse.Namespace, *, clock_required: bool = True
         if any(value is not None for value in given):
             flags = "--lat/--lon/--altitude" + ("/--site-tz" if record else "/--tz")
             raise HybridtrackError(f"give either --site or {flags}, not both")
-        return sites.get(args.site)
+        with flag_named("--site"):  # 'unknown site 'atlantis'' had named no flag
+            return sites.get(args.site)
     clock = (site_tz or args.tz) if record else args.tz
     if args.lat is not None and args.lon is not None:
         if clock is None and (clock_required or not record):

@@ -129,6 +129,7 @@ def _stream(source, args, config, *, heading: str) -> int:
     if not args.out:
         raise HybridtrackError("--stream writes its log to disk: give --out FOLDER")
     claim(stream_files(args.out).values())  # a bad --out is refused before the bar
+    source.check_span()  # and a span without a whole local day
     with leaving_out(args, [Result.files(args.out)["report"]], "--stream"), \
             progress_bar(source, label=config.controller.strategy) as bar:
         result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
@@ -245,6 +246,7 @@ def _replay(args: argparse.Namespace) -> int:
         _refuse_reading_flags(args)
         site = site_from_arguments(args)
         source = recorded_days(args.file, site, tz=args.tz)
+        source.check_span()  # before the wind's note
         config = replay_config(args, source.wind_measured)
         return _stream(source, args, config,
                        heading=f"replay of {args.file} at {site.name}, {collector_from_arguments(args).kind}, "

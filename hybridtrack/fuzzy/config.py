@@ -367,10 +367,17 @@ class FuzzyConfig:
         if self.input_names == INPUT_NAMES[::-1]:  # the photocurrent had been scored as the variation
             raise HybridtrackError("inputs: intensity must come first, then variation (the classifier takes a "
                                    f"reading's intensity and variation in that order), got {list(self.input_names)}")
-        for var in self.inputs:
+        from .classifier import impossible_reading
+
+        for var, reading in zip(self.inputs, INPUT_NAMES):
             var.check(f"inputs.{var.name}")
             if var.raw_range is None:
                 raise HybridtrackError(f"inputs.{var.name}: raw_range is missing")
+            # the readings a sensor gives: [30, 1e308] mA had mapped every real one onto the universe's floor
+            bound = next((v for v in var.raw_range if impossible_reading(v, reading)), None)
+            if bound is not None:
+                raise HybridtrackError(f"inputs.{var.name}: raw_range {list(var.raw_range)}: {bound:g} is no reading; "
+                                       f"{impossible_reading(bound, reading)}")
         self.output.check(f"output.{self.output.name}")
         self._validate_reach()
         if len(set(self.input_names)) != 2 or self.output.name in self.input_names:
