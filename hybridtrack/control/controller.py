@@ -27,7 +27,7 @@ from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, O
                     SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
-from .sensing import SensorGate
+from .sensing import SensorGate, axis_offset
 from .skywatch import ClassifierTable, SkyWatch
 from .wind import WindGuard, unreadable, unreadable_reason
 
@@ -437,7 +437,8 @@ class Controller:
             if verdict == OK and obs.t < self.distrusted_until:
                 verdict = IMPLAUSIBLE
             if verdict == OK:
-                verdict = self._offer(i, a, dt, reading[a] + obs.offset[a], trusted)
+                offset, measures = axis_offset(obs.offset, a, reading)
+                verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures)
             valid[a] = verdict == OK
             if valid[a]:
                 self.out_axes["sun"][a][i] = gate.filter.angle
@@ -671,7 +672,8 @@ class Controller:
     def _night_target(self, a: int) -> float:
         return self.park[a] if self.config.sensor_only else self.drives[a].stow
 
-    def _target(self, i: int, a: int, t: float, dt: float, reading: float, valid: bool, obs: Observation) -> float:
+    def _target(self, i: int, a: int, t: float, dt: float, reading: float, valid: bool, rough: float) -> float:
+        """The angle to drive axis `a` to; `rough` is the acquisition cells' offset in its degrees."""
         mode, gate, drive = self.mode, self.gates[a], self.drives[a]
         lead = self.config.lead
         if mode == STOW_WIND:
@@ -686,7 +688,7 @@ class Controller:
                 return gate.filter.angle + (_lead(gate.filter.rate, dt, drive.deadband) if lead else 0.0)
             # a filter coasted beyond the plausibility bound of the calibrated model: the computed target
         if mode == SEARCH:
-            rough = obs.coarse[a]  # the drive's speed limits the step; a scan later the cells look again
+            # the drive's speed limits the step; a scan later the cells look again
             return reading if math.isnan(rough) else reading + rough
         m = self.model[a][i]
         if math.isnan(m):
@@ -735,7 +737,8 @@ class Controller:
                 moves.append(step)
                 continue
             low, high = drive.limits
-            target = min(max(self._target(i, a, t, dt, reading[a], valid[a], obs), low), high)
+            rough, _ = axis_offset(obs.coarse, a, reading)
+            target = min(max(self._target(i, a, t, dt, reading[a], valid[a], rough), low), high)
             error = target - reading[a]
             held = mode == STOW_WIND and abs(reading[a] - drive.stow) <= drive.deadband  # stowed: never move
             threshold = drive.resolution if stowing or mode == SEARCH else drive.deadband
