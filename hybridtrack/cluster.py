@@ -61,6 +61,14 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         Worker processes of the local cluster (one thread each); the machine's cores when None.
     what : str
         What needs Dask, for the message when it is missing.
+
+    Notes
+    -----
+    The client is not made Dask's default (``set_as_default=False``): the runs are given to it by
+    name, and Dask's global scheduler setting stays the caller's. As the default, an open client
+    had set it to ``dask.distributed`` for the whole process, and one not closed in turn left it
+    so: the next field's save (xarray's netCDF writer asks Dask for its scheduler) then failed with
+    "Requested dask.distributed scheduler but no Client active".
     """
     try:
         from dask.distributed import Client, LocalCluster
@@ -69,7 +77,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
     check_where(scheduler, workers)
     if scheduler:
         try:
-            client = Client(scheduler, timeout="10s")
+            client = Client(scheduler, timeout="10s", set_as_default=False)
         # TypeError: distributed's TLS and UCX connectors refuse to start without their setup
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
@@ -96,7 +104,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
     if held:  # a SIGTERM came while the workers started: stop them, then end as it asks
         close_cluster(cluster)
         signal.raise_signal(signal.SIGTERM)
-    return Client(cluster), cluster
+    return Client(cluster, set_as_default=False), cluster
 
 
 #: Seconds a running scheduler is given to have a worker: its runs would wait for one forever.
@@ -137,7 +145,7 @@ def finished(client, futures: Iterable) -> Iterator[tuple]:
     A task must not return an exception's (type, value, traceback): distributed gives an error so."""
     from dask.distributed import as_completed
 
-    done = as_completed(futures, with_results=True, raise_errors=False)
+    done = as_completed(futures, loop=client.loop, with_results=True, raise_errors=False)  # not the default client
     alone_since = None
     while not done.is_empty():
         if done.has_ready():

@@ -43,3 +43,9 @@ def blamed(check, given: dict, error: str) -> list:
         return []
     alone = [key for key in given if refusal({key: given[key]}) == error]
     return alone or [key for key in given if refusal({k: v for k, v in given.items() if k != key}) != error]
+
+
+def quoted_cut(text: str, longest: int) -> str:
+    """`text` quoted as a message shows it: cut to its first 20 characters, with its length, when
+    longer than `longest` (a corrupted cell or header of millions of characters)."""
+    return repr(text) if len(text) <= longest else f"{text[:20]!r}... ({len(text):,} characters)"

@@ -16,6 +16,7 @@ every step in one call of the broadcasting functions of `hybridtrack.collectors`
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import dataclasses
 import math
@@ -907,15 +908,23 @@ def _blocks(frame: pd.DataFrame, runs: list, job: dict, threads: int, workers: i
 
 def _threaded(frame: pd.DataFrame, runs: list, job: dict, threads: int):
     """Each collector's result as it is done, on `threads` threads sharing this context's memory
-    of the sky (each task runs in a copy of the context, whose memories are the same objects)."""
+    of the sky (each task runs in a copy of the context, whose memories are the same objects).
+
+    With more than one thread, the first collector runs alone first, its world and its plan side
+    by side (`hybridtrack.simulation.track`): they compute the pieces every later run shares
+    (the true sun and the sky on one side, the controller's clock, sun and derivatives on the
+    other) at once, where two first runs on two threads had computed one side while the other
+    thread waited for it, then the other side the same way."""
     if threads == 1:
         for run in runs:
             yield run_collectors(frame, [run], **job)
         return
     from concurrent.futures import ThreadPoolExecutor, as_completed
 
+    yield run_collectors(frame, runs[:1], **job, side_by_side=True)
     with ThreadPoolExecutor(threads, thread_name_prefix="hybridtrack-field") as pool:
-        futures = [pool.submit(contextvars.copy_context().run, run_collectors, frame, [run], **job) for run in runs]
+        futures = [pool.submit(contextvars.copy_context().run, run_collectors, frame, [run], **job)
+                   for run in runs[1:]]
         try:
             for future in as_completed(futures):
                 yield future.result()
@@ -924,17 +933,21 @@ def _threaded(frame: pd.DataFrame, runs: list, job: dict, threads: int):
                 future.cancel()
 
 
-def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, seed: int, keep_log: bool) -> list:
+def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, seed: int, keep_log: bool,
+                   side_by_side: bool = False) -> list:
     """Run a block of a field's collectors, each ``(i, name, collector, imperfections)``, and
     return for each ``(i, row, events, log)``: its row of the collector table, its events and
     its log's kept columns (`LOG_VARIABLES`, as arrays; None unless `keep_log`). The sun and sky
-    every run of the block asks for are computed once (`hybridtrack.reuse.reuse_work`)."""
+    every run of the block asks for are computed once (`hybridtrack.reuse.reuse_work`). Each run
+    keeps to its thread unless `side_by_side`, when its world and plan take a second thread as
+    `simulate`'s do."""
     from .metrics import offered_light
     from .reuse import reuse_work
     from .simulation import _scored, one_thread, track
 
     done = []
-    with reuse_work(), one_thread():  # the field spreads its runs over the cores itself
+    # the field spreads its runs over the cores itself
+    with reuse_work(), contextlib.nullcontext() if side_by_side else one_thread():
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))

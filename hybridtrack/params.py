@@ -19,7 +19,7 @@ import pandas as pd
 
 from .errors import HybridtrackError
 
-__all__ = ["number", "whole", "seed", "duration", "angle_pair"]
+__all__ = ["number", "whole", "seed", "duration", "refuse_unitless", "LONGEST_DURATION", "angle_pair"]
 
 #: The largest seed: numpy's generators take any non-negative integer; this keeps it in 64 bits.
 MAX_SEED = 2**63 - 1
@@ -87,14 +87,36 @@ def timedelta(text) -> pd.Timedelta:
     return pd.Timedelta(_LOWER_DAY.sub("D", text) if isinstance(text, str) else text)
 
 
+_BARE_NUMBER = re.compile(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*")
+
+
+def refuse_unitless(value, what: str) -> None:
+    """Refuse a duration written as a bare number (``5``, ``"5"``), naming `what`: pandas reads
+    one as nanoseconds, so a TOML ``dwell = "5"`` had been a dwell of 5 ns."""
+    if (_real(value) and not isinstance(value, np.timedelta64)) or \
+            (isinstance(value, str) and _BARE_NUMBER.fullmatch(value)):
+        shown = str(value).strip()
+        raise HybridtrackError(f"{what} {value!r} has no unit; write it with one, such as '{shown}min' or '{shown}s'")
+
+
+#: The longest controller or sensor timing `duration` takes: each (a dwell, a hold, a window, a
+#: time constant, a distrust) works within the controller's day, whose offsets and windows start
+#: afresh each morning; a longer one is a slip of unit (``"400D"`` for ``"400min"``).
+LONGEST_DURATION = pd.Timedelta(days=1)
+
+
 def duration(text, name: str) -> pd.Timedelta:
-    """A positive, finite duration such as ``"20min"``."""
+    """A positive, finite duration with a unit such as ``"20min"``, at most `LONGEST_DURATION`."""
+    refuse_unitless(text, name)
     try:
         value = timedelta(text)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         value = None
     if value is None or value is pd.NaT or value <= pd.Timedelta(0):
         raise HybridtrackError(f"{name} {text!r} is not a positive duration such as '20min'")
+    if value > LONGEST_DURATION:
+        raise HybridtrackError(f"{name} {text!r} is longer than a day, the controller's day that every timing "
+                               "works within: a slip of unit?")
     return value
 
 

@@ -149,7 +149,8 @@ def _as_written(value: str, form: re.Pattern, parse):
 
 
 def parse_freq(text: str) -> pd.Timedelta:
-    """Parse a positive step such as ``1min``, ``10s`` or ``1h``."""
+    """Parse a positive step such as ``1min``, ``10s`` or ``1h``; a bare number is refused."""
+    params.refuse_unitless(text, "step")
     try:
         step = params.timedelta(str(text))
     except ValueError:

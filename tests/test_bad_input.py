@@ -567,8 +567,9 @@ def test_a_sensor_too_dull_to_see_the_sun_is_refused_and_the_dullest_taken_runs(
 def test_a_config_that_never_ends_is_refused_at_its_limit(capsys):
     """``--config /dev/zero`` had been read until the memory ran out (a MemoryError traceback)."""
     assert main(["simulate", "--site", "lanzhou", "--date", "2021-06-21", "--config", "/dev/zero"]) == 2
-    assert capsys.readouterr().err == ("hybridtrack: error: /dev/zero: larger than 16 MiB, more than a config file "
-                                       "can be (a device that never ends?)\n")
+    # refused at its first piece as binary (before, once 16 MiB had been read, as too large)
+    assert capsys.readouterr().err == ("hybridtrack: error: /dev/zero: looks binary, not a text config file (a device "
+                                       "or a stream of binary data?)\n")
 
 
 def test_a_file_is_read_whole_up_to_its_limit_and_refused_one_byte_past_it(tmp_path):

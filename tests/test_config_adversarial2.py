@@ -77,3 +77,24 @@ def test_a_config_of_comments_alone_is_read_as_the_defaults(tmp_path):
     path = tmp_path / "run.toml"
     path.write_text("# every setting at its default\n")
     assert SimulationConfig.from_toml(path) == SimulationConfig()
+
+
+@pytest.mark.parametrize("value", ["5", 5, 5.0, " 5 "])
+def test_a_duration_without_a_unit_is_refused_not_read_as_nanoseconds(value):
+    """pandas reads a bare number as nanoseconds: a TOML `dwell = "5"` had been a dwell of 5 ns
+    (and `dwell = 5` too), a mode switch allowed at every scan, without a word."""
+    from hybridtrack.control import ControllerConfig
+
+    with pytest.raises(HybridtrackError, match=r"controller: dwell .*5.* has no unit; write it with one, such as '5(\.0)?min'"):
+        ControllerConfig(dwell=value)
+
+
+@pytest.mark.parametrize("name, value", [("wind_hold", "400D"), ("distrust", "25h"), ("calibration_tau", "2D")])
+def test_a_controller_timing_longer_than_a_day_is_refused(name, value):
+    """Every controller timing works within its day (offsets and windows start afresh each
+    morning); `wind_hold = "400D"` (for 400min) had held the stow for 400 days."""
+    from hybridtrack.control import ControllerConfig
+
+    with pytest.raises(HybridtrackError, match=f"controller: {name} '{value}' is longer than a day"):
+        ControllerConfig(**{name: value})
+    assert ControllerConfig(**{name: "24h"}).minutes(name) == 1440.0

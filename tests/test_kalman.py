@@ -60,3 +60,40 @@ def test_the_fast_filter_is_filterpys_at_every_step(seed, q, r):
 def test_the_engines_are_chosen_by_name():
     assert isinstance(make_filter("fast", 1e-4, 0.0025), FastKalman)
     assert isinstance(make_filter("filterpy", 1e-4, 0.0025), FilterpyKalman)
+
+
+@pytest.mark.parametrize("strategy", ["sensor", "hybrid-always"])
+def test_a_reading_the_gate_rejects_advances_the_filter_one_scan_not_two(strategy):
+    """A reading that fails the innovation gate is a scan with no measurement: the filter predicts
+    across that scan once. The controller's gate predicts before it judges the innovation; the
+    controller then coasted every gate without a taken reading, so an outlier scan had predicted
+    twice: the angle ran a scan's motion ahead and the variance grew twice. Compared with filterpy
+    predicting once from the state before the scan."""
+    from hybridtrack.control import Controller, ControllerConfig, ControllerPlan, Observation
+    from hybridtrack.control.modes import SENSOR_STATUS
+    from hybridtrack.drive import Drive
+    from hybridtrack.fuzzy import FuzzyWeatherClassifier
+    from hybridtrack.skyinputs import SkyInputConfig
+
+    n, outlier = 60, 40
+    model = np.linspace(40.0, 40.0 + 0.25 * (n - 1), n)[:, None]  # the sun at 0.25° a minute
+    plan = ControllerPlan(np.arange(n, dtype=float), model, np.ones(n, bool), np.zeros(n))
+    config = ControllerConfig(strategy=strategy)
+    controller = Controller(config, [Drive()], plan, FuzzyWeatherClassifier(), SkyInputConfig.published(), 30.0,
+                            [90.0])
+    gate = controller.gates[0]
+    obs, angle = Observation(1), 90.0
+    for i in range(n):
+        before = (gate.filter.angle, gate.filter.rate, gate.filter.p00, gate.filter.p01, gate.filter.p11)
+        obs.i, obs.t, obs.wind, obs.intensity, obs.true_sky = i, float(i), 3.0, 280.0, -1
+        miss = 1.5 if i == outlier else 0.0  # far outside the gate, inside the 2° plausibility bound
+        obs.encoder[0], obs.offset[0], obs.valid, obs.coarse[0] = angle, model[i, 0] - angle + miss, True, 0.0
+        angle = min(max(angle + controller.step(obs)[0], 0.0), 180.0)
+        if i == outlier:
+            break
+    assert SENSOR_STATUS[controller.outputs().sensor_status[outlier]] == "outlier"
+    kf = reference(config.process_noise, gate.filter.r, before[0], before[1])
+    kf.P = np.array([[before[2], before[3]], [before[3], before[4]]])
+    predict(kf, config.process_noise, 1.0)
+    assert gate.filter.angle == pytest.approx(kf.x[0, 0], abs=1e-12)
+    assert gate.filter.p00 == pytest.approx(kf.P[0, 0], rel=1e-12)

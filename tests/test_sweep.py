@@ -320,8 +320,8 @@ def test_bad_sweep_input_is_one_line_and_status_2(tmp_path, capsys, content, fla
     (["--scheduler", "nonsense://x"], "cannot reach the Dask scheduler at nonsense://x: unknown address scheme"),
     (["--scheduler", "tcp://"], "cannot reach the Dask scheduler at tcp://: "),
     (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "give either --scheduler or --workers, not both"),
-    (["--workers", "0"], "workers must be a whole number within [1, 1,024], got 0"),
-    (["--scheduler", ""], "scheduler must be an address such as 'tcp://host:8786', got ''"),
+    (["--workers", "0"], "--workers must be a whole number within [1, 1,024], got 0"),
+    (["--scheduler", ""], "--scheduler must be an address such as 'tcp://host:8786', got ''"),
 ])
 def test_where_the_runs_go_is_checked_before_anything_is_printed(tmp_path, capsys, flags, message):
     """The run count ("s.toml: 2 runs over seed") had been printed above the refusal."""
@@ -766,3 +766,25 @@ def test_a_local_cluster_takes_no_more_workers_than_the_longest_runs_fit_in_memo
         sweeps._workers_that_fit(sweep, runs, 3, chosen=True)
     monkeypatch.setattr(budget, "memory_budget", lambda: 1_000_000)  # not one: each run's own check says so
     assert sweeps._workers_that_fit(sweep, runs, 2, chosen=False) == 1
+
+
+def test_a_dask_client_of_ours_leaves_dasks_scheduler_setting_and_default_client_alone():
+    """dask_client's clients were made Dask's default: while one was open Dask's global scheduler
+    setting read 'dask.distributed', and one not closed in turn left it so, after which a field's
+    save failed in xarray's netCDF writer ('Requested dask.distributed scheduler but no Client
+    active'; seen after this file's tests, now and then). No client of ours is the default."""
+    import dask
+    from dask.distributed import LocalCluster, default_client
+
+    from hybridtrack.cluster import close, dask_client
+
+    before = dask.config.get("scheduler", None)
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        client, _ = dask_client(cluster.scheduler_address, None)
+        try:
+            assert dask.config.get("scheduler", None) == before
+            with pytest.raises(ValueError, match="No clients found"):
+                default_client()
+        finally:
+            close(client, None)
+    assert dask.config.get("scheduler", None) == before

@@ -82,4 +82,8 @@ def test_a_day_step_in_lower_case_reads_without_pandas_deprecation_warning(text,
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert parse_freq(text) == pd.Timedelta(days=days)
-        assert duration(text, "dwell") == pd.Timedelta(days=days)
+        if days <= 1:
+            assert duration(text, "dwell") == pd.Timedelta(days=days)
+        else:  # read as days, then refused: no controller timing is longer than its day
+            with pytest.raises(HybridtrackError, match=f"dwell '{text}' is longer than a day"):
+                duration(text, "dwell")

@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import re
 import signal
 import sys
 import threading
@@ -51,6 +52,9 @@ class OneLineParser(argparse.ArgumentParser):
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
+        # argparse takes '-1e9' and '-inf' for options, not values (its negative numbers are only
+        # '-12' and '-1.5'): '--altitude -1e3' had been refused as '--altitude: expected one argument'
+        self._negative_number_matcher = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$|^-(?i:inf|infinity)$")
         self.register("action", None, _StoreOnce)
         self.register("action", "store", _StoreOnce)
 
@@ -104,6 +108,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         with _terminate_as_interrupt(), reader_may_leave():  # --help and --version print here too: a full standard output is one line
             args = build_parser().parse_args(argv)
             _refuse_empty_paths(args)
+            _check_zones_and_steps(args)
             with replacing(getattr(args, "force", False)) as replaced, removing_empty_folders():
                 status = args._run(args)
                 if replaced:
@@ -163,6 +168,35 @@ def _refuse_empty_paths(args) -> None:
             raise HybridtrackError(f"--{name} is empty: give a file to read, or leave --{name} out (an unset shell "
                                    "variable?)")
         setattr(args, name, os.path.expanduser(value))
+
+
+#: The options that name a time zone.
+_ZONE_OPTIONS = ("tz", "site_tz")
+
+
+def _check_zones_and_steps(args) -> None:
+    """Refuse a time zone flag that is empty or no zone, and a step without its unit, by the flag.
+
+    ``--tz ''`` (``--tz "$TZ"`` with TZ unset) had been read as no zone: ``sun --lat --lon --tz ''``
+    ran in UTC without a word, and ``--site-tz ''`` was dropped for the file's zone. A zone no one
+    knows was refused without naming ``--tz``. A step of a bare number (``--freq 10``) is read by
+    pandas as nanoseconds, and had been refused as a step of 10ns needing 10,800,000 GB.
+    """
+    from ..params import refuse_unitless
+    from ..times import check_tz
+
+    for name in _ZONE_OPTIONS:
+        value = getattr(args, name, None)
+        if not isinstance(value, str):
+            continue
+        flag = "--" + name.replace("_", "-")
+        if not value.strip():
+            raise HybridtrackError(f"{flag} is empty: give an IANA time zone such as Asia/Shanghai, or leave {flag} "
+                                   "out (an unset shell variable?)")
+        check_tz(value, f"{flag}: ")
+    freq = getattr(args, "freq", None)
+    if isinstance(freq, str):
+        refuse_unitless(freq, "--freq: step")
 
 
 if __name__ == "__main__":  # pragma: no cover

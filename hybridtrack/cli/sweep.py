@@ -20,10 +20,16 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
 @command("sweep", "run a grid of runs (config fields, sites, dates, weather, seeds, strategies, collectors) on Dask",
          _sweep_arguments)
 def _sweep(args: argparse.Namespace) -> int:
-    from ..cluster import check_where
+    from ..cluster import MAX_WORKERS, check_where
+    from ..params import whole
     from ..outputs import claim, held
     from ..sweep import Sweep, SweepInterrupted, partial_file, pareto_front, run_sweep, save_sweep, sweep_files
 
+    if args.workers is not None:  # named as the flag, as field's is ('workers must be ...' had not been)
+        whole(args.workers, "--workers", 1, MAX_WORKERS)
+    if args.scheduler is not None and not args.scheduler.strip():  # --scheduler "$ADDR" with ADDR unset
+        raise HybridtrackError(f"--scheduler must be an address such as 'tcp://host:8786', got {args.scheduler!r}; "
+                               "leave it out for a local cluster (an unset shell variable?)")
     check_where(args.scheduler, args.workers)  # before anything is printed: a refusal is the one line
     sweep = Sweep.from_toml(args.file)
     # a folder that cannot be used fails now, not after the runs

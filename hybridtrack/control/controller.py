@@ -23,7 +23,7 @@ from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import AXIS_NAMES, EncoderMonitor
 from .mountfit import MountEstimator, ordered_dot, pull_spread
-from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, SEARCH, SENSOR,
+from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, OUTLIER, SEARCH, SENSOR,
                     SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
@@ -431,6 +431,7 @@ class Controller:
         status = OK
         trusted = config.calibrates and self._trusts_sensor(sky, obs)
         self.held_miss = math.nan
+        predicted = [False] * self.axes  # a gate that judged an outlier has predicted across this scan
         for a, gate in enumerate(self.gates):
             verdict = gate.judge(obs.offset[a], obs.valid, obs.coarse[a],
                                  self._turn(a, self._expected_sun(i, a, t) - reading[a]))
@@ -439,13 +440,13 @@ class Controller:
             if verdict == OK:
                 offset, measures = axis_offset(obs.offset, a, reading)
                 verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures)
-            valid[a] = verdict == OK
+            valid[a], predicted[a] = verdict == OK, verdict == OUTLIER
             if valid[a]:
                 self.out_axes["sun"][a][i] = gate.filter.angle
             if verdict != OK and status == OK:
                 status = verdict
         for a, gate in enumerate(self.gates):
-            if not valid[a]:
+            if not (valid[a] or predicted[a]):
                 gate.coast(dt)
         self._held_off(i, t, all(valid))
         if all(valid):

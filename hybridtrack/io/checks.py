@@ -57,6 +57,7 @@ _HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "
 #: What each repair did, for strict mode's refusal.
 REPAIRS = {
     "unreadable": "text in a numeric column", "truncated": "a last line cut short",
+    "short_rows": "a line with fewer fields than the header",
     "missing_markers": "a logger's missing-value marker",
     "dst_dropped": "a time stamp that does not exist in the time zone",
     "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",

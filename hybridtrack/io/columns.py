@@ -15,7 +15,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
-from ..errors import HybridtrackError
+from ..errors import HybridtrackError, quoted_cut
 from .units import any_known_unit
 
 __all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "STAMP_PARTS", "split_header",
@@ -104,7 +104,21 @@ def check_names(mapping: Mapping[str, str], flag: str) -> None:
             raise HybridtrackError(f"unknown column name {name!r} in {flag}; use {', '.join(allowed)}")
 
 
+#: The longest column name read as a quantity's: the longest aliases with a unit and a note
+#: (``Direct Normal Irradiance (W/m^2) [CHP1 s/n 123456]``) are under 100 characters. A header
+#: cell of a million characters (a corrupted first line) had taken 3 seconds to match per
+#: million, and was printed whole in the report's ``not read`` line.
+LONGEST_NAME = 256
+
+
+def name_shown(header: str) -> str:
+    """A column's name as a message or the report quotes it: a long one cut, with its length."""
+    return quoted_cut(header, LONGEST_NAME)
+
+
 def _matches(header: str, name: str) -> bool:
+    if len(header) > LONGEST_NAME:
+        return False
     base = split_header(header)[0]
     return base in ALIASES[name] or (name == "time" and header.strip().lower() in ALIASES["time"])
 
@@ -121,7 +135,7 @@ def resolve_columns(where: str, headers: list[str], columns: Mapping[str, str] |
     for name, header in columns.items():
         found = _find(headers, header)
         if found is None:
-            shown = ", ".join(repr(h) if not h.strip() else h for h in headers)
+            shown = ", ".join(name_shown(h) if not h.strip() or len(h) > LONGEST_NAME else h for h in headers)
             raise HybridtrackError(f"{where}: no column {header!r} (mapped to {name}); columns are {shown}")
         twice = next((other for other, taken in mapping.items() if taken == found), None)
         if twice is not None:
@@ -159,7 +173,7 @@ def not_read(headers: list[str], mapping: Mapping[str, str]) -> list[str]:
         if header in taken or not header.strip() or split_header(header)[0] == LABEL_COLUMN:
             continue
         like = next((name for name in WEATHER_COLUMNS if _matches(header, name)), None)
-        shown.append(repr(header) + (f" (looks like {like})" if like else ""))
+        shown.append(name_shown(header) + (f" (looks like {like})" if like else ""))
     return shown
 
 

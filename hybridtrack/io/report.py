@@ -14,7 +14,7 @@ import pandas as pd
 __all__ = ["validation_report", "ISSUES"]
 
 #: Report keys that make the verdict "usable, with issues" rather than "clean".
-ISSUES = ("unreadable", "missing_markers", "truncated", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
+ISSUES = ("unreadable", "missing_markers", "truncated", "short_rows", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
           "impossible", "light_at_night", "wind_missing", "empty_dropped")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
@@ -25,6 +25,7 @@ _CHANGES = {
     "padding": "dropped (NUL bytes after the text: a logger card's unwritten tail)",
     "units_converted": "converted", "unreadable": "set to NaN (unreadable text)",
     "truncated": "dropped (a last line cut short)",
+    "short_rows": "padded with NaN (lines short of fields)",
     "missing_markers": "set to NaN (a logger's missing-value marker: -9999, 7999, ...)",
     "dst_dropped": "dropped (DST: stamps that do not exist)", "unsorted": "sorted (stamps out of order)",
     "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
@@ -64,7 +65,8 @@ def _head(report: dict, frame: pd.DataFrame) -> list[str]:
     if "header_notes" in report:
         lines.append(f"  header notes (not units, ignored): {_describe(report['header_notes'])}")
     lines.append(f"  time: {report.get('time', '?')}" + "".join(f"; {prefix}{report[key]}" for key, prefix in
-                                                            (("offset_written", ""), ("date_order", "dates "))
+                                                            (("offset_written", ""), ("date_order", "dates "),
+                                                             ("end_of_day", ""))
                                                             if key in report))
     if "site" in report:
         lines.append(f"  site: {report['site']}")

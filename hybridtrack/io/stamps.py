@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import HybridtrackError
+from ..errors import HybridtrackError, quoted_cut
 
 __all__ = ["parse_stamps", "fixed_zone", "offset_in_name", "CLOCK_ZONES"]
 
@@ -95,7 +95,18 @@ class _Column:
 
     def refuse(self, row: int, problem: str):
         raise HybridtrackError(f"{self.path}: line {int(self.lines[row])}, column {self.header!r}: "
-                               f"{self.text.iloc[row]!r} {problem}")
+                               f"{shown(self.text.iloc[row])} {problem}")
+
+
+#: The longest cell read as a time stamp: the longest form read (``Thursday, 10/06/2021 12:00:00.000000
+#: +08:00 (CST)``) is about 50 characters. A corrupted cell of 200,000 digits had been handed to the
+#: date parser, which took minutes over it, and then quoted whole in the message.
+LONGEST_STAMP = 80
+
+
+def shown(cell: str) -> str:
+    """A cell as a message quotes it: a long one cut, with its length."""
+    return quoted_cut(str(cell), LONGEST_STAMP)
 
 
 #: The readings of an ``a/b/c`` date: which of its numbers (groups 0, 2 and 3 of `_DMY`) is the
@@ -434,6 +445,9 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
     empty = np.flatnonzero((column.text == "").to_numpy())
     if len(empty):
         column.refuse(int(empty[0]), "is an empty time stamp")
+    long = np.flatnonzero((column.text.str.len() > LONGEST_STAMP).to_numpy())
+    if len(long):  # before any parser sees it: dateutil's takes minutes over a long cell
+        column.refuse(int(long[0]), f"is not a time stamp (longer than {LONGEST_STAMP} characters)")
     if column.text.str.fullmatch(_COMPACT_HOURS).all():
         report["date_order"] = "written yyyymmddHH"
         column.text = column.text.str.replace(r"^(\d{4})(\d{2})(\d{2})(\d{2})$", r"\1-\2-\3 \4:00", regex=True)
@@ -458,6 +472,10 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
                          "remove it and give the zone (--tz)")
     if midnight.any():
         index = index + pd.to_timedelta(midnight.astype(int), unit="D")
+        at = np.flatnonzero(midnight)
+        lines_at = ", ".join(str(int(v)) for v in column.lines[at[:5]]) + (", ..." if len(at) > 5 else "")
+        report["end_of_day"] = (f"{len(at)} stamp{'s' if len(at) > 1 else ''} of 24:00 read as 00:00 of the next day "
+                                f"(line{'s' if len(at) > 1 else ''} {lines_at})")
     _refuse_twelve_hour_clock(column, index)
     if has_offset.any():
         return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)

@@ -70,6 +70,9 @@ class Table:
     #: mid-line): how many fields it has. Its last field may be a number cut short (``645.3``
     #: written as ``64``), so it is not read (`hybridtrack.io.weather`).
     cut_short: int = 0
+    #: The other rows with fewer fields than the header, padded with empty cells: each's file line
+    #: and how many fields it has (`hybridtrack.io.weather` reports those missing a column it reads).
+    short: dict[int, int] = field(default_factory=dict)
 
 
 #: The longest field the csv module is let read: Python's default, 131,072 characters, had
@@ -182,10 +185,11 @@ def _without_repeated_header(rows: list[list[str]], numbers: list[int], preamble
 
 
 def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str], header_line: int,
-          skipped: dict, preamble: list[list[str]]) -> tuple[list[list[str]], list[int], int]:
+          skipped: dict, preamble: list[list[str]]) -> tuple[list[list[str]], list[int], int, dict[int, int]]:
     """The rows' fields, each as long as `headers`, and their file lines; empty rows and lines
     repeating the `preamble` (the header and the lines about it, each as stripped fields) skipped,
-    long rows refused; and the field count of a last row cut short (`Table.cut_short`, else 0)."""
+    long rows refused; the field count of a last row cut short (`Table.cut_short`, else 0); and
+    the other short rows' lines and field counts (`Table.short`)."""
     width = len(headers)
     empty = [not line.strip(sep + ' \t"') for _, line in body]  # ';;;;': a row the logger left empty
     if any(empty):
@@ -198,6 +202,9 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
     rows, numbers = _without_repeated_header(rows, numbers, preamble, skipped)
     short = [len(fields) < width for fields in rows]
     cut_short = len(rows[-1]) if len(rows) > 2 and short[-1] and not any(short[:-1]) else 0
+    padded = {numbers[i]: len(fields) for i, fields in enumerate(rows) if short[i]}
+    if cut_short:
+        padded.pop(numbers[-1])
     for i, fields in enumerate(rows):
         if len(fields) == width:
             continue
@@ -205,7 +212,7 @@ def _rows(path: Path, body: list[tuple[int, str]], sep: str, headers: list[str],
             raise HybridtrackError(f"{path}: line {numbers[i]}: {len(fields)} fields, but the header on line "
                                    f"{header_line} names {width}")
         rows[i] = fields[:width] + [""] * (width - len(fields))
-    return rows, numbers, cut_short
+    return rows, numbers, cut_short, padded
 
 
 def _refuse_open_quote(path: Path, body: list[tuple[int, str]]) -> None:
@@ -261,12 +268,12 @@ def locate_table(path: Path, text: str) -> Table:
         raise HybridtrackError(f"{path}: the table has a header but no rows")
     preamble = [[f.strip() for f in fields] for fields in (*(_split(line, sep) for _, line in kept[:position]),
                                                           headers, *meta)]
-    rows, numbers, cut_short = _rows(path, body, sep, headers, kept[position][0], skipped, preamble)
+    rows, numbers, cut_short, padded = _rows(path, body, sep, headers, kept[position][0], skipped, preamble)
     units = {h: u.strip() for h, u in zip(headers, meta[0])} if meta else {}
     units.update({h: site[f"{h} Units"] for h in headers if site.get(f"{h} Units")})  # NSRDB: 'GHI Units'
     decimal = _decimal(sep, rows)
     return Table(headers, rows, np.asarray(numbers), sep, decimal, units=units, skipped=skipped, kind=kind,
-                 site=site, site_line=kept[1][0] if site else 0, cut_short=cut_short)
+                 site=site, site_line=kept[1][0] if site else 0, cut_short=cut_short, short=padded)
 
 
 def _site_header(first: list[str]) -> bool:

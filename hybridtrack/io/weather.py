@@ -19,8 +19,8 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .checks import check_frame, check_magnitude, refuse_repairs
 from .closure import closure_check
-from .columns import (IRRADIANCE, LABEL_COLUMN, STAMP_PARTS, WEATHER_COLUMNS, check_names, not_read, resolve_columns,
-                      split_header)
+from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, name_shown,
+                      not_read, resolve_columns, split_header)
 from .files import file_text
 from .formats import PVLIB_FORMATS, RECOGNISED_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
@@ -197,6 +197,23 @@ def _without_cut_last(table: Table, report: dict) -> Table:
     return dataclasses.replace(table, rows=table.rows[:-1], lines=table.lines[:-1])
 
 
+def _short_rows(table: Table, mapping: dict, report: dict) -> None:
+    """Count as ``short_rows`` the rows before the last with fewer fields than the header that
+    miss a column read (`Table.short`): their missing cells are read as NaN, and their last field
+    may be a number cut short (a logger that lost power mid-line and wrote on in a new line:
+    ``...,06:00,64`` read as a GHI of 64 W/m²). They had been padded with NaN without a word
+    ('changes: none'); a row missing only columns not read is left alone."""
+    read = [table.headers.index(header) for name, header in mapping.items() if header in table.headers]
+    if not table.short or not read:
+        return
+    needed = max(read) + 1
+    lines = [line for line, fields in table.short.items() if fields < needed]
+    if lines:
+        report["short_rows"] = {"count": len(lines), "lines": lines[:5],
+                                "why": f"fewer fields than the header's {len(table.headers)}; the missing cells "
+                                       "read as NaN, the last one kept as written (a line cut short?)"}
+
+
 def _without_empty_columns(table: Table, report: dict) -> Table:
     """`table` without its columns that have no name and no value in any row: Excel's "Save as
     CSV" pads rows to the sheet's used range (``time;ghi;dni;dhi;;``), and the two unnamed columns
@@ -279,13 +296,15 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
     if unread:
         report["not_read"] = unread
     table = _without_cut_last(table, report)
+    _short_rows(table, mapping, report)
     if not {"time", "date", "year"} & set(mapping):
         raise HybridtrackError(f"{path}: no time column found; name it with columns={{'time': ...}} "
                                f"(--map time=COLUMN, or --map time= for an unnamed first column); columns are "
-                               f"{', '.join(repr(h) if not h else h for h in table.headers)}")
+                               f"{', '.join(name_shown(h) if not h or len(h) > LONGEST_NAME else h for h in table.headers)}")
     if not any(name in mapping for name in (*IRRADIANCE, "photocurrent")):
         raise HybridtrackError(f"{path}: no irradiance column found (ghi, dni, dhi); map one, e.g. --map "
-                               f"dni=COLUMN; columns are {', '.join(table.headers)}")
+                               f"dni=COLUMN; columns are "
+                               f"{', '.join(name_shown(h) if len(h) > LONGEST_NAME else h for h in table.headers)}")
     meta = header_site(path, table) if table.site else {}
     index, keep = _stamps(path, table, mapping, cells, tz, site, dayfirst, report, meta.get("zone"))
     frame = pd.DataFrame(index=index)

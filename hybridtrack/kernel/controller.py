@@ -1070,6 +1070,7 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
     status = OK
     trusted = cfg.calibrates and _trusts_sensor(cfg, sky, obs[4])
     state.s[HELD_MISS] = math.nan
+    predicted = 0  # bit a: axis a's gate judged an outlier, so it has predicted across this scan
     for a in range(axes):
         offset = obs_axes[a, 1]
         verdict = gate_judge(cfg, state, a, offset, obs[2] != 0.0, obs_axes[a, 2],
@@ -1080,12 +1081,14 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
             offset, measures = axis_offset(obs_axes[:, 1], a, reading)
             verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted and measures, axes, obs[3])
         valid[a] = verdict == OK
+        if verdict == OUTLIER:
+            predicted |= 1 << a
         if valid[a]:
             out.sun[i, a] = state.kf[a, X0]
         if verdict != OK and status == OK:
             status = verdict
     for a in range(axes):
-        if not valid[a]:
+        if not (valid[a] or predicted >> a & 1):
             gate_coast(cfg, state, a, dt)
     _held_off(state, log, i, t, valid.all())
     if valid.all():
