@@ -51,8 +51,10 @@ def true_fit_parameters(imperfections, collector) -> dict[str, float]:
         return {"axis_azimuth_error": imperfections.axis_azimuth_error,
                 "axis_tilt_error": imperfections.axis_tilt_error,
                 "encoder_offset": zero + imperfections.axis_roll_error}
+    # a heliostat's sensor is biased across its face, the collimation term, not on its azimuth axis
     return {"axis_tilt_error": imperfections.axis_tilt_error, "axis_roll_error": imperfections.axis_roll_error,
-            "encoder_offset_azimuth": zero + imperfections.axis_azimuth_error, "encoder_offset": zero}
+            "encoder_offset_azimuth": imperfections.encoder_offset + imperfections.axis_azimuth_error,
+            "encoder_offset": zero, "collimation_error": imperfections.sensor_bias}
 
 
 def draw_mount_fit(ax, x, fit: pd.DataFrame, truth: dict[str, float] | None = None) -> None:

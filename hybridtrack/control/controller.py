@@ -143,9 +143,9 @@ class Controller:
         self.calibrators = [Calibrator(config.minutes("calibration_tau"), config.calibration_max_rate)
                             for _ in drives]
         self.jacobian, self.weight = plan.jacobian, plan.weight
-        self.fit = MountEstimator(self.axes, config.sensor_noise) if plan.jacobian is not None else None
+        self.fit = MountEstimator(self.axes, config.sensor_noise, parameters=plan.jacobian.shape[2]) if plan.jacobian is not None else None
         self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise) if self.fit is not None else None
-        self.theta = np.zeros(2 + self.axes)
+        self.theta = np.zeros(self.fit.n if self.fit is not None else 2 + self.axes)
         self.fit_since = 0.0
         self.fitted_at = [-math.inf] * self.axes
         self.recorded_updates = -1
