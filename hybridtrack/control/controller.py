@@ -23,8 +23,8 @@ from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import AXIS_NAMES, EncoderMonitor
 from .mountfit import MountEstimator, ordered_dot, pull_spread
-from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, OUTLIER, SEARCH, SENSOR,
-                    SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
+from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, INVALID, MODES, NOT_READ, OK, OUT_OF_VIEW, OUTLIER,
+                    SEARCH, SENSOR, SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
 from .sensing import SensorGate, axis_offset
@@ -143,7 +143,8 @@ class Controller:
         self.calibrators = [Calibrator(config.minutes("calibration_tau"), config.calibration_max_rate)
                             for _ in drives]
         self.jacobian, self.weight = plan.jacobian, plan.weight
-        self.fit = MountEstimator(self.axes, config.sensor_noise, parameters=plan.jacobian.shape[2]) if plan.jacobian is not None else None
+        self.fit = MountEstimator(self.axes, config.sensor_noise, parameters=plan.jacobian.shape[2]) \
+            if plan.jacobian is not None else None
         self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise) if self.fit is not None else None
         self.theta = np.zeros(self.fit.n if self.fit is not None else 2 + self.axes)
         self.fit_since = 0.0
@@ -439,7 +440,10 @@ class Controller:
                 verdict = IMPLAUSIBLE
             if verdict == OK:
                 offset, measures = axis_offset(obs.offset, a, reading)
-                verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures)
+                if not measures and config.uses_model and not math.isnan(self.model[a][i]):
+                    verdict = INVALID  # no measure of the azimuth near the zenith: the calibrated model steers
+                else:
+                    verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures)
             valid[a], predicted[a] = verdict == OK, verdict == OUTLIER
             if valid[a]:
                 self.out_axes["sun"][a][i] = gate.filter.angle

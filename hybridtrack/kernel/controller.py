@@ -1079,7 +1079,11 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
             verdict = IMPLAUSIBLE
         if verdict == OK:
             offset, measures = axis_offset(obs_axes[:, 1], a, reading)
-            verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted and measures, axes, obs[3])
+            if not measures and cfg.uses_model and not math.isnan(plan.model[i, a]):
+                verdict = INVALID  # no measure of the azimuth near the zenith: the calibrated model steers
+            else:
+                verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted and measures, axes,
+                                 obs[3])
         valid[a] = verdict == OK
         if verdict == OUTLIER:
             predicted |= 1 << a
