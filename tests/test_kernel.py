@@ -292,7 +292,7 @@ def test_a_recorded_pointing_signal_runs_the_same_compiled(mixed_day, collector)
 def test_the_clock_watch_alarms_the_same_compiled():
     """Both of the clock watch's alarms, worded by the kernel as the reference words them, and the
     summary's clock fit (a trough drifting a minute a day, a heliostat five minutes wrong: two
-    sunny days, as its sensor's collimation error leaves one day's estimate at 3.6σ)."""
+    sunny days, as its sensor's collimation error leaves one day's estimate under 4σ)."""
     drifting = replaced(imperfections={"clock_drift": 60.0, "clock_error": 0.0, "commissioned_days_ago": 0.0}, seed=1)
     runs = both(synthetic("lanzhou", "2021-06-21", "2021-06-23", weather="sunny", seed=1), "lanzhou",
                 config=drifting, collector="trough-ns")

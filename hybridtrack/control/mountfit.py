@@ -72,6 +72,9 @@ Stone, K. W. (1986). *Automatic heliostat track alignment method*. US Patent 4,5
 Khalsa, S. S. S., Ho, C. K. & Andraka, C. E. (2011). An automated method to correct heliostat
 tracking errors. SolarPACES 2011, Granada. SAND2011-6233C.
 
+Wallace, P. T. *TPOINT: a telescope pointing analysis system* (manual), "The pointing terms": the
+altazimuth collimation error CA, a left-right shift constant on the sky, CA·sec(elevation) in azimuth.
+
 Ljung, L. & Söderström, T. (1983). *Theory and Practice of Recursive Identification*. MIT Press.
 
 Perez, R., Ineichen, P., Seals, R., Michalsky, J. & Stewart, R. (1990). Modeling daylight
