@@ -6,7 +6,9 @@ The controller logs its mount fit every scan (`simulate`'s log: ``fit_<name>`` a
 sensor can show of the mount, which is not always one field of `Imperfections` alone:
 
 * the sensor's mounting bias adds to every encoder zero (the sensor reads the sun at the true
-  angle plus the encoder's zero plus its own bias, and no reading can tell the two apart);
+  angle plus the encoder's zero plus its own bias, and no reading can tell the two apart), but a
+  heliostat's azimuth zero: its sensor reads across the mirror's face, and its bias there is the
+  collimation error, bias / cos(elevation) of azimuth (`collimation_error`);
 * a heliostat's pedestal turned about the vertical is an azimuth encoder offset (Stone 1986);
   its two tilts are the world's `axis_tilt_error` (about the east-west line) and
   `axis_roll_error` (about the north-south line). A single axis's roll is an encoder offset.
@@ -51,8 +53,10 @@ def true_fit_parameters(imperfections, collector) -> dict[str, float]:
         return {"axis_azimuth_error": imperfections.axis_azimuth_error,
                 "axis_tilt_error": imperfections.axis_tilt_error,
                 "encoder_offset": zero + imperfections.axis_roll_error}
+    # a heliostat's sensor is biased across its face, the collimation term, not on its azimuth axis
     return {"axis_tilt_error": imperfections.axis_tilt_error, "axis_roll_error": imperfections.axis_roll_error,
-            "encoder_offset_azimuth": zero + imperfections.axis_azimuth_error, "encoder_offset": zero}
+            "encoder_offset_azimuth": imperfections.encoder_offset + imperfections.axis_azimuth_error,
+            "encoder_offset": zero, "collimation_error": imperfections.sensor_bias}
 
 
 def draw_mount_fit(ax, x, fit: pd.DataFrame, truth: dict[str, float] | None = None) -> None:

@@ -54,7 +54,8 @@ from .params import duration, number
 from .sky import MinuteGrid, smooth_noise
 
 __all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "SceneLight",
-           "scene_light", "sensor_scene", "circumsolar_light", "read_pointing", "read_photocurrent", "coarse_offset"]
+           "scene_light", "sensor_scene", "circumsolar_light", "sensor_frame", "read_pointing", "read_photocurrent",
+           "coarse_offset"]
 
 #: A weather frame column holding a recorded photocurrent (mA), used instead of the model.
 RECORDED_COLUMN = "photocurrent"
@@ -351,13 +352,43 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
                        diffuse=light.diffuse)
 
 
+def sensor_frame(azimuth_miss: float, target_elevation: float, elevation: float) -> tuple[float, float]:
+    """Where a heliostat's sensor, on the mirror, sees its target: degrees across its face and
+    along it, from axis misses.
+
+    Parameters
+    ----------
+    azimuth_miss : float
+        Degrees the target's azimuth lies from the azimuth axis's angle (wrapped to a half turn).
+    target_elevation : float
+        The target's elevation on the mount, degrees.
+    elevation : float
+        The elevation axis's angle, degrees.
+
+    Returns
+    -------
+    (float, float)
+        The angle across the sensor's face (out of the plane the elevation axis turns the
+        sensor's axis in), ``asin(cos e · sin Δaz)``, and the angle along it (in that plane),
+        ``atan2(sin e, cos e · cos Δaz) - elevation``: the target's cross-elevation and
+        elevation errors in the sensor's own frame (docs/world.md, "The sensor's frame"). Near
+        the zenith a large azimuth miss is a small angle across the face: at 89° a 26.7° miss
+        is 0.45°.
+    """
+    d, e = math.radians(azimuth_miss), math.radians(target_elevation)
+    across = math.degrees(math.asin(math.cos(e) * math.sin(d)))
+    along = math.degrees(math.atan2(math.sin(e), math.cos(e) * math.cos(d))) - elevation
+    return across, (along + 180.0) % 360.0 - 180.0
+
+
 def read_pointing(offsets, beam: float, aureole: float, patch: float, patch_offset, noise, model: SensorModel):
     """What the fine cells report for one scan: the offset per axis and whether they see a sun.
 
     Parameters
     ----------
     offsets : sequence of float
-        Degrees from the sensor's axis to the true sun, per axis (the mounting bias included).
+        Degrees from the sensor's axis to the true sun, per axis, in the sensor's own frame (a
+        heliostat's: `sensor_frame`; the mounting bias included).
     beam, aureole, patch : float
         The scene's light (`SensorScene`) at this scan, W/m².
     patch_offset : sequence of float

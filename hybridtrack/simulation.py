@@ -914,7 +914,8 @@ def _calibration_summary(mount: MountEstimate | None, fitted: dict | None, out, 
         return None
     values = [mount.axis_azimuth_error, mount.axis_tilt_error] if collector.single_axis \
         else [mount.axis_tilt_error, mount.axis_roll_error]
-    return {name: round(float(v), 5) for name, v in zip(names, [*values, *mount.encoder_offset])}
+    collimation = [] if collector.single_axis else [mount.collimation_error]
+    return {name: round(float(v), 5) for name, v in zip(names, [*values, *mount.encoder_offset, *collimation])}
 
 
 def _run(world: World, controller: Controller, progress, bulk_nights: bool) -> None:

@@ -41,7 +41,7 @@ from .mounting import (geometry_key, heliostat_sun, incidence_cosine, mount_targ
                        pointing_vectors)
 from .reuse import Same, shared
 from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SceneLight, SensorModel, coarse_offset, read_photocurrent,
-                     read_pointing, scene_light, sensor_scene)
+                     read_pointing, scene_light, sensor_frame, sensor_scene)
 from .sun import solar_position
 from .times import HOUR_NS, plus_seconds
 
@@ -318,12 +318,21 @@ class World:
 
     # -- each scan -------------------------------------------------------------------------------
 
-    def _offset(self, truth: list, a: int, i: int) -> float:
-        """Degrees from the sensor's axis to the true sun on axis `a` (the mounting bias included)."""
+    def _miss(self, truth: list, a: int, i: int) -> float:
+        """Degrees axis `a` stands short of its true target (a turning axis's the short way round);
+        a single axis or a heliostat's azimuth axis (0)."""
         difference = truth[a][i] - self.actual[a]
         if self.circular[a]:
             difference = (difference + 180.0) % 360.0 - 180.0
-        return difference + self.sensor.bias
+        return difference
+
+    def _offsets(self, truth: list, i: int) -> list:
+        """Degrees from the sensor's axis to the true sun per axis, in the sensor's own frame (the
+        mounting bias included): a single axis's miss as it is, a heliostat's as its sensor on the
+        mirror sees it (`hybridtrack.sensor.sensor_frame`; axis 0 azimuth, 1 elevation)."""
+        azimuth_miss = self._miss(truth, 0, i)
+        misses = [azimuth_miss] if self.axes == 1 else sensor_frame(azimuth_miss, truth[1][i], self.actual[1])
+        return [miss + self.sensor.bias for miss in misses]
 
     def _encoder(self, faults: dict, a: int, i: int) -> float:
         if "encoder_frozen" in faults and faults["encoder_frozen"][i] and not math.isnan(self.last_encoder[a]):
@@ -338,7 +347,7 @@ class World:
         """Fill `obs` with what the controller's instruments read at scan `i`."""
         scans = self._listed()
         beam, aureole, patch, patch_offset, diffuse = scans["scene"]
-        offsets = [self._offset(scans["truth"], a, i) for a in range(self.axes)]
+        offsets = self._offsets(scans["truth"], i)
         noise = [scans["noise"][a][i] for a in range(self.axes)]
         if scans["pointing"] is not None:  # as recorded: what the logger's sensor said
             reported = [scans["pointing"][a][i] for a in range(self.axes)]

@@ -36,9 +36,26 @@ def test_a_clock_gaining_a_minute_a_day_is_alarmed_with_its_drift_on_a_trough():
     assert clock["drift_s_per_day"] == pytest.approx(60.0, abs=4 * clock["drift_std_s_per_day"])
 
 
+@pytest.mark.xfail(strict=True, reason="one day tells a 5-min clock from the sensor's collimation error at 3.8σ, "
+                                       "not 4σ: 303 ± 80 s (truth 302 s); the next test alarms it in two days")
 def test_a_heliostat_shows_a_clock_set_five_minutes_wrong_in_one_sunny_day():
+    """Before the sensor read in its own frame and the mount had a collimation term, 352 ± 66 s
+    (5.3σ). A bias across the mirror's face is bias / cos(e) of azimuth, and over one day cos(e)
+    moves with the sun's azimuth rate enough to leave the clock's 1σ a fifth wider (80 s), so the
+    estimate, nearer the truth than it was, is 3.8σ from zero and not alarmed until a second day."""
     imperfections = Imperfections(clock_error=300.0, clock_drift=0.0)
     result = _run("delingha", "2018-06-21", "2018-06-21", "heliostat", clock_error=300.0, clock_drift=0.0)
+    truth = imperfections.clock_error + imperfections.longitude_error * SECONDS_PER_DEGREE
+    assert any("clock off by" in r for r in _clock_alarms(result))
+    clock = result.summary["clock"]
+    assert clock["error_s"] == pytest.approx(truth, abs=4 * clock["error_std_s"])
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_heliostat_shows_a_clock_set_five_minutes_wrong_in_two_sunny_days(seed):
+    """The collimation term's price: a second day. Measured 312-376 s, 1σ 59-82 s, truth 302 s."""
+    imperfections = Imperfections(clock_error=300.0, clock_drift=0.0)
+    result = _run("delingha", "2018-06-21", "2018-06-22", "heliostat", seed=seed, clock_error=300.0, clock_drift=0.0)
     truth = imperfections.clock_error + imperfections.longitude_error * SECONDS_PER_DEGREE
     assert any("clock off by" in r for r in _clock_alarms(result))
     clock = result.summary["clock"]

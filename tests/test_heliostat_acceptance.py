@@ -9,10 +9,12 @@ from hybridtrack.sky import synthetic
 from hybridtrack.world import Imperfections
 
 MOUNT = Imperfections(axis_tilt_error=0.4, axis_roll_error=-0.3, axis_azimuth_error=0.5, encoder_offset=0.3)
-#: What the sensor can show of that mount: each encoder zero carries the sensor's mounting bias, and
-#: the pedestal's turn about the vertical is an azimuth encoder offset (Stone 1986).
-SEEN = {"axis_tilt_error": 0.4, "axis_roll_error": -0.3,
-        "encoder_offset_azimuth": 0.3 + MOUNT.sensor_bias + 0.5, "encoder_offset": 0.3 + MOUNT.sensor_bias}
+#: What the sensor can show of that mount: the pedestal's turn about the vertical is an azimuth
+#: encoder offset (Stone 1986); the sensor's mounting bias, read on the mirror's face, is an angle
+#: along it, which the elevation zero carries, and one across it, the collimation error (its
+#: bias / cos(elevation) of azimuth: docs/world.md, "The sensor's frame").
+SEEN = {"axis_tilt_error": 0.4, "axis_roll_error": -0.3, "encoder_offset_azimuth": 0.3 + 0.5,
+        "encoder_offset": 0.3 + MOUNT.sensor_bias, "collimation_error": MOUNT.sensor_bias}
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3, 4, 5])

@@ -23,11 +23,11 @@ from .config import ControllerConfig
 from .disagreement import DisagreementMonitor
 from .encoder import AXIS_NAMES, EncoderMonitor
 from .mountfit import MountEstimator, ordered_dot, pull_spread
-from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, MODES, NOT_READ, OK, OUT_OF_VIEW, OUTLIER, SEARCH, SENSOR,
-                    SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
+from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, INVALID, MODES, NOT_READ, OK, OUT_OF_VIEW, OUTLIER,
+                    SEARCH, SENSOR, SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
-from .sensing import SensorGate
+from .sensing import SensorGate, axis_offset
 from .skywatch import ClassifierTable, SkyWatch
 from .wind import WindGuard, unreadable, unreadable_reason
 
@@ -143,9 +143,10 @@ class Controller:
         self.calibrators = [Calibrator(config.minutes("calibration_tau"), config.calibration_max_rate)
                             for _ in drives]
         self.jacobian, self.weight = plan.jacobian, plan.weight
-        self.fit = MountEstimator(self.axes, config.sensor_noise) if plan.jacobian is not None else None
+        self.fit = MountEstimator(self.axes, config.sensor_noise, parameters=plan.jacobian.shape[2]) \
+            if plan.jacobian is not None else None
         self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise) if self.fit is not None else None
-        self.theta = np.zeros(2 + self.axes)
+        self.theta = np.zeros(self.fit.n if self.fit is not None else 2 + self.axes)
         self.fit_since = 0.0
         self.fitted_at = [-math.inf] * self.axes
         self.recorded_updates = -1
@@ -438,7 +439,11 @@ class Controller:
             if verdict == OK and obs.t < self.distrusted_until:
                 verdict = IMPLAUSIBLE
             if verdict == OK:
-                verdict = self._offer(i, a, dt, reading[a] + obs.offset[a], trusted)
+                offset, measures = axis_offset(obs.offset, a, reading)
+                if not measures and config.uses_model and not math.isnan(self.model[a][i]):
+                    verdict = INVALID  # no measure of the azimuth near the zenith: the calibrated model steers
+                else:
+                    verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures)
             valid[a], predicted[a] = verdict == OK, verdict == OUTLIER
             if valid[a]:
                 self.out_axes["sun"][a][i] = gate.filter.angle
@@ -672,7 +677,8 @@ class Controller:
     def _night_target(self, a: int) -> float:
         return self.park[a] if self.config.sensor_only else self.drives[a].stow
 
-    def _target(self, i: int, a: int, t: float, dt: float, reading: float, valid: bool, obs: Observation) -> float:
+    def _target(self, i: int, a: int, t: float, dt: float, reading: float, valid: bool, rough: float) -> float:
+        """The angle to drive axis `a` to; `rough` is the acquisition cells' offset in its degrees."""
         mode, gate, drive = self.mode, self.gates[a], self.drives[a]
         lead = self.config.lead
         if mode == STOW_WIND:
@@ -687,7 +693,7 @@ class Controller:
                 return gate.filter.angle + (_lead(gate.filter.rate, dt, drive.deadband) if lead else 0.0)
             # a filter coasted beyond the plausibility bound of the calibrated model: the computed target
         if mode == SEARCH:
-            rough = obs.coarse[a]  # the drive's speed limits the step; a scan later the cells look again
+            # the drive's speed limits the step; a scan later the cells look again
             return reading if math.isnan(rough) else reading + rough
         m = self.model[a][i]
         if math.isnan(m):
@@ -736,7 +742,8 @@ class Controller:
                 moves.append(step)
                 continue
             low, high = drive.limits
-            target = min(max(self._target(i, a, t, dt, reading[a], valid[a], obs), low), high)
+            rough, _ = axis_offset(obs.coarse, a, reading)
+            target = min(max(self._target(i, a, t, dt, reading[a], valid[a], rough), low), high)
             error = target - reading[a]
             held = mode == STOW_WIND and abs(reading[a] - drive.stow) <= drive.deadband  # stowed: never move
             threshold = drive.resolution if stowing or mode == SEARCH else drive.deadband

@@ -9,8 +9,16 @@ axis's encoder zero:
 * a heliostat: the pedestal's two tilt components (``axis_tilt_error`` about the east-west
   line, ``axis_roll_error`` about the north-south line) and the zero offsets of its azimuth
   and elevation encoders (``encoder_offset_azimuth``, ``encoder_offset``). A pedestal turned
-  about the vertical is the same as an azimuth encoder offset, and is reported as one. The
-  axes' non-orthogonality and gravity sag of the full model are left out.
+  about the vertical is the same as an azimuth encoder offset, and is reported as one. Its sun
+  sensor sits on the mirror and reads across the mirror's face, so its mounting bias across the
+  face is the pointing model's collimation term (``collimation_error``, CA): CA / cos(e) of
+  azimuth at the target's elevation e (`collimation_secant`, |cos e| held to cos 85° as the
+  controller's conversion holds it, `hybridtrack.control.sensing.axis_offset`), nothing of
+  elevation. Without it the fit and the clock watch had only a constant azimuth zero for what
+  grows through the day as sec(e): the zero took part of it (0.93-0.955° for 0.86°) and the clock
+  watch the rest (a clock 160-210 s fast over three sunny days, against -8 to +22 s without a
+  bias). The axes' non-orthogonality (NPAE, tan e) and gravity sag of the full model are left out:
+  the world has neither.
 
 Each trusted sensor reading gives, per axis, the sun's angle in encoder coordinates. Against
 the controller's computed target it is a linear measurement of the parameters through the
@@ -64,6 +72,9 @@ Stone, K. W. (1986). *Automatic heliostat track alignment method*. US Patent 4,5
 Khalsa, S. S. S., Ho, C. K. & Andraka, C. E. (2011). An automated method to correct heliostat
 tracking errors. SolarPACES 2011, Granada. SAND2011-6233C.
 
+Wallace, P. T. *TPOINT: a telescope pointing analysis system* (manual), "The pointing terms": the
+altazimuth collimation error CA, a left-right shift constant on the sky, CA·sec(elevation) in azimuth.
+
 Ljung, L. & Söderström, T. (1983). *Theory and Practice of Recursive Identification*. MIT Press.
 
 Perez, R., Ineichen, P., Seals, R., Michalsky, J. & Stewart, R. (1990). Modeling daylight
@@ -99,7 +110,18 @@ def parameter_names(collector) -> list[str]:
     """The fitted parameters: the two pedestal (axis) terms, then one encoder zero per axis."""
     if collector.single_axis:
         return ["axis_azimuth_error", "axis_tilt_error", "encoder_offset"]
-    return ["axis_tilt_error", "axis_roll_error", "encoder_offset_azimuth", "encoder_offset"]
+    return ["axis_tilt_error", "axis_roll_error", "encoder_offset_azimuth", "encoder_offset", "collimation_error"]
+
+
+def collimation_secant(elevation):
+    """1 / cos(elevation), |cos| held to cos 85° (`hybridtrack.control.sensing.COSINE_FLOOR`): the
+    azimuth degrees a heliostat's sensor collimation error of one degree across the mirror's face
+    takes at that elevation of the target (degrees), as the controller converts its sensor's
+    readings (`hybridtrack.control.sensing.axis_offset`)."""
+    from .sensing import COSINE_FLOOR
+
+    cosine = np.cos(np.radians(np.asarray(elevation, float)))
+    return 1.0 / np.where(cosine < 0.0, np.minimum(cosine, -COSINE_FLOOR), np.maximum(cosine, COSINE_FLOOR))
 
 
 def jacobian(altitude, azimuth, collector) -> np.ndarray:
@@ -121,7 +143,7 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
     from .plan import MountEstimate
 
     names = parameter_names(collector)
-    axes = len(names) - 2
+    axes = 1 if collector.single_axis else 2
     h = ROTATION_STEP
     gradient = _angle_gradient(vectors, collector)  # (N, axes, 3)
     out = np.zeros((len(vectors), axes, len(names)))
@@ -132,6 +154,8 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
         out[:, :, k] = np.einsum("nac,nc->na", gradient, turned)
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
+    if axes == 2:  # the sensor's collimation error: an angle across the face is sec(e) of azimuth
+        out[:, 0, 4] = collimation_secant(np.degrees(np.arcsin(np.clip(vectors[:, 2], -1.0, 1.0))))
     return np.nan_to_num(out, copy=False)  # in place: a heliostat-year's copy took 0.03 s
 
 
@@ -190,8 +214,8 @@ class MountEstimator:
     """
 
     def __init__(self, axes: int, noise: float, prior: float = 2.0, memory: float = 3 * 1440.0,
-                 clip: float = 3.0, check_every: int = 10):
-        self.n = 2 + axes
+                 clip: float = 3.0, check_every: int = 10, parameters: int | None = None):
+        self.n = 2 + axes if parameters is None else parameters
         self.theta = np.zeros(self.n)
         self.prior = prior * prior
         self.p = np.eye(self.n) * self.prior

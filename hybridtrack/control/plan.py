@@ -60,12 +60,18 @@ class MountEstimate:
         Degrees (see `hybridtrack.mounting.mounting_rotation`).
     encoder_offset : tuple of float
         Degrees, per axis: the encoder reads the true angle plus this.
+    collimation_error : float
+        Degrees across a heliostat's mirror face at which its sun sensor centres the sun (its
+        mounting bias, the world's ``sensor_bias``): ``collimation_error / cos(elevation)`` of
+        azimuth (`hybridtrack.control.mountfit.collimation_secant`), the pointing model's
+        collimation term. Not used by a single axis.
     """
 
     axis_azimuth_error: float = 0.0
     axis_tilt_error: float = 0.0
     axis_roll_error: float = 0.0
     encoder_offset: tuple[float, ...] = field(default=(0.0,))
+    collimation_error: float = 0.0
 
     @classmethod
     def from_parameters(cls, names: list[str], values) -> MountEstimate:
@@ -74,7 +80,7 @@ class MountEstimate:
         encoders = (given.get("encoder_offset_azimuth", 0.0), given["encoder_offset"]) \
             if "encoder_offset_azimuth" in given else (given["encoder_offset"],)
         return cls(given.get("axis_azimuth_error", 0.0), given.get("axis_tilt_error", 0.0),
-                   given.get("axis_roll_error", 0.0), encoders)
+                   given.get("axis_roll_error", 0.0), encoders, given.get("collimation_error", 0.0))
 
     def rotation(self, collector: Collector) -> np.ndarray:
         """The mount's rotation (`hybridtrack.mounting.mounting_rotation`)."""
@@ -87,7 +93,13 @@ class MountEstimate:
     def vector_targets(self, vectors: np.ndarray, collector: Collector) -> np.ndarray:
         """`targets` from the pointing vectors (`hybridtrack.mounting.pointing_vectors`, ``night=True``)."""
         targets = angles_on_mount(vectors, collector, self.rotation(collector))
-        return targets + np.resize(np.asarray(self.encoder_offset, float), targets.shape[1])
+        targets = targets + np.resize(np.asarray(self.encoder_offset, float), targets.shape[1])
+        if self.collimation_error and targets.shape[-1] == 2:
+            from .mountfit import collimation_secant
+
+            elevation = np.degrees(np.arcsin(np.clip(np.asarray(vectors, float)[..., 2], -1.0, 1.0)))
+            targets[..., 0] += self.collimation_error * collimation_secant(elevation)
+        return targets
 
 
 @dataclass

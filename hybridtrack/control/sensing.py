@@ -14,6 +14,11 @@ nor restart with the rate that drifted (a heliostat's azimuth near the zenith sp
 than the filter's process noise allows, and a filter that kept its own rate there was rejected
 again at once and coasted the drive away), nor, coasted across a gap, take the gap's swing for a
 rate (a heliostat's zenith pass between 30-minute scans had taught it 1.2°/min).
+
+A heliostat's sensor sits on the mirror and reads its azimuth offset across its own face: an
+azimuth miss Δaz at elevation e is about Δaz·cos e there (docs/world.md, "The sensor's frame").
+The controller turns it back into azimuth degrees with the elevation its own encoder reads and
+the sensor's elevation reading (`axis_offset`).
 """
 
 from __future__ import annotations
@@ -24,7 +29,77 @@ from collections import deque
 from .kalman import make_filter
 from .modes import IMPLAUSIBLE, INVALID, LOW_LIGHT, OK, OUT_OF_VIEW, OUTLIER, STUCK
 
-__all__ = ["SensorGate"]
+__all__ = ["SensorGate", "axis_offset", "AZIMUTH", "ELEVATION", "COSINE_FLOOR"]
+
+#: A heliostat's axes, in the order of its drives and encoders (`hybridtrack.control.encoder.AXIS_NAMES`).
+AZIMUTH, ELEVATION = 0, 1
+
+#: The least size of the cosine a heliostat's azimuth reading is divided by (`axis_offset`):
+#: cos 85°. The divisor is the cosine of the sun's elevation as the controller sees it, which is
+#: off the true one by the installation (encoder zero, pedestal tilt and turn: with the clock and
+#: site, the 1.8° open-loop budget at most); toward the zenith cos(e - 1.8°)/cos e grows without
+#: bound, and an over-converted reading swings the azimuth past the sun and back. With the floor
+#: the gain on a reading (true cosine over divisor) is at most cos 83.2°/cos 85° = 1.36, short of
+#: the 2 at which a proportional correction diverges; below 1 near the zenith the loop converges
+#: in more scans. The sensor's noise is multiplied 11.5 times at most (0.03° to 0.34° of azimuth,
+#: still 0.03° of pointing).
+COSINE_FLOOR = math.cos(math.radians(85.0))
+
+
+def axis_offset(sensed, a: int, reading) -> tuple[float, bool]:
+    """A sensor's offset on axis `a` in that axis's degrees.
+
+    Parameters
+    ----------
+    sensed : sequence of float
+        The offsets the sensor (or its acquisition cells) reads per axis, degrees in its own
+        frame (NaN: none).
+    a : int
+        The axis.
+    reading : sequence of float
+        Where the controller's encoders say each axis stands, degrees (one: a single axis).
+
+    Returns
+    -------
+    (float, bool)
+        The offset, and whether it measures the axis. A single axis's reading is its offset. A
+        heliostat's are turned back into axis degrees (Notes), with the sun's elevation in the
+        sensor's plane ``φ`` taken as the encoder's elevation plus the elevation reading (the
+        encoder's alone without one). The azimuth's ``cos φ`` is held to `COSINE_FLOOR` in size
+        (NaN counts as the floor): a floored reading only turns the axis toward the sun (its
+        size is the floor's, not the sun's), so it may steer but not calibrate (at 89° it had
+        taught the calibration a 30° azimuth offset that held the mirror 20° of azimuth off all
+        afternoon). It steers only a controller without a model (sensor-only); one with a
+        calibrated model takes it as no measure of the azimuth (an invalid reading) and lets the
+        model steer the pass: fed to the filter, a 10° miss at 89.5° read as 1° and the gate's
+        outliers and restarts had made a 1-minute hybrid's zenith pass its worst (0.205° with a
+        perfect sensor, 0.037° with the model).
+
+    Notes
+    -----
+    The sensor reads ``c = asin(cos e · sin Δaz)`` across its face and ``φ - elevation`` along it,
+    ``φ = atan2(sin e, cos e · cos Δaz)`` (`hybridtrack.sensor.sensor_frame`, ``e`` the sun's
+    elevation on the mount). Inverted: ``Δaz = atan2(sin c, cos c · cos φ)``, which is ``c / cos φ``
+    for a small ``c`` (the division by the cosine of the elevation), and turns the azimuth a half
+    turn for a sun past the zenith (``φ`` above 90°, where the elevation axis cannot follow);
+    ``e = asin(cos c · sin φ)``. The sun's elevation, not the mirror's, is the divisor: between
+    coarse scans they part by what the sun climbed (7° an hour), and the mirror's had taken 4.6°
+    of a 7.9° azimuth miss at 82° on a 60-minute scan.
+    """
+    if len(reading) == 1:
+        return sensed[a], True
+    across, along = sensed[AZIMUTH], sensed[ELEVATION]
+    if math.isnan(sensed[a]):
+        return math.nan, True
+    c = 0.0 if math.isnan(across) else math.radians(across)
+    phi = math.radians(reading[ELEVATION] + (0.0 if math.isnan(along) else along))
+    if a == ELEVATION:
+        return math.degrees(math.asin(math.cos(c) * math.sin(phi))) - reading[ELEVATION], True
+    cosine = math.cos(phi)
+    if abs(cosine) >= COSINE_FLOOR:
+        return math.degrees(math.atan2(math.sin(c), math.cos(c) * cosine)), True
+    floor = -COSINE_FLOOR if cosine < 0.0 else COSINE_FLOOR
+    return math.degrees(math.atan2(math.sin(c), math.cos(c) * floor)), False
 
 
 class SensorGate:

@@ -159,7 +159,7 @@ def _state(controller: Controller, minutes: np.ndarray) -> kc.ControllerState:
     k[kc.HELD_OFF_RAISED] = c.held_off_raised
     k[[kc.MOUNT_AT_SCAN, kc.MOUNT_AT_UPDATES]] = -1
     fit = c.fit
-    p = 2 + axes if fit else 0
+    p = fit.n if fit else 0
     if fit:
         k[[kc.UPDATES, kc.FROZEN]] = [fit.updates, fit.axis_frozen]
     windows = [c.sky.window_minutes] + ([c.sky.mean.window] if c.sky.mean is not None else [])

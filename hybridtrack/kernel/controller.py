@@ -13,6 +13,7 @@ WindGuard               `wind_watch`, `wind_heard`, `wind_update`, `wind_release
 SkyWatch                `trailing_mean`, `trailing_range`, `sky_update`
 ClassifierTable         `table_score`, `table_code`
 SensorGate + Kalman     `gate_judge`, `gate_take`, `kalman_*`
+axis_offset             `axis_offset`
 Calibrator.learn        `calibrator_learn`, `_start_day`
 MountEstimator          `fit_forget`, `fit_update`, `fit_check`, `fit_solve`, `fit_excess_light`
 pull_spread             `pull_spread`
@@ -41,6 +42,7 @@ from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGH
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
 from ..control.mountfit import HORIZON, LEVEL_READINGS, LIGHT_TOLERANCE, MAX_CONDITION
 from ..control.mountfit import spd_inverse as reference_spd_inverse  # compiled below
+from ..control.sensing import AZIMUTH, COSINE_FLOOR, ELEVATION
 from ..control.wind import READABLE, STUCK_HOURS, STUCK_SPREAD
 from . import events as ev
 from .jit import kernel
@@ -480,6 +482,25 @@ def _spread(values, a):
     for value in values[a, 1:]:
         high, low = max(high, value), min(low, value)
     return high - low
+
+
+@kernel
+def axis_offset(sensed, a, reading):
+    """`hybridtrack.control.sensing.axis_offset`."""
+    if reading.shape[0] == 1:
+        return sensed[a], True
+    across, along = sensed[AZIMUTH], sensed[ELEVATION]
+    if math.isnan(sensed[a]):
+        return math.nan, True
+    c = 0.0 if math.isnan(across) else math.radians(across)
+    phi = math.radians(reading[ELEVATION] + (0.0 if math.isnan(along) else along))
+    if a == ELEVATION:
+        return math.degrees(math.asin(math.cos(c) * math.sin(phi))) - reading[ELEVATION], True
+    cosine = math.cos(phi)
+    if abs(cosine) >= COSINE_FLOOR:
+        return math.degrees(math.atan2(math.sin(c), math.cos(c) * cosine)), True
+    floor = -COSINE_FLOOR if cosine < 0.0 else COSINE_FLOOR
+    return math.degrees(math.atan2(math.sin(c), math.cos(c) * floor)), False
 
 
 @kernel
@@ -1057,7 +1078,12 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
         if verdict == OK and obs[0] < state.s[DISTRUSTED_UNTIL]:
             verdict = IMPLAUSIBLE
         if verdict == OK:
-            verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted, axes, obs[3])
+            offset, measures = axis_offset(obs_axes[:, 1], a, reading)
+            if not measures and cfg.uses_model and not math.isnan(plan.model[i, a]):
+                verdict = INVALID  # no measure of the azimuth near the zenith: the calibrated model steers
+            else:
+                verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted and measures, axes,
+                                 obs[3])
         valid[a] = verdict == OK
         if verdict == OUTLIER:
             predicted |= 1 << a
@@ -1212,7 +1238,7 @@ def _strayed(cfg, plan, state, i, a, angle):
 
 
 @kernel
-def _target(cfg, plan, state, i, a, t, dt, reading, valid, coarse):
+def _target(cfg, plan, state, i, a, t, dt, reading, valid, rough):
     mode = state.k[MODE]
     deadband = cfg.deadband[a]
     if mode == STOW_WIND:
@@ -1226,7 +1252,7 @@ def _target(cfg, plan, state, i, a, t, dt, reading, valid, coarse):
         if valid or not _strayed(cfg, plan, state, i, a, state.kf[a, X0]):
             return state.kf[a, X0] + (_lead(state.kf[a, X1], dt, deadband) if cfg.lead else 0.0)
     if mode == SEARCH:
-        return reading if math.isnan(coarse) else reading + coarse
+        return reading if math.isnan(rough) else reading + rough
     m = plan.model[i, a]
     if math.isnan(m):
         return cfg.stow[a]
@@ -1264,7 +1290,8 @@ def _command(cfg, plan, state, awake_plan, i, t, dt, reading, valid, obs_axes, t
             moves[a] = step
             continue
         low, high = cfg.low[a], cfg.high[a]
-        target = min(max(_target(cfg, plan, state, i, a, t, dt, reading[a], valid[a], obs_axes[a, 2]), low), high)
+        rough = axis_offset(obs_axes[:, 2], a, reading)[0]
+        target = min(max(_target(cfg, plan, state, i, a, t, dt, reading[a], valid[a], rough), low), high)
         error = target - reading[a]
         held = mode == STOW_WIND and abs(reading[a] - cfg.stow[a]) <= cfg.deadband[a]
         threshold = cfg.resolution[a] if stowing or mode == SEARCH else cfg.deadband[a]

@@ -32,11 +32,31 @@ WorldState = namedtuple("WorldState", ["actual", "last_encoder", "angles"])
 
 
 @kernel
-def _offset(w, state, a, i):
+def _miss(w, state, a, i):
     difference = w.truth[a, i] - state.actual[a]
     if w.circular[a]:
         difference = (difference + 180.0) % 360.0 - 180.0
-    return difference + w.bias
+    return difference
+
+
+@kernel
+def sensor_frame(azimuth_miss, target_elevation, elevation):
+    """`hybridtrack.sensor.sensor_frame`."""
+    d, e = math.radians(azimuth_miss), math.radians(target_elevation)
+    across = math.degrees(math.asin(math.cos(e) * math.sin(d)))
+    along = math.degrees(math.atan2(math.sin(e), math.cos(e) * math.cos(d))) - elevation
+    return across, (along + 180.0) % 360.0 - 180.0
+
+
+@kernel
+def _offsets(w, state, i, offsets):
+    """World._offsets: fill `offsets`."""
+    azimuth_miss = _miss(w, state, 0, i)
+    if offsets.shape[0] == 1:
+        offsets[0] = azimuth_miss + w.bias
+    else:
+        across, along = sensor_frame(azimuth_miss, w.truth[1, i], state.actual[1])
+        offsets[0], offsets[1] = across + w.bias, along + w.bias
 
 
 @kernel
@@ -107,8 +127,7 @@ def world_observe(w, state, i, obs, obs_axes, offsets, reported):
     """World.observe: fill the observation of scan `i` (`obs`: t, wind, valid, intensity, true sky;
     `obs_axes`: encoder, offset, coarse per axis); `offsets` and `reported` are scratch."""
     axes = state.actual.shape[0]
-    for a in range(axes):
-        offsets[a] = _offset(w, state, a, i)
+    _offsets(w, state, i, offsets)
     if w.has_pointing:  # as recorded: what the logger's sensor said
         valid = True
         for a in range(axes):
