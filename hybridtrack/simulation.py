@@ -894,11 +894,15 @@ def _check_memory(memory: dict, collector: Collector) -> None:
     _check_memory_form(memory)
     names, axes = parameter_names(collector), 1 if collector.single_axis else 2
     theta, offsets = memory.get("theta"), memory.get("offsets")
-    if (theta is not None and len(theta) != len(names)) or (offsets is not None and len(offsets) != axes):
+    if offsets is not None and len(offsets) != axes:
         raise HybridtrackError(f"warm_start: this memory was left by a run of another kind of collector "
-                               f"({len(theta) if theta is not None else len(offsets)} terms; a {collector.kind} "
-                               f"has {len(names) if theta is not None else axes}); pass the memory of a "
+                               f"({len(offsets)} offsets; a {collector.kind} has {axes}); pass the memory of a "
                                f"{collector.kind} run")
+    if theta is not None and len(theta) != len(names):  # a heliostat's fit of 4 terms: before its collimation term
+        raise HybridtrackError(f"warm_start: this memory's mount fit has {len(theta)} terms and a {collector.kind}'s "
+                               f"has {len(names)} ({', '.join(names)}): it was left by a run of another kind of "
+                               "collector, or by an earlier hybridtrack (a heliostat's fit gained collimation_error); "
+                               f"pass the memory of a {collector.kind} run of this version")
 
 
 def _calibration_summary(mount: MountEstimate | None, fitted: dict | None, out, collector: Collector) -> dict | None:

@@ -483,6 +483,19 @@ def test_a_memory_left_by_another_kind_of_collector_is_refused_in_one_line(left_
     simulate(following, "lanzhou", collector=left_by, warm_start=memory)  # its own kind carries on, the next day
 
 
+def test_a_heliostat_memory_from_before_the_collimation_term_says_so():
+    """A heliostat's mount fit gained its fifth term (collimation_error); a memory of four, left by
+    an earlier version, had been refused as 'another kind of collector'."""
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="5min")
+    memory = simulate(day, "lanzhou", collector="heliostat").memory
+    n = 4
+    old = {**memory, "theta": memory["theta"][:n], "p": [row[:n] for row in memory["p"][:n]],
+           "information": [row[:n] for row in memory["information"][:n]]}
+    with pytest.raises(HybridtrackError, match="mount fit has 4 terms and a heliostat's has 5 .*collimation_error.*"
+                                               "an earlier hybridtrack"):
+        simulate(day, "lanzhou", collector="heliostat", warm_start=old)
+
+
 @pytest.mark.parametrize("frame_day, site, collector, message", [
     ("2021-01-10", "lanzhou", "trough-ns", "ended at 2021-06-21 23:55:00\\+08:00, not before this run starts"),
     ("2021-06-21", "lanzhou", "trough-ns", "not before this run starts"),  # the same day again
