@@ -42,7 +42,7 @@ from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGH
                              OUTLIER, SEARCH, SENSOR, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
 from ..control.mountfit import HORIZON, LEVEL_READINGS, LIGHT_TOLERANCE, MAX_CONDITION
 from ..control.mountfit import spd_inverse as reference_spd_inverse  # compiled below
-from ..control.sensing import AZIMUTH, COSINE_FLOOR, ELEVATION
+from ..control.sensing import axis_offset as reference_axis_offset  # compiled below
 from ..control.wind import READABLE, STUCK_HOURS, STUCK_SPREAD
 from . import events as ev
 from .jit import kernel
@@ -484,23 +484,8 @@ def _spread(values, a):
     return high - low
 
 
-@kernel
-def axis_offset(sensed, a, reading):
-    """`hybridtrack.control.sensing.axis_offset`."""
-    if reading.shape[0] == 1:
-        return sensed[a], True
-    across, along = sensed[AZIMUTH], sensed[ELEVATION]
-    if math.isnan(sensed[a]):
-        return math.nan, True
-    c = 0.0 if math.isnan(across) else math.radians(across)
-    phi = math.radians(reading[ELEVATION] + (0.0 if math.isnan(along) else along))
-    if a == ELEVATION:
-        return math.degrees(math.asin(math.cos(c) * math.sin(phi))) - reading[ELEVATION], True
-    cosine = math.cos(phi)
-    if abs(cosine) >= COSINE_FLOOR:
-        return math.degrees(math.atan2(math.sin(c), math.cos(c) * cosine)), True
-    floor = -COSINE_FLOOR if cosine < 0.0 else COSINE_FLOOR
-    return math.degrees(math.atan2(math.sin(c), math.cos(c) * floor)), False
+#: sensing.axis_offset itself, compiled: the same steps, so the same bits.
+axis_offset = kernel(reference_axis_offset)
 
 
 @kernel
