@@ -124,6 +124,12 @@ def collimation_secant(elevation):
     return 1.0 / np.where(cosine < 0.0, np.minimum(cosine, -COSINE_FLOOR), np.maximum(cosine, COSINE_FLOOR))
 
 
+def vector_collimation_secant(vectors) -> np.ndarray:
+    """`collimation_secant` at the elevation of each pointing vector (``(..., 3)``, unit, z up):
+    what the plan's targets and the fit's derivatives both take of the collimation error."""
+    return collimation_secant(np.degrees(np.arcsin(np.clip(np.asarray(vectors, float)[..., 2], -1.0, 1.0))))
+
+
 def jacobian(altitude, azimuth, collector) -> np.ndarray:
     """d(target)/d(parameter) per scan, (N, axes, parameters): the pedestal terms by the chain
     rule through the mount's rotation about the nominal mount (`vector_jacobian`), each encoder
@@ -155,7 +161,7 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
     if axes == 2:  # the sensor's collimation error: an angle across the face is sec(e) of azimuth
-        out[:, 0, 4] = collimation_secant(np.degrees(np.arcsin(np.clip(vectors[:, 2], -1.0, 1.0))))
+        out[:, 0, 4] = vector_collimation_secant(vectors)
     return np.nan_to_num(out, copy=False)  # in place: a heliostat-year's copy took 0.03 s
 
 

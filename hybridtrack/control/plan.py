@@ -95,10 +95,9 @@ class MountEstimate:
         targets = angles_on_mount(vectors, collector, self.rotation(collector))
         targets = targets + np.resize(np.asarray(self.encoder_offset, float), targets.shape[1])
         if self.collimation_error and targets.shape[-1] == 2:
-            from .mountfit import collimation_secant
+            from .mountfit import vector_collimation_secant
 
-            elevation = np.degrees(np.arcsin(np.clip(np.asarray(vectors, float)[..., 2], -1.0, 1.0)))
-            targets[..., 0] += self.collimation_error * collimation_secant(elevation)
+            targets[..., 0] += self.collimation_error * vector_collimation_secant(vectors)
         return targets
 
 
