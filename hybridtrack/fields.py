@@ -818,7 +818,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     -------
     FieldResult
     """
-    from .kernel import uses_kernel
+    from .kernel import decided, uses_kernel
     from .reuse import reuse_work
     from .simulation import _check_frame, checked_config, warn_of_nights_left_out
     from .sun import solar_position
@@ -838,6 +838,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     if workers is not None:
         params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()
+    config = decided(config, len(frame) * len(collectors))  # on the field's scans, not each collector's
     threads = _thread_count(threads, frame, len(collectors), keep_log, dask=workers is not None or scheduler is not None,
                             compiled=uses_kernel(config, len(frame)))
     runs = [(i, name, collector, imperfect) for i, (name, collector, imperfect)

@@ -782,7 +782,7 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     ----------
     Apache Parquet file format: row groups, https://parquet.apache.org/docs/file-format/
     """
-    from .kernel import uses_kernel
+    from .kernel import decided
     from .simulation import checked_config
 
     if not isinstance(source, DaySource):
@@ -796,9 +796,8 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     collector = as_collector(collector)
-    if config.engine == "auto" and source.steps and uses_kernel(config, source.steps):
-        # whether the kernel pays is a question of the whole span, not of one day's segment
-        config = dataclasses.replace(config, engine="compiled")
+    if source.steps:  # whether the kernel pays is a question of the whole span, not of one day's segment
+        config = decided(config, source.steps)
     running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                              resolution=resolution)  # checks `resolution` before anything is written
     source.check_span()

@@ -35,6 +35,7 @@ whatever the number of workers. A run that fails is kept, with its error, and th
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import itertools
@@ -474,10 +475,11 @@ def _plain(value):
     return value
 
 
-def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
+def run_one(base: dict, grid_values: dict, source: str = "sweep", sweep_steps: int = 0) -> dict:
     """One run of a sweep: its row of the table. Never raises: a failure is the row's ``error``,
     which names the grid's key and value (``grid.drive.deadband = -1: ...``) when the value the
-    run refused came from the grid."""
+    run refused came from the grid. The config's ``engine = "auto"`` is decided on the sweep's
+    steps in all (`sweep_steps`; `hybridtrack.kernel.decided`), not on the run's own."""
     spec = _spec(base, grid_values)
     row = _row(spec)
     try:
@@ -487,7 +489,11 @@ def run_one(base: dict, grid_values: dict, source: str = "sweep") -> dict:
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, not the end of the sweep
         return _failed(row, exc)
     try:
-        row.update(_metrics(spec["strategy"], *setup), error=None)
+        from .kernel import decided
+
+        seed, config, weather, collector = setup
+        config = decided(config, sweep_steps)
+        row.update(_metrics(spec["strategy"], seed, config, weather, collector), error=None)
     except Exception as exc:  # noqa: BLE001
         return _failed(row, exc)
     return row
@@ -583,8 +589,9 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         if started is not None:
             started()
         # one map, not a submit a run: 100,000 submits took 45 s before the bar appeared
+        steps = _all_steps(sweep, runs)
         futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
-                                      pure=False), runs))
+                                      [steps] * len(runs), pure=False), runs))
         with tqdm(total=len(futures), unit="run", file=sys.stderr, disable=not progress, leave=False) as bar:
             try:
                 for future, row, error in finished(client, futures):
@@ -672,14 +679,8 @@ def _workers_that_fit(sweep: Sweep, runs: list[dict], workers: int, *, chosen: b
     run alone is checked as it is read). Fewer than `workers` where the default does not fit;
     refused, naming the longest run, where the user `chosen` them."""
     from .budget import BYTES_PER_STEP, readable_size, memory_budget
-    from .times import parse_freq
 
-    def steps(run: dict) -> tuple[int, int, str]:
-        spec = _spec(sweep.base, run)
-        days, freq = _whole_days(spec["days"]), _step(spec["freq"])
-        return days * pd.Timedelta(days=1) // parse_freq(freq), days, freq
-
-    count, days, freq = max(steps(run) for run in runs)
+    count, days, freq = max(_steps(sweep, run) for run in runs)
     size, budget = count * BYTES_PER_STEP, memory_budget()
     fitting = max(1, min(workers, budget // max(size, 1)))
     if chosen and fitting < workers:
@@ -688,6 +689,24 @@ def _workers_that_fit(sweep: Sweep, runs: list[dict], workers: int, *, chosen: b
                                f"{readable_size(budget)} the runs may use; {fitting} fit: use --workers {fitting} "
                                "(workers= from Python)")
     return fitting
+
+
+def _steps(sweep: Sweep, run: dict) -> tuple[int, int, str]:
+    """A run's steps, whole days and step (``freq``)."""
+    from .times import parse_freq
+
+    spec = _spec(sweep.base, run)
+    days, freq = _whole_days(spec["days"]), _step(spec["freq"])
+    return days * pd.Timedelta(days=1) // parse_freq(freq), days, freq
+
+
+def _all_steps(sweep: Sweep, runs: list[dict]) -> int:
+    """The steps of every run the sweep can read (one it cannot fails on its own, as its row)."""
+    total = 0
+    for run in runs:
+        with contextlib.suppress(HybridtrackError):
+            total += _steps(sweep, run)[0]
+    return total
 
 
 def _check_columns(table, names: list, what: str, *, numbers: bool = False) -> None:
