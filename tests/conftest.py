@@ -20,10 +20,29 @@ def spa_calls(monkeypatch):
     return calls
 
 
+@pytest.fixture
+def engine_choices(monkeypatch):
+    """A list of the engine each run asks `uses_kernel` about (its config's ``engine``), with the
+    kernel neither compiled nor cached as far as ``auto`` can tell and `COMPILE_PAYS_AT` left for
+    the test to set."""
+    import hybridtrack.kernel as kernel
+    import hybridtrack.simulation as simulation
+
+    engines = []
+    real = simulation.uses_kernel
+    monkeypatch.setattr(simulation, "uses_kernel", lambda config, scans=0: engines.append(config.engine)
+                        or real(config, scans))
+    monkeypatch.setattr(kernel, "compiled", lambda: False)
+    monkeypatch.setattr(kernel, "cached", lambda: False)
+    return engines
+
+
 #: Tests that run the compiled controller kernel: every test of these modules, and any test
 #: parametrised with ``engine="compiled"`` or named here.
 _KERNEL_MODULES = ("test_kernel.py",)
-_KERNEL_TESTS = ("test_the_carried_clock_watch_runs_the_same_on_both_engines",)
+_KERNEL_TESTS = ("test_the_carried_clock_watch_runs_the_same_on_both_engines",
+                 "test_the_engine_is_chosen_on_the_fields_scans_not_each_collectors",
+                 "test_a_sweeps_runs_choose_the_engine_on_the_sweeps_steps")
 
 
 def pytest_collection_modifyitems(config, items):

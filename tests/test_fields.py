@@ -687,19 +687,13 @@ def test_a_field_saves_its_log_whatever_dasks_global_scheduler_says(day, tmp_pat
         assert dict(saved.sizes) == {"collector": 2, "time": 60}
 
 
-def test_the_engine_is_chosen_on_the_fields_scans_not_each_collectors(day, monkeypatch):
+def test_the_engine_is_chosen_on_the_fields_scans_not_each_collectors(day, monkeypatch, engine_choices):
     """Where the kernel is neither compiled nor cached, ``auto`` compiles it from COMPILE_PAYS_AT
     scans: a field's collectors are counted together (each alone had run the reference loop, a
-    20-row year 35 s a row against 0.6 s), and a field too short to pay runs the reference."""
+    20-row year 34 s a row against 0.6 s), and a field too short to pay runs the reference."""
     import hybridtrack.kernel as kernel
-    import hybridtrack.simulation as simulation
 
-    engines = []
-    real = simulation.uses_kernel
-    monkeypatch.setattr(simulation, "uses_kernel", lambda config, scans=0: engines.append(config.engine)
-                        or real(config, scans))
-    monkeypatch.setattr(kernel, "compiled", lambda: False)
-    monkeypatch.setattr(kernel, "cached", lambda: False)
+    engines = engine_choices
     monkeypatch.setattr(kernel, "COMPILE_PAYS_AT", 3 * len(day))
     simulate_field(day, "lanzhou", TroughLoop(count=3), keep_log=False, threads=1)
     assert engines == ["compiled"] * 6  # each collector's run and its warm-start day

@@ -790,21 +790,15 @@ def test_a_dask_client_of_ours_leaves_dasks_scheduler_setting_and_default_client
     assert dask.config.get("scheduler", None) == before
 
 
-def test_a_sweeps_runs_choose_the_engine_on_the_sweeps_steps(monkeypatch):
+def test_a_sweeps_runs_choose_the_engine_on_the_sweeps_steps(monkeypatch, engine_choices):
     """Where the kernel is neither compiled nor cached, ``auto`` compiles it once the sweep's runs
     together pay for it: each run's own steps had kept every run on the reference loop."""
     import hybridtrack.kernel as kernel
-    import hybridtrack.simulation as simulation
     from hybridtrack.sweep import _all_steps
 
     sweep = Sweep.from_dict(TINY)
     assert _all_steps(sweep, sweep.runs()) == 6 * 96
-    engines = []
-    real = simulation.uses_kernel
-    monkeypatch.setattr(simulation, "uses_kernel", lambda config, scans=0: engines.append(config.engine)
-                        or real(config, scans))
-    monkeypatch.setattr(kernel, "compiled", lambda: False)
-    monkeypatch.setattr(kernel, "cached", lambda: False)
+    engines = engine_choices
     monkeypatch.setattr(kernel, "COMPILE_PAYS_AT", 6 * 96)
     first = run_one(sweep.base, sweep.runs()[0], "s.toml", 6 * 96)
     alone = run_one(sweep.base, sweep.runs()[0], "s.toml", 96)
