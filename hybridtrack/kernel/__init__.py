@@ -80,12 +80,30 @@ def uses_kernel(config, scans: int = 0) -> bool:
 
 
 def decided(config, scans: int):
-    """`config` with ``engine = "auto"`` decided for `scans` scans in all, for a caller that runs
-    many runs in one process (a field's collectors, a stream's days, a sweep's runs on a worker):
-    whether the kernel pays is a question of all of them, not of each run's own scans, which would
-    run every collector of a field-year on the reference loop where the kernel is not cached yet
-    (a 20-row Fresnel year: about 35 s a row against 0.6 s, after one compile of a minute or two).
-    ``compiled`` where the kernel pays, the config unchanged otherwise."""
+    """`config` with ``engine = "auto"`` decided for `scans` scans in all.
+
+    For a caller that runs many runs (a field's collectors, a stream's days, a sweep's runs):
+    whether the kernel pays is a question of all of them, not of each run's own scans, which had
+    run every collector of a field-year on the reference loop where the kernel was not cached
+    (a 20-row Fresnel year: 34 s a row against 0.6 s, after one compile of two to three minutes).
+
+    Parameters
+    ----------
+    config : SimulationConfig
+    scans : int
+        The scans of every run the caller will make.
+
+    Returns
+    -------
+    SimulationConfig
+        With ``engine = "compiled"`` where ``auto`` takes the kernel for `scans` (`uses_kernel`);
+        `config` itself otherwise (``reference``, ``compiled``, or ``auto`` that does not pay).
+
+    References
+    ----------
+    ``docs/kernel.md``, "Choosing it": where the measured costs behind `LOAD_PAYS_AT` and
+    `COMPILE_PAYS_AT` are given.
+    """
     if config.engine == "auto" and uses_kernel(config, scans):
         return dataclasses.replace(config, engine="compiled")
     return config
