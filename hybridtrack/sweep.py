@@ -680,7 +680,10 @@ def _workers_that_fit(sweep: Sweep, runs: list[dict], workers: int, *, chosen: b
     refused, naming the longest run, where the user `chosen` them."""
     from .budget import BYTES_PER_STEP, readable_size, memory_budget
 
-    count, days, freq = max(_steps(sweep, run) for run in runs)
+    readable = _readable_steps(sweep, runs)
+    if not readable:  # every run fails on its own days or step, as its row says
+        return 1
+    count, days, freq = max(readable)
     size, budget = count * BYTES_PER_STEP, memory_budget()
     fitting = max(1, min(workers, budget // max(size, 1)))
     if chosen and fitting < workers:
@@ -700,13 +703,20 @@ def _steps(sweep: Sweep, run: dict) -> tuple[int, int, str]:
     return days * pd.Timedelta(days=1) // parse_freq(freq), days, freq
 
 
-def _all_steps(sweep: Sweep, runs: list[dict]) -> int:
-    """The steps of every run the sweep can read (one it cannot fails on its own, as its row)."""
-    total = 0
+def _readable_steps(sweep: Sweep, runs: list[dict]) -> list[tuple[int, int, str]]:
+    """`_steps` of every run whose days and step can be read; a run whose cannot (a grid's
+    ``days = 0`` or ``freq = "2h"``) fails on its own, its row naming the grid's value, and the
+    sweep goes on (it had ended the whole sweep before it started, naming neither file nor key)."""
+    readable = []
     for run in runs:
         with contextlib.suppress(HybridtrackError):
-            total += _steps(sweep, run)[0]
-    return total
+            readable.append(_steps(sweep, run))
+    return readable
+
+
+def _all_steps(sweep: Sweep, runs: list[dict]) -> int:
+    """The steps of every run the sweep can read (`_readable_steps`)."""
+    return sum(steps for steps, _, _ in _readable_steps(sweep, runs))
 
 
 def _check_columns(table, names: list, what: str, *, numbers: bool = False) -> None:

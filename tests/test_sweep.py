@@ -804,3 +804,19 @@ def test_a_sweeps_runs_choose_the_engine_on_the_sweeps_steps(monkeypatch, engine
     alone = run_one(sweep.base, sweep.runs()[0], "s.toml", 96)
     assert engines == ["compiled"] * 2 + ["auto"] * 2  # each run and its warm-start day
     assert first == alone  # the same run either way
+
+
+def test_a_grids_unreadable_days_or_step_fail_their_runs_not_the_sweep():
+    """Sizing the cluster reads every run's days and step; one that cannot be read (``days = 0``,
+    ``freq = "2h"``) had ended the whole sweep before it started, naming neither file nor key.
+    Now it is left to its run, whose row names the grid's value."""
+    from hybridtrack.sweep import _all_steps, _workers_that_fit
+
+    for grid in ({"days": [1, 0]}, {"freq": ["15min", "2h", "abc"]}):
+        base = {k: v for k, v in TINY["base"].items() if k not in grid}
+        sweep = Sweep.from_dict({"base": base, "grid": grid}, source="s.toml")
+        runs = sweep.runs()
+        assert _workers_that_fit(sweep, runs, 2, chosen=True) == 2
+        assert _all_steps(sweep, runs) == 96
+        key, value = next(iter(grid)), grid[next(iter(grid))][1]
+        assert run_one(sweep.base, runs[1], "s.toml")["error"].startswith(f"HybridtrackError: grid.{key} = {value!r}:")
