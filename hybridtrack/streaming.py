@@ -41,6 +41,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import datetime as dt
+import itertools
 import os
 import shutil
 import sys
@@ -59,7 +60,7 @@ from .io.files import input_path
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
-from .times import local_midnight, parse_date, parse_freq
+from .times import check_tz, local_midnight, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
            "read_log", "stream_files", "partial_files"]
@@ -286,6 +287,8 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     DaySource
     """
     site = sites.get(site)
+    if tz is not None:  # a zone that is none had escaped as zoneinfo's KeyError once the stream started
+        tz = check_tz(tz, "recorded_days: tz: ")
     path = input_path(path, "weather file")
     if path.is_dir():
         raise HybridtrackError(f"{path}: is a folder, not a weather file")
@@ -319,10 +322,13 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     steps = None
     if suffix == ".csv":
 
+        first_row = 2  # the file's line: the header is line 1
+
         def pieces():
             try:
-                for k, piece in enumerate(pd.read_csv(path, sep=separator, chunksize=chunk_rows, low_memory=False)):
-                    yield stamped(piece, 2 + k * chunk_rows)  # the file's line: the header is line 1
+                with pd.read_csv(path, sep=separator, chunksize=chunk_rows, low_memory=False) as reader:
+                    for k, piece in enumerate(reader):
+                        yield stamped(piece, first_row + k * chunk_rows)
             except HybridtrackError:
                 raise
             except (ValueError, pd.errors.ParserError) as exc:
@@ -336,13 +342,16 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
         except (OSError, pa.ArrowException) as exc:
             raise HybridtrackError(f"{path}: cannot read as Parquet ({exc})") from None
         steps = handle.metadata.num_rows
+        first_row = 1
 
         def pieces():
             schema = handle.schema_arrow
             for k, batch in enumerate(handle.iter_batches(batch_size=chunk_rows)):
-                yield stamped(pa.Table.from_batches([batch], schema=schema).to_pandas(), 1 + k * chunk_rows)
+                yield stamped(pa.Table.from_batches([batch], schema=schema).to_pandas(), first_row + k * chunk_rows)
 
-    return DaySource(site, f"{path}", steps, None, lambda: _by_day(pieces(), site, str(path)),
+    rows = lambda: itertools.count(first_row, chunk_rows)  # noqa: E731 - each piece's first row
+    return DaySource(site, f"{path}", steps, None,
+                     lambda: _by_day(_magnitude_checked(pieces(), path, rows()), site, str(path)),
                      wind_measured="wind_speed" in measured)
 
 
@@ -449,8 +458,9 @@ def _in_order(piece: pd.DataFrame, path: Path, first_row: int) -> None:
 
 def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
     """Refuse what the reader's checks would repair (`hybridtrack.io.checks`): a value outside
-    its column's physical range, a negative irradiance or wind (a night offset the reader clips)
-    and irradiance in kW/m²; each by its row (`first_row` is the piece's first) and column."""
+    its column's physical range, or a negative irradiance or wind (a night offset the reader
+    clips); each by its row (`first_row` is the piece's first) and column. Irradiance in kW/m² is
+    judged over a day of pieces (`_magnitude_checked`)."""
     for column, (low, high) in LIMITS.items():
         if column not in piece:
             continue
@@ -462,11 +472,37 @@ def _physical(piece: pd.DataFrame, path: Path, first_row: int) -> None:
                 f"{path}: row {first_row + int(bad[0])}, column {column!r}: {values[bad[0]]:g} is outside "
                 f"{floor:g}..{high:g} {FRAME_UNITS[column]} (a streamed file is read as written, without the "
                 f"reader's repairs: convert it once with hybridtrack check FILE --out clean.parquet)")
-    if len(piece) < 2:  # no span to judge a magnitude over
-        return
-    lines = piece.assign(_line=np.arange(first_row, first_row + len(piece), dtype=float))
-    check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack check FILE --units "
-                                                  "{name}=kW/m2 --out clean.parquet")
+
+
+#: The span of rows a streamed file's irradiance magnitude is judged over (`_magnitude_checked`):
+#: a day holds the sun's light, where a few hours of night hold none to judge.
+MAGNITUDE_SPAN = pd.Timedelta(days=1)
+#: The irradiance columns the magnitude check reads (`hybridtrack.io.checks.check_magnitude`).
+_IRRADIANCE = ("ghi", "dhi", "dni")
+
+
+def _magnitude_checked(pieces: Iterator[pd.DataFrame], path: Path, first_rows: Iterator[int]) -> Iterator[pd.DataFrame]:
+    """`pieces` (each starting at the file's row from `first_rows`) passed on unchanged, with
+    irradiance in kW/m² refused (`check_magnitude`) over spans of at least `MAGNITUDE_SPAN` (or
+    the whole file, if shorter), each judged before its last piece is passed on. Judged a piece at
+    a time, a file read in small chunks (``chunk_rows`` of six hours or less) had never been."""
+    window: list[pd.DataFrame] = []
+
+    def judge():
+        lines = pd.concat(window)
+        if len(lines) >= 2:
+            check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack check FILE "
+                                                          "--units {name}=kW/m2 --out clean.parquet")
+
+    for piece, first_row in zip(pieces, first_rows):
+        columns = [name for name in _IRRADIANCE if name in piece]
+        window.append(piece[columns].assign(_line=np.arange(first_row, first_row + len(piece), dtype=float)))
+        if len(piece) and window[-1].index[-1] - window[0].index[0] >= MAGNITUDE_SPAN:
+            judge()
+            window = []
+        yield piece
+    if window:
+        judge()
 
 
 # -- the run -------------------------------------------------------------------------------------

@@ -350,6 +350,23 @@ def test_a_bad_cell_in_a_streamed_file_is_named_and_nothing_is_left_behind(tmp_p
     assert not (tmp_path / "run").exists()  # not even the folder the command made for it
 
 
+@pytest.mark.parametrize("chunk_rows", [3, 24, 200_000])
+def test_kw_per_m2_is_refused_whatever_the_chunks_it_is_read_in(tmp_path, chunk_rows):
+    """The magnitude is judged over a day of rows, not over each chunk: chunks of six hours or
+    less had each been too short to judge, and a kW/m² file ran as a month of overcast."""
+    path = tmp_path / "weather.csv"
+    path.write_text("time,dni\n" + "".join(f"2021-06-{d}T{h:02d}:00:00+08:00,{0.9 * (6 <= h <= 18)}\n"
+                                            for d in (21, 22) for h in range(24)))
+    with pytest.raises(HybridtrackError, match=r"column 'dni': dni is at most 0\.9 over \d+ hours; the values look "
+                                               r"like kW/m² read as W/m²"):
+        list(recorded_days(path, SITE, chunk_rows=chunk_rows))
+
+
+def test_an_unknown_zone_for_a_streamed_files_stamps_is_refused_by_name(tmp_path):
+    with pytest.raises(HybridtrackError, match="recorded_days: tz: unknown time zone 'Mars/X'"):
+        recorded_days(tmp_path / "weather.csv", SITE, tz="Mars/X")
+
+
 def test_a_lone_stamp_on_a_day_joins_its_neighbour_and_every_step_runs(tmp_path):
     """A logger's day export runs 00:00 to the next 00:00 inclusive: the last stamp is alone on its
     local day (a run needs two steps). It joins the day before; a lone first stamp joins the day
