@@ -523,6 +523,9 @@ class StreamResult:
         What the controller carries out of the last segment (`hybridtrack.simulation.Result`).
     config : SimulationConfig
         The run's config (each segment's differs only in its noise seed and the clock's age).
+    kept_as_read : KeptAsRead
+        The weather's missing readings and gaps, which the run kept as they were
+        (``streamed.kept_as_read`` in the summary).
 
     A run that stops part way (an error, an interrupt) leaves the log and events of the days it
     finished, and no ``summary.json``.
@@ -534,6 +537,7 @@ class StreamResult:
     collector: Collector
     config: object
     memory: dict | None = field(default=None, repr=False)
+    kept_as_read: KeptAsRead | None = field(default=None, repr=False)
 
     def log(self, columns=None, *, day=None) -> pd.DataFrame:
         """The log read back (all of it, or one local `day`), `columns` only if given."""
@@ -854,8 +858,10 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
     memory: bool | dict = warm_start
     start = None
     wind, cycle, last = set(), [], None
+    kept = KeptAsRead()
     try:
         for day, frame in source:
+            kept.add(frame)
             begin = frame.index[0]
             start = begin if start is None else start
             age = (begin - start) / pd.Timedelta(days=1)
@@ -883,9 +889,74 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
     summary["wind_data"] = wind.pop() if len(wind) == 1 else "partly missing"
     summary["day_cycle"] = cycle
     summary["streamed"] = {"segments": run.segments, "segment": "one local day, cut at midnight",
-                           "p95_resolution_deg": running.resolution, "weather": source.describe}
+                           "p95_resolution_deg": running.resolution, "weather": source.describe,
+                           "kept_as_read": kept.report()}
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
-    return StreamResult(summary, files, site, collector, config, memory)
+    return StreamResult(summary, files, site, collector, config, memory, kept)
+
+
+#: The columns whose missing readings a streamed run counts (`KeptAsRead`).
+COUNTED_COLUMNS = ("dni", "dhi", "ghi", "wind_speed", "photocurrent")
+#: A step longer than this many times the weather's typical step is a gap, as the record reader
+#: counts them (`hybridtrack.io.checks`).
+GAP_STEPS = 1.5
+
+
+@dataclass
+class KeptAsRead:
+    """What a streamed run's weather holds that the run keeps as it is, counted as its days pass
+    (`stream` repairs nothing; `hybridtrack.io.read_weather` counts the same in its report): the
+    missing readings of each column (each a sensor's fault the controller must survive) and the
+    gaps, steps longer than `GAP_STEPS` times the first day's typical step (a day missing from the
+    file among them); each with the time of its first."""
+
+    missing: dict = field(default_factory=dict)
+    gaps: int = 0
+    longest: pd.Timedelta = pd.Timedelta(0)
+    first_gap_after: pd.Timestamp | None = None
+    step: int | None = None
+    last: pd.Timestamp | None = None
+
+    def add(self, frame: pd.DataFrame) -> None:
+        """Count a day's frame, the day after the one counted before it."""
+        for column in COUNTED_COLUMNS:
+            if column in frame:
+                missing = frame[column].isna().to_numpy()
+                if missing.any():
+                    count, first = self.missing.get(column, (0, frame.index[int(np.argmax(missing))]))
+                    self.missing[column] = (count + int(missing.sum()), first)
+        index = frame.index if self.last is None else frame.index.insert(0, self.last)
+        steps = np.diff(index.as_unit("ns").asi8)
+        if self.step is None and len(frame) > 1:
+            self.step = int(np.median(np.diff(frame.index.as_unit("ns").asi8)))
+        if self.step:
+            at = np.flatnonzero(steps > GAP_STEPS * self.step)
+            if len(at) and self.first_gap_after is None:
+                self.first_gap_after = index[at[0]]
+            if len(at):
+                self.gaps += len(at)
+                self.longest = max(self.longest, pd.Timedelta(int(steps[at].max()), "ns"))
+        self.last = frame.index[-1]
+
+    def report(self) -> dict:
+        """As the summary holds it: ``missing`` by column (count, first) and, if any, ``gaps``
+        (count, longest, the stamp before the first)."""
+        from .io.checks import span
+
+        out = {"missing": {column: {"count": count, "first": str(first)}
+                           for column, (count, first) in self.missing.items()}}
+        if self.gaps:
+            out["gaps"] = {"count": self.gaps, "longest": span(self.longest), "first_after": str(self.first_gap_after)}
+        return out
+
+    def lines(self) -> list[str]:
+        """A line of text for each finding, as the command line prints them."""
+        said = [f"kept as read: {count:,} missing {column} reading{'s' * (count > 1)} (the first at {first})"
+                for column, (count, first) in self.missing.items()]
+        if self.gaps:
+            said.append(f"kept as read: {self.gaps:,} gap{'s' * (self.gaps > 1)} in the time steps, the longest "
+                        f"{self.report()['gaps']['longest']} (the first after {self.first_gap_after})")
+        return said
 
 
 def _whole(day: dt.date, frame: pd.DataFrame, site) -> bool:

@@ -362,6 +362,26 @@ def test_kw_per_m2_is_refused_whatever_the_chunks_it_is_read_in(tmp_path, chunk_
         list(recorded_days(path, SITE, chunk_rows=chunk_rows))
 
 
+def test_what_a_stream_keeps_as_read_is_counted_in_its_summary_and_said(tmp_path, capsys):
+    """A streamed file is not repaired, but nothing in it passes unsaid: a missing reading and a
+    missing day are counted as the record reader counts them (it had said neither)."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-20", "2021-06-23", weather="sunny", freq="15min", seed=1)
+    frame.loc["2021-06-20 13:30+08:00", "dni"] = np.nan
+    kept = frame[frame.index.date != pd.Timestamp("2021-06-22").date()]  # the third day missing
+    kept.to_csv(tmp_path / "weather.csv", index_label="time")
+    assert main(["replay", str(tmp_path / "weather.csv"), "--site", SITE, "--stream", "--out",
+                 str(tmp_path / "run")]) == 0
+    said = capsys.readouterr().out
+    assert "kept as read: 1 missing dni reading (the first at 2021-06-20 13:30:00+08:00)" in said
+    assert "kept as read: 1 gap in the time steps, the longest 1455min (the first after 2021-06-21 23:45:00+08:00)" \
+        in said
+    report = json.loads((tmp_path / "run" / "summary.json").read_text())["streamed"]["kept_as_read"]
+    assert report == {"missing": {"dni": {"count": 1, "first": "2021-06-20 13:30:00+08:00"}},
+                      "gaps": {"count": 1, "longest": "1455min", "first_after": "2021-06-21 23:45:00+08:00"}}
+
+
 def test_an_unknown_zone_for_a_streamed_files_stamps_is_refused_by_name(tmp_path):
     with pytest.raises(HybridtrackError, match="recorded_days: tz: unknown time zone 'Mars/X'"):
         recorded_days(tmp_path / "weather.csv", SITE, tz="Mars/X")

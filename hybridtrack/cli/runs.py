@@ -135,6 +135,8 @@ def _stream(source, args, config, *, heading: str) -> int:
         result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
                         config=config, progress=bar.update)
     print(heading + f" (streamed in {result.summary['streamed']['segments']} day-long segments)")
+    for line in result.kept_as_read.lines():
+        print(line)
     print(summary_table({result.summary["strategy"]: result.summary}))
     print("wrote " + ", ".join(str(p) for p in result.files.values()))
     return 0
