@@ -76,6 +76,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         raise HybridtrackError(f"{what} need dask.distributed: pip install 'dask[distributed]'") from None
     check_where(scheduler, workers)
     if scheduler:
+        _refuse_unreachable(scheduler)
         try:
             client = Client(scheduler, timeout="10s", set_as_default=False)
         # TypeError: distributed's TLS and UCX connectors refuse to start without their setup
@@ -105,6 +106,50 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         close_cluster(cluster)
         signal.raise_signal(signal.SIGTERM)
     return Client(cluster, set_as_default=False), cluster
+
+
+#: Seconds a scheduler's address is given to answer (`_refuse_unreachable`), as the client is.
+CONNECT_TIMEOUT = 10.0
+#: The address schemes a scheduler is reached by (``inproc``: a cluster in this very process).
+SCHEMES = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
+
+
+def _refuse_unreachable(scheduler: str) -> None:
+    """Refuse an address that is none (``tcp://:abc``, ``file://x``), naming the form, and a TCP
+    address nothing answers at or an in-process one no cluster of this process has, before a Dask
+    client is made for it: a client whose start failed was left to Python's collector, whose
+    close of it waited 20 s at the end of the command and then printed a traceback under the
+    one-line refusal."""
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    form = "a Dask scheduler's address is such as 'tcp://host:8786'"
+    try:
+        scheme, location = parse_address(scheduler.strip())
+        host, port = parse_host_port(location, 8786) if scheme in ("tcp", "tls") else ("", None)
+        if scheme in ("tcp", "tls") and not host:
+            raise ValueError("no host")
+    except (ValueError, TypeError):  # the parser's own words are about Python ("invalid literal for int()")
+        raise HybridtrackError(f"scheduler {scheduler!r} is not an address: {form}") from None
+    if scheme not in SCHEMES:
+        raise HybridtrackError(f"scheduler {scheduler!r}: {form}; {scheme}:// is not one a scheduler is reached by")
+    if scheme == "inproc":
+        from distributed.comm.inproc import global_manager
+
+        try:
+            listening = global_manager.get_listener_for(location) is not None
+        except ValueError:
+            raise HybridtrackError(f"scheduler {scheduler!r} is not an address: {form}") from None
+        if not listening:
+            raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: no cluster of this process "
+                                   "listens there")
+    if scheme != "tcp":  # TLS and the others need their own setup: the client's start judges them
+        return
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT).close()
+    except OSError as exc:
+        raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
 
 
 #: Seconds a running scheduler is given to have a worker: its runs would wait for one forever.
