@@ -352,6 +352,19 @@ def _drives(collector: Collector, config: SimulationConfig) -> list[Drive]:
 LONGEST_STEP = pd.Timedelta(hours=1)
 
 
+def run_step(freq) -> pd.Timedelta:
+    """`freq` (``"1min"``, ``"10s"``) as the step of a run's synthetic weather, refused beyond
+    `LONGEST_STEP`: ``"2h"`` or ``"1D"`` had made a frame that every run then refused as a
+    frame ("resample the frame"), which a user who gave a step and no frame cannot do."""
+    from .times import parse_freq
+
+    step = parse_freq(freq)
+    if step > LONGEST_STEP:
+        raise HybridtrackError(f"step {freq!r} is longer than a run's longest, {LONGEST_STEP / pd.Timedelta(hours=1):g} h "
+                               "(a tracking controller is replayed at steps of an hour or finer)")
+    return step
+
+
 def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     if not isinstance(frame, pd.DataFrame) or not isinstance(frame.index, pd.DatetimeIndex):
         raise HybridtrackError("the weather frame must be a DataFrame on a DatetimeIndex")

@@ -369,15 +369,11 @@ def _step(freq) -> str:
     """The step as the text `hybridtrack.sky.synthetic` takes, such as ``"1min"``, refused beyond
     the longest a run takes (`hybridtrack.simulation.LONGEST_STEP`): a base ``freq = "2h"`` (or
     ``"1D"``, one step a day) had been taken, to fail every run once the cluster was up."""
-    from .simulation import LONGEST_STEP
-    from .times import parse_freq
+    from .simulation import run_step
 
     if not isinstance(freq, str):
         raise HybridtrackError(f"freq must be a step such as '1min' or '10s', got {freq!r}")
-    if parse_freq(freq) > LONGEST_STEP:
-        raise HybridtrackError(f"freq {freq!r} is longer than a run's longest step, "
-                               f"{LONGEST_STEP / pd.Timedelta(hours=1):g} h (a tracking controller is replayed "
-                               "at steps of an hour or finer)")
+    run_step(freq)
     return freq
 
 

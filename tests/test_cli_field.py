@@ -121,6 +121,8 @@ def test_bad_field_input_is_one_line_and_status_2(tmp_path, capsys, content, ext
     (["heliostat", "--axis-azimuth", "3"], "--axis-azimuth describes a fresnel or trough field, not a heliostat"),
     (["heliostat", "--collector-length", "3"], "--collector-length describes a trough field"),
     (["heliostat", "--count", "3", "--positions", "m.csv"], "give one or the other"),
+    # had been refused as a frame to resample, a frame the user never gave
+    (["trough", "--count", "2", "--freq", "2h"], "--freq: step '2h' is longer than a run's longest, 1 h"),
 ])
 def test_bad_field_flags(capsys, flags, message):
     assert main(["field", *flags, "--site", "lanzhou", "--date", "2021-06-21"]) == 2

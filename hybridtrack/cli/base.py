@@ -307,7 +307,8 @@ def synthetic_span(args: argparse.Namespace):
     import datetime as dt
 
     from ..sky import check_weather
-    from ..times import parse_date, parse_freq
+    from ..simulation import run_step
+    from ..times import parse_date
 
     if not 1 <= args.days <= 3660:
         raise HybridtrackError(f"--days must be between 1 and 3660, got {args.days}")
@@ -318,7 +319,7 @@ def synthetic_span(args: argparse.Namespace):
     with flag_named("--date"):
         first = parse_date(args.date)
     with flag_named("--freq"):
-        parse_freq(args.freq)
+        run_step(args.freq)
     with flag_named("--weather"):
         check_weather(args.weather.split(",") if "," in args.weather else args.weather, args.days)
     return first, first + dt.timedelta(days=args.days - 1)
