@@ -251,7 +251,13 @@ def _refuse_overlapping(xyz: np.ndarray) -> None:
 
 
 def _finite_number(value, name: str, *, positive: bool = False, bound: float = MAX_DISTANCE) -> float:
-    return float(_finite_vector([value], name, positive=positive, bound=bound)[0])
+    """`value` as one finite number (`_finite_vector`'s checks); a list or an array of several is
+    refused as not one number (it had been told it must be "a non-empty list")."""
+    number = _as_numbers(value)
+    if number is not None and number.size != 1:
+        raise HybridtrackError(f"{name} must be one number for the whole field, got {_brief(value)}")
+    return float(_finite_vector(number.ravel() if number is not None else [value], name, positive=positive,
+                                bound=bound)[0])
 
 
 @dataclass(frozen=True)
@@ -408,7 +414,9 @@ class HeliostatField:
     def __post_init__(self) -> None:
         _spread_of(self)
         xyz = _as_numbers(_by_name(self.positions))
-        if xyz is None or xyz.ndim != 2 or xyz.shape[1] not in (2, 3) or len(xyz) == 0:
+        if xyz is not None and xyz.size == 0:  # numbers, but none of them: no field
+            raise HybridtrackError("heliostat positions are empty: a field needs at least one mirror")
+        if xyz is None or xyz.ndim != 2 or xyz.shape[1] not in (2, 3):
             raise HybridtrackError(f"heliostat positions must be numbers, (N, 2) or (N, 3) metres, got {_brief(self.positions)}")
         if xyz.shape[1] == 2:
             xyz = np.column_stack([xyz, np.zeros(len(xyz))])

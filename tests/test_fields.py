@@ -170,6 +170,12 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
     (lambda: HeliostatField(spread=0.2), "HeliostatField: spread must be an ImperfectionSpread, got float"),
     # each length was bounded, the line was not: 100,000 collectors had reached 100,000 km
     (lambda: TroughLoop(count=100_000, collector_length=1000.0), "reach 9.9999e\\+07 m along the axis, beyond 5000 m"),
+    # had said "must be a non-empty list of numbers" of a setting that takes one number
+    (lambda: FresnelField(receiver_height=[10, 11]), r"receiver height must be one number for the whole field, got \[10, 11\]"),
+    (lambda: TroughLoop(collector_length=np.array([150.0, 140.0])), "collector length must be one number"),
+    # had said "must be numbers" of numbers: none of them
+    (lambda: HeliostatField(positions=np.zeros((0, 2))), "^heliostat positions are empty: a field needs at least one mirror$"),
+    (lambda: HeliostatField(positions=[]), "heliostat positions are empty"),
 ])
 def test_bad_fields_are_refused_with_what_is_wrong(make, message):
     with pytest.raises(HybridtrackError, match=message):
