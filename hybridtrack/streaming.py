@@ -495,11 +495,12 @@ def _magnitude_checked(pieces: Iterator[pd.DataFrame], path: Path, first_rows: I
                                                           "--units {name}=kW/m2 --out clean.parquet")
 
     for piece, first_row in zip(pieces, first_rows):
-        columns = [name for name in _IRRADIANCE if name in piece]
-        window.append(piece[columns].assign(_line=np.arange(first_row, first_row + len(piece), dtype=float)))
-        if len(piece) and window[-1].index[-1] - window[0].index[0] >= MAGNITUDE_SPAN:
-            judge()
-            window = []
+        if len(piece):  # an empty piece (a header alone) has no span
+            columns = [name for name in _IRRADIANCE if name in piece]
+            window.append(piece[columns].assign(_line=np.arange(first_row, first_row + len(piece), dtype=float)))
+            if window[-1].index[-1] - window[0].index[0] >= MAGNITUDE_SPAN:
+                judge()
+                window = []
         yield piece
     if window:
         judge()
