@@ -21,7 +21,7 @@ from hybridtrack.fuzzy import FuzzyConfig
 from hybridtrack.io import read_weather
 from hybridtrack.outputs import replacing
 from hybridtrack.sensor import SensorModel
-from hybridtrack.simulation import SimulationConfig
+from hybridtrack.simulation import SimulationConfig, run_step
 from hybridtrack.sky import synthetic
 from hybridtrack.skyinputs import SkyInputConfig
 from hybridtrack.sun import solar_position
@@ -208,7 +208,10 @@ MATRIX = [
      lambda p: ["sun", "--site", "lanzhou", "--date", "2021-06-21", "--freq", "1ns"], "steps of 1ns would need about"),
     # a day at 2-day steps is its midnight alone: it had been refused as a frame, naming no step
     ("a step longer than the period", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq="2d"),
-     lambda p: SIMULATE + ["--freq", "2d"], "step '2d' leaves 1 time step in the period: a weather frame needs"),
+     None, "step '2d' leaves 1 time step in the period: a weather frame needs"),
+    # the command line refuses a step no run takes before it makes a frame (it had said "resample the frame")
+    ("a step longer than a run's", lambda tmp: None, lambda p: run_step("2d"),
+     lambda p: SIMULATE + ["--freq", "2d"], "step '2d' is longer than a run's longest, 1 h"),
     ("an empty step", lambda tmp: None, lambda p: synthetic("lanzhou", "2021-06-21", freq=""),
      lambda p: SIMULATE + ["--freq", ""], "step '' is not a duration"),
     ("reversed working hours", config_file("[controller]\nworking_hours = ['20:00', '05:00']\n"),
