@@ -399,6 +399,22 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     return frame
 
 
+def _refuse_unphysical_light(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
+    """Refuse a frame's light no sky at `site` gives: direct light at night (`_refuse_light_at_night`)
+    or irradiance a thousand times too small, kW/m² where W/m² belong (judged as a file's is,
+    `hybridtrack.io.checks.check_magnitude`, against the clear sky of Haurwitz (1945) on the true
+    sun). A frame darker than any sky is not refused, as a file is: a frame made in memory with
+    no diffuse light (DHI of 0) is a simplification a test may make on purpose."""
+    import pvlib
+
+    from .io.checks import check_magnitude
+
+    _refuse_light_at_night(frame, site, altitude)
+    clear = pvlib.clearsky.haurwitz(pd.Series(90.0 - altitude, index=frame.index))["ghi"].to_numpy(float)
+    check_magnitude("the weather frame", frame, {}, clear, too_dark=False,
+                    remedy="multiply the frame's {name} by 1000 (irradiance is in W/m²)")
+
+
 def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
     """Refuse a frame whose direct light comes while the sun is down at `site`: another place's
     weather, or an index in another time zone (a Denver day run at Lanzhou scored 0.9999).
@@ -650,7 +666,7 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
 
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
     # once for a field's collectors under one frame (`hybridtrack.reuse`): a refusal is not kept
-    shared(("light at night", Same(frame), site), lambda: _refuse_light_at_night(frame, site, world.altitude))
+    shared(("light checked", Same(frame), site), lambda: _refuse_unphysical_light(frame, site, world.altitude))
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
     compiled = uses_kernel(config, world.n)

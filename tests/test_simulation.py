@@ -605,6 +605,24 @@ def test_a_frame_whose_light_comes_while_the_sun_is_down_is_refused():
         simulate(days.set_axis(days.index + pd.Timedelta(hours=8)), "lanzhou")
 
 
+@pytest.mark.parametrize("columns, named", [(["dni"], "dni is at most 1.0"), (["dni", "dhi", "ghi"], "ghi is at most 1.1"),
+                                             (["dni", "dhi"], "dni is at most 1.0")])
+def test_a_frame_in_kilowatts_is_refused_as_a_file_is(columns, named):
+    """A frame made in memory with irradiance in kW/m² had run as a day without a beam (the
+    magnitude check was a file's only): on a clear June day at Lanzhou the clear sky (Haurwitz)
+    reaches about 1,000 W/m², so a largest value of 1.06 is kW/m²."""
+    from hybridtrack.fields import FresnelField, simulate_field
+
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    scaled = day.assign(**{name: day[name] / 1000.0 for name in columns})
+    for run in (lambda: simulate(scaled, "lanzhou"), lambda: simulate(scaled[["dni"]], "lanzhou"),
+                lambda: simulate_field(scaled, "lanzhou", FresnelField(row_distances=(-2.0, 2.0)))):
+        with pytest.raises(HybridtrackError, match=f"the weather frame: column '(dni|ghi)': ({named}|dni is at most 1.0)"
+                                                   f".*kW/m² read as W/m²: multiply the frame's (dni|ghi) by 1000"):
+            run()
+    assert simulate(day.assign(dhi=0.0), "lanzhou").summary["energy_capture"] > 0.9  # no diffuse: a test's choice
+
+
 @pytest.mark.parametrize("engine", ["reference", "compiled"])
 def test_a_sensor_only_tracker_started_at_midnight_sleeps_until_daylight(engine):
     """Its first dark scan had been taken for dusk: it woke at 00:00 ('daylight' at 30 mA of dark

@@ -67,7 +67,10 @@ REPAIRS = {
 
 
 def first_lines(frame: pd.DataFrame, mask) -> list[int]:
-    """The file lines of the first five rows in `mask` (resampled rows have none)."""
+    """The file lines of the first five rows in `mask` (resampled rows, and a frame made in
+    memory, have none)."""
+    if "_line" not in frame:
+        return []
     lines = frame["_line"].to_numpy()[np.asarray(mask, bool)]
     return [int(v) for v in lines[np.isfinite(lines)][:5]]
 
@@ -202,8 +205,8 @@ def _drop_empty(frame: pd.DataFrame, report: dict) -> pd.DataFrame:
     return frame
 
 
-def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
-                    remedy: str = "give the unit (--units {name}=kW/m2)") -> None:
+def check_magnitude(path: Path | str, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
+                    remedy: str = "give the unit (--units {name}=kW/m2)", too_dark: bool = True) -> None:
     """Refuse irradiance a thousand times too small (kW/m² read as W/m²), or darker than any sky.
 
     In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
@@ -212,7 +215,8 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
     reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
     judged so only in a file without GHI and DHI, since an overcast day has none. With a site,
     GHI or DHI that stays darker than any sky while the sun is high is refused too
-    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column).
+    (`_refuse_too_dark`) unless `too_dark` is False. `remedy` ends the kW/m² message (``{name}`` is
+    the column); `path` may be any name of the frame's source.
     """
     _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
@@ -235,7 +239,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
         if suspicious:
             raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
                                    f"{remedy.format(name=name)}")
-        if clear_ghi is not None:
+        if clear_ghi is not None and too_dark:
             _refuse_too_dark(where, frame, name, top, clear_ghi)
 
 
