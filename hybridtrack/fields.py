@@ -45,6 +45,7 @@ from .collectors import (
 from .errors import HybridtrackError
 from .mounting import incidence_cosine
 from .outputs import claim, output_folder, remove_earlier, removing_empty_folders, strict_json, together, write
+from .times import stamp_minutes
 from .world import IMPERFECTION_LIMITS, Imperfections
 
 __all__ = ["ImperfectionSpread", "FresnelField", "TroughLoop", "HeliostatField", "FieldResult", "simulate_field",
@@ -988,10 +989,9 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
 
 
 def _energy(light: np.ndarray, index: pd.DatetimeIndex) -> float:
-    """kWh/m² of `light` (W/m² at each stamp), each stamp standing for the frame's typical step
-    (its median: a gap in the frame is light nobody saw, not light to count)."""
-    step_hours = float(np.median(np.diff(index.as_unit("ns").asi8))) / 3.6e12
-    return float(light.sum()) * step_hours / 1000.0
+    """kWh/m² of `light` (W/m² at each stamp), each stamp standing for its own step
+    (`hybridtrack.times.stamp_minutes`: a gap in the frame is light nobody saw, not light to count)."""
+    return float(np.sum(light * stamp_minutes(index))) / 60e3
 
 
 def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:

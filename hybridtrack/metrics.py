@@ -29,7 +29,7 @@ import pandas as pd
 
 from . import params
 from .errors import HybridtrackError
-from .times import check_tz
+from .times import check_tz, stamp_minutes
 
 __all__ = ["summarize", "score", "RunningSummary", "offered_light", "daily", "shares", "share_counts", "event_counts", "moved_axes",
            "weighted_quantile", "acceptance", "held_error", "ACCEPTANCE_HALF_ANGLE", "TRACKING_MODES",
@@ -93,7 +93,8 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
 
     Columns: ``weight`` (direct light on the aperture where the error is scored, else 0),
     ``error``, ``offered`` (direct light a perfect tracker would catch), ``captured`` (what this
-    one caught through the acceptance model) and ``moved`` (drive axes that moved this step).
+    one caught through the acceptance model), the light in W min/m² over each stamp's own step
+    (`hybridtrack.times.stamp_minutes`: a frame of mixed steps weighs a minute alike in each) and ``moved`` (drive axes that moved this step).
     """
     half_angle = _half_angle(collector)
     _check_log(log, sun_up, incidence)
@@ -101,9 +102,10 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
     error = log["error"].to_numpy(float)
     beam = dni * np.asarray(incidence, float)  # direct light on the aperture
     tracking = log["mode"].isin(TRACKING_MODES).to_numpy() & (beam > 0) & np.isfinite(error)
-    offered = offered_light(dni, sun_up, incidence)
+    minutes = stamp_minutes(log.index)  # light over the stamp's own step, so mixed steps weigh alike
+    offered = offered_light(dni, sun_up, incidence) * minutes
     gained = acceptance(np.where(tracking, error, np.inf), half_angle)
-    return pd.DataFrame({"weight": np.where(tracking, beam, 0.0), "error": np.where(tracking, error, np.nan),
+    return pd.DataFrame({"weight": np.where(tracking, beam * minutes, 0.0), "error": np.where(tracking, error, np.nan),
                          "offered": offered, "captured": np.where(tracking, offered * gained, 0.0),
                          "moved": moved_axes(log)}, index=log.index)
 
@@ -397,11 +399,7 @@ def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidenc
     steps = _steps(log, collector, sun_up, incidence)
     local = log.index.tz_convert(check_tz(tz))
     day = pd.Index(local.date, name="date")
-    elapsed = np.asarray((log.index - log.index[0]) / pd.Timedelta(minutes=1), float)  # any index unit
-    minutes = np.diff(elapsed, append=elapsed[-1])
-    if len(minutes) > 1:
-        minutes[-1] = minutes[-2]
-    minutes = np.minimum(minutes, np.median(minutes) if len(minutes) else 1.0)  # a gap is not time in a mode
+    minutes = stamp_minutes(log.index)  # each stamp its own step: a gap is not time in a mode
     rows = []
     sky = log["sky"].astype(str).where(np.asarray(sun_up, bool), "night")
     for date, where in pd.Series(np.arange(len(log)), index=day).groupby(level=0):

@@ -39,7 +39,7 @@ from . import params
 from .budget import check_steps
 from .errors import HybridtrackError
 from .sites import Site, get
-from .times import clock_hours, local_midnight, local_range, parse_freq
+from .times import clock_hours, local_midnight, local_range, parse_freq, stamp_minutes
 
 __all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES",
            "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
@@ -459,15 +459,16 @@ def daily_summary(frame: pd.DataFrame, site: Site | str) -> pd.DataFrame:
     position = solar_position(frame.index, site)
     cos_z = np.clip(np.cos(np.radians(position["zenith"].to_numpy(float))), 0.0, None)
     extra = pvlib.irradiance.get_extra_radiation(frame.index).to_numpy(float) * cos_z
-    step_hours = np.median(np.diff(frame.index.as_unit("ns").asi8)) / 3.6e12 if len(frame) > 1 else 1.0 / 60.0
+    hours = stamp_minutes(frame.index) / 60.0  # each stamp its own step; a gap counts no light
     day = frame.index.tz_convert(site.tz).date
     up = position["altitude"].to_numpy(float) > 0
     table = pd.DataFrame({"ghi": frame["ghi"].to_numpy(float), "dni": frame["dni"].to_numpy(float), "extra": extra,
+                          "ghi_wh": frame["ghi"].to_numpy(float) * hours, "dni_wh": frame["dni"].to_numpy(float) * hours,
                           "up": up, "sunshine": up & (frame["dni"].to_numpy(float) >= 120.0)}, index=day)
     grouped = table.groupby(level=0)
     out = pd.DataFrame({
-        "dni_kwh_m2": grouped["dni"].sum() * step_hours / 1000.0,
-        "ghi_kwh_m2": grouped["ghi"].sum() * step_hours / 1000.0,
+        "dni_kwh_m2": grouped["dni_wh"].sum() / 1000.0,
+        "ghi_kwh_m2": grouped["ghi_wh"].sum() / 1000.0,
         "clearness_index": grouped["ghi"].sum() / grouped["extra"].sum(),
         "sunshine_share": grouped["sunshine"].sum() / grouped["up"].sum().clip(lower=1),
     })

@@ -13,7 +13,7 @@ from .errors import HybridtrackError
 
 __all__ = ["parse_date", "check_dates", "FIRST_DATE", "LAST_DATE", "parse_clock", "parse_freq", "local_range",
            "local_midnight", "check_tz", "clock_hours", "clock_nanoseconds", "calendar_days", "day_of_year",
-           "plus_seconds", "HOUR_NS", "DAY_NS"]
+           "plus_seconds", "stamp_minutes", "HOUR_NS", "DAY_NS"]
 
 
 def clock_nanoseconds(local: pd.DatetimeIndex):
@@ -22,6 +22,29 @@ def clock_nanoseconds(local: pd.DatetimeIndex):
 
     wall = local.tz_localize(None) if local.tz is not None else local
     return np.asarray(wall.as_unit("ns").asi8)
+
+
+#: Minutes a stamp stands for at most (`stamp_minutes`): a run's longest step, an hour.
+LONGEST_STAMP_MINUTES = 60.0
+
+
+def stamp_minutes(index: pd.DatetimeIndex):
+    """Minutes each stamp of `index` stands for: the shorter of its steps to the stamps either side
+    (the one side at an end), at most `LONGEST_STAMP_MINUTES`; a lone stamp a minute.
+
+    A gap is time nobody measured, so it lengthens no stamp; a frame of mixed steps (a 15-minute
+    day beside a 1-minute day) weighs each stamp by its own step, where the frame's median step had
+    made the 15-minute day count a fifteenth of its light. On a regular grid every stamp stands for
+    the step, exactly.
+    """
+    import numpy as np
+
+    ns = np.asarray(index.as_unit("ns").asi8)
+    if len(ns) < 2:
+        return np.ones(len(ns))
+    steps = np.diff(ns) / 6e10
+    before, after = np.concatenate(([steps[0]], steps)), np.concatenate((steps, [steps[-1]]))
+    return np.minimum(np.minimum(before, after), LONGEST_STAMP_MINUTES)
 
 
 def plus_seconds(times: pd.DatetimeIndex, seconds) -> pd.DatetimeIndex:

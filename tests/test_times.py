@@ -87,3 +87,18 @@ def test_a_day_step_in_lower_case_reads_without_pandas_deprecation_warning(text,
         else:  # read as days, then refused: no controller timing is longer than its day
             with pytest.raises(HybridtrackError, match=f"dwell '{text}' is longer than a day"):
                 duration(text, "dwell")
+
+
+def test_each_stamp_stands_for_its_own_step_and_a_gap_for_none():
+    """Hand-counted: 15-min stamps, then a 2-h gap, then 1-min stamps; the ends take their one
+    side; a step over an hour is capped at an hour; a lone stamp is a minute."""
+    from hybridtrack.times import stamp_minutes
+
+    start = pd.Timestamp("2021-06-21 06:00", tz="Asia/Shanghai")
+    stamps = pd.DatetimeIndex([start + pd.Timedelta(minutes=m) for m in (0, 15, 30, 150, 151, 152)])
+    np.testing.assert_array_equal(stamp_minutes(stamps), [15, 15, 15, 1, 1, 1])
+    sparse = pd.DatetimeIndex([start, start + pd.Timedelta(hours=3)])
+    np.testing.assert_array_equal(stamp_minutes(sparse), [60, 60])
+    np.testing.assert_array_equal(stamp_minutes(stamps[:1]), [1])
+    regular = pd.date_range(start, periods=5, freq="10s")
+    np.testing.assert_array_equal(stamp_minutes(regular), np.full(5, 10 / 60))
