@@ -14,7 +14,7 @@ import contextvars
 import dataclasses
 import functools
 import threading
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -516,11 +516,11 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         The controller's sky classifier; the published one by default.
     faults : dict, optional
         Injected faults for testing, one array value per step; see `FAULTS`.
-    progress : callable, optional
+    progress : callable or bool, optional
         Called with the number of steps done since its last call (e.g. a tqdm bar's update),
         from the thread that runs the scan loop: for a long compiled run
         (`SIDE_BY_SIDE_FROM` scans or more) a second thread, so it must be safe to call from
-        one (tqdm's is).
+        one (tqdm's is). True shows a bar of the steps on stderr; False or None nothing.
     bulk_nights : bool
         Record a night asleep at stow in one go (the same result, faster; a test keeps it so).
     warm_start : bool or dict
@@ -535,8 +535,38 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     Result
     """
     warn_of_nights_left_out(frame, site)
-    return _scored(track(frame, site, collector=collector, strategy=strategy, config=config, classifier=classifier,
-                         faults=faults, progress=progress, bulk_nights=bulk_nights, warm_start=warm_start))
+    with progress_updates(progress, lambda: _step_bar(frame)) as update:
+        return _scored(track(frame, site, collector=collector, strategy=strategy, config=config, classifier=classifier,
+                             faults=faults, progress=update, bulk_nights=bulk_nights, warm_start=warm_start))
+
+
+@contextmanager
+def progress_updates(progress, bar: Callable) -> Iterator[Callable | None]:
+    """What a run calls with each count of steps done, from its `progress` argument: a callable as
+    given; True a tqdm bar made by `bar()` and closed after (as a field's ``progress=True``); False
+    or None nothing (`check_progress`)."""
+    check_progress(progress)
+    if isinstance(progress, (bool, np.bool_)) and progress:
+        with bar() as made:
+            yield made.update
+        return
+    yield progress or None
+
+
+def check_progress(progress) -> None:
+    """Refuse a `progress` that is neither a callable, True, False nor None, by name."""
+    if progress is not None and not isinstance(progress, (bool, np.bool_)) and not callable(progress):
+        raise HybridtrackError(f"progress must be a callable (a tqdm bar's update), True, False or None, got "
+                               f"{progress!r:.60}")
+
+
+def _step_bar(frame: pd.DataFrame):
+    """A tqdm bar over a frame's steps, on stderr."""
+    import sys
+
+    from tqdm import tqdm
+
+    return tqdm(total=len(frame), unit="step", unit_scale=True, file=sys.stderr, leave=False, mininterval=1.0)
 
 
 class NightsLeftOutWarning(UserWarning):

@@ -801,8 +801,9 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     warm_start : bool
         The first segment's warm start (`hybridtrack.simulate`); later segments go on from the
         one before (its `Result.memory`).
-    progress : callable, optional
-        Called with the steps done since its last call.
+    progress : callable or bool, optional
+        Called with the steps done since its last call; True shows a bar on stderr
+        (`progress_bar`), False or None nothing (`hybridtrack.simulation.progress_updates`).
     on_segment : callable, optional
         Called with each segment's `Result` before it is dropped (tests, custom tallies).
     resolution : float
@@ -824,14 +825,13 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     Apache Parquet file format: row groups, https://parquet.apache.org/docs/file-format/
     """
     from .kernel import decided
-    from .simulation import checked_config
+    from .simulation import check_progress, checked_config, progress_updates
 
     if not isinstance(source, DaySource):
         raise HybridtrackError("source must be a DaySource (synthetic_days, recorded_days or frame_days)")
     site = source.site
     config = checked_config(config)
-    if progress is not None and not callable(progress):  # it is called with each count of steps done
-        raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
+    check_progress(progress)
     if on_segment is not None and not callable(on_segment):
         raise HybridtrackError(f"on_segment must be a callable or None, got {on_segment!r:.60}")
     if strategy is not None:
@@ -845,9 +845,9 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     files = stream_files(out)
     partial = partial_files(files)
     claim([*files.values(), partial["events"]], folders=[partial["log"]])  # the log's segments: a folder
-    with held(files["log"].parent):  # no other run may append to this folder's log while this one does
-        return _stream_segments(source, files, site, collector, config, classifier, warm_start, progress,
-                                on_segment, running)
+    with held(files["log"].parent), progress_updates(progress, lambda: progress_bar(source)) as update:
+        return _stream_segments(source, files, site, collector, config, classifier, warm_start, update,
+                                on_segment, running)  # no other run may append to this folder's log meanwhile
 
 
 def _stream_segments(source: DaySource, files: dict, site, collector: Collector, config, classifier,

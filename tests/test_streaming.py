@@ -648,13 +648,29 @@ def test_a_second_streamed_run_into_the_folder_another_is_writing_is_refused(tmp
     assert again.files["summary"].exists() and not (tmp_path / "run" / ".hybridtrack.lock").exists()
 
 
-@pytest.mark.parametrize("arguments, message", [(dict(progress=True), "progress must be a callable"),
+@pytest.mark.parametrize("arguments, message", [(dict(progress="yes"), "progress must be a callable"),
                                                 (dict(on_segment=5), "on_segment must be a callable")])
 def test_callbacks_that_are_not_callable_are_refused_before_anything_is_written(tmp_path, arguments, message):
     """They raised a TypeError after the first day, leaving its partial files (found by helper-2)."""
     with pytest.raises(HybridtrackError, match=message):
         stream(_two_days(), tmp_path / "run", **arguments)
     assert not (tmp_path / "run").exists()
+
+
+def test_progress_true_shows_a_bar_and_false_none_as_a_fields_does(tmp_path, capsys):
+    """`stream(progress=False)` had been refused where `simulate_field(progress=False)` is taken:
+    simulate and stream now take a bar switch as a field does, beside a callable."""
+    from hybridtrack.sky import synthetic
+
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="30min", seed=1)
+    quiet = simulate(day, "lanzhou", progress=False).summary
+    assert capsys.readouterr().err == ""
+    shown = simulate(day, "lanzhou", progress=True).summary
+    assert "/48.0 [" in capsys.readouterr().err and shown == quiet  # a bar over the 48 steps, gone when done
+    stream(_two_days(), tmp_path / "quiet", progress=False)
+    assert capsys.readouterr().err == ""
+    stream(_two_days(), tmp_path / "shown", progress=True)
+    assert "streaming" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("options, message", [
