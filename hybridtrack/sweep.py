@@ -648,9 +648,15 @@ def _as_text(values: pd.Series) -> pd.Series:
 
     For the columns pandas cannot make one native column of, which Parquet cannot store: values of
     several types (``[0.1, "wide"]``), whole numbers beyond 64 bits (a seed of 1e20, which fails
-    its run but must not lose the table), tables. Text keeps every digit, where a float would not.
+    its run but must not lose the table), tables. Text keeps every digit, where a float would not;
+    a boolean is written as TOML writes it (``true``, where Python's ``str`` gave ``True``).
     """
-    return values.map(lambda v: v if v is None else str(v)).astype("string")
+    def text(value):
+        if isinstance(value, (bool, np.bool_)):
+            return "true" if value else "false"
+        return value if value is None else str(value)
+
+    return values.map(text).astype("string")
 
 
 def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:

@@ -230,6 +230,10 @@ def test_a_grid_of_mixed_types_makes_a_table_parquet_can_hold(tmp_path):
     table.to_parquet(tmp_path / "runs.parquet", index=False)
     assert list(pd.read_parquet(tmp_path / "runs.parquet")["drive.deadband"]) == ["0.1", "wide"]
     assert table["error"].isna().tolist() == [True, False]
+    grid = Sweep.from_dict({**TINY, "grid": {"controller.lead": [True, "x"]}})
+    flags = _table([run_one(grid.base, {"run": k, "controller.lead": v}) for k, v in enumerate([True, "x"])])
+    assert list(flags["controller.lead"]) == ["true", "x"]  # as the sweep's TOML wrote it, not Python's 'True'
+    assert flags["error"].isna().tolist() == [True, False]
 
 
 def test_a_seed_beyond_64_bits_fails_its_run_and_the_table_keeps_every_digit(tmp_path):
