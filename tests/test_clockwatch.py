@@ -92,3 +92,22 @@ def test_no_clock_alarm_on_a_healthy_clock(collector, site, start, end, weather,
     """Default imperfections: a clock 15 s behind and gaining a second a day, as a PLC's does."""
     result = _run(site, start, end, collector, weather=weather, seed=seed)
     assert not _clock_alarms(result)
+
+
+def test_a_parameter_the_readings_cannot_tell_keeps_its_priors_one_sigma():
+    """Readings with no rate say nothing of the clock: its 1σ is the prior's 600 s, however
+    scattered the readings are. Scaling the whole covariance by the scatter (here about 100 times
+    the datasheet variance) had reported it at 600 s times that scatter's root; a trough's
+    streamed year had said 1,884 s. The mount's offset, which the readings do tell, takes the
+    scatter: by hand, the residuals' standard deviation over the root of their count."""
+    from hybridtrack.control.clockwatch import PRIOR, ClockWatch
+
+    watch = ClockWatch(1, 0.05)
+    residuals = 0.5 * np.random.default_rng(1).standard_normal(40)
+    for k, residual in enumerate(residuals):
+        watch.add(5.0 * k, 0, [1.0], 0.0, residual, 1.0)  # rate 0: a clock error moves nothing
+    estimate, std = watch.solve()
+    assert std[1] == pytest.approx(PRIOR["clock"], rel=1e-12) and estimate[1] == 0.0
+    by_hand = residuals.std(ddof=1) / np.sqrt(len(residuals))
+    assert std[0] == pytest.approx(by_hand, rel=0.1)  # the residuals' serial correlation is clipped at 0
+    assert estimate[0] == pytest.approx(residuals.mean(), rel=1e-3)

@@ -945,25 +945,35 @@ def clock_solve(moments, sums, count, span, prior, r):
     `span` days: (estimate, 1σ), each of the mount's parameters, the clock's error and its drift
     (held at zero, 1σ infinite, under DRIFT_DAYS). The residuals' squares are the sums expanded
     about the estimate, Σ(y − xβ)² = Σy² − 2β·Σxy + βᵀ(Σxxᵀ)β, so no evening goes over the
-    readings."""
+    readings. The 1σ is the scaled readings' information with the priors' as they are (the
+    reference's words)."""
     n = prior.shape[0]
     k = n if span >= DRIFT_DAYS else n - 1
-    information, projected = np.zeros((k, k)), np.zeros(k)
+    projected = np.zeros(k)
     for j in range(k):
         projected[j] = sums[XY, j] / r
-        for m in range(k):
-            information[j, m] = moments[XX, j, m] / r
-        information[j, j] += prior[j]
-    covariance = np.linalg.inv(information)
-    estimate = covariance @ projected
+    estimate = np.linalg.inv(_information(moments, prior, r, k)) @ projected
     squares = max(sums[YY, n] - 2.0 * _linear(sums, XY, estimate, k) + _quadratic(moments, XX, estimate, k), 0.0)
     unit_variance = max(1.0, squares / r / max(count - k, 1))
-    factor = _correlation_factor(moments, sums, estimate, k)
+    covariance = np.linalg.inv(_information(moments, prior, r * unit_variance * _correlation_factor(moments, sums,
+                                                                                                   estimate, k), k))
     estimates, std = np.zeros(n), np.full(n, np.inf)
     for j in range(k):
         estimates[j] = estimate[j]
-        std[j] = math.sqrt(covariance[j, j] * unit_variance * factor)
+        std[j] = math.sqrt(covariance[j, j])
     return estimates, std
+
+
+@kernel(allocates=True)
+def _information(moments, prior, r, k):
+    """The clock fit's information over its first `k` parameters: the readings' moments over the
+    noise variance `r`, and the priors'."""
+    information = np.zeros((k, k))
+    for j in range(k):
+        for m in range(k):
+            information[j, m] = moments[XX, j, m] / r
+        information[j, j] += prior[j]
+    return information
 
 
 @kernel
