@@ -43,18 +43,38 @@ def test_the_fast_filter_is_filterpys_at_every_step(seed, q, r):
         for f in (fast, wrapped):
             f.predict(dt)
         predict(kf, q, dt)
-        z = truth + rng.normal(0.0, np.sqrt(r))
-        residual, variance = z - kf.x[0, 0], kf.P[0, 0] + r  # before the update, as the gate reads it
+        scale = float(rng.choice([1.0, 1.0, 4.0, 131.6]))  # a heliostat's azimuth: 1/cos² of 0°, 60°, 85°
+        z = truth + rng.normal(0.0, np.sqrt(r * scale))
+        residual, variance = z - kf.x[0, 0], kf.P[0, 0] + r * scale  # before the update, as the gate reads it
         for f in (fast, wrapped):
-            assert f.innovation(z) == pytest.approx((residual, variance), rel=1e-9, abs=1e-12)
+            assert f.innovation(z, scale) == pytest.approx((residual, variance), rel=1e-9, abs=1e-12)
         if rng.random() < 0.8:  # some scans have no reading to take in
             for f in (fast, wrapped):
-                f.update(z)
-            kf.update(np.array([[z]]))
+                f.update(z, scale)
+            kf.update(np.array([[z]]), R=np.array([[r * scale]]))
         for f in (fast, wrapped):
             assert (f.angle, f.rate) == pytest.approx((kf.x[0, 0], kf.x[1, 0]), rel=1e-9, abs=1e-12)
         np.testing.assert_allclose([[fast.p00, fast.p01], [fast.p01, fast.p11]], kf.P, rtol=1e-9, atol=1e-15)
     assert abs(fast.angle - truth) < 1.0  # it tracked the ramp it was given
+
+
+def test_a_heliostats_azimuth_reading_is_as_noisy_as_its_division_makes_it():
+    """By hand: a small angle c across the sensor's face is c / cos φ of azimuth, so its variance
+    is R / cos² φ: 4 at φ = 60°, 1/cos² 85° (the floor) from there to the zenith and past it; the
+    elevation and a single axis keep R. Checked against the conversion itself (`axis_offset`)."""
+    from hybridtrack.control.sensing import AZIMUTH, ELEVATION, axis_offset, reading_scale
+
+    assert reading_scale([0.01, 0.0], AZIMUTH, [180.0, 60.0]) == pytest.approx(4.0, rel=1e-12)
+    assert reading_scale([0.01, 0.0], AZIMUTH, [180.0, 0.0]) == 1.0
+    floor = 1.0 / np.cos(np.radians(85.0)) ** 2
+    for elevation in (85.0, 89.9, 95.0):
+        assert reading_scale([0.01, np.nan], AZIMUTH, [180.0, elevation]) == pytest.approx(floor, rel=1e-12)
+    assert reading_scale([0.01, 0.5], ELEVATION, [180.0, 70.0]) == 1.0
+    assert reading_scale([0.3], 0, [12.0]) == 1.0
+    for elevation, along in ((30.0, 0.2), (70.0, -0.4)):  # the scale is the square of the conversion's slope
+        slope = (axis_offset([1e-4, along], AZIMUTH, [0.0, elevation])[0]
+                 - axis_offset([-1e-4, along], AZIMUTH, [0.0, elevation])[0]) / 2e-4
+        assert reading_scale([0.0, along], AZIMUTH, [0.0, elevation]) == pytest.approx(slope ** 2, rel=1e-6)
 
 
 def test_the_engines_are_chosen_by_name():

@@ -444,7 +444,8 @@ def test_the_gate_and_kalman_filter_compiled_take_readings_as_the_reference(pack
         z = 0.25 * k + rng.normal(0, 0.05) + (3.0 if rng.random() < 0.05 else 0.0)
         miss = rng.normal(0, 1.2) if rng.random() < 0.5 else np.nan
         dt = float(rng.choice([1.0, 1.0, 2.0]))
-        assert gate_take(cfg, state, 0, z, dt, miss, 2.0, 0.25) == gate.take(z, dt, miss, 2.0, 0.25)
+        scale = float(rng.choice([1.0, 1.0, 4.0, 131.6]))  # R as a heliostat's azimuth reading scales it
+        assert gate_take(cfg, state, 0, z, dt, miss, 2.0, 0.25, scale) == gate.take(z, dt, miss, 2.0, 0.25, scale)
         if k % 500 == 0:
             gate.forget()
             state.gate[0, READY] = 0

@@ -27,7 +27,7 @@ from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, INVALID, MODES, NO
                     SEARCH, SENSOR, SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
-from .sensing import SensorGate, axis_offset
+from .sensing import SensorGate, axis_offset, reading_scale
 from .skywatch import ClassifierTable, SkyWatch
 from .wind import WindGuard, unreadable, unreadable_reason
 
@@ -443,7 +443,8 @@ class Controller:
                 if not measures and config.uses_model and not math.isnan(self.model[a][i]):
                     verdict = INVALID  # no measure of the azimuth near the zenith: the calibrated model steers
                 else:
-                    verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures)
+                    verdict = self._offer(i, a, dt, reading[a] + offset, trusted and measures,
+                                          reading_scale(obs.offset, a, reading))
             valid[a], predicted[a] = verdict == OK, verdict == OUTLIER
             if valid[a]:
                 self.out_axes["sun"][a][i] = gate.filter.angle
@@ -511,8 +512,9 @@ class Controller:
         """The fitted mount's correction of scans `i` to `j` - 1, (j - i, axes)."""
         return ordered_dot(self.jacobian[i:j], self.theta)
 
-    def _offer(self, i: int, a: int, dt: float, z: float, trusted: bool) -> int:
-        """Offer the sensor's sun angle on axis `a` to the gate, and let a trusted one calibrate."""
+    def _offer(self, i: int, a: int, dt: float, z: float, trusted: bool, scale: float) -> int:
+        """Offer the sensor's sun angle on axis `a` to the gate (its variance the filter's R times
+        `scale`, `reading_scale`), and let a trusted one calibrate."""
         config, gate = self.config, self.gates[a]
         m0 = self.model[a][i]
         m1 = self.model[a][i - 1] if i else math.nan
@@ -523,7 +525,7 @@ class Controller:
             rate = self._turn(a, m0 - m1) / dt
         else:  # no computed sun: the filter's own rate, once it has one
             rate = gate.filter.rate if gate.ready else 0.0
-        verdict = gate.take(z, dt, miss, bound, rate)
+        verdict = gate.take(z, dt, miss, bound, rate, scale)
         if verdict == IMPLAUSIBLE and not abs(miss) <= abs(self.held_miss):  # the first, or further off
             self.held_miss = miss
         if verdict == OK and trusted and has_model:

@@ -37,13 +37,13 @@ class FastKalman:
         self.p01 = p01 + dt * p11 + q * dt * dt / 2.0
         self.p11 = p11 + q * dt
 
-    def innovation(self, z: float) -> tuple[float, float]:
-        """The residual of a measurement `z` and its variance."""
-        return z - self.x0, self.p00 + self.r
+    def innovation(self, z: float, scale: float = 1.0) -> tuple[float, float]:
+        """The residual of a measurement `z` and its variance (R times `scale`)."""
+        return z - self.x0, self.p00 + self.r * scale
 
-    def update(self, z: float) -> None:
-        """Take in a measurement of the angle, degrees."""
-        y, s = z - self.x0, self.p00 + self.r
+    def update(self, z: float, scale: float = 1.0) -> None:
+        """Take in a measurement of the angle, degrees, of variance R times `scale`."""
+        y, s = z - self.x0, self.p00 + self.r * scale
         k0, k1 = self.p00 / s, self.p01 / s
         self.x0 += k0 * y
         self.x1 += k1 * y
@@ -87,13 +87,14 @@ class FilterpyKalman:
         self.kf.Q = q * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
         self.kf.predict()
 
-    def innovation(self, z: float) -> tuple[float, float]:
-        """The residual of a measurement `z` and its variance."""
-        return z - float(self.kf.x[0, 0]), float(self.kf.P[0, 0] + self.kf.R[0, 0])
+    def innovation(self, z: float, scale: float = 1.0) -> tuple[float, float]:
+        """The residual of a measurement `z` and its variance (R times `scale`)."""
+        return z - float(self.kf.x[0, 0]), float(self.kf.P[0, 0] + self.kf.R[0, 0] * scale)
 
-    def update(self, z: float) -> None:
-        """Take in a measurement of the angle, degrees."""
-        self.kf.update(np.array([[z]]))
+    def update(self, z: float, scale: float = 1.0) -> None:
+        """Take in a measurement of the angle, degrees, of variance R times `scale` (filterpy's
+        ``R`` for this one update)."""
+        self.kf.update(np.array([[z]]), R=self.kf.R * scale)
 
     @property
     def angle(self) -> float:

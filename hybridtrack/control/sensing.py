@@ -29,7 +29,7 @@ from collections import deque
 from .kalman import make_filter
 from .modes import IMPLAUSIBLE, INVALID, LOW_LIGHT, OK, OUT_OF_VIEW, OUTLIER, STUCK
 
-__all__ = ["SensorGate", "axis_offset", "AZIMUTH", "ELEVATION", "COSINE_FLOOR"]
+__all__ = ["SensorGate", "axis_offset", "reading_scale", "AZIMUTH", "ELEVATION", "COSINE_FLOOR"]
 
 #: A heliostat's axes, in the order of its drives and encoders (`hybridtrack.control.encoder.AXIS_NAMES`).
 AZIMUTH, ELEVATION = 0, 1
@@ -102,6 +102,21 @@ def axis_offset(sensed, a: int, reading) -> tuple[float, bool]:
     return math.degrees(math.atan2(math.sin(c), math.cos(c) * floor)), False
 
 
+def reading_scale(sensed, a: int, reading) -> float:
+    """What the filter's R, the datasheet's variance of a reading across the sensor's face, is
+    multiplied by in axis `a`'s degrees: 1 for a single axis and a heliostat's elevation; for its
+    azimuth ``1 / cos² φ``, the square of `axis_offset`'s division (``φ`` and the floor
+    `COSINE_FLOOR` as it takes them). A small angle ``c`` across the face is ``c / cos φ`` of
+    azimuth, so the reading's noise is too: with R fixed the filter had taken azimuth readings near
+    the zenith as sure as at the horizon, and more of them as outliers."""
+    if len(reading) == 1 or a == ELEVATION:
+        return 1.0
+    along = sensed[ELEVATION]
+    phi = math.radians(reading[ELEVATION] + (0.0 if math.isnan(along) else along))
+    cosine = max(abs(math.cos(phi)), COSINE_FLOOR)
+    return 1.0 / (cosine * cosine)
+
+
 class SensorGate:
     """One axis: judge the reading, and keep the Kalman-filtered sun angle (encoder coordinates)."""
 
@@ -136,9 +151,10 @@ class SensorGate:
             return INVALID
         return OK
 
-    def take(self, z: float, dt: float, miss: float, bound: float, rate: float) -> int:
+    def take(self, z: float, dt: float, miss: float, bound: float, rate: float, scale: float = 1.0) -> int:
         """Offer the sun angle `z` (reading plus offset); `miss` is z less the calibrated model (NaN:
-        none); `rate` (degrees a minute) is the sun's to start the filter at."""
+        none); `rate` (degrees a minute) is the sun's to start the filter at; `scale` multiplies
+        the filter's R, the reading's variance in this axis's degrees (`reading_scale`)."""
         if abs(miss) > bound:
             return IMPLAUSIBLE
         kf = self.filter
@@ -147,7 +163,7 @@ class SensorGate:
             self.ready = True
             return OK
         kf.predict(dt)
-        y, s = kf.innovation(z)
+        y, s = kf.innovation(z, scale)
         if s > bound * bound and not math.isnan(miss):  # coasted until it knows the angle worse than the model
             kf.reset(z, rate)  # that vouches for this reading: an update's rate gain would take the gap's swing
             self.rejected = 0  # for a rate (a heliostat's zenith pass across 30-minute scans: 1.2°/min)
@@ -158,7 +174,7 @@ class SensorGate:
                 return OUTLIER
             kf.reset(z, rate)
         else:
-            kf.update(z)
+            kf.update(z, scale)
         self.rejected = 0
         return OK
 

@@ -14,6 +14,7 @@ SkyWatch                `trailing_mean`, `trailing_range`, `sky_update`
 ClassifierTable         `table_score`, `table_code`
 SensorGate + Kalman     `gate_judge`, `gate_take`, `kalman_*`
 axis_offset             `axis_offset`
+reading_scale           `reading_scale`
 Calibrator.learn        `calibrator_learn`, `_start_day`
 MountEstimator          `fit_forget`, `fit_update`, `fit_check`, `fit_solve`, `fit_excess_light`
 pull_spread             `pull_spread`
@@ -43,6 +44,7 @@ from ..control.modes import (ASTRONOMICAL, FAULT, IMPLAUSIBLE, INVALID, LOW_LIGH
 from ..control.mountfit import HORIZON, LEVEL_READINGS, LIGHT_TOLERANCE, MAX_CONDITION
 from ..control.mountfit import spd_inverse as reference_spd_inverse  # compiled below
 from ..control.sensing import axis_offset as reference_axis_offset  # compiled below
+from ..control.sensing import reading_scale as reference_reading_scale  # compiled below
 from ..control.wind import READABLE, STUCK_HOURS, STUCK_SPREAD
 from . import events as ev
 from .jit import kernel
@@ -463,9 +465,9 @@ def kalman_predict(cfg, state, a, dt):
 
 
 @kernel
-def kalman_update(cfg, state, a, z):
+def kalman_update(cfg, state, a, z, scale):
     kf = state.kf
-    y, s = z - kf[a, X0], kf[a, P00] + cfg.r[a]
+    y, s = z - kf[a, X0], kf[a, P00] + cfg.r[a] * scale
     k0, k1 = kf[a, P00] / s, kf[a, P01] / s
     kf[a, X0] += k0 * y
     kf[a, X1] += k1 * y
@@ -486,6 +488,8 @@ def _spread(values, a):
 
 #: sensing.axis_offset itself, compiled: the same steps, so the same bits.
 axis_offset = kernel(reference_axis_offset)
+#: sensing.reading_scale itself, compiled.
+reading_scale = kernel(reference_reading_scale)
 
 
 @kernel
@@ -511,7 +515,7 @@ def gate_judge(cfg, state, a, measured, valid, coarse, expected):
 
 
 @kernel
-def gate_take(cfg, state, a, z, dt, miss, bound, rate):
+def gate_take(cfg, state, a, z, dt, miss, bound, rate, scale):
     """SensorGate.take."""
     if abs(miss) > bound:
         return IMPLAUSIBLE
@@ -521,7 +525,7 @@ def gate_take(cfg, state, a, z, dt, miss, bound, rate):
         gate[a, READY] = 1
         return OK
     kalman_predict(cfg, state, a, dt)
-    y, s = z - state.kf[a, X0], state.kf[a, P00] + cfg.r[a]
+    y, s = z - state.kf[a, X0], state.kf[a, P00] + cfg.r[a] * scale
     if s > bound * bound and not math.isnan(miss):
         kalman_reset(state, a, z, rate)
         gate[a, REJECTED] = 0
@@ -532,7 +536,7 @@ def gate_take(cfg, state, a, z, dt, miss, bound, rate):
             return OUTLIER
         kalman_reset(state, a, z, rate)
     else:
-        kalman_update(cfg, state, a, z)
+        kalman_update(cfg, state, a, z, scale)
     gate[a, REJECTED] = 0
     return OK
 
@@ -1021,7 +1025,7 @@ def _plausibility_bound(cfg, plan, i, a, axes):
 
 
 @kernel(inline=True)
-def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes, intensity):
+def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes, intensity, scale):
     m0 = plan.model[i, a]
     m1 = plan.model[i - 1, a] if i else math.nan
     bound = _plausibility_bound(cfg, plan, i, a, axes)
@@ -1031,7 +1035,7 @@ def _offer(cfg, plan, state, log, i, a, dt, z, trusted, axes, intensity):
         rate = _turn(cfg, a, m0 - m1) / dt
     else:  # no computed sun: the filter's own rate, once it has one
         rate = state.kf[a, X1] if state.gate[a, READY] else 0.0
-    verdict = gate_take(cfg, state, a, z, dt, miss, bound, rate)
+    verdict = gate_take(cfg, state, a, z, dt, miss, bound, rate, scale)
     if verdict == IMPLAUSIBLE and not abs(miss) <= abs(state.s[HELD_MISS]):  # the first, or further off
         state.s[HELD_MISS] = miss
     if verdict == OK and trusted and has_model:
@@ -1078,7 +1082,7 @@ def _sense(cfg, plan, state, out, log, i, t, dt, obs, obs_axes, reading, awake, 
                 verdict = INVALID  # no measure of the azimuth near the zenith: the calibrated model steers
             else:
                 verdict = _offer(cfg, plan, state, log, i, a, dt, reading[a] + offset, trusted and measures, axes,
-                                 obs[3])
+                                 obs[3], reading_scale(obs_axes[:, 1], a, reading))
         valid[a] = verdict == OK
         if verdict == OUTLIER:
             predicted |= 1 << a
