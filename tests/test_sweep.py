@@ -521,7 +521,7 @@ def test_ctrl_c_keeps_the_finished_runs_and_no_worker_prints_a_traceback(tmp_pat
         seen += chunk
     os.killpg(child.pid, getattr(signal, signal_name))
     error = (seen + child.stderr.read()).decode()
-    assert child.wait(timeout=60) == status and f"hybridtrack: {said}; " in error
+    assert child.wait(timeout=60) == status and f"hybridtrack: {said}; " in error, error[-3000:]
     assert "Traceback" not in error and "KeyboardInterrupt" not in error
     finished = pd.read_parquet(tmp_path / "out" / "runs.partial.parquet")
     assert 3 <= len(finished) < 400 and finished["run"].is_unique and finished["error"].isna().all()
