@@ -401,18 +401,59 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
 
 def _refuse_unphysical_light(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
     """Refuse a frame's light no sky at `site` gives: direct light at night (`_refuse_light_at_night`)
-    or irradiance a thousand times too small, kW/m² where W/m² belong (judged as a file's is,
-    `hybridtrack.io.checks.check_magnitude`, against the clear sky of Haurwitz (1945) on the true
-    sun). A frame darker than any sky is not refused, as a file is: a frame made in memory with
-    no diffuse light (DHI of 0) is a simplification a test may make on purpose."""
+    or irradiance in kW/m² where W/m² belong (`_refuse_kilowatts`)."""
+    _refuse_light_at_night(frame, site, altitude)
+    _refuse_kilowatts(frame, site, altitude)
+
+
+#: The largest value of a day's irradiance in kW/m² (the solar constant is 1.361 kW/m²).
+KILOWATT_TOP = 1.5
+#: W/m² of the site's clear-sky GHI (Haurwitz) a day must reach before its magnitude is judged.
+JUDGED_FROM = 300.0
+#: W/m²: DHI below this is no sky's, in kW/m² or W/m² alike (a frame's "no diffuse light", 0 or
+#: its rounding, 1e-13, beam-only DHI by closure); in kW/m² a day's DHI with the clear sky at
+#: `JUDGED_FROM` is tens of W/m², 0.02 or more.
+NO_DIFFUSE = 0.01
+
+
+def _refuse_kilowatts(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
+    """Refuse a frame made in memory whose irradiance is in kW/m², judged day by day (a frame of
+    days in two units is refused by its first kW/m² day) where the site's clear sky (Haurwitz
+    1945, on the true sun) reaches `JUDGED_FROM`: GHI, or DHI above `NO_DIFFUSE`, whose largest
+    value is at most `KILOWATT_TOP`; or DNI of at most that beside a beam GHI shows
+    (`hybridtrack.io.checks.horizontal_beam`: `BEAM_SEEN` W/m² or more). No sky is so dark with
+    the sun so high. DNI alone is not judged: a DNI-only overcast day has none to show (a file's
+    whole span is, `hybridtrack.io.checks.check_magnitude`), and a frame's DNI of 0 beside a
+    sunny GHI is its maker's to mean."""
     import pvlib
 
-    from .io.checks import check_magnitude
+    from .io.checks import BEAM_SEEN, horizontal_beam
 
-    _refuse_light_at_night(frame, site, altitude)
     clear = pvlib.clearsky.haurwitz(pd.Series(90.0 - altitude, index=frame.index))["ghi"].to_numpy(float)
-    check_magnitude("the weather frame", frame, {}, clear, too_dark=False,
-                    remedy="multiply the frame's {name} by 1000 (irradiance is in W/m²)")
+    days = pd.Series(np.arange(len(frame)), index=frame.index.tz_convert(site.tz).date)
+    beam = horizontal_beam(frame, clear) if "ghi" in frame.columns else None
+    for day, rows in days.groupby(level=0):
+        rows = rows.to_numpy()
+        if not np.nanmax(clear[rows]) >= JUDGED_FROM:
+            continue
+        for name, low, beside_beam in (("ghi", 0.0, False), ("dhi", NO_DIFFUSE, False), ("dni", 0.0, True)):
+            if name not in frame.columns or (beside_beam and not _beam_seen(beam, rows, BEAM_SEEN)):
+                continue
+            values = frame[name].to_numpy(float)[rows]
+            top = np.nanmax(values) if np.isfinite(values).any() else np.nan
+            if low < top <= KILOWATT_TOP:
+                seen = (f"{beam[1]} {np.nanmax(beam[0][rows]):.0f} W/m² (a direct beam)" if beside_beam else
+                        f"the clear sky reaches {np.nanmax(clear[rows]):.0f} W/m²")
+                raise HybridtrackError(f"the weather frame on {day}: column {name!r}: {name} is at most {top:g} while "
+                                       f"{seen}; the values look like kW/m², where W/m² belong: multiply the frame's "
+                                       f"{name} by 1000")
+
+
+def _beam_seen(beam: tuple | None, rows: np.ndarray, least: float) -> bool:
+    """Whether the direct light on the horizontal (`horizontal_beam`'s) reaches `least` W/m² in `rows`."""
+    if beam is None or not np.isfinite(beam[0][rows]).any():
+        return False
+    return bool(np.nanmax(beam[0][rows]) >= least)
 
 
 def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:

@@ -605,22 +605,40 @@ def test_a_frame_whose_light_comes_while_the_sun_is_down_is_refused():
         simulate(days.set_axis(days.index + pd.Timedelta(hours=8)), "lanzhou")
 
 
-@pytest.mark.parametrize("columns, named", [(["dni"], "dni is at most 1.0"), (["dni", "dhi", "ghi"], "ghi is at most 1.1"),
-                                             (["dni", "dhi"], "dni is at most 1.0")])
-def test_a_frame_in_kilowatts_is_refused_as_a_file_is(columns, named):
+@pytest.mark.parametrize("columns, named", [(["dni"], "dni is at most 1.0638 while ghi - dhi reaches 1038 W/m²"),
+                                             (["dni", "dhi", "ghi"], "ghi is at most 1.1387"),
+                                             (["dhi"], "dhi is at most 0.2663")])
+def test_a_frame_in_kilowatts_is_refused_day_by_day(columns, named):
     """A frame made in memory with irradiance in kW/m² had run as a day without a beam (the
     magnitude check was a file's only): on a clear June day at Lanzhou the clear sky (Haurwitz)
-    reaches about 1,000 W/m², so a largest value of 1.06 is kW/m²."""
+    reaches about 1,000 W/m², so a largest value of 1.06 is kW/m². Judged by day, a second day in
+    kW/m² after one in W/m² is refused by its date."""
     from hybridtrack.fields import FresnelField, simulate_field
 
     day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=1)
     scaled = day.assign(**{name: day[name] / 1000.0 for name in columns})
-    for run in (lambda: simulate(scaled, "lanzhou"), lambda: simulate(scaled[["dni"]], "lanzhou"),
+    message = f"the weather frame on 2021-06-21: column '[a-z]+': {named}.*multiply the frame's [a-z]+ by 1000"
+    for run in (lambda: simulate(scaled, "lanzhou"),
                 lambda: simulate_field(scaled, "lanzhou", FresnelField(row_distances=(-2.0, 2.0)))):
-        with pytest.raises(HybridtrackError, match=f"the weather frame: column '(dni|ghi)': ({named}|dni is at most 1.0)"
-                                                   f".*kW/m² read as W/m²: multiply the frame's (dni|ghi) by 1000"):
+        with pytest.raises(HybridtrackError, match=message):
             run()
-    assert simulate(day.assign(dhi=0.0), "lanzhou").summary["energy_capture"] > 0.9  # no diffuse: a test's choice
+    before = synthetic("lanzhou", "2021-06-20", weather="sunny", freq="10min", seed=1)
+    with pytest.raises(HybridtrackError, match="the weather frame on 2021-06-21: column"):
+        simulate(pd.concat([before, scaled]), "lanzhou")
+
+
+def test_a_frame_no_sky_could_tell_from_kilowatts_runs():
+    """What a frame may hold on purpose, and DNI alone on a day without a beam, are not refused
+    (helper-32 found each refused by the first check): DHI of 0 or of rounding (beam-only DHI by
+    closure, 1e-13); a DNI-only overcast day whose DNI peaks at 1.41 W/m² (the package's own
+    Nanjing sky, 2 of 40 such days); DNI of 0 all day beside a sunny GHI."""
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    assert simulate(day.assign(dhi=0.0), "lanzhou").summary["energy_capture"] > 0.9
+    assert simulate(day.assign(dhi=1e-13), "lanzhou").summary["energy_capture"] > 0.9
+    overcast = synthetic("nanjing", "2013-12-22", weather="overcast", freq="10min", seed=3)
+    assert 0.0 < overcast["dni"].max() <= 1.5
+    assert simulate(overcast[["dni", "wind_speed"]], "nanjing").summary["steps"] == 144
+    assert simulate(day.assign(dni=0.0), "lanzhou").summary["energy_capture"] is None  # no beam offered
 
 
 @pytest.mark.parametrize("engine", ["reference", "compiled"])

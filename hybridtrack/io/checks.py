@@ -67,10 +67,7 @@ REPAIRS = {
 
 
 def first_lines(frame: pd.DataFrame, mask) -> list[int]:
-    """The file lines of the first five rows in `mask` (resampled rows, and a frame made in
-    memory, have none)."""
-    if "_line" not in frame:
-        return []
+    """The file lines of the first five rows in `mask` (resampled rows have none)."""
     lines = frame["_line"].to_numpy()[np.asarray(mask, bool)]
     return [int(v) for v in lines[np.isfinite(lines)][:5]]
 
@@ -205,8 +202,8 @@ def _drop_empty(frame: pd.DataFrame, report: dict) -> pd.DataFrame:
     return frame
 
 
-def check_magnitude(path: Path | str, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
-                    remedy: str = "give the unit (--units {name}=kW/m2)", too_dark: bool = True) -> None:
+def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
+                    remedy: str = "give the unit (--units {name}=kW/m2)") -> None:
     """Refuse irradiance a thousand times too small (kW/m² read as W/m²), or darker than any sky.
 
     In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
@@ -215,8 +212,7 @@ def check_magnitude(path: Path | str, frame: pd.DataFrame, report: dict, clear_g
     reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
     judged so only in a file without GHI and DHI, since an overcast day has none. With a site,
     GHI or DHI that stays darker than any sky while the sun is high is refused too
-    (`_refuse_too_dark`) unless `too_dark` is False. `remedy` ends the kW/m² message (``{name}`` is
-    the column); `path` may be any name of the frame's source.
+    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column).
     """
     _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
@@ -239,7 +235,7 @@ def check_magnitude(path: Path | str, frame: pd.DataFrame, report: dict, clear_g
         if suspicious:
             raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
                                    f"{remedy.format(name=name)}")
-        if clear_ghi is not None and too_dark:
+        if clear_ghi is not None:
             _refuse_too_dark(where, frame, name, top, clear_ghi)
 
 
@@ -271,7 +267,7 @@ BEAM_SEEN = 100.0
 SUN_OUT = 0.8
 
 
-def _horizontal_beam(frame: pd.DataFrame, clear_ghi: np.ndarray | None) -> tuple[np.ndarray, str] | None:
+def horizontal_beam(frame: pd.DataFrame, clear_ghi: np.ndarray | None) -> tuple[np.ndarray, str] | None:
     """Direct light on the horizontal the file shows, and how it was seen: GHI - DHI, or, without
     DHI but with the site's clear sky, GHI where it reaches `SUN_OUT` of the clear sky."""
     if "dhi" in frame:
@@ -286,13 +282,13 @@ def _horizontal_beam(frame: pd.DataFrame, clear_ghi: np.ndarray | None) -> tuple
 def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict, remedy: str,
                                   clear_ghi: np.ndarray | None) -> None:
     """Refuse DNI of at most 1.5 while GHI shows a direct beam of `BEAM_SEEN` W/m² or more
-    (`_horizontal_beam`): kW/m² beside W/m² columns had been read as W/m², the file called clean,
+    (`horizontal_beam`): kW/m² beside W/m² columns had been read as W/m², the file called clean,
     and a clear day replayed as overcast (the magnitude check judges DNI alone only without GHI
     and DHI). Without DHI a DNI of 0 all day is refused too (a dead pyrheliometer): DHI derived
     from it is GHI itself, and no closure check can see it."""
     if not {"ghi", "dni"} <= set(frame.columns):
         return
-    beam = _horizontal_beam(frame, clear_ghi)
+    beam = horizontal_beam(frame, clear_ghi)
     dni = frame["dni"].to_numpy(float)
     if beam is None or not (np.isfinite(dni).any() and np.isfinite(beam[0]).any()):
         return
