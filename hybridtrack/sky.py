@@ -449,7 +449,9 @@ def daily_summary(frame: pd.DataFrame, site: Site | str) -> pd.DataFrame:
     """Per local day: DNI and GHI totals (kWh/m²), clearness index, sunshine share.
 
     The daily clearness index is the day's GHI over the extraterrestrial irradiance on a
-    horizontal plane; the sunshine share is the share of daylight steps with DNI ≥ 120 W/m².
+    horizontal plane; the sunshine share is the share of daylight time with DNI ≥ 120 W/m² (the
+    WMO's sunshine threshold). Each stamp stands for its own step
+    (`hybridtrack.times.stamp_minutes`), in the sums and the shares alike.
     """
     import pvlib
 
@@ -462,15 +464,15 @@ def daily_summary(frame: pd.DataFrame, site: Site | str) -> pd.DataFrame:
     hours = stamp_minutes(frame.index) / 60.0  # each stamp its own step; a gap counts no light
     day = frame.index.tz_convert(site.tz).date
     up = position["altitude"].to_numpy(float) > 0
-    table = pd.DataFrame({"ghi": frame["ghi"].to_numpy(float), "dni": frame["dni"].to_numpy(float), "extra": extra,
-                          "ghi_wh": frame["ghi"].to_numpy(float) * hours, "dni_wh": frame["dni"].to_numpy(float) * hours,
-                          "up": up, "sunshine": up & (frame["dni"].to_numpy(float) >= 120.0)}, index=day)
-    grouped = table.groupby(level=0)
+    dni = frame["dni"].to_numpy(float)
+    table = pd.DataFrame({"ghi": frame["ghi"].to_numpy(float) * hours, "dni": dni * hours, "extra": extra * hours,
+                          "up": up * hours, "sunshine": (up & (dni >= 120.0)) * hours}, index=day)  # Wh/m², hours
+    sums = table.groupby(level=0).sum()
     out = pd.DataFrame({
-        "dni_kwh_m2": grouped["dni_wh"].sum() / 1000.0,
-        "ghi_kwh_m2": grouped["ghi_wh"].sum() / 1000.0,
-        "clearness_index": grouped["ghi"].sum() / grouped["extra"].sum(),
-        "sunshine_share": grouped["sunshine"].sum() / grouped["up"].sum().clip(lower=1),
+        "dni_kwh_m2": sums["dni"] / 1000.0,
+        "ghi_kwh_m2": sums["ghi"] / 1000.0,
+        "clearness_index": sums["ghi"] / sums["extra"],
+        "sunshine_share": (sums["sunshine"] / sums["up"]).where(sums["up"] > 0, 0.0),
     })
     out.index.name = "date"
     return out

@@ -26,16 +26,26 @@ def clock_nanoseconds(local: pd.DatetimeIndex):
 
 #: Minutes a stamp stands for at most (`stamp_minutes`): a run's longest step, an hour.
 LONGEST_STAMP_MINUTES = 60.0
+#: Steps either side of a step whose median is its local step (`stamp_minutes`).
+LOCAL_STEPS = 4
+#: A step longer than this many local steps is a gap that counts no time (`stamp_minutes`): a
+#: reading or two missed is integrated across, as the trapezoid rule does, and a logger's jitter
+#: (±20 s on 1-minute stamps makes steps of 20 to 100 s) is never a gap.
+GAP_STEPS = 2.5
 
 
 def stamp_minutes(index: pd.DatetimeIndex):
-    """Minutes each stamp of `index` stands for: the shorter of its steps to the stamps either side
-    (the one side at an end), at most `LONGEST_STAMP_MINUTES`; a lone stamp a minute.
+    """Minutes each stamp of `index` stands for: half of each step beside it (the midpoint rule,
+    so jittered stamps lose no time: the halves add up to the span), at most
+    `LONGEST_STAMP_MINUTES`. A step that is a gap (longer than `GAP_STEPS` times the median of the
+    `LOCAL_STEPS` steps either side of it) counts no time: a stamp beside one takes its other step
+    whole, as an end stamp does, and a stamp between two the local step.
 
-    A gap is time nobody measured, so it lengthens no stamp; a frame of mixed steps (a 15-minute
-    day beside a 1-minute day) weighs each stamp by its own step, where the frame's median step had
-    made the 15-minute day count a fifteenth of its light. On a regular grid every stamp stands for
-    the step, exactly.
+    So a stamp alone in a 3-hour gap of a 1-minute frame is a minute; a frame of mixed steps (a
+    15-minute day beside a 1-minute day) weighs each stamp by its own steps, where the frame's
+    median step had made the 15-minute day count a fifteenth of its light; two stamps 1 ns apart
+    share one step. On a regular grid every stamp stands for the step, exactly; a lone stamp
+    for a minute.
     """
     import numpy as np
 
@@ -43,8 +53,27 @@ def stamp_minutes(index: pd.DatetimeIndex):
     if len(ns) < 2:
         return np.ones(len(ns))
     steps = np.diff(ns) / 6e10
-    before, after = np.concatenate(([steps[0]], steps)), np.concatenate((steps, [steps[-1]]))
-    return np.minimum(np.minimum(before, after), LONGEST_STAMP_MINUTES)
+    local = _local_steps(steps)
+    counted = np.where(steps > GAP_STEPS * local, np.nan, steps)
+    before, after = np.concatenate(([np.nan], counted)), np.concatenate((counted, [np.nan]))
+    halves = np.where(np.isnan(before), after, np.where(np.isnan(after), before, 0.5 * (before + after)))
+    alone = np.fmin(np.concatenate(([np.nan], local)), np.concatenate((local, [np.nan])))
+    return np.minimum(np.where(np.isnan(halves), alone, halves), LONGEST_STAMP_MINUTES)
+
+
+def _local_steps(steps):
+    """The median of the `LOCAL_STEPS` steps either side of each step that may be a gap (longer
+    than `GAP_STEPS` shortest steps; NaN for the rest, which cannot be): a regular grid has none
+    to judge, and a day-only logger's year a few hundred nights, not 525,600 medians."""
+    import numpy as np
+
+    local = np.full(len(steps), np.nan)
+    maybe = np.flatnonzero(steps > GAP_STEPS * steps.min())
+    if len(maybe):
+        padded = np.concatenate((np.full(LOCAL_STEPS, np.nan), steps, np.full(LOCAL_STEPS, np.nan)))
+        windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * LOCAL_STEPS + 1)[maybe]
+        local[maybe] = np.nanmedian(windows, axis=1)
+    return local
 
 
 def plus_seconds(times: pd.DatetimeIndex, seconds) -> pd.DatetimeIndex:

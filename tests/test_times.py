@@ -89,9 +89,13 @@ def test_a_day_step_in_lower_case_reads_without_pandas_deprecation_warning(text,
                 duration(text, "dwell")
 
 
-def test_each_stamp_stands_for_its_own_step_and_a_gap_for_none():
-    """Hand-counted: 15-min stamps, then a 2-h gap, then 1-min stamps; the ends take their one
-    side; a step over an hour is capped at an hour; a lone stamp is a minute."""
+def test_each_stamp_stands_for_half_of_each_step_beside_it_and_a_gap_for_none():
+    """Hand-counted: 15-min stamps, then a 2-h gap, then 1-min stamps (a stamp beside the gap takes
+    its other step whole, an end stamp its one step); a step over an hour is capped at an hour; a
+    lone stamp is a minute; a reading missed is integrated across (1.5 min each side), two missed
+    are a gap; a stamp alone in a 3-h gap is a minute; two stamps 1 ns apart share one minute;
+    jittered stamps (±20 s, helper-32: the shorter step either side had lost 19.8 %) add up to
+    their span."""
     from hybridtrack.times import stamp_minutes
 
     start = pd.Timestamp("2021-06-21 06:00", tz="Asia/Shanghai")
@@ -102,3 +106,14 @@ def test_each_stamp_stands_for_its_own_step_and_a_gap_for_none():
     np.testing.assert_array_equal(stamp_minutes(stamps[:1]), [1])
     regular = pd.date_range(start, periods=5, freq="10s")
     np.testing.assert_array_equal(stamp_minutes(regular), np.full(5, 10 / 60))
+    minutes = pd.date_range(start, periods=1000, freq="1min")
+    np.testing.assert_array_equal(stamp_minutes(minutes.delete([100]))[98:102], [1, 1.5, 1.5, 1])
+    np.testing.assert_array_equal(stamp_minutes(minutes.delete([200, 201]))[198:202], [1, 1, 1, 1])
+    alone = pd.DatetimeIndex([*minutes[:300], minutes[400], *minutes[600:]])
+    np.testing.assert_array_equal(stamp_minutes(alone)[299:302], [1, 1, 1])
+    twice = minutes[:10].append(pd.DatetimeIndex([minutes[9] + pd.Timedelta(1, "ns")])).append(minutes[10:20])
+    assert stamp_minutes(twice)[9:11].sum() == pytest.approx(1.0, rel=1e-9)
+    jittered = minutes + pd.to_timedelta(np.random.default_rng(1).uniform(-20, 20, len(minutes)), unit="s")
+    span = (jittered[-1] - jittered[0]) / pd.Timedelta(minutes=1)
+    ends = (jittered[1] - jittered[0] + jittered[-1] - jittered[-2]) / pd.Timedelta(minutes=2)  # the ends' halves
+    assert stamp_minutes(jittered).sum() == pytest.approx(span + ends, rel=1e-12)
