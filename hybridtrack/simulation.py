@@ -37,6 +37,7 @@ from .outputs import claim, output_folder, remove_earlier, removing_empty_folder
 from .reuse import Same, shared
 from .fuzzy import FuzzyWeatherClassifier
 from .fuzzy.classifier import READING_LIMIT
+from .io.checks import span
 from .kernel import ENGINES, run_compiled, uses_kernel
 from .metrics import score, summarize
 from .mountreport import FIT_PREFIX
@@ -350,6 +351,9 @@ def _drives(collector: Collector, config: SimulationConfig) -> list[Drive]:
 #: a tracking controller is replayed over; a longer step, in which the sun turns more than 15°, is
 #: not a scan (a 13-hour step made a day of two scans and a meaningless score).
 LONGEST_STEP = pd.Timedelta(hours=1)
+#: The shortest step a run is replayed at: a PLC's scan of a tracking drive, which turns about
+#: 0.004° a second with the sun (the year at 1-second steps is the finest this project runs).
+SHORTEST_STEP = pd.Timedelta(seconds=1)
 
 
 def run_step(freq) -> pd.Timedelta:
@@ -391,6 +395,10 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     first, last = frame.index[0], frame.index[-1]
     check_steps(first, last, (last - first) / (len(frame) - 1), what="the weather frame")
     typical = pd.Timedelta(int(np.median(np.diff(frame.index.as_unit("ns").asi8))), "ns")
+    if typical < SHORTEST_STEP:
+        raise HybridtrackError(f"the weather frame's stamps are {span(typical)} apart (median): a tracking "
+                               f"controller is replayed at steps of {span(SHORTEST_STEP)} or longer; were epoch "
+                               "seconds read as nanoseconds? (pandas.to_datetime(values, unit='s'))")
     if typical > LONGEST_STEP:
         hours = typical / pd.Timedelta(hours=1)
         raise HybridtrackError(f"the weather frame's steps are {hours:g} h apart (median), in which the sun turns "
@@ -627,7 +635,7 @@ def warn_of_nights_left_out(frame: pd.DataFrame, site) -> None:
     if not isinstance(frame, pd.DataFrame) or "nights_left_out" in frame.attrs.get("validation", {}):
         return
     try:
-        left_out = night_gaps(frame, site)
+        left_out = night_gaps(_check_frame(frame), site)  # a frame of 1-ns steps: no night filled at them
     except HybridtrackError:  # a site, an index or stamps the run refuses with its own words
         return
     if left_out:

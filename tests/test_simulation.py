@@ -627,6 +627,23 @@ def test_a_frame_in_kilowatts_is_refused_day_by_day(columns, named):
         simulate(pd.concat([before, scaled]), "lanzhou")
 
 
+@pytest.mark.parametrize("divisor, shown", [(60e9, "1ns"), (120, "500ms")])
+def test_a_frame_of_steps_under_a_second_is_refused_in_one_line(divisor, shown):
+    """Epoch seconds read as nanoseconds (pandas.to_datetime without unit='s') put a day in 1.4 µs:
+    simulate and simulate_field asked numpy for terabytes (MemoryError, helper-32) filling the
+    nights at that step. 1 s steps run."""
+    from hybridtrack.fields import FresnelField, simulate_field
+
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="1min", seed=1)
+    squeezed = day.set_axis(day.index[0] + (day.index - day.index[0]) / divisor)
+    for run in (lambda: simulate(squeezed, "lanzhou"), lambda: simulate_field(squeezed, "lanzhou", FresnelField())):
+        with pytest.raises(HybridtrackError, match=f"stamps are {shown} apart .median.: .* steps of 1s or longer; "
+                                                   "were epoch seconds read as nanoseconds"):
+            run()
+    fine = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="1s", seed=1).iloc[40_000:40_600]
+    assert simulate(fine, "lanzhou").summary["steps"] == 600
+
+
 def test_a_frame_no_sky_could_tell_from_kilowatts_runs():
     """What a frame may hold on purpose, and DNI alone on a day without a beam, are not refused
     (helper-32 found each refused by the first check): DHI of 0 or of rounding (beam-only DHI by
