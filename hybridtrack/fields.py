@@ -809,8 +809,10 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     keep_log : bool
         Keep every collector's log in `FieldResult.dataset` (about 50 bytes per collector
         and step, 80 for a heliostat); False keeps only the metrics.
-    progress : bool, optional
-        A progress bar over collectors (on stderr); by default when there are more than four.
+    progress : bool or callable, optional
+        A progress bar over collectors (on stderr); by default when there are more than four. A
+        callable is called with each count of collectors done instead (as `hybridtrack.simulate`
+        calls one with steps).
     threads : int, optional
         Run the collectors on this many threads of this process, sharing one computation of
         the sky they stand under (`hybridtrack.reuse`); by default one per core the process
@@ -829,7 +831,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     """
     from .kernel import decided, uses_kernel
     from .reuse import reuse_work
-    from .simulation import _check_frame, checked_config, warn_of_nights_left_out
+    from .simulation import _check_frame, check_progress, checked_config, progress_updates, warn_of_nights_left_out
     from .sun import solar_position
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
@@ -837,9 +839,9 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                                f"got {type(field).__name__}")
     config = checked_config(config)
     seed = params.seed(config.seed if seed is None else seed)
-    for name, flag in (("keep_log", keep_log), ("progress", progress)):
-        if not isinstance(flag, (bool, np.bool_)) and not (name == "progress" and flag is None):
-            raise HybridtrackError(f"{name} must be True or False, got {flag!r:.60}")
+    if not isinstance(keep_log, (bool, np.bool_)):
+        raise HybridtrackError(f"keep_log must be True or False, got {keep_log!r:.60}")
+    check_progress(progress)
     check_where(scheduler, workers, threads)  # before the sky is computed
     site = sites.get(site)
     frame = _check_frame(frame)
@@ -852,10 +854,10 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                             compiled=uses_kernel(config, len(frame)))
     runs = [(i, name, collector, imperfect) for i, (name, collector, imperfect)
             in enumerate(zip(field.names, collectors, field.spread.draw(config.imperfections, len(collectors), seed, field.names)))]
-    bar = _bar(len(runs), progress)
     rows, events, store = [None] * len(runs), [None] * len(runs), None
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
-    with bar, reuse_work():  # in this process, every run shares the sun and sky with the others
+    shown = len(runs) > 4 if progress is None else progress
+    with progress_updates(shown, lambda: _bar(len(runs))) as update, reuse_work():  # every run shares the sky
         truth = solar_position(frame.index, site, config.truth)  # the table's, and the runs' from memory
         for block in _blocks(frame, runs, job, threads, workers, scheduler):
             for i, row, run_events, log in block:
@@ -863,7 +865,8 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                 if keep_log:
                     store = store or _LogStore(field.names, frame, log)
                     store.add(i, log)
-                bar.update()
+                if update is not None:
+                    update(1)
     table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
@@ -871,11 +874,11 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     return FieldResult(table, summary, all_events, dataset, field, site)
 
 
-def _bar(total: int, progress: bool | None):
+def _bar(total: int):
+    """A tqdm bar over a field's collectors, on stderr."""
     from tqdm import tqdm
 
-    return tqdm(total=total, unit="collector", file=sys.stderr, leave=False,
-                disable=not (progress if progress is not None else total > 4))
+    return tqdm(total=total, unit="collector", file=sys.stderr, leave=False)
 
 
 def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, keep_log: bool, *, dask: bool,

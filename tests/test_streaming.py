@@ -658,8 +658,8 @@ def test_callbacks_that_are_not_callable_are_refused_before_anything_is_written(
 
 
 def test_progress_true_shows_a_bar_and_false_none_as_a_fields_does(tmp_path, capsys):
-    """`stream(progress=False)` had been refused where `simulate_field(progress=False)` is taken:
-    simulate and stream now take a bar switch as a field does, beside a callable."""
+    """`stream(progress=False)` had been refused where `simulate_field(progress=False)` is taken,
+    and a field refused the callable simulate and stream take: all three take both."""
     from hybridtrack.sky import synthetic
 
     day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="30min", seed=1)
@@ -671,6 +671,13 @@ def test_progress_true_shows_a_bar_and_false_none_as_a_fields_does(tmp_path, cap
     assert capsys.readouterr().err == ""
     stream(_two_days(), tmp_path / "shown", progress=True)
     assert "streaming" in capsys.readouterr().err
+    from hybridtrack.fields import TroughLoop, simulate_field
+
+    counted = []
+    simulate_field(day, "lanzhou", TroughLoop(count=3), progress=counted.append)  # a callable, as simulate's
+    assert counted == [1, 1, 1] and capsys.readouterr().err == ""
+    with pytest.raises(HybridtrackError, match="progress must be a callable .*, True, False or None, got 'yes'"):
+        simulate_field(day, "lanzhou", TroughLoop(count=3), progress="yes")
 
 
 @pytest.mark.parametrize("options, message", [
