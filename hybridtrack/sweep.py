@@ -463,12 +463,26 @@ def _frame(site, start: str, days: int, weather: str, freq: str, gusts_per_day: 
 
 
 def _plain(value):
-    """A table cell: dates and lists as text, everything else as it is."""
+    """A table cell: dates and lists as text (`_text`), everything else as it is."""
     if isinstance(value, (list, tuple)):
-        return ",".join(str(v) for v in value)
+        return ",".join(_text(v) for v in value)
     if hasattr(value, "isoformat"):
         return value.isoformat()
     return value
+
+
+def _text(value) -> str:
+    """A grid value as text, as its TOML wrote it: ``true`` (not Python's ``True``), a list's
+    items joined by commas, a table's as ``{key = value, ...}``, a date in ISO form."""
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple)):
+        return ",".join(_text(v) for v in value)
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{key} = {_text(v)}" for key, v in value.items()) + "}"
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
+    return str(value)
 
 
 def run_one(base: dict, grid_values: dict, source: str = "sweep", sweep_steps: int = 0) -> dict:
@@ -649,14 +663,9 @@ def _as_text(values: pd.Series) -> pd.Series:
     For the columns pandas cannot make one native column of, which Parquet cannot store: values of
     several types (``[0.1, "wide"]``), whole numbers beyond 64 bits (a seed of 1e20, which fails
     its run but must not lose the table), tables. Text keeps every digit, where a float would not;
-    a boolean is written as TOML writes it (``true``, where Python's ``str`` gave ``True``).
+    a boolean is written as TOML writes it (``true``, where Python's ``str`` gave ``True``; `_text`).
     """
-    def text(value):
-        if isinstance(value, (bool, np.bool_)):
-            return "true" if value else "false"
-        return value if value is None else str(value)
-
-    return values.map(text).astype("string")
+    return values.map(lambda v: v if v is None else _text(v)).astype("string")
 
 
 def pareto_front(table: pd.DataFrame, x: str, y: str) -> pd.DataFrame:

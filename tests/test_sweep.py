@@ -234,6 +234,10 @@ def test_a_grid_of_mixed_types_makes_a_table_parquet_can_hold(tmp_path):
     flags = _table([run_one(grid.base, {"run": k, "controller.lead": v}) for k, v in enumerate([True, "x"])])
     assert list(flags["controller.lead"]) == ["true", "x"]  # as the sweep's TOML wrote it, not Python's 'True'
     assert flags["error"].isna().tolist() == [True, False]
+    nested = [[True, False], "x", {"a": True}]  # within lists and tables too (helper-32)
+    grid = Sweep.from_dict({**TINY, "grid": {"controller.lead": nested}})
+    cells = _table([run_one(grid.base, {"run": k, "controller.lead": v}) for k, v in enumerate(nested)])
+    assert list(cells["controller.lead"]) == ["true,false", "x", "{a = true}"]
 
 
 def test_a_seed_beyond_64_bits_fails_its_run_and_the_table_keeps_every_digit(tmp_path):
