@@ -908,8 +908,9 @@ class KeptAsRead:
     """What a streamed run's weather holds that the run keeps as it is, counted as its days pass
     (`stream` repairs nothing; `hybridtrack.io.read_weather` counts the same in its report): the
     missing readings of each column (each a sensor's fault the controller must survive) and the
-    gaps, steps longer than `GAP_STEPS` times the first day's typical step (a day missing from the
-    file among them); each with the time of its first."""
+    gaps, steps longer than `GAP_STEPS` times the typical (median) step of the day they end in (a
+    day missing from the file among them; a 15-minute day after a 1-minute day is no gap each
+    step, as the first day's step had made it); each with the time of its first."""
 
     missing: dict = field(default_factory=dict)
     gaps: int = 0
@@ -928,8 +929,9 @@ class KeptAsRead:
                     self.missing[column] = (count + int(missing.sum()), first)
         index = frame.index if self.last is None else frame.index.insert(0, self.last)
         steps = np.diff(index.as_unit("ns").asi8)
-        if self.step is None and len(frame) > 1:
-            self.step = int(np.median(np.diff(frame.index.as_unit("ns").asi8)))
+        own = steps if self.last is None else steps[1:]  # the day's own steps, not the one into it
+        if len(own):
+            self.step = int(np.median(own))
         if self.step:
             at = np.flatnonzero(steps > GAP_STEPS * self.step)
             if len(at) and self.first_gap_after is None:

@@ -382,6 +382,19 @@ def test_what_a_stream_keeps_as_read_is_counted_in_its_summary_and_said(tmp_path
                       "gaps": {"count": 1, "longest": "1455min", "first_after": "2021-06-21 23:45:00+08:00"}}
 
 
+def test_a_day_at_a_coarser_step_is_no_gap_at_each_step(tmp_path):
+    """A 1-minute day then a 15-minute day: each step is judged against its own day's step (the
+    first day's had counted 95 gaps of 15 minutes, helper-32); a day missing after them is one."""
+    from hybridtrack.sky import synthetic
+
+    first = synthetic(SITE, "2021-06-20", weather="sunny", freq="1min", seed=1)
+    second = synthetic(SITE, "2021-06-21", weather="sunny", freq="15min", seed=1)
+    fourth = synthetic(SITE, "2021-06-23", weather="sunny", freq="15min", seed=1)
+    result = stream(frame_days(pd.concat([first, second, fourth]), SITE), tmp_path / "run")
+    assert result.kept_as_read.report()["gaps"] == {"count": 1, "longest": "1455min",
+                                                    "first_after": "2021-06-21 23:45:00+08:00"}
+
+
 def test_an_unknown_zone_for_a_streamed_files_stamps_is_refused_by_name(tmp_path):
     with pytest.raises(HybridtrackError, match="recorded_days: tz: unknown time zone 'Mars/X'"):
         recorded_days(tmp_path / "weather.csv", SITE, tz="Mars/X")
