@@ -13,7 +13,7 @@ from .errors import HybridtrackError
 
 __all__ = ["parse_date", "check_dates", "FIRST_DATE", "LAST_DATE", "parse_clock", "parse_freq", "local_range",
            "local_midnight", "check_tz", "clock_hours", "clock_nanoseconds", "calendar_days", "day_of_year",
-           "plus_seconds", "stamp_minutes", "HOUR_NS", "DAY_NS"]
+           "plus_seconds", "stamp_minutes", "local_steps", "HOUR_NS", "DAY_NS"]
 
 
 def clock_nanoseconds(local: pd.DatetimeIndex):
@@ -53,7 +53,7 @@ def stamp_minutes(index: pd.DatetimeIndex):
     if len(ns) < 2:
         return np.ones(len(ns))
     steps = np.diff(ns) / 6e10
-    local = _local_steps(steps)
+    local = local_steps(steps, GAP_STEPS)
     counted = np.where(steps > GAP_STEPS * local, np.nan, steps)
     before, after = np.concatenate(([np.nan], counted)), np.concatenate((counted, [np.nan]))
     halves = np.where(np.isnan(before), after, np.where(np.isnan(after), before, 0.5 * (before + after)))
@@ -61,14 +61,19 @@ def stamp_minutes(index: pd.DatetimeIndex):
     return np.minimum(np.where(np.isnan(halves), alone, halves), LONGEST_STAMP_MINUTES)
 
 
-def _local_steps(steps):
-    """The median of the `LOCAL_STEPS` steps either side of each step that may be a gap (longer
-    than `GAP_STEPS` shortest steps; NaN for the rest, which cannot be): a regular grid has none
-    to judge, and a day-only logger's year a few hundred nights, not 525,600 medians."""
+def local_steps(steps, gap: float):
+    """The median of the `LOCAL_STEPS` steps either side of (and with) each of `steps` that may be
+    a gap, longer than `gap` times the shortest; NaN for the rest, which cannot be. A step is a gap
+    where it is longer than `gap` times its local step: a regular grid has none to judge, and a
+    day-only logger's year a few hundred nights, not 525,600 medians; a 15-minute day beside a
+    1-minute day is no gap at each step, as it is against the frame's median step."""
     import numpy as np
 
+    steps = np.asarray(steps, float)
     local = np.full(len(steps), np.nan)
-    maybe = np.flatnonzero(steps > GAP_STEPS * steps.min())
+    if not len(steps):
+        return local
+    maybe = np.flatnonzero(steps > gap * steps.min())
     if len(maybe):
         padded = np.concatenate((np.full(LOCAL_STEPS, np.nan), steps, np.full(LOCAL_STEPS, np.nan)))
         windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * LOCAL_STEPS + 1)[maybe]

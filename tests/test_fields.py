@@ -3,6 +3,7 @@
 import dataclasses
 import threading
 import time
+import warnings
 from types import SimpleNamespace
 
 import numpy as np
@@ -436,13 +437,15 @@ def test_a_frame_of_mixed_steps_offers_the_light_of_its_days_apart():
     (1 min) had counted the 15-minute day's light a fifteenth (helper's finding: 13.74 kWh/m²
     offered for 12.89 + 12.88 apart); the field's energy, the daily table and the sky's daily
     summary now add up."""
+    from hybridtrack.simulation import NightsLeftOutWarning
     from hybridtrack.sky import daily_summary
 
     first = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="15min", seed=1)
     second = synthetic("lanzhou", "2021-06-22", weather="cloudy", freq="1min", seed=2)
     both = pd.concat([first, second])
     field = TroughLoop(count=1)
-    with pytest.warns(UserWarning):  # a 15-min stamp's night reads as a night left out beside 1-min steps
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NightsLeftOutWarning)  # a 15-min day's steps are its own, not gaps
         together = simulate_field(both, "lanzhou", field, keep_log=False).collectors["offered"].iloc[0]
     apart = [simulate_field(day, "lanzhou", field, keep_log=False).collectors["offered"].iloc[0]
              for day in (first, second)]

@@ -29,6 +29,7 @@ import pandas as pd
 
 from .. import sites
 from ..errors import HybridtrackError
+from ..times import local_steps
 from .columns import IRRADIANCE
 
 __all__ = ["fill_nights", "night_gaps", "TWILIGHT"]
@@ -38,6 +39,8 @@ __all__ = ["fill_nights", "night_gaps", "TWILIGHT"]
 #: mid-latitudes, longer towards the poles). A gap with more daylight in it is a logger down by
 #: day as well, whose light nobody can tell: left as a gap.
 TWILIGHT = pd.Timedelta(hours=3)
+#: A step longer than this many of its local steps is a gap (as `hybridtrack.io` counts gaps).
+GAP = 1.5
 
 
 def _step(index: pd.DatetimeIndex) -> pd.Timedelta:
@@ -46,10 +49,13 @@ def _step(index: pd.DatetimeIndex) -> pd.Timedelta:
 
 
 def _instants(index: pd.DatetimeIndex, step: pd.Timedelta, tz: str) -> tuple[pd.DatetimeIndex, np.ndarray]:
-    """The stamps at `step` strictly inside each gap longer than 1.5 steps, and each one's gap
+    """The stamps at `step` strictly inside each gap, a step longer than `GAP` times its local one
+    (`hybridtrack.times.local_steps`: a frame's 15-minute day beside its 1-minute day has none),
+    and each one's gap
     (its row before; -1 and ``len(index)`` for the first local day's start before the first row
     and the last one's end after the last row, which the file leaves out as well)."""
-    gaps = np.flatnonzero(pd.TimedeltaIndex(index[1:] - index[:-1]) > 1.5 * step)
+    steps = np.diff(index.as_unit("ns").asi8).astype(float)
+    gaps = np.flatnonzero(steps > GAP * local_steps(steps, GAP))
     first = index[0].tz_convert(tz).normalize().tz_convert(index.tz)
     last = (index[-1].tz_convert(tz).normalize() + pd.Timedelta(days=1)).tz_convert(index.tz)
     inside = [pd.date_range(index[0] - step * ((index[0] - first) // step), index[0] - step / 2, freq=step),
