@@ -599,7 +599,7 @@ def progress_updates(progress, bar: Callable) -> Iterator[Callable | None]:
         with bar() as made:
             yield made.update
         return
-    yield progress or None
+    yield progress if callable(progress) else None
 
 
 def check_progress(progress) -> None:
