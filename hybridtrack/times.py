@@ -53,6 +53,8 @@ def stamp_minutes(index: pd.DatetimeIndex):
     if len(ns) < 2:
         return np.ones(len(ns))
     steps = np.diff(ns) / 6e10
+    if steps.min() == steps.max():  # a regular grid, the common case, at a field's every collector
+        return np.full(len(ns), min(steps[0], LONGEST_STAMP_MINUTES))
     local = local_steps(steps, GAP_STEPS)
     counted = np.where(steps > GAP_STEPS * local, np.nan, steps)
     before, after = np.concatenate(([np.nan], counted)), np.concatenate((counted, [np.nan]))
