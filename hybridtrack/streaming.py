@@ -60,7 +60,7 @@ from .io.files import input_path
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
-from .times import check_tz, local_midnight, parse_date, parse_freq
+from .times import check_tz, local_midnight, local_steps, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
            "read_log", "stream_files", "partial_files"]
@@ -908,15 +908,15 @@ class KeptAsRead:
     """What a streamed run's weather holds that the run keeps as it is, counted as its days pass
     (`stream` repairs nothing; `hybridtrack.io.read_weather` counts the same in its report): the
     missing readings of each column (each a sensor's fault the controller must survive) and the
-    gaps, steps longer than `GAP_STEPS` times the typical (median) step of the day they end in (a
-    day missing from the file among them; a 15-minute day after a 1-minute day is no gap each
-    step, as the first day's step had made it); each with the time of its first."""
+    gaps, steps longer than `GAP_STEPS` times their local step (`hybridtrack.times.local_steps`, as
+    the nights a logger left out are found; a day missing from the file among them, and a
+    15-minute day after a 1-minute day no gap at each step, as the first day's step had made it);
+    each with the time of its first."""
 
     missing: dict = field(default_factory=dict)
     gaps: int = 0
     longest: pd.Timedelta = pd.Timedelta(0)
     first_gap_after: pd.Timestamp | None = None
-    step: int | None = None
     last: pd.Timestamp | None = None
 
     def add(self, frame: pd.DataFrame) -> None:
@@ -929,16 +929,12 @@ class KeptAsRead:
                     self.missing[column] = (count + int(missing.sum()), first)
         index = frame.index if self.last is None else frame.index.insert(0, self.last)
         steps = np.diff(index.as_unit("ns").asi8)
-        own = steps if self.last is None else steps[1:]  # the day's own steps, not the one into it
-        if len(own):
-            self.step = int(np.median(own))
-        if self.step:
-            at = np.flatnonzero(steps > GAP_STEPS * self.step)
-            if len(at) and self.first_gap_after is None:
-                self.first_gap_after = index[at[0]]
-            if len(at):
-                self.gaps += len(at)
-                self.longest = max(self.longest, pd.Timedelta(int(steps[at].max()), "ns"))
+        at = np.flatnonzero(steps > GAP_STEPS * local_steps(steps, GAP_STEPS))
+        if len(at) and self.first_gap_after is None:
+            self.first_gap_after = index[at[0]]
+        if len(at):
+            self.gaps += len(at)
+            self.longest = max(self.longest, pd.Timedelta(int(steps[at].max()), "ns"))
         self.last = frame.index[-1]
 
     def report(self) -> dict:
