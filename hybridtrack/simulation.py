@@ -414,10 +414,6 @@ def _refuse_unphysical_light(frame: pd.DataFrame, site: sites.Site, altitude: np
     _refuse_kilowatts(frame, site, altitude)
 
 
-#: The largest value of a day's irradiance in kW/m² (the solar constant is 1.361 kW/m²).
-KILOWATT_TOP = 1.5
-#: W/m² of the site's clear-sky GHI (Haurwitz) a day must reach before its magnitude is judged.
-JUDGED_FROM = 300.0
 #: W/m²: DHI below this is no sky's, in kW/m² or W/m² alike (a frame's "no diffuse light", 0 or
 #: its rounding, 1e-13, beam-only DHI by closure); in kW/m² a day's DHI with the clear sky at
 #: `JUDGED_FROM` is tens of W/m², 0.02 or more.
@@ -435,33 +431,33 @@ def _refuse_kilowatts(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarra
     sunny GHI is its maker's to mean."""
     import pvlib
 
-    from .io.checks import BEAM_SEEN, horizontal_beam
+    from .io.checks import BEAM_SEEN, JUDGED_FROM, KILOWATT_TOP, horizontal_beam
 
     clear = pvlib.clearsky.haurwitz(pd.Series(90.0 - altitude, index=frame.index))["ghi"].to_numpy(float)
     days = pd.Series(np.arange(len(frame)), index=frame.index.tz_convert(site.tz).date)
     beam = horizontal_beam(frame, clear) if "ghi" in frame.columns else None
+    light = {name: frame[name].to_numpy(float) for name in ("ghi", "dhi", "dni") if name in frame.columns}
     for day, rows in days.groupby(level=0):
         rows = rows.to_numpy()
-        if not np.nanmax(clear[rows]) >= JUDGED_FROM:
+        sky, seen = _top(clear, rows), _top(beam[0], rows) if beam is not None else np.nan
+        if not sky >= JUDGED_FROM:
             continue
         for name, low, beside_beam in (("ghi", 0.0, False), ("dhi", NO_DIFFUSE, False), ("dni", 0.0, True)):
-            if name not in frame.columns or (beside_beam and not _beam_seen(beam, rows, BEAM_SEEN)):
+            if name not in light or (beside_beam and not seen >= BEAM_SEEN):
                 continue
-            values = frame[name].to_numpy(float)[rows]
-            top = np.nanmax(values) if np.isfinite(values).any() else np.nan
+            top = _top(light[name], rows)
             if low < top <= KILOWATT_TOP:
-                seen = (f"{beam[1]} {np.nanmax(beam[0][rows]):.0f} W/m² (a direct beam)" if beside_beam else
-                        f"the clear sky reaches {np.nanmax(clear[rows]):.0f} W/m²")
+                why = (f"{beam[1]} {seen:.0f} W/m² (a direct beam)" if beside_beam else
+                       f"the clear sky reaches {sky:.0f} W/m²")
                 raise HybridtrackError(f"the weather frame on {day}: column {name!r}: {name} is at most {top:g} while "
-                                       f"{seen}; the values look like kW/m², where W/m² belong: multiply the frame's "
+                                       f"{why}; the values look like kW/m², where W/m² belong: multiply the frame's "
                                        f"{name} by 1000")
 
 
-def _beam_seen(beam: tuple | None, rows: np.ndarray, least: float) -> bool:
-    """Whether the direct light on the horizontal (`horizontal_beam`'s) reaches `least` W/m² in `rows`."""
-    if beam is None or not np.isfinite(beam[0][rows]).any():
-        return False
-    return bool(np.nanmax(beam[0][rows]) >= least)
+def _top(values: np.ndarray, rows: np.ndarray) -> float:
+    """The largest of `values` at `rows`, NaN where none is a number."""
+    part = values[rows]
+    return float(np.nanmax(part)) if np.isfinite(part).any() else np.nan
 
 
 def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:

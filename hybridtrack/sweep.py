@@ -464,11 +464,7 @@ def _frame(site, start: str, days: int, weather: str, freq: str, gusts_per_day: 
 
 def _plain(value):
     """A table cell: dates and lists as text (`_text`), everything else as it is."""
-    if isinstance(value, (list, tuple)):
-        return ",".join(_text(v) for v in value)
-    if hasattr(value, "isoformat"):
-        return value.isoformat()
-    return value
+    return _text(value) if isinstance(value, (list, tuple)) or hasattr(value, "isoformat") else value
 
 
 def _text(value) -> str:

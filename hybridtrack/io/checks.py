@@ -202,6 +202,13 @@ def _drop_empty(frame: pd.DataFrame, report: dict) -> pd.DataFrame:
     return frame
 
 
+#: The largest value of a day's irradiance in kW/m² (the solar constant is 1.361 kW/m²): at most
+#: this, where the clear sky reaches `JUDGED_FROM`, is kW/m² read as W/m².
+KILOWATT_TOP = 1.5
+#: W/m² of the site's clear-sky GHI (Haurwitz) the span must reach before its magnitude is judged.
+JUDGED_FROM = 300.0
+
+
 def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
                     remedy: str = "give the unit (--units {name}=kW/m2)") -> None:
     """Refuse irradiance a thousand times too small (kW/m² read as W/m²), or darker than any sky.
@@ -224,10 +231,10 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
         top = float(np.nanmax(values))
         if clear_ghi is not None:
             reference = float(np.nanmax(clear_ghi)) if len(clear_ghi) else 0.0
-            suspicious = reference >= 300.0 and 0.0 < top <= 1.5
+            suspicious = reference >= JUDGED_FROM and 0.0 < top <= KILOWATT_TOP
             why = f"at most {top:g} while the clear sky reaches {reference:.0f} W/m²"
         else:
-            suspicious = hours >= 6.0 and 0.0 < top <= 1.5
+            suspicious = hours >= 6.0 and 0.0 < top <= KILOWATT_TOP
             why = f"at most {top:g} over {hours:.0f} hours"
         header = report.get("columns", {}).get(name, name)
         line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
@@ -294,7 +301,7 @@ def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict,
         return
     top, seen = float(np.nanmax(dni)), float(np.nanmax(beam[0]))
     lowest = 0.0 if "dhi" in frame else -np.inf
-    if lowest < top <= 1.5 and seen >= BEAM_SEEN:
+    if lowest < top <= KILOWATT_TOP and seen >= BEAM_SEEN:
         header = report.get("columns", {}).get("dni", "dni")
         why = ("is the pyrheliometer dead or off the sun? remove the column from the file to derive DNI from GHI"
                if top <= 0.0 else f"the values look like kW/m² read as W/m²: {remedy.format(name='dni')}")
