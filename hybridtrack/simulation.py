@@ -434,30 +434,24 @@ def _refuse_kilowatts(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarra
     from .io.checks import BEAM_SEEN, JUDGED_FROM, KILOWATT_TOP, horizontal_beam
 
     clear = pvlib.clearsky.haurwitz(pd.Series(90.0 - altitude, index=frame.index))["ghi"].to_numpy(float)
-    days = pd.Series(np.arange(len(frame)), index=frame.index.tz_convert(site.tz).date)
     beam = horizontal_beam(frame, clear) if "ghi" in frame.columns else None
-    light = {name: frame[name].to_numpy(float) for name in ("ghi", "dhi", "dni") if name in frame.columns}
-    for day, rows in days.groupby(level=0):
-        rows = rows.to_numpy()
-        sky, seen = _top(clear, rows), _top(beam[0], rows) if beam is not None else np.nan
-        if not sky >= JUDGED_FROM:
+    columns = {"sky": clear, "seen": beam[0] if beam is not None else np.full(len(frame), np.nan),
+               **{name: frame[name].to_numpy(float) for name in ("ghi", "dhi", "dni") if name in frame.columns}}
+    days = frame.index.tz_convert(site.tz).normalize()  # local midnights: no Python date made per stamp
+    tops = pd.DataFrame(columns, index=days).groupby(level=0).max()  # NaN where a day has no number
+    tops = tops[tops["sky"] >= JUDGED_FROM]
+    for name, low, beside_beam in (("ghi", 0.0, False), ("dhi", NO_DIFFUSE, False), ("dni", 0.0, True)):
+        if name not in tops:
             continue
-        for name, low, beside_beam in (("ghi", 0.0, False), ("dhi", NO_DIFFUSE, False), ("dni", 0.0, True)):
-            if name not in light or (beside_beam and not seen >= BEAM_SEEN):
-                continue
-            top = _top(light[name], rows)
-            if low < top <= KILOWATT_TOP:
-                why = (f"{beam[1]} {seen:.0f} W/m² (a direct beam)" if beside_beam else
-                       f"the clear sky reaches {sky:.0f} W/m²")
-                raise HybridtrackError(f"the weather frame on {day}: column {name!r}: {name} is at most {top:g} while "
-                                       f"{why}; the values look like kW/m², where W/m² belong: multiply the frame's "
-                                       f"{name} by 1000")
-
-
-def _top(values: np.ndarray, rows: np.ndarray) -> float:
-    """The largest of `values` at `rows`, NaN where none is a number."""
-    part = values[rows]
-    return float(np.nanmax(part)) if np.isfinite(part).any() else np.nan
+        beside = tops["seen"] >= BEAM_SEEN if beside_beam else True
+        found = tops[(tops[name] > low) & (tops[name] <= KILOWATT_TOP) & beside]
+        if len(found):
+            day, top = found.index[0].date(), found.iloc[0]
+            why = (f"{beam[1]} {top['seen']:.0f} W/m² (a direct beam)" if beside_beam else
+                   f"the clear sky reaches {top['sky']:.0f} W/m²")
+            raise HybridtrackError(f"the weather frame on {day}: column {name!r}: {name} is at most {top[name]:g} while "
+                                   f"{why}; the values look like kW/m², where W/m² belong: multiply the frame's "
+                                   f"{name} by 1000")
 
 
 def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
