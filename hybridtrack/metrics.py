@@ -94,7 +94,8 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
     Columns: ``weight`` (direct light on the aperture where the error is scored, else 0),
     ``error``, ``offered`` (direct light a perfect tracker would catch), ``captured`` (what this
     one caught through the acceptance model), the light in W min/m² over each stamp's own step
-    (`hybridtrack.times.stamp_minutes`: a frame of mixed steps weighs a minute alike in each) and ``moved`` (drive axes that moved this step).
+    (`hybridtrack.times.stamp_minutes`: a frame of mixed steps weighs a minute alike in each),
+    and ``moved`` (drive axes that moved this step).
     """
     half_angle = _half_angle(collector)
     _check_log(log, sun_up, incidence)
