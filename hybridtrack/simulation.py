@@ -707,9 +707,11 @@ class Tracked:
 def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
           config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
           faults: dict | None = None, progress=None, bulk_nights: bool = True,
-          warm_start: bool | dict = True) -> Tracked:
+          warm_start: bool | dict = True, fit_columns: bool = True) -> Tracked:
     """`simulate`'s run without its scoring: the world and the controller stepped over the frame.
-    Takes `simulate`'s arguments; returns a `Tracked`."""
+    Takes `simulate`'s arguments; returns a `Tracked`. Without `fit_columns` the compiled kernel
+    keeps no mount fit at each scan: for a run scored by `Tracked.scores` alone, whose log is
+    never made (`hybridtrack.kernel.bridge.run_compiled`)."""
     config = checked_config(config)
     if progress is not None and not callable(progress):  # it is called with each count of steps done
         raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
@@ -743,7 +745,7 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
 
     def run_scans():
         if compiled:
-            return run_compiled(world, controller, progress, bulk_nights and not faults, stop)
+            return run_compiled(world, controller, progress, bulk_nights and not faults, stop, fit_columns)
         _run(world, controller, progress, bulk_nights and not faults)
         return controller.outputs()
 

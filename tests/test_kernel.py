@@ -149,6 +149,22 @@ def test_nights_in_bulk_or_scan_by_scan_run_the_same_compiled(mixed_day):
     assert_same_run(bulk, scans)
 
 
+@pytest.mark.parametrize("collector", ["fresnel", "heliostat"])
+def test_a_run_without_fit_columns_scores_and_ends_the_same_as_the_reference(mixed_day, collector):
+    """A field's collector that keeps no log runs without the mount fit at each scan: its scores,
+    events and carried memory are still the reference loop's."""
+    from hybridtrack.simulation import track
+
+    runs = {engine: track(mixed_day, "lanzhou", collector=collector, fit_columns=engine == "reference",
+                          config=SimulationConfig(engine=engine)) for engine in ("reference", "compiled")}
+    lean, full = runs["compiled"], runs["reference"]
+    assert lean.out.fit.shape == (len(mixed_day), 0) and full.out.fit.shape[1] > 0
+    assert_same_summary(full.scores(full.events()), lean.scores(lean.events()), "scores")
+    pd.testing.assert_frame_equal(full.events(), lean.events())
+    assert_same_summary(full.memory(), lean.memory(), "memory")
+    assert_same_numbers(full.world.angles, lean.world.angles, "angles")
+
+
 def test_the_kernel_reports_progress_over_every_scan(mixed_day):
     done = []
     simulate(mixed_day, "lanzhou", config=SimulationConfig(engine="compiled"), progress=done.append)

@@ -40,23 +40,25 @@ def test_a_piece_is_computed_once_per_key_inside_the_block_and_every_time_outsid
     assert len(calls) == 5
 
 
-def test_arrays_are_matched_by_their_values_and_handed_out_as_copies():
+def test_arrays_are_matched_by_their_values_and_handed_out_read_only():
     calls, compute = counted()
     with reuse_work():
         first = shared(("piece", Content(np.linspace(0.0, 1.0, 11))), compute)
-        first[0] = 99.0  # a run that writes into its copy
+        with pytest.raises(ValueError, match="read-only"):
+            first[0] = 99.0  # a run that writes into what it was handed
         second = shared(("piece", Content(np.linspace(0.0, 1.0, 11))), compute)
         shared(("piece", Content(np.linspace(0.0, 1.0, 12))), compute)
         shared(("piece", Content(np.linspace(0.0, 1.0, 11).astype(np.float32))), compute)
     assert second[0] == 0.0 and len(calls) == 3
 
 
-def test_frames_tuples_and_dicts_come_back_as_copies():
+def test_frames_tuples_and_dicts_come_back_as_copies_or_read_only():
     frame = pd.DataFrame({"a": [1.0, 2.0]})
     with reuse_work():
         got = shared(("x",), lambda: (frame, {"alarm": np.zeros(2)}, "text"))
         got[0].loc[0, "a"] = 5.0
-        got[1]["alarm"][0] = 5.0
+        with pytest.raises(ValueError, match="read-only"):
+            got[1]["alarm"][0] = 5.0
         again = shared(("x",), lambda: None)
     assert again[0].loc[0, "a"] == 1.0 and again[1]["alarm"][0] == 0.0 and again[2] == "text"
 

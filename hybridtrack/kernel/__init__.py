@@ -109,8 +109,8 @@ def decided(config, scans: int):
     return config
 
 
-def run_compiled(world, controller, progress, bulk_nights, stop=None):
+def run_compiled(world, controller, progress, bulk_nights, stop=None, fit_columns=True):
     """Run the scans through the kernel (`hybridtrack.kernel.bridge.run_compiled`)."""
     from .bridge import run_compiled as run
 
-    return run(world, controller, progress, bulk_nights, stop)
+    return run(world, controller, progress, bulk_nights, stop, fit_columns)

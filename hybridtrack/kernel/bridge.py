@@ -248,16 +248,21 @@ def _write_back(controller: Controller, state: kc.ControllerState) -> None:
                         if state.k[slot]}
 
 
-def run_compiled(world: World, controller: Controller, progress, bulk_nights: bool, stop=None) -> ControllerOutputs:
+def run_compiled(world: World, controller: Controller, progress, bulk_nights: bool, stop=None,
+                 fit_columns: bool = True) -> ControllerOutputs:
     """Run the scans through the compiled kernels; return the controller's outputs, with the
     world's angles and the controller's memory written back into `world` and `controller`.
     A `stop` event (`threading.Event`) that is set ends the run at its next chunk of scans, its
-    outputs cut short: for a caller that is giving up (Ctrl-C while the loop runs on a thread)."""
+    outputs cut short: for a caller that is giving up (Ctrl-C while the loop runs on a thread).
+    Without `fit_columns` the outputs hold no mount fit at each scan (``fit_value`` and
+    ``fit_std`` have no columns): a run scored without its log (a field's collector that keeps
+    none) need not fill two numbers a scan for each mount parameter: 25 MB over a Fresnel row's
+    year, 42 MB over a heliostat's."""
     n, axes = world.n, world.axes
     arrays, world_state = pack_world(world)
     cfg, plan = _settings(controller), _plan(controller)
     state = _state(controller, arrays.minutes)
-    out = _record(n, axes, len(state.theta))
+    out = _record(n, axes, len(state.theta) if fit_columns else 0)
     events = _events(1024 + EVENTS_PER_SCAN)
     wind_ok = np.concatenate([[0], np.cumsum(controller.wind.gusts(world.wind))])
     obs, obs_axes, moves = np.zeros(5), np.zeros((axes, 3)), np.zeros(axes)

@@ -194,10 +194,9 @@ def _record(cfg, plan, state, out, i, status, targets, reading):
         out.target[i, a] = targets[a]
         out.reading[i, a] = reading[a]
         out.calibration[i, a] = _correction(cfg, plan, state, i, a)
-    if cfg.has_fit:
-        for m in range(state.theta.shape[0]):
-            out.fit_value[i, m] = state.theta[m]
-            out.fit_std[i, m] = math.sqrt(max(state.p[m, m], 0.0))
+    for m in range(out.fit_value.shape[1]):  # none where the run keeps no fit columns
+        out.fit_value[i, m] = state.theta[m]
+        out.fit_std[i, m] = math.sqrt(max(state.p[m, m], 0.0))
 
 
 @kernel
@@ -1374,8 +1373,7 @@ def controller_rest(cfg, plan, state, out, i, j, last_t):
             out.reading[scan, a] = state.encoder[a, BELIEVED]
             out.calibration[scan, a] = _correction(cfg, plan, state, scan, a)
             out.sun[scan, a] = math.nan
-        if cfg.has_fit:
-            for m in range(state.theta.shape[0]):
-                out.fit_value[scan, m] = state.theta[m]
-                out.fit_std[scan, m] = math.sqrt(max(state.p[m, m], 0.0))
+        for m in range(out.fit_value.shape[1]):
+            out.fit_value[scan, m] = state.theta[m]
+            out.fit_std[scan, m] = math.sqrt(max(state.p[m, m], 0.0))
 
