@@ -31,21 +31,26 @@ __all__ = ["commission", "warm_memory", "clear_day"]
 
 
 def clear_day(site, collector: Collector, config, start: pd.Timestamp, strategy: str, days_before: float,
-              classifier=None):
+              classifier=None, sky_seed: int | None = None):
     """The run of `strategy` over a clear day at `site`, `days_before` local days before `start`,
     with the controller's clock as it was then, tracked but not scored (`simulation.Tracked`: only
-    its memory is wanted)."""
-    from .reuse import apart
+    its memory is wanted).
+
+    The day's sky is drawn from `sky_seed` (by default the config's seed, which also seeds the
+    world's own draws: the sensor's noise). A field's collectors stood under one sky the day
+    before as they do in the run: the field gives them its seed, and they share the day's frame
+    and what follows from it alone (its sun and its light; `hybridtrack.reuse`)."""
+    from .reuse import same_object
     from .simulation import track
     from .sky import synthetic
 
     day = _day_before(start.tz_convert(site.tz), days_before)
-    frame = synthetic(site, day, weather="sunny", seed=config.seed)
+    seed = config.seed if sky_seed is None else sky_seed
+    frame = same_object(("clear day", site, day, seed), lambda: synthetic(site, day, weather="sunny", seed=seed))
     age = max(config.imperfections.commissioned_days_ago - days_before, 0.0)
     setup = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy),
                                 imperfections=dataclasses.replace(config.imperfections, commissioned_days_ago=age))
-    with apart():  # the day's frame is this run's own: nothing of it is another run's to share
-        return track(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
+    return track(frame, site, collector=collector, config=setup, classifier=classifier, warm_start=False)
 
 
 def _day_before(start: pd.Timestamp, days: float) -> dt.date:
@@ -63,7 +68,8 @@ def _day_before(start: pd.Timestamp, days: float) -> dt.date:
     return day
 
 
-def commission(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> MountEstimate:
+def commission(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None,
+               sky_seed: int | None = None) -> MountEstimate:
     """The mount fitted online over a clear day of sensor tracking at commissioning, then frozen.
 
     Parameters
@@ -75,14 +81,19 @@ def commission(site, collector: Collector, config, start: pd.Timestamp, *, class
     start : pandas.Timestamp
         The run's first step.
     classifier : FuzzyWeatherClassifier, optional
+    sky_seed : int, optional
+        Seeds the day's sky (`clear_day`); by default the config's seed.
     """
     days = max(config.imperfections.commissioned_days_ago, 1.0)
-    run = clear_day(site, collector, config, start, "hybrid-always", days, classifier)
+    run = clear_day(site, collector, config, start, "hybrid-always", days, classifier, sky_seed)
     return MountEstimate.from_parameters(parameter_names(collector), run.memory()["theta"])
 
 
-def warm_memory(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None) -> dict:
+def warm_memory(site, collector: Collector, config, start: pd.Timestamp, *, classifier=None,
+                sky_seed: int | None = None) -> dict:
     """What the run's own strategy carries out of the clear day before (`Controller.memory`): its
-    mount fit and offsets. Not the clock watch's readings: the run's watch starts afresh."""
-    memory = clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier).memory()
+    mount fit and offsets. Not the clock watch's readings: the run's watch starts afresh. The
+    day's sky is drawn from `sky_seed` (`clear_day`)."""
+    memory = clear_day(site, collector, config, start, config.controller.strategy, 1.0, classifier,
+                       sky_seed).memory()
     return {key: value for key, value in memory.items() if key != "clock"}

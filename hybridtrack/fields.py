@@ -804,8 +804,9 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         The run config; its imperfections are the centre of every collector's draw.
     seed : int, optional
         Seeds the imperfection draws and each collector's sensor noise: collector ``i``'s
-        draws depend only on `seed` and ``i``. By default the config's seed, as the command
-        line's ``--seed`` defaults to the ``--config`` file's.
+        draws depend only on `seed` and ``i``; and the sky of the clear day before the run (warm
+        start, commissioning), one sky for the whole field as the run's frame is. By default
+        the config's seed, as the command line's ``--seed`` defaults to the ``--config`` file's.
     keep_log : bool
         Keep every collector's log in `FieldResult.dataset` (about 50 bytes per collector
         and step, 80 for a heliostat); False keeps only the metrics.
@@ -987,7 +988,8 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
         for i, name, collector, imperfect in runs:
             run_config = dataclasses.replace(config, imperfections=imperfect,
                                              seed=int(np.random.SeedSequence([seed, i]).generate_state(1)[0]))
-            run = track(frame, site, collector=collector, strategy=strategy, config=run_config, fit_columns=keep_log)
+            run = track(frame, site, collector=collector, strategy=strategy, config=run_config, fit_columns=keep_log,
+                        sky_seed=seed)  # the day before the run under one sky too
             if keep_log:  # the whole result, for its log
                 result = _scored(run)
                 scores, events, log = result.summary, result.events, _kept(result.log)

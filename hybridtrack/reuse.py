@@ -28,14 +28,15 @@ import pandas as pd
 
 from .sun import reuse_positions
 
-__all__ = ["Content", "Same", "apart", "reuse_work", "shared", "ENTRIES"]
+__all__ = ["Content", "Same", "reuse_work", "shared", "same_object", "ENTRIES"]
 
 T = TypeVar("T")
 #: Pieces a `reuse_work` block keeps: the ones every run shares are used by each run and stay (ten
-#: for a field of rows or troughs on one axis line); a field whose collectors each have their own
-#: clock adds five per run (its plan and what follows from it), which must not pile up (a year's
-#: plan is some 40 MB) but only outlive the runs on the other threads.
-ENTRIES = 20
+#: for a field of rows or troughs on one axis line, and some ten small ones of the clear day before
+#: the run); a field whose collectors each have their own clock adds five per run (its plan and
+#: what follows from it), which must not pile up (a year's plan is some 40 MB) but only outlive
+#: the runs on the other threads.
+ENTRIES = 32
 _MEMORY: ContextVar[tuple[threading.Lock, dict, int, dict] | None] = ContextVar("hybridtrack_reuse_work", default=None)
 
 
@@ -71,19 +72,6 @@ def reuse_work(entries: int = ENTRIES) -> Iterator[None]:
         _MEMORY.reset(token)
 
 
-@contextmanager
-def apart() -> Iterator[None]:
-    """Within this block `shared` neither finds nor keeps pieces: for a run whose pieces no other
-    run will ask for (a collector's own warm-start day, `hybridtrack.commissioning.clear_day`),
-    which would otherwise push the field's shared pieces out of the memory. The sun's own memory
-    (`hybridtrack.sun.reuse_positions`) stays."""
-    token = _MEMORY.set(None)
-    try:
-        yield
-    finally:
-        _MEMORY.reset(token)
-
-
 def shared(key: tuple | None, compute: Callable[[], T]) -> T:
     """``compute()``, or its earlier answer for the same `key` inside a `reuse_work` block; a key
     of None is a piece no other run will ask for (`hybridtrack.mounting.geometry_key`), computed
@@ -112,6 +100,22 @@ def shared(key: tuple | None, compute: Callable[[], T]) -> T:
         return compute()
     underway.wait()
     return shared(key, compute)  # found now, unless that computation failed
+
+
+class _Held:
+    """An answer `_handed` passes on as it is (`same_object`)."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value) -> None:
+        self.value = value
+
+
+def same_object(key: tuple, compute: Callable[[], T]) -> T:
+    """`shared`, handing every request the very object computed, not a copy: for a frame the runs
+    only read and key their own shared pieces on by identity (`Same`), as a field's runs do the
+    field's frame (the clear day before the run, `hybridtrack.commissioning.clear_day`)."""
+    return shared(key, lambda: _Held(compute())).value
 
 
 class _Busy(threading.local):

@@ -707,11 +707,13 @@ class Tracked:
 def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
           config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
           faults: dict | None = None, progress=None, bulk_nights: bool = True,
-          warm_start: bool | dict = True, fit_columns: bool = True) -> Tracked:
+          warm_start: bool | dict = True, fit_columns: bool = True, sky_seed: int | None = None) -> Tracked:
     """`simulate`'s run without its scoring: the world and the controller stepped over the frame.
     Takes `simulate`'s arguments; returns a `Tracked`. Without `fit_columns` the compiled kernel
     keeps no mount fit at each scan: for a run scored by `Tracked.scores` alone, whose log is
-    never made (`hybridtrack.kernel.bridge.run_compiled`)."""
+    never made (`hybridtrack.kernel.bridge.run_compiled`). `sky_seed` seeds the sky of the clear
+    day before the run (warm start, commissioning; `hybridtrack.commissioning.clear_day`): by
+    default the config's seed; a field gives its collectors its own."""
     config = checked_config(config)
     if progress is not None and not callable(progress):  # it is called with each count of steps done
         raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
@@ -733,7 +735,7 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
     told = installed_site(site, config.imperfections)  # the site as the installer told the controller
 
     def plan_ahead():
-        return _controller_side(frame.index, site, told, collector, config, classifier, faults, warm_start)
+        return _controller_side(frame.index, site, told, collector, config, classifier, faults, warm_start, sky_seed)
 
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
     # once for a field's collectors under one frame (`hybridtrack.reuse`): a refusal is not kept
@@ -843,12 +845,12 @@ def _side_by_side(first, second, scans: int, cancel=None):
 
 
 def _controller_side(index: pd.DatetimeIndex, site: sites.Site, told: sites.Site, collector: Collector,
-                     config: SimulationConfig, classifier, faults: dict, warm_start):
+                     config: SimulationConfig, classifier, faults: dict, warm_start, sky_seed: int | None = None):
     """What the controller brings and plans before its first scan, from what it has (its clock, the
     site it was `told`, its memory; nothing of the world's, whose `site` only sets its warm-start
     day): the commissioned mount and warm memory, the plan, the classifier and the clear sky it
     expects (None where it expects none)."""
-    mount, memory = _history(site, collector, config, index[0], classifier, warm_start)
+    mount, memory = _history(site, collector, config, index[0], classifier, warm_start, sky_seed)
     clock = controller_clock(index, config.imperfections, faults)
     plan = make_plan(clock, scan_timer(index), told, collector, config.controller, mount)
     clf = classifier or FuzzyWeatherClassifier(fuzzy_config(config.sky))
@@ -886,8 +888,9 @@ def _wind_data(frame: pd.DataFrame) -> str:
     return "measured" if present.all() else ("missing" if not present.any() else "partly missing")
 
 
-def _history(site, collector, config, start, classifier, warm_start):
-    """What the controller brings from before the run: a commissioned mount, a warm calibration."""
+def _history(site, collector, config, start, classifier, warm_start, sky_seed=None):
+    """What the controller brings from before the run: a commissioned mount, a warm calibration
+    (from a clear day whose sky `sky_seed` seeds)."""
     from .commissioning import commission, warm_memory
 
     if isinstance(warm_start, dict):  # an earlier run carried on
@@ -897,14 +900,14 @@ def _history(site, collector, config, start, classifier, warm_start):
         memory.pop("origin", None)
         mount = memory.pop("commissioned", None)
         if config.controller.strategy == "astronomical-commissioned" and mount is None:
-            mount = commission(site, collector, config, start, classifier=classifier)
+            mount = commission(site, collector, config, start, classifier=classifier, sky_seed=sky_seed)
         if "clock" in memory:
             memory["clock"] = ClockWatch.rebase(memory["clock"], start)
         return mount, memory if config.controller.calibrates else None
     if config.controller.strategy == "astronomical-commissioned":  # an open loop is always commissioned
-        return commission(site, collector, config, start, classifier=classifier), None
+        return commission(site, collector, config, start, classifier=classifier, sky_seed=sky_seed), None
     if warm_start and config.controller.calibrates:
-        return None, warm_memory(site, collector, config, start, classifier=classifier)
+        return None, warm_memory(site, collector, config, start, classifier=classifier, sky_seed=sky_seed)
     return None, None
 
 

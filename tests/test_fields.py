@@ -16,7 +16,8 @@ from hybridtrack import HybridtrackError, simulate, simulate_field, sites
 from hybridtrack.collectors import Collector, fresnel_angle, heliostat_normal, trough_angle
 from hybridtrack.fields import (FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns,
                                 run_collectors)
-from hybridtrack.simulation import SimulationConfig
+from hybridtrack.commissioning import warm_memory
+from hybridtrack.simulation import SimulationConfig, _scored, track
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import altitude_azimuth, solar_position
 from hybridtrack.times import local_range
@@ -222,8 +223,8 @@ def test_a_field_run_is_each_collectors_own_run(day):
     result = simulate_field(day, "lanzhou", field, seed=11, config=config)
     drawn = field.spread.draw(config.imperfections, 2, 11)
     for i, (name, collector) in enumerate(zip(field.names, field.collectors())):
-        alone = simulate(day, "lanzhou", collector=collector, config=dataclasses.replace(
-            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([11, i]).generate_state(1)[0])))
+        alone = _scored(track(day, "lanzhou", collector=collector, sky_seed=11, config=dataclasses.replace(
+            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([11, i]).generate_state(1)[0]))))
         row = result.collectors.loc[name]
         assert row["rms"] == alone.summary["tracking_error_deg"]["rms"]
         assert row["moves"] == alone.summary["moves"] and row["energy_capture"] == alone.summary["energy_capture"]
@@ -233,6 +234,23 @@ def test_a_field_run_is_each_collectors_own_run(day):
         meanings = result.dataset["mode"].attrs["flag_meanings"].split()
         assert list(np.asarray(meanings)[codes]) == list(alone.log["mode"].astype(str))
     assert len(result.events) > 0 and set(result.events["collector"]) == set(field.names)
+
+
+def test_the_field_stood_under_one_sky_the_day_before(day, monkeypatch):
+    """The clear day before the run (the warm start's) is drawn once, from the field's seed, for
+    every collector, as the run's own frame is one sky; each collector's sensor noise on it is
+    still its own (a row alone under that day, with its own seed, ends with the same memory)."""
+    import hybridtrack.sky as sky
+
+    drawn, synthetic_day = [], sky.synthetic
+    monkeypatch.setattr(sky, "synthetic", lambda *a, **k: drawn.append(k["seed"]) or synthetic_day(*a, **k))
+    field = FresnelField(row_distances=[-4.0, 2.0, 6.0])
+    simulate_field(day, "lanzhou", field, seed=21, threads=2, keep_log=False)
+    assert drawn == [21]
+    seeds = [int(np.random.SeedSequence([21, i]).generate_state(1)[0]) for i in range(2)]
+    memories = [warm_memory(sites.get("lanzhou"), field.collectors()[0], SimulationConfig(seed=s), day.index[0],
+                            sky_seed=21)["offsets"] for s in seeds]
+    assert drawn == [21, 21, 21] and memories[0] != memories[1]  # one sky, each sensor's own noise
 
 
 def test_a_configs_seed_seeds_the_field_unless_seed_is_given():
@@ -274,8 +292,8 @@ def test_rows_on_one_axis_line_share_their_geometry_and_heliostats_keep_their_ow
     """Under one sun, the sun's direction (the world's and the plan's) and its incidence on the
     aperture are computed once for a field's rows or troughs on one axis line, and so are the
     mount fit's derivatives; a heliostat's pointing turns on its own aim point, so each of those
-    is its own, but the sun's unit vectors it starts from are shared. Each collector's warm-start
-    day is its own run, apart from the field's memory."""
+    is its own, but the sun's unit vectors it starts from are shared. (The clear day before the
+    run, a day's scans, is not counted here: `test_the_field_stood_under_one_sky_the_day_before`.)"""
     import hybridtrack.control.plan as plan
     import hybridtrack.mounting as mounting
 
@@ -299,8 +317,8 @@ def test_collectors_with_their_own_clocks_and_sites_share_no_sky(day):
     drawn = field.spread.draw(config.imperfections, 2, 5)
     assert drawn[0].clock_error != drawn[1].clock_error and drawn[0].latitude_error != drawn[1].latitude_error
     for i, (name, collector) in enumerate(zip(field.names, field.collectors())):
-        alone = simulate(day, "lanzhou", collector=collector, config=dataclasses.replace(
-            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([5, i]).generate_state(1)[0])))
+        alone = _scored(track(day, "lanzhou", collector=collector, sky_seed=5, config=dataclasses.replace(
+            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([5, i]).generate_state(1)[0]))))
         np.testing.assert_array_equal(result.dataset["angle"].sel(collector=name).to_numpy(), alone.log["angle"])
         np.testing.assert_array_equal(result.dataset["target"].sel(collector=name).to_numpy(), alone.log["target"])
         assert result.collectors.loc[name, "rms"] == alone.summary["tracking_error_deg"]["rms"]

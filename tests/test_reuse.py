@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hybridtrack.reuse import Content, Same, apart, reuse_work, shared
+from hybridtrack.reuse import Content, Same, reuse_work, same_object, shared
 
 
 def counted():
@@ -95,21 +95,32 @@ def test_the_memory_keeps_the_pieces_used_most_recently():
         assert len(calls) == 12
 
 
-def test_a_piece_without_a_key_and_a_block_apart_are_computed_every_time_and_not_kept():
-    """A heliostat's own geometry (no key) and a run's own warm-start day (`apart`) would only push
-    the field's shared pieces out of the memory."""
+def test_a_piece_without_a_key_is_computed_every_time_and_not_kept():
+    """A heliostat's own geometry (no key) would only push the field's shared pieces out of the memory."""
     calls, compute = counted()
     with reuse_work(entries=2):
         shared(("field's",), compute)
         shared(None, compute)
         shared(None, compute)
-        with apart():
-            for run in range(3):
-                shared(("this run's own", run), compute)
-                shared(("field's",), compute)  # not found apart either
-        assert len(calls) == 9
-        shared(("field's",), compute)  # still kept: nothing apart was
-        assert len(calls) == 9
+        assert len(calls) == 3
+        shared(("field's",), compute)  # still kept
+        assert len(calls) == 3
+
+
+def test_the_same_object_is_handed_to_every_request_for_it():
+    """A frame the runs key their own pieces on by identity (a field's clear day before the run) is
+    handed as the very object, computed once."""
+    calls = []
+
+    def day():
+        calls.append(1)
+        return pd.DataFrame({"dni": [800.0, 810.0]})
+
+    with reuse_work():
+        first, second = same_object(("clear day", 1), day), same_object(("clear day", 1), day)
+        other = same_object(("clear day", 2), day)
+    assert first is second and other is not first and len(calls) == 2
+    assert same_object(("clear day", 1), day) is not first  # outside a block: computed again
 
 
 def _in_threads(*calls) -> list:
