@@ -309,7 +309,7 @@ def _cloud_edges(minutes: np.ndarray, clearness: np.ndarray) -> np.ndarray | Non
     return lfilter([1.0 - keep], [1.0, -keep], sign, zi=[keep * sign[0]])[0]
 
 
-def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel, *, clear_dni=None,
+def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame | None, model: SensorModel, *, clear_dni=None,
                  clear_dhi=None, rng: np.random.Generator, circumsolar=None,
                  light: SceneLight | None = None) -> SensorScene:
     """What a sun-facing sensor has in view at each step of a weather frame (world side).
@@ -318,8 +318,8 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     ----------
     frame : pandas.DataFrame
         ``dni`` and ``dhi`` (recorded or synthetic).
-    position : pandas.DataFrame
-        The true sun (``zenith``, ``azimuth``) on the same index.
+    position : pandas.DataFrame or None
+        The true sun (``zenith``, ``azimuth``) on the same index; not read where `light` is given.
     model : SensorModel
     clear_dni, clear_dhi : array-like
         Clear-sky DNI and DHI on the same index (a synthetic frame's ``dni_clear`` and
@@ -347,8 +347,11 @@ def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame, model: SensorModel
     low, high = model.patch_distance
     distance = low + (high - low) * 0.5 * (1.0 + np.tanh(smooth_noise(index, rng, 30.0, 1.0, grid=grid)))
     direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * smooth_noise(index, rng, 20.0, 1.0, grid=grid)
-    offset = (side * distance)[:, None] * np.stack([np.cos(direction), np.sin(direction)], axis=1)
-    return SensorScene(beam=light.beam, aureole=light.aureole, patch=light.patch, patch_offset=offset,
+    offset = np.empty((2, len(index)))  # each axis's offsets in a row of their own, as the world reads them
+    np.cos(direction, out=offset[0])
+    np.sin(direction, out=offset[1])
+    offset *= side * distance
+    return SensorScene(beam=light.beam, aureole=light.aureole, patch=light.patch, patch_offset=offset.T,
                        diffuse=light.diffuse)
 
 

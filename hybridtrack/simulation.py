@@ -536,7 +536,7 @@ def checked_config(config) -> SimulationConfig:
 def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns", strategy: str | None = None,
              config: SimulationConfig | None = None, classifier: FuzzyWeatherClassifier | None = None,
              faults: dict | None = None, progress=None, bulk_nights: bool = True,
-             warm_start: bool | dict = True) -> Result:
+             warm_start: bool | dict = True, sky_seed: int | None = None) -> Result:
     """Run a tracking controller over a weather frame.
 
     Parameters
@@ -568,6 +568,12 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
         before the run (`hybridtrack.commissioning`). ``False`` starts from nothing. A dict is
         an earlier run's `Result.memory`: this run goes on from where that one ended (a long run
         in day-long parts, `hybridtrack.streaming`).
+    sky_seed : int, optional
+        Seeds the sky of that clear day before the run; by default the config's seed, which
+        seeds the world's own draws (the sensor's noise) too. A field's collectors share one
+        (`hybridtrack.simulate_field`'s seed): collector ``i`` of a field runs alone as
+        ``simulate(..., config=replace(config, imperfections=drawn[i], seed=its_seed),
+        sky_seed=field_seed)``.
 
     Returns
     -------
@@ -576,7 +582,8 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     warn_of_nights_left_out(frame, site)
     with progress_updates(progress, lambda: _step_bar(frame)) as update:
         return _scored(track(frame, site, collector=collector, strategy=strategy, config=config, classifier=classifier,
-                             faults=faults, progress=update, bulk_nights=bulk_nights, warm_start=warm_start))
+                             faults=faults, progress=update, bulk_nights=bulk_nights, warm_start=warm_start,
+                             sky_seed=sky_seed))
 
 
 @contextmanager
@@ -718,6 +725,7 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
     if progress is not None and not callable(progress):  # it is called with each count of steps done
         raise HybridtrackError(f"progress must be a callable (a tqdm bar's update) or None, got {progress!r:.60}")
     _check_run_options(classifier, bulk_nights, warm_start)
+    sky_seed = None if sky_seed is None else params.seed(sky_seed, "sky_seed")
     if strategy is not None:
         config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, strategy=strategy))
     site = sites.get(site)

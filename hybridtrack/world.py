@@ -199,8 +199,7 @@ class World:
         rng = np.random.default_rng(seed)
         self._sun_model = truth
         self._sun_key = (Same(index), site, truth)  # what the true sun turns on, in every shared key of it
-        position = self._true_sun()
-        self.altitude, self.azimuth = position["altitude"].to_numpy(), position["azimuth"].to_numpy()
+        self.altitude, self.azimuth = self._true_sun()
         rotation = mounting_rotation(imperfections.axis_azimuth_error, imperfections.axis_tilt_error, collector.axis,
                                      imperfections.axis_roll_error)
         key = geometry_key(self._sun_key, "pointing", collector)  # None: a heliostat's are its own
@@ -209,8 +208,8 @@ class World:
                                    sun=self._heliostat_sun())
         weather = frame if "dhi" in frame.columns else frame.assign(dhi=0.0)
         light = shared(("scene light", Same(frame), *self._sun_key, self.sensor.view_share),
-                       lambda: self._scene_light(weather, position))
-        scene = sensor_scene(weather, position, self.sensor, rng=rng, light=light)
+                       lambda: self._scene_light(weather))
+        scene = sensor_scene(weather, None, self.sensor, rng=rng, light=light)
         self.scene = (scene.beam, scene.aureole, scene.patch, np.ascontiguousarray(scene.patch_offset.T), scene.diffuse)
         self.truth_axes = np.ascontiguousarray(np.nan_to_num(self.truth[:, :self.axes].T))
         self.noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
@@ -220,8 +219,8 @@ class World:
         self.recorded_pointing = self._recorded_pointing_columns(frame)
         self.frame_dni = frame["dni"].to_numpy(float)
         self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
-        self.true_sky = self._true_sky(frame)
-        self.minutes = scan_timer(index)
+        self.true_sky = shared(("true sky", Same(frame)), lambda: self._true_sky(frame))
+        self.minutes = shared(("scan timer", Same(index)), lambda: scan_timer(index))
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.actual = [d.stow - imperfections.encoder_offset for d in drives]  # parked where stow reads
         self.angles = np.full((self.axes, self.n), np.nan)
@@ -258,18 +257,19 @@ class World:
                                    f"the frame has {', '.join(present)}")
         return np.array([frame[name].to_numpy(float) for name in names])
 
-    def _true_sun(self) -> pd.DataFrame:
-        """SPA where the sun can be up (a cheap model finds where); the sun far below elsewhere.
-        Computed once for the runs of a field (`hybridtrack.reuse`)."""
+    def _true_sun(self) -> tuple[np.ndarray, np.ndarray]:
+        """The true sun's altitude and azimuth, degrees: SPA where the sun can be up (a cheap model
+        finds where); the sun far below elsewhere. Computed once for the runs of a field
+        (`hybridtrack.reuse`), and handed to each as read-only arrays, not a frame to copy."""
         return shared(("true sun", *self._sun_key), self._sun_where_up)
 
-    def _sun_where_up(self) -> pd.DataFrame:
+    def _sun_where_up(self) -> tuple[np.ndarray, np.ndarray]:
         candidate = self._sun_may_be_up()
         altitude, azimuth = np.full(self.n, -90.0), np.zeros(self.n)
         if candidate.any():
             spa = solar_position(self.index[candidate], self.site, self._sun_model)
             altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
-        return pd.DataFrame({"altitude": altitude, "azimuth": azimuth, "zenith": 90.0 - altitude}, index=self.index)
+        return altitude, azimuth
 
     def _sun_may_be_up(self) -> np.ndarray:
         """Scans where the sun may be above -3°, as the cheap PLC model sees it at a knot every
@@ -285,16 +285,17 @@ class World:
         return altitude[(stamps + HOUR_NS // 2) // HOUR_NS - first] > -3.0 - 7.5 - 0.5
 
     def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
-        """The frame's clear-sky DNI and DHI, or Ineichen's under the true sun (`position`)."""
+        """The frame's clear-sky DNI and DHI, or Ineichen's under the true sun (`position`, its zenith)."""
         if "dni_clear" in frame.columns and "dhi_clear" in frame.columns:
             return frame["dni_clear"].to_numpy(float), frame["dhi_clear"].to_numpy(float)
         from .sky import clear_sky
 
         return clear_sky(self.index, self.site, position["zenith"].to_numpy(float))[1:]
 
-    def _scene_light(self, weather: pd.DataFrame, position: pd.DataFrame) -> SceneLight:
+    def _scene_light(self, weather: pd.DataFrame) -> SceneLight:
         """The light in the sensor's view from the weather and the true sun: the same for every
         collector under them."""
+        position = pd.DataFrame({"azimuth": self.azimuth, "zenith": 90.0 - self.altitude}, index=self.index)
         clear_dni, clear_dhi = self._clear_sky(weather, position)
         return scene_light(weather, position, self.sensor, clear_dni=clear_dni, clear_dhi=clear_dhi)
 

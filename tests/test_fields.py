@@ -17,7 +17,7 @@ from hybridtrack.collectors import Collector, fresnel_angle, heliostat_normal, t
 from hybridtrack.fields import (FresnelField, HeliostatField, ImperfectionSpread, TroughLoop, collector_columns,
                                 run_collectors)
 from hybridtrack.commissioning import warm_memory
-from hybridtrack.simulation import SimulationConfig, _scored, track
+from hybridtrack.simulation import SimulationConfig
 from hybridtrack.sky import synthetic
 from hybridtrack.sun import altitude_azimuth, solar_position
 from hybridtrack.times import local_range
@@ -223,8 +223,8 @@ def test_a_field_run_is_each_collectors_own_run(day):
     result = simulate_field(day, "lanzhou", field, seed=11, config=config)
     drawn = field.spread.draw(config.imperfections, 2, 11)
     for i, (name, collector) in enumerate(zip(field.names, field.collectors())):
-        alone = _scored(track(day, "lanzhou", collector=collector, sky_seed=11, config=dataclasses.replace(
-            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([11, i]).generate_state(1)[0]))))
+        alone = simulate(day, "lanzhou", collector=collector, sky_seed=11, config=dataclasses.replace(
+            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([11, i]).generate_state(1)[0])))
         row = result.collectors.loc[name]
         assert row["rms"] == alone.summary["tracking_error_deg"]["rms"]
         assert row["moves"] == alone.summary["moves"] and row["energy_capture"] == alone.summary["energy_capture"]
@@ -251,6 +251,12 @@ def test_the_field_stood_under_one_sky_the_day_before(day, monkeypatch):
     memories = [warm_memory(sites.get("lanzhou"), field.collectors()[0], SimulationConfig(seed=s), day.index[0],
                             sky_seed=21)["offsets"] for s in seeds]
     assert drawn == [21, 21, 21] and memories[0] != memories[1]  # one sky, each sensor's own noise
+
+
+@pytest.mark.parametrize("bad", [-1, 1.5, float("nan"), "1", True])
+def test_a_sky_seed_that_is_no_seed_is_refused_by_name(day, bad):
+    with pytest.raises(HybridtrackError, match="^sky_seed"):
+        simulate(day, "lanzhou", sky_seed=bad)
 
 
 def test_a_configs_seed_seeds_the_field_unless_seed_is_given():
@@ -317,8 +323,8 @@ def test_collectors_with_their_own_clocks_and_sites_share_no_sky(day):
     drawn = field.spread.draw(config.imperfections, 2, 5)
     assert drawn[0].clock_error != drawn[1].clock_error and drawn[0].latitude_error != drawn[1].latitude_error
     for i, (name, collector) in enumerate(zip(field.names, field.collectors())):
-        alone = _scored(track(day, "lanzhou", collector=collector, sky_seed=5, config=dataclasses.replace(
-            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([5, i]).generate_state(1)[0]))))
+        alone = simulate(day, "lanzhou", collector=collector, sky_seed=5, config=dataclasses.replace(
+            config, imperfections=drawn[i], seed=int(np.random.SeedSequence([5, i]).generate_state(1)[0])))
         np.testing.assert_array_equal(result.dataset["angle"].sel(collector=name).to_numpy(), alone.log["angle"])
         np.testing.assert_array_equal(result.dataset["target"].sel(collector=name).to_numpy(), alone.log["target"])
         assert result.collectors.loc[name, "rms"] == alone.summary["tracking_error_deg"]["rms"]
