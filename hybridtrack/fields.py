@@ -833,7 +833,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     from .kernel import decided, uses_kernel
     from .reuse import reuse_work
     from .simulation import _check_frame, check_progress, checked_config, progress_updates, warn_of_nights_left_out
-    from .sun import solar_position
+    from .world import true_sun
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
@@ -860,7 +860,6 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
     shown = len(runs) > 4 if progress is None else progress
     with progress_updates(shown, lambda: _bar(len(runs))) as update, reuse_work():  # every run shares the sky
-        truth = solar_position(frame.index, site, config.truth)  # the table's, and the runs' from memory
         for block in _blocks(frame, runs, job, threads, workers, scheduler):
             for i, row, run_events, log in block:
                 rows[i], events[i] = row, run_events
@@ -869,6 +868,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
                     store.add(i, log)
                 if update is not None:
                     update(1)
+        truth = true_sun(frame.index, site, config.truth)  # the runs' (on Dask: computed here)
     table = _collector_table(rows, field, frame["dni"].to_numpy(float), truth)
     summary = _field_summary(table, field, site, strategy or config.controller.strategy, frame)
     all_events = pd.concat(events, ignore_index=True) if events else pd.DataFrame()
@@ -1009,8 +1009,9 @@ def _energy(light: np.ndarray, index: pd.DatetimeIndex) -> float:
     return float(np.sum(light * stamp_minutes(index))) / 60e3
 
 
-def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFrame) -> pd.DataFrame:
-    """The collectors' rows with their positions first and, for a Fresnel field, their end loss last."""
+def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: tuple) -> pd.DataFrame:
+    """The collectors' rows with their positions first and, for a Fresnel field, their end loss last
+    (under the true sun, `truth`: altitude and azimuth, `hybridtrack.world.true_sun`)."""
     table = pd.DataFrame(rows, index=pd.Index(field.names, name="collector"))
     for column in table.columns[table.dtypes == object]:  # a metric no step scored is None: NaN, as a number
         table[column] = table[column].astype(float)
@@ -1018,8 +1019,7 @@ def _collector_table(rows: list[dict], field, dni: np.ndarray, truth: pd.DataFra
         table.insert(i, axis, field.positions[:, i])
     if isinstance(field, FresnelField):
         table.insert(3, "row_distance", field.row_distances)
-        altitude, azimuth = truth["altitude"].to_numpy(), truth["azimuth"].to_numpy()
-        for column, values in _end_loss_columns(field, dni, altitude, azimuth).items():
+        for column, values in _end_loss_columns(field, dni, *truth).items():
             table[column] = values
     return table
 

@@ -45,7 +45,8 @@ from .sensor import (RECORDED_COLUMN, RECORDED_POINTING, SceneLight, SensorModel
 from .sun import solar_position
 from .times import HOUR_NS, plus_seconds
 
-__all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site", "controller_clock", "scan_timer"]
+__all__ = ["Imperfections", "World", "HARD_STOP_MARGIN", "installed_site", "controller_clock", "scan_timer",
+           "true_sun"]
 
 #: Degrees the mechanism's hard stops lie beyond the drive's software limits.
 HARD_STOP_MARGIN = 1.0
@@ -149,6 +150,37 @@ def controller_clock(index: pd.DatetimeIndex, imperfections: Imperfections, faul
         return reading(np.nan_to_num(np.asarray(faults["clock"], float)))
     key = ("controller clock", Same(index), imp.clock_error, imp.clock_drift, imp.commissioned_days_ago)
     return shared(key, lambda: reading(np.zeros(len(index))))
+
+
+def true_sun(index: pd.DatetimeIndex, site: sites.Site, model: str) -> tuple[np.ndarray, np.ndarray]:
+    """The true sun's altitude and azimuth at each stamp, degrees: `model`'s (SPA) where the sun
+    can be up (a cheap model finds where), the sun far below (-90°) elsewhere. Computed once for
+    the runs of a field and its table (`hybridtrack.reuse`), and handed to each as read-only
+    arrays."""
+    return shared(("true sun", Same(index), site, model), lambda: _sun_where_up(index, site, model))
+
+
+def _sun_where_up(index: pd.DatetimeIndex, site: sites.Site, model: str) -> tuple[np.ndarray, np.ndarray]:
+    candidate = _sun_may_be_up(index, site)
+    altitude, azimuth = np.full(len(index), -90.0), np.zeros(len(index))
+    if candidate.any():
+        spa = solar_position(index[candidate], site, model)
+        altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
+    return altitude, azimuth
+
+
+def _sun_may_be_up(index: pd.DatetimeIndex, site: sites.Site) -> np.ndarray:
+    """Stamps where the sun may be above -3°, as the cheap PLC model sees it at a knot every
+    hour: each stamp is judged by its nearest knot, half an hour away at most, in which the
+    sun's altitude moves 7.5° at most (the earth turns 0.25° a minute), and by 0.5° more for
+    the model's declination and equation of time, held for each calendar day."""
+    stamps = np.asarray(index.as_unit("ns").asi8)
+    if not len(stamps):
+        return np.zeros(0, bool)
+    first = stamps.min() // HOUR_NS
+    knots = pd.DatetimeIndex(np.arange(first, stamps.max() // HOUR_NS + 2) * HOUR_NS).tz_localize("UTC")
+    altitude = solar_position(knots, site, "plc")["altitude"].to_numpy()
+    return altitude[(stamps + HOUR_NS // 2) // HOUR_NS - first] > -3.0 - 7.5 - 0.5
 
 
 class World:
@@ -258,31 +290,7 @@ class World:
         return np.array([frame[name].to_numpy(float) for name in names])
 
     def _true_sun(self) -> tuple[np.ndarray, np.ndarray]:
-        """The true sun's altitude and azimuth, degrees: SPA where the sun can be up (a cheap model
-        finds where); the sun far below elsewhere. Computed once for the runs of a field
-        (`hybridtrack.reuse`), and handed to each as read-only arrays, not a frame to copy."""
-        return shared(("true sun", *self._sun_key), self._sun_where_up)
-
-    def _sun_where_up(self) -> tuple[np.ndarray, np.ndarray]:
-        candidate = self._sun_may_be_up()
-        altitude, azimuth = np.full(self.n, -90.0), np.zeros(self.n)
-        if candidate.any():
-            spa = solar_position(self.index[candidate], self.site, self._sun_model)
-            altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
-        return altitude, azimuth
-
-    def _sun_may_be_up(self) -> np.ndarray:
-        """Scans where the sun may be above -3°, as the cheap PLC model sees it at a knot every
-        hour: each scan is judged by its nearest knot, half an hour away at most, in which the
-        sun's altitude moves 7.5° at most (the earth turns 0.25° a minute), and by 0.5° more for
-        the model's declination and equation of time, held for each calendar day."""
-        stamps = np.asarray(self.index.as_unit("ns").asi8)
-        if not len(stamps):
-            return np.zeros(0, bool)
-        first = stamps.min() // HOUR_NS
-        knots = pd.DatetimeIndex(np.arange(first, stamps.max() // HOUR_NS + 2) * HOUR_NS).tz_localize("UTC")
-        altitude = solar_position(knots, self.site, "plc")["altitude"].to_numpy()
-        return altitude[(stamps + HOUR_NS // 2) // HOUR_NS - first] > -3.0 - 7.5 - 0.5
+        return true_sun(self.index, self.site, self._sun_model)
 
     def _clear_sky(self, frame: pd.DataFrame, position: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
         """The frame's clear-sky DNI and DHI, or Ineichen's under the true sun (`position`, its zenith)."""
