@@ -830,7 +830,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     -------
     FieldResult
     """
-    from .kernel import decided, uses_kernel
+    from .kernel import COMPILING, compiles_first, decided, uses_kernel
     from .reuse import reuse_work
     from .simulation import _check_frame, check_progress, checked_config, progress_updates, warn_of_nights_left_out
     from .world import true_sun
@@ -859,6 +859,8 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     rows, events, store = [None] * len(runs), [None] * len(runs), None
     job = dict(site=site, strategy=strategy, config=config, seed=seed, keep_log=keep_log)
     shown = len(runs) > 4 if progress is None else progress
+    if shown is True and compiles_first(config, len(frame)):
+        print(COMPILING, file=sys.stderr)
     with progress_updates(shown, lambda: _bar(len(runs))) as update, reuse_work():  # every run shares the sky
         for block in _blocks(frame, runs, job, threads, workers, scheduler):
             for i, row, run_events, log in block:

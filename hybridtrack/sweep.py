@@ -596,6 +596,8 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
             started()
         # one map, not a submit a run: 100,000 submits took 45 s before the bar appeared
         steps = _all_steps(sweep, runs)
+        if progress:
+            _say_if_compiling(sweep, runs, steps)
         futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
                                       [steps] * len(runs), pure=False), runs))
         with tqdm(total=len(futures), unit="run", file=sys.stderr, disable=not progress, leave=False) as bar:
@@ -620,6 +622,20 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
     if stop is not None:
         raise SweepInterrupted(_table(rows) if rows else None, len(runs), stop) from None
     return _table(rows)
+
+
+def _say_if_compiling(sweep: Sweep, runs: list[dict], steps: int) -> None:
+    """Say so on stderr where the runs will compile the kernel first: each worker compiles it
+    before its first run, and the bar stands at 0 for minutes (judged on the first run's config;
+    one that cannot be set up says nothing here and fails as its own row)."""
+    from .kernel import COMPILING, compiles_first
+
+    try:
+        config = _setup(_spec(sweep.base, runs[0]), sweep.base, sweep.source)[1]
+        if compiles_first(config, steps):
+            print(COMPILING, file=sys.stderr)
+    except HybridtrackError:
+        pass
 
 
 class SweepInterrupted(KeyboardInterrupt):

@@ -755,3 +755,13 @@ def test_the_engine_is_chosen_on_the_fields_scans_not_each_collectors(day, monke
     engines.clear()
     simulate_field(day, "lanzhou", TroughLoop(count=2), keep_log=False, threads=1)
     assert engines == ["auto"] * 4
+
+
+@pytest.mark.parametrize("progress, compiles, said", [(True, True, True), (True, False, False), (False, True, False)])
+def test_a_field_that_compiles_the_kernel_first_says_so_beside_its_bar(day, monkeypatch, capsys, progress, compiles,
+                                                                       said):
+    import hybridtrack.kernel as kernel
+
+    monkeypatch.setattr(kernel, "compiles_first", lambda config, scans: compiles)
+    simulate_field(day, "lanzhou", FresnelField(row_distances=[-2.0, 2.0]), keep_log=False, progress=progress)
+    assert ("compiling the controller kernel" in capsys.readouterr().err) is said

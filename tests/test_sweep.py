@@ -846,3 +846,30 @@ def test_a_grids_unreadable_days_or_step_fail_their_runs_not_the_sweep():
         assert _all_steps(sweep, runs) == 96
         key, value = next(iter(grid)), grid[next(iter(grid))][1]
         assert run_one(sweep.base, runs[1], "s.toml")["error"].startswith(f"HybridtrackError: grid.{key} = {value!r}:")
+
+
+@pytest.mark.parametrize("compiles", [True, False])
+def test_a_sweep_that_compiles_the_kernel_first_says_so_before_its_bar_stands_still(monkeypatch, capsys, compiles):
+    """A fresh install's first sweep sat at 0 % for about two minutes while each worker compiled
+    the kernel, with no word of it."""
+    import hybridtrack.kernel as kernel
+    from hybridtrack.sweep import _say_if_compiling
+
+    seen = []
+    monkeypatch.setattr(kernel, "compiles_first", lambda config, scans: seen.append((config, scans)) or compiles)
+    sweep = Sweep.from_dict(TINY)
+    _say_if_compiling(sweep, sweep.runs(), 1440)
+    said = capsys.readouterr().err
+    assert seen and isinstance(seen[0][0], SimulationConfig) and seen[0][1] == 1440
+    assert ("compiling the controller kernel" in said) is compiles
+
+
+def test_compiles_first_is_the_kernel_taken_neither_compiled_nor_cached(monkeypatch):
+    import hybridtrack.kernel as kernel
+
+    config = SimulationConfig(engine="compiled")
+    for compiled_here, cached_on_disk, expected in ((False, False, True), (True, False, False), (False, True, False)):
+        monkeypatch.setattr(kernel, "compiled", lambda: compiled_here)
+        monkeypatch.setattr(kernel, "cached", lambda: cached_on_disk)
+        assert kernel.compiles_first(config, 10) is expected
+    assert kernel.compiles_first(SimulationConfig(engine="reference"), 10**9) is False

@@ -17,7 +17,8 @@ import dataclasses
 from ..errors import HybridtrackError
 from .jit import available
 
-__all__ = ["ENGINES", "COMPILE_PAYS_AT", "LOAD_PAYS_AT", "available", "cached", "compiled", "unsupported", "uses_kernel", "decided", "run_compiled"]
+__all__ = ["ENGINES", "COMPILE_PAYS_AT", "LOAD_PAYS_AT", "COMPILING", "available", "cached", "compiled", "compiles_first",
+           "unsupported", "uses_kernel", "decided", "run_compiled"]
 
 #: The choices of `SimulationConfig.engine`.
 ENGINES = ("auto", "compiled", "reference")
@@ -59,6 +60,18 @@ def cached() -> bool:
         return bool(run_scans._cache._cache_file._load_index())  # {} when absent or stale
     except Exception:  # pragma: no cover - numba's cache internals moved: compile only when it pays
         return False
+
+
+#: What a run with a progress bar says before it compiles the kernel: its bar stands still meanwhile.
+COMPILING = ("compiling the controller kernel before the first step (numba; once per install or upgrade, "
+             "about 2 minutes on 2 cores, then kept in its cache)")
+
+
+def compiles_first(config, scans: int = 0) -> bool:
+    """Whether a run of `config` over `scans` scans compiles the kernel before its first scan: it
+    takes the kernel (`uses_kernel`), which is neither compiled in this process nor in numba's
+    disk cache (76-115 s on a 2-core machine, ``docs/kernel.md``), while its bar shows nothing done."""
+    return uses_kernel(config, scans) and not compiled() and not cached()
 
 
 def uses_kernel(config, scans: int = 0) -> bool:
