@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import mountpass
 from .collectors import (Collector, _broadcast, _finite, across_angle, as_collector, checked_sun, checked_vectors,
                          heliostat_normal, normal_angles, receiver_angle, sun_path, sun_vector)
 from .errors import HybridtrackError
@@ -74,7 +75,8 @@ def mounting_rotation(axis_azimuth_error, axis_tilt_error, axis_azimuth, axis_ro
 
 
 def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray | None = None, *,
-                  night: bool = False, vectors: np.ndarray | None = None, sun: np.ndarray | None = None) -> np.ndarray:
+                  night: bool = False, vectors: np.ndarray | None = None, sun: np.ndarray | None = None,
+                  engine: str = "auto") -> np.ndarray:
     """Target angles of one collector on a mount turned by `rotation` (`mounting_rotation`), degrees.
 
     Returns shape (N, 1) for single-axis collectors (trough convention) and (N, 2) for a
@@ -84,10 +86,11 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     `pointing_vectors` (with the same `night`) when the caller has them, `sun` its unit vectors
     (a heliostat's, `heliostat_sun`) otherwise: each (N, 3), refused by name otherwise (they had
     raised numpy's IndexError). One collector and one (3, 3) rotation: `angles_on_mount`
-    broadcasts over rotations.
+    broadcasts over rotations. `engine` as `angles_on_mount`'s.
     """
     alt, az = sun_path(altitude, azimuth, "mount_targets")
     collector = as_collector(collector)
+    _check_engine(engine, "mount_targets")
     if rotation is not None and np.shape(rotation) != (3, 3):  # numpy's ValueError, deep in a product
         raise HybridtrackError(f"mount_targets: rotation must be a 3 x 3 matrix (mounting_rotation), got shape "
                                f"{np.shape(rotation)}")
@@ -95,16 +98,20 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     sun = _path_vectors(sun, "mount_targets", "sun", len(alt))
     if night:
         return angles_on_mount(pointing_vectors(alt, az, collector, night=True, sun=sun) if vectors is None
-                               else vectors, collector, rotation)
+                               else vectors, collector, rotation, engine=engine)
     # only where the sun is up: half a year's scans are nights, where a heliostat's NaN normals cost
     # numpy's slow path (a mirror's targets for a year took 0.13 s, against 0.05 s up only)
+    if vectors is not None and engine != "numpy":  # one compiled pass, NaN where the sun is down
+        fast = _compiled_angles(vectors, collector, rotation, engine, altitude=alt)
+        if fast is not None:
+            return fast
     up = ~(alt < 0)
     if vectors is None:
         vectors = pointing_vectors(alt[up], az[up], collector, sun=None if sun is None else sun[up])
     else:
         vectors = vectors[up]
     out = np.full((len(alt), 1 if collector.single_axis else 2), np.nan)
-    out[up] = angles_on_mount(vectors, collector, rotation)
+    out[up] = angles_on_mount(vectors, collector, rotation, engine=engine)
     return out
 
 
@@ -190,13 +197,23 @@ def rotate(vectors, rotation) -> np.ndarray:
     return np.einsum("...c,...dc->...d", vectors, matrices)
 
 
-def angles_on_mount(vectors, collector: Collector, rotation=None) -> np.ndarray:
+def angles_on_mount(vectors, collector: Collector, rotation=None, *, engine: str = "auto") -> np.ndarray:
     """The collector's angles ``(..., axes)``, degrees, that follow `vectors` ``(..., 3)``
     (`pointing_vectors`) on a mount turned by `rotation` (`mounting_rotation`, ``(..., 3, 3)``
     broadcast against the vectors as `rotate` does; None: the nominal mount). One vector gives
     one row of angles, (axes,); a wrong shape is refused by name (one vector had raised numpy's
-    IndexError)."""
+    IndexError).
+
+    `engine`: ``numpy`` the reference path below; ``compiled`` (where numba is installed) a path
+    of vectors (N, 3) under one rotation in one pass (`hybridtrack.mountpass`), the same bits;
+    ``auto`` compiled where it applies. Either takes the reference path for what the pass
+    leaves to it (other shapes, a vector on the horizon, a refusal)."""
     vectors, collector = checked_vectors(vectors, "angles_on_mount", "vectors"), as_collector(collector)
+    _check_engine(engine, "angles_on_mount")
+    if engine != "numpy":
+        fast = _compiled_angles(vectors, collector, rotation, engine)
+        if fast is not None:
+            return fast
     rotated = vectors if rotation is None else rotate(vectors, rotation)
     if collector.kind == "heliostat":
         return np.stack(normal_angles(rotated), axis=-1)
@@ -204,6 +221,26 @@ def angles_on_mount(vectors, collector: Collector, rotation=None) -> np.ndarray:
     if collector.kind == "fresnel":
         sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
     return np.asarray(sun)[..., None]
+
+
+def _check_engine(engine, function: str) -> None:
+    if engine not in mountpass.ENGINES:
+        raise HybridtrackError(f"{function}: unknown engine {engine!r}; choose {', '.join(mountpass.ENGINES)}")
+    if engine == "compiled" and not mountpass.available():
+        raise HybridtrackError(f"{function}: the compiled engine needs numba, which is not installed here")
+
+
+def _compiled_angles(vectors: np.ndarray, collector: Collector, rotation, engine: str, altitude=None):
+    """`angles_on_mount` in one compiled pass (`hybridtrack.mountpass`), NaN where `altitude`
+    (if given) is below zero; None where the pass does not apply."""
+    if not mountpass.available():
+        return None
+    if collector.kind == "heliostat":
+        return mountpass.heliostat_angles(vectors, rotation, altitude)
+    b = np.radians(_finite(collector.axis, "axis azimuth"))  # the axis's trigonometry as across_angle's
+    receiver = receiver_angle(collector.row_distance, collector.receiver_height) \
+        if collector.kind == "fresnel" else None
+    return mountpass.single_axis_angles(vectors, rotation, np.cos(b), np.sin(b), receiver, altitude)
 
 
 def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np.ndarray:

@@ -1,0 +1,116 @@
+"""The compiled pass of a collector's angles (`hybridtrack.mountpass`) against numpy's path
+(`angles_on_mount(..., engine="numpy")`, its reference), bit for bit; and where the pass leaves
+a path to the reference (a vector on the horizon, an infinite or zero vector)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hybridtrack import sites
+from hybridtrack.collectors import Collector, sun_vector
+from hybridtrack.errors import HybridtrackError
+from hybridtrack.fields import FresnelField, HeliostatField
+from hybridtrack.mounting import angles_on_mount, mount_targets, mounting_rotation, pointing_vectors
+from hybridtrack.sun import solar_position
+
+COLLECTORS = {"trough-ns": Collector("trough-ns"), "trough-ew": Collector("trough-ew"),
+              "trough-30": Collector("trough", axis_azimuth=30.0), "fresnel-west": FresnelField().collectors()[2],
+              "fresnel-east": FresnelField().collectors()[17], "heliostat": HeliostatField.rings(2).collectors()[1]}
+
+
+def _sun():
+    """A year's sun path every 53 minutes: nights and days of every season, some NaN."""
+    index = pd.date_range("2021-01-01", "2021-12-31", freq="53min", tz="UTC")
+    position = solar_position(index, sites.get("lanzhou"), "spa")
+    altitude, azimuth = position["altitude"].to_numpy(copy=True), position["azimuth"].to_numpy(copy=True)
+    altitude[::97] = np.nan
+    return altitude, azimuth
+
+
+def _same_bits(got, expected):
+    assert got.shape == expected.shape
+    assert np.array_equal(got.view(np.int64), expected.view(np.int64))  # NaN's bits too
+
+
+@pytest.mark.parametrize("name", COLLECTORS)
+@pytest.mark.parametrize("night", [False, True])
+@pytest.mark.parametrize("mount", [None, (0.3, -0.2, 0.1), (-4.0, 3.0, -2.5)])
+def test_compiled_angles_are_numpys_bit_for_bit(name, night, mount):
+    collector = COLLECTORS[name]
+    altitude, azimuth = _sun()
+    rotation = None if mount is None else mounting_rotation(mount[0], mount[1], collector.axis, mount[2])
+    vectors = pointing_vectors(altitude, azimuth, collector, night=night)
+    expected = angles_on_mount(vectors, collector, rotation, engine="numpy")
+    assert np.isfinite(expected).any() and np.isnan(expected).any()
+    _same_bits(angles_on_mount(vectors, collector, rotation, engine="compiled"), expected)
+    _same_bits(angles_on_mount(vectors, collector, rotation), expected)
+    given = None if collector.kind == "heliostat" else vectors
+    expected = mount_targets(altitude, azimuth, collector, rotation, vectors=given, night=night, engine="numpy")
+    _same_bits(mount_targets(altitude, azimuth, collector, rotation, vectors=given, night=night,
+                             engine="compiled"), expected)
+
+
+def test_a_trough_on_a_known_sun_reads_pvlibs_tracker_through_the_pass():
+    """An independent reference beside numpy's path: pvlib's single-axis tracker (trough
+    convention: 90° + its rotation) on a north-south axis."""
+    import pvlib
+
+    altitude, azimuth = np.array([10.0, 35.0, 62.0, 20.0]), np.array([95.0, 130.0, 200.0, 260.0])
+    got = angles_on_mount(sun_vector(altitude, azimuth), Collector("trough-ns"), engine="compiled")
+    pv = pvlib.tracking.singleaxis(90 - altitude, azimuth, axis_azimuth=180, backtrack=False, max_angle=180)
+    np.testing.assert_allclose(got[:, 0], 90 + np.asarray(pv["tracker_theta"]), rtol=0, atol=1e-9)
+
+
+def test_a_vector_on_the_horizon_takes_the_reference_path():
+    """A vector with an up component of exactly zero along the axis gives 90° (the reference's
+    rule for no part across the axis), with the pass as without it."""
+    vectors = np.array([[0.0, 1.0, 0.0], [0.3, 0.5, 0.8], [1.0, 0.0, 0.0]])
+    got = angles_on_mount(vectors, Collector("trough-ns"), engine="compiled")
+    _same_bits(got, angles_on_mount(vectors, Collector("trough-ns"), engine="numpy"))
+    assert got[0, 0] == 90.0 and got[2, 0] == 0.0
+
+
+@pytest.mark.parametrize("name", ["trough-ns", "heliostat"])
+def test_an_infinite_vector_is_refused_by_name_either_way(name):
+    vectors = np.array([[0.3, 0.5, 0.8], [np.inf, 0.0, 0.5]])
+    messages = []
+    for engine in ("numpy", "compiled"):
+        with pytest.raises(HybridtrackError) as refused:
+            angles_on_mount(vectors, COLLECTORS[name], engine=engine)
+        messages.append(str(refused.value))
+    assert messages[0] == messages[1] and "finite" in messages[0]
+
+
+def test_a_zero_normal_is_refused_either_way():
+    for engine in ("numpy", "compiled"):
+        with pytest.raises(HybridtrackError, match="zero vector"):
+            angles_on_mount(np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 0.0]]), Collector("heliostat"), engine=engine)
+
+
+def test_an_unknown_engine_is_refused_by_name():
+    with pytest.raises(HybridtrackError, match="unknown engine 'fast'"):
+        angles_on_mount(np.array([[0.0, 1.0, 1.0]]), Collector(), engine="fast")
+    with pytest.raises(HybridtrackError, match="mount_targets: unknown engine"):
+        mount_targets([30.0], [120.0], Collector(), engine=None)
+
+
+def test_without_numba_the_reference_path_runs_and_compiled_is_refused():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import hybridtrack
+
+    script = ("import sys\nsys.modules['numba'] = None\n"
+              "from hybridtrack.collectors import Collector\n"
+              "from hybridtrack.errors import HybridtrackError\n"
+              "from hybridtrack.mounting import angles_on_mount\n"
+              "print(angles_on_mount([[0.0, 0.6, 0.8]], Collector())[0, 0])\n"
+              "try:\n    angles_on_mount([[0.0, 0.6, 0.8]], Collector(), engine='compiled')\n"
+              "except HybridtrackError as error:\n    print(error)\n")
+    env = {"PYTHONPATH": str(Path(hybridtrack.__file__).parents[1]), "PATH": ""}
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=300)
+    assert done.returncode == 0, done.stderr
+    first, second = done.stdout.strip().splitlines()
+    assert float(first) == pytest.approx(np.degrees(np.arctan2(0.8, 0.0)))
+    assert "needs numba" in second
