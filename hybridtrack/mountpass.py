@@ -28,7 +28,7 @@ try:
 except ImportError:  # pragma: no cover - numba is a dependency; the reference path is tested by asking for it
     numba = None
 
-__all__ = ["available", "single_axis_angles", "heliostat_angles"]
+__all__ = ["available", "single_axis_angles", "heliostat_angles", "derivatives"]
 
 ENGINES = ("auto", "compiled", "numpy")
 
@@ -92,6 +92,89 @@ def _heliostat_pass(vectors, rotation, altitude, out):
         out[i, 0] = azimuth + 0.0
         out[i, 1] = math.degrees(math.atan2(z, horizontal))
     return True
+
+
+@_compiled
+def _finite_or_extreme(value):
+    """numpy's nan_to_num of one number: NaN 0, an infinity the largest float of its sign."""
+    if value != value:
+        return 0.0
+    if math.isinf(value):
+        return np.finfo(np.float64).max if value > 0.0 else -np.finfo(np.float64).max
+    return value
+
+
+@_compiled
+def _turned_dot(g0, g1, g2, turn, x, y, z):
+    """The angle gradient (g0, g1, g2) dotted with the vector turned by `turn`, as einsum sums it."""
+    t0 = x * turn[0, 0] + y * turn[0, 1] + z * turn[0, 2]
+    t1 = x * turn[1, 0] + y * turn[1, 1] + z * turn[1, 2]
+    t2 = x * turn[2, 0] + y * turn[2, 1] + z * turn[2, 2]
+    return g0 * t0 + g1 * t1 + g2 * t2
+
+
+@_compiled
+def _single_axis_derivatives(x, y, z, turns, cos_axis, sin_axis, scale, row):
+    """`row` (1, 3): a single axis's angle by the two pedestal terms and its encoder zero."""
+    across = x * cos_axis - y * sin_axis
+    span = across * across + z * z
+    d_across, d_z = -z / span, across / span
+    g0, g1, g2 = scale * (d_across * cos_axis), scale * (-d_across * sin_axis), scale * d_z
+    for k in range(2):
+        row[0, k] = _turned_dot(g0, g1, g2, turns[k], x, y, z)
+    row[0, 2] = 1.0
+
+
+@_compiled
+def _heliostat_derivatives(x, y, z, turns, degrees, floor, row):
+    """`row` (2, 5): a heliostat's azimuth and elevation by its two pedestal terms, its encoder
+    zeros and its sensor's collimation (sec e of azimuth)."""
+    flat = x * x + y * y
+    squared = z * z
+    squared = 0.0 if squared < 0.0 else (1.0 if squared > 1.0 else squared)
+    g00, g01, g02 = degrees * (y / flat), degrees * (-x / flat), degrees * 0.0
+    g10, g11, g12 = degrees * 0.0, degrees * 0.0, degrees * (1.0 / math.sqrt(1.0 - squared))
+    for k in range(2):
+        row[0, k] = _turned_dot(g00, g01, g02, turns[k], x, y, z)
+        row[1, k] = _turned_dot(g10, g11, g12, turns[k], x, y, z)
+    row[0, 2] = row[1, 3] = 1.0
+    clipped = -1.0 if z < -1.0 else (1.0 if z > 1.0 else z)
+    cosine = math.cos(math.radians(math.degrees(math.asin(clipped))))
+    row[0, 4] = 1.0 / (min(cosine, -floor) if cosine < 0.0 else (cosine if cosine != cosine else max(cosine, floor)))
+
+
+@_compiled
+def _derivative_pass(vectors, lit, turns, cos_axis, sin_axis, scale, degrees, floor, heliostat, out):
+    """`out` (N, axes, parameters), zero beforehand: each lit scan's derivatives, NaN as 0 and an
+    infinity as the largest float (numpy's nan_to_num)."""
+    for i in range(vectors.shape[0]):
+        if not lit[i]:
+            continue
+        x, y, z = vectors[i, 0], vectors[i, 1], vectors[i, 2]
+        row = out[i]
+        if heliostat:
+            _heliostat_derivatives(x, y, z, turns, degrees, floor, row)
+        else:
+            _single_axis_derivatives(x, y, z, turns, cos_axis, sin_axis, scale, row)
+        for a in range(row.shape[0]):
+            for k in range(row.shape[1]):
+                row[a, k] = _finite_or_extreme(row[a, k])
+
+
+def derivatives(vectors: np.ndarray, lit: np.ndarray, turns: np.ndarray, heliostat: bool, cos_axis: float,
+                sin_axis: float, scale: float, degrees: float, floor: float) -> np.ndarray | None:
+    """The mount fit's derivatives of the targets (`hybridtrack.control.mountfit.vector_jacobian`)
+    at the `lit` scans of `vectors` (N, 3), zero elsewhere, in one pass: `turns` the rotation's
+    derivatives by the two pedestal terms (2, 3, 3); a single axis's by its axis's cosine and
+    sine and `scale` (degrees, halved for a Fresnel row), a heliostat's by `degrees` and the
+    collimation's cosine `floor`. None without numba or for a path that is not (N, 3) floats."""
+    if numba is None or vectors.ndim != 2 or vectors.shape[1:] != (3,) or vectors.dtype != np.float64:
+        return None
+    out = np.zeros((len(vectors), 2 if heliostat else 1, 5 if heliostat else 3))
+    _derivative_pass(np.ascontiguousarray(vectors), np.ascontiguousarray(lit, dtype=np.bool_),
+                     np.ascontiguousarray(turns, dtype=float), float(cos_axis), float(sin_axis), float(scale),
+                     float(degrees), float(floor), bool(heliostat), out)
+    return out
 
 
 def _ready(vectors: np.ndarray, rotation, altitude) -> tuple | None:

@@ -305,10 +305,10 @@ def test_rows_on_one_axis_line_share_their_geometry_and_heliostats_keep_their_ow
 
     frame = synthetic("lanzhou", "2021-06-21", "2021-06-22", weather="mixed", seed=3)  # two days: not a warm start
     suns, derivatives = [], []
-    sun_vector, lit_jacobian = mounting.sun_vector, plan._lit_jacobian
+    sun_vector, vector_jacobian = mounting.sun_vector, plan.vector_jacobian
     monkeypatch.setattr(mounting, "sun_vector", lambda alt, az: suns.append(np.size(alt)) or sun_vector(alt, az))
-    monkeypatch.setattr(plan, "_lit_jacobian", lambda vectors, lit, collector: derivatives.append(len(lit))
-                        or lit_jacobian(vectors, lit, collector))
+    monkeypatch.setattr(plan, "vector_jacobian", lambda vectors, collector, lit: derivatives.append(len(lit))
+                        or vector_jacobian(vectors, collector, lit=lit))
     simulate_field(frame, "lanzhou", field, threads=2, keep_log=False)
     assert (suns.count(len(frame)), derivatives.count(len(frame))) == computed
 

@@ -88,7 +88,10 @@ import math
 
 import numpy as np
 
+from .. import mountpass
+from ..errors import HybridtrackError
 from ..mounting import pointing_vectors, rotate
+from .sensing import COSINE_FLOOR
 
 __all__ = ["MountEstimator", "jacobian", "pull_spread", "spd_inverse", "ordered_dot", "ordered_matmul",
            "parameter_names", "MAX_CONDITION", "ROTATION_STEP", "LEVEL_READINGS", "LIGHT_TOLERANCE", "HORIZON"]
@@ -137,7 +140,8 @@ def jacobian(altitude, azimuth, collector) -> np.ndarray:
     return vector_jacobian(pointing_vectors(altitude, azimuth, collector, night=True), collector)
 
 
-def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
+def vector_jacobian(vectors: np.ndarray, collector, *, lit: np.ndarray | None = None,
+                    engine: str = "auto") -> np.ndarray:
     """`jacobian` from the collector's pointing vectors (`hybridtrack.mounting.pointing_vectors`,
     with ``night=True``), when the caller has them already.
 
@@ -145,24 +149,56 @@ def vector_jacobian(vectors: np.ndarray, collector) -> np.ndarray:
     nominal mount is a constant 3 × 3 matrix (central differences of `mounting_rotation` over
     1e-4°, exact to about 1e-12); the chain rule through the angle's own gradient
     (`_angle_gradient`) gives the target's derivative at every scan without turning the
-    geometry four times."""
-    from .plan import MountEstimate
+    geometry four times.
 
-    names = parameter_names(collector)
+    `lit`: the scans where the computed target exists (the plan's), zero elsewhere, as it comes
+    out there anyway (no target, no derivative); a year's nights are half its scans. `engine`:
+    ``numpy`` the reference path; ``auto`` one compiled pass where numba is installed
+    (`hybridtrack.mountpass.derivatives`), the same bits (`tests/test_mountpass.py`).
+    """
+    if engine not in ("auto", "numpy"):
+        raise HybridtrackError(f"vector_jacobian: unknown engine {engine!r}; choose auto, numpy")
+    turns = _rotation_derivatives(collector)
+    if engine == "auto":
+        b = np.radians(collector.axis)
+        fast = mountpass.derivatives(vectors, np.ones(len(vectors), bool) if lit is None else lit, turns,
+                                     collector.kind == "heliostat", np.cos(b), np.sin(b),
+                                     (0.5 if collector.kind == "fresnel" else 1.0) * np.degrees(1.0),
+                                     np.degrees(1.0), COSINE_FLOOR)
+        if fast is not None:
+            return fast
+    if lit is not None:
+        derivatives = vector_jacobian(vectors[lit], collector, engine="numpy")
+        out = np.zeros((len(lit), *derivatives.shape[1:]))
+        out[lit] = derivatives
+        return out
     axes = 1 if collector.single_axis else 2
-    h = ROTATION_STEP
     gradient = _angle_gradient(vectors, collector)  # (N, axes, 3)
-    out = np.zeros((len(vectors), axes, len(names)))
-    for k, name in enumerate(names[:2]):
-        up, down = (MountEstimate.from_parameters(names, [sign * h if n == name else 0.0 for n in names])
-                    .rotation(collector) for sign in (1.0, -1.0))
-        turned = rotate(vectors, (up - down) / (2.0 * h))  # d(vectors as the mount sees)/d(parameter)
-        out[:, :, k] = np.einsum("nac,nc->na", gradient, turned)
+    out = np.zeros((len(vectors), axes, len(parameter_names(collector))))
+    for k, turn in enumerate(turns):
+        turned = rotate(vectors, turn)  # d(vectors as the mount sees)/d(parameter)
+        # summed in this order, not einsum's own (by the machine's SIMD width: (0 + 2) + 1 here)
+        out[:, :, k] = gradient[..., 0] * turned[:, None, 0] + gradient[..., 1] * turned[:, None, 1] \
+            + gradient[..., 2] * turned[:, None, 2]
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
     if axes == 2:  # the sensor's collimation error: an angle across the face is sec(e) of azimuth
         out[:, 0, 4] = vector_collimation_secant(vectors)
     return np.nan_to_num(out, copy=False)  # in place: a heliostat-year's copy took 0.03 s
+
+
+def _rotation_derivatives(collector) -> np.ndarray:
+    """d(rotation)/d(parameter) at the nominal mount for the two pedestal terms, (2, 3, 3):
+    central differences of `mounting_rotation` over `ROTATION_STEP`."""
+    from .plan import MountEstimate
+
+    names, h = parameter_names(collector), ROTATION_STEP
+    turns = []
+    for name in names[:2]:
+        up, down = (MountEstimate.from_parameters(names, [sign * h if n == name else 0.0 for n in names])
+                    .rotation(collector) for sign in (1.0, -1.0))
+        turns.append((up - down) / (2.0 * h))
+    return np.array(turns)
 
 
 def _angle_gradient(vectors: np.ndarray, collector) -> np.ndarray:

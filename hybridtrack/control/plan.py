@@ -36,6 +36,7 @@ from ..sun import solar_position
 from ..reuse import Content, Same, shared
 from ..times import clock_hours, parse_clock, plus_seconds
 from .config import ControllerConfig
+from .mountfit import vector_jacobian
 
 __all__ = ["MountEstimate", "ControllerPlan", "make_plan", "east_park", "CLOCK_STEP_SECONDS"]
 
@@ -184,7 +185,7 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     if config.calibrates:
         lit = np.isfinite(model).all(axis=1)
         plan.jacobian = shared(geometry_key((*sun_key, Content(lit)), "derivatives", collector),
-                               lambda: _lit_jacobian(vectors, lit, collector))
+                               lambda: vector_jacobian(vectors, collector, lit=lit))
         plan.weight = np.ones(model.shape)
         if not collector.single_axis:  # an azimuth error counts cos(elevation) in pointing terms
             plan.weight[:, 0] = np.cos(np.radians(np.clip(model[:, 1], 0.0, 90.0)))
@@ -255,18 +256,6 @@ def _sun_day(clock: pd.DatetimeIndex, altitude: np.ndarray, site: Site, config: 
             other = solar_position(clock[near] + direction * shift, site, config.sun_model)["altitude"].to_numpy()
             awake[near] |= (other > config.min_altitude) & (other > altitude[near])
     return awake
-
-
-def _lit_jacobian(vectors: np.ndarray, lit: np.ndarray, collector: Collector) -> np.ndarray:
-    """`mountfit.jacobian` at the scans `lit` (where the computed target exists); zero elsewhere,
-    as it comes out there anyway (no target, no derivative): a year's nights are half its scans,
-    not worth four mounts."""
-    from .mountfit import vector_jacobian
-
-    derivatives = vector_jacobian(vectors[lit], collector)
-    out = np.zeros((len(lit), *derivatives.shape[1:]))
-    out[lit] = derivatives
-    return out
 
 
 def east_park(collector: Collector) -> list[float]:
