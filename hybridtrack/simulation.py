@@ -737,8 +737,12 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
         _check_true_sky(frame)
 
     def build_world():
-        return World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults,
-                     truth=config.truth)
+        world = World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults,
+                      truth=config.truth)
+        # once for a field's collectors under one frame (`hybridtrack.reuse`): a refusal is not kept;
+        # on the world's side, beside the plan, which takes longer (a field's first run waits for both)
+        shared(("light checked", Same(frame), site), lambda: _refuse_unphysical_light(frame, site, world.altitude))
+        return world
 
     told = installed_site(site, config.imperfections)  # the site as the installer told the controller
 
@@ -746,8 +750,6 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
         return _controller_side(frame.index, site, told, collector, config, classifier, faults, warm_start, sky_seed)
 
     world, (mount, memory, plan, clf, clear) = _side_by_side(build_world, plan_ahead, len(frame))
-    # once for a field's collectors under one frame (`hybridtrack.reuse`): a refusal is not kept
-    shared(("light checked", Same(frame), site), lambda: _refuse_unphysical_light(frame, site, world.altitude))
     controller = Controller(config.controller, drives, plan, clf, config.sky, config.sensor.dark_current,
                             east_park(collector), memory, config.sensor.responsivity, config.sensor.direct_threshold)
     compiled = uses_kernel(config, world.n)
