@@ -288,8 +288,8 @@ def test_a_field_without_its_log_scores_each_collector_as_its_whole_result_does(
 
 
 @pytest.mark.parametrize("field, computed", [
-    (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (4, 1)),  # pointing (world, plan), incidence, the
-    # field's end loss; derivatives
+    (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (3, 1)),  # pointing (world, plan), incidence (which the
+    # rows' end losses take too); derivatives
     (TroughLoop(count=3), (3, 1)),
     # the sun's unit vectors once for the world and once for the plan; each mirror's derivatives its own
     (HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0], [-30.0, -80.0]]), (2, 3)),
