@@ -26,6 +26,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 import pandas as pd
 
+from . import mountpass
 from .errors import HybridtrackError
 from .params import finite_array, number
 
@@ -425,6 +426,24 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
         ``sun_vector(altitude, azimuth)``, if computed already (a field's heliostats share it):
         of the sun position's shape and (3,); another is refused.
     """
+    unit = aim_unit(aim)
+    alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
+    _broadcast("heliostat_normal", altitude=alt, azimuth=az, aim_points=unit[..., 0])
+    if sun is None:
+        s = direction_vectors(alt, az)
+    else:
+        s = checked_vectors(sun, "heliostat_normal", "sun", np.broadcast_shapes(alt.shape, az.shape) + (3,))
+    fast = mountpass.heliostat_normals(s, unit, alt)  # a sun path and one aim point: one compiled pass, same bits
+    if fast is not None:
+        return fast
+    bisector = s + unit
+    n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
+    return np.where((alt < 0.0)[..., None], np.nan, n)
+
+
+def aim_unit(aim) -> np.ndarray:
+    """Unit vectors ``(..., 3)`` from a mirror centre towards its aim points, refused by name
+    unless three finite coordinates, not all zero."""
     try:
         target = finite_array(aim, not_numbers="aim point", infinite="aim point")
     except HybridtrackError:  # text and ragged lists are no point ("0", "20", "100" had been read as one)
@@ -432,15 +451,7 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     norm = np.linalg.norm(target, axis=-1, keepdims=True) if target.ndim else np.zeros(1)
     if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
         raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
-    alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
-    _broadcast("heliostat_normal", altitude=alt, azimuth=az, aim_points=target[..., 0])
-    if sun is None:
-        s = direction_vectors(alt, az)
-    else:
-        s = checked_vectors(sun, "heliostat_normal", "sun", np.broadcast_shapes(alt.shape, az.shape) + (3,))
-    bisector = s + target / norm
-    n = bisector / np.linalg.norm(bisector, axis=-1, keepdims=True)
-    return np.where((alt < 0.0)[..., None], np.nan, n)
+    return target / norm
 
 
 def normal_angles(normals) -> tuple[np.ndarray, np.ndarray]:

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import params, sites
+from . import mountpass, params, sites
 from .collectors import GEOMETRY_KINDS, Collector, as_collector, within_turn
 from .control import (MODES, SENSOR_STATUS, SKY_CODES, Controller, ControllerConfig, MountEstimate, Observation,
                       make_plan)
@@ -1170,12 +1170,18 @@ def _sky_categorical(codes: np.ndarray, names: tuple[str, ...]) -> pd.Categorica
     return pd.Categorical.from_codes(recode[codes], categories=list(SKY_CODES))
 
 
-def _pointing_error(collector: Collector, world: World) -> np.ndarray:
+def _pointing_error(collector: Collector, world: World, engine: str = "auto") -> np.ndarray:
     """The pointing error at each scan (degrees): a single axis' angle less its true target; a
-    heliostat's angle between its actual and its required mirror normal."""
+    heliostat's angle between its actual and its required mirror normal (in one compiled pass
+    where numba is installed, `hybridtrack.mountpass.normal_errors`, the same bits as the numpy
+    path below, `engine="numpy"`)."""
     from .collectors import direction_vectors
 
     truth, angle = world.truth, world.angles.T
+    if not collector.single_axis and engine == "auto":
+        fast = mountpass.normal_errors(world.angles, truth)
+        if fast is not None:
+            return fast
     if collector.single_axis:  # within ±180°: an axis whose limits pass a turn stands a turn off its target
         error = angle[:, 0] - truth[:, 0]
         wound = np.abs(error) > 180.0  # rare: the remainder on the whole year took 0.07 s (its NaN nights)
