@@ -52,6 +52,7 @@ import pandas as pd
 from .errors import HybridtrackError
 from .params import duration, number
 from .sky import MinuteGrid, smooth_noise
+from .smoothing import one_pole
 
 __all__ = ["SensorModel", "sensor_view", "RECORDED_COLUMN", "RECORDED_POINTING", "SensorScene", "SceneLight",
            "scene_light", "sensor_scene", "circumsolar_light", "sensor_frame", "read_pointing", "read_photocurrent",
@@ -298,15 +299,13 @@ def _cloud_edges(minutes: np.ndarray, clearness: np.ndarray) -> np.ndarray | Non
     this times -1 or 1, which is the filter of the flipped steps exactly (the filter is linear,
     and a sign change is exact in floating point).
     """
-    from scipy.signal import lfilter
-
     if len(minutes) < 2:
         return None
     clear = clearness >= 0.5
     crossings = np.concatenate([[0], np.cumsum(clear[1:] != clear[:-1])])
     sign = np.where(crossings % 2 == 0, 1.0, -1.0)
     keep = np.exp(-float(np.median(np.diff(minutes))) / 2.0)
-    return lfilter([1.0 - keep], [1.0, -keep], sign, zi=[keep * sign[0]])[0]
+    return one_pole(sign, 1.0 - keep, keep, keep * sign[0])
 
 
 def sensor_scene(frame: pd.DataFrame, position: pd.DataFrame | None, model: SensorModel, *, clear_dni=None,

@@ -39,6 +39,7 @@ from . import params
 from .budget import check_steps
 from .errors import HybridtrackError
 from .sites import Site, get
+from .smoothing import one_pole
 from .times import clock_hours, local_midnight, local_range, parse_freq, stamp_minutes
 
 __all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES",
@@ -291,9 +292,7 @@ def smooth_noise(index: pd.DatetimeIndex, rng: np.random.Generator, minutes: flo
     grid = grid or MinuteGrid.of(index)
     phi = np.exp(-1.0 / minutes)
     shocks = rng.normal(0.0, sigma * np.sqrt(1 - phi**2), grid.knots)
-    from scipy.signal import lfilter
-
-    return grid.place(lfilter([1.0], [1.0, -phi], shocks))
+    return grid.place(one_pole(shocks, 1.0, phi))
 
 
 def clear_sky(index: pd.DatetimeIndex, site: Site, apparent_zenith, *,

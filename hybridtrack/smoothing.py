@@ -1,0 +1,53 @@
+"""A first-order recursive filter, compiled where numba is installed: scipy's ``lfilter`` of one
+pole without importing ``scipy.signal``.
+
+The sky's smoothed noise (an AR(1) series, `hybridtrack.sky.smooth_noise`) and the side of the
+sun a cloud's bright edge is on (`hybridtrack.sensor`) are each one pole, ``y[n] = z + g·x[n]``
+with the state ``z = k·y[n]`` carried to the next sample. ``scipy.signal.lfilter`` computes
+them, but importing ``scipy.signal`` takes 0.5–0.7 s of every process after pvlib (1.4 s
+alone): a command-line run's, a benchmark's, each sweep worker's. The loop here is
+``lfilter``'s own recursion (its direct form II transposed: the output the state plus the gain
+times the input, then the state the pole times the output), so it gives the same bits; a test
+holds the two equal bit for bit. Without numba it is ``lfilter`` itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+try:
+    import numba
+except ImportError:  # pragma: no cover - numba is a dependency; the lfilter path is tested by asking for it
+    numba = None
+
+__all__ = ["one_pole"]
+
+
+def _recursion(values, gain, pole, state, out):
+    for n in range(values.shape[0]):
+        out[n] = state + gain * values[n]
+        state = pole * out[n]
+
+
+if numba is not None:
+    _recursion = numba.njit(cache=True, nogil=True, error_model="numpy")(_recursion)
+
+
+def one_pole(values: np.ndarray, gain: float, pole: float, state: float = 0.0, *, engine: str = "auto") -> np.ndarray:
+    """``scipy.signal.lfilter([gain], [1, -pole], values, zi=[state])[0]``: the first-order
+    recursive filter ``y[n] = z + gain·x[n]``, ``z = pole·y[n]``, from the state `state`.
+
+    `engine`: ``lfilter`` scipy's own; ``auto`` the compiled recursion where numba is installed.
+    """
+    values = np.ascontiguousarray(values, dtype=float)
+    if engine not in ("auto", "lfilter"):
+        from .errors import HybridtrackError
+
+        raise HybridtrackError(f"one_pole: unknown engine {engine!r}; choose auto, lfilter")
+    if engine == "lfilter" or numba is None:
+        from scipy.signal import lfilter
+
+        return lfilter([gain], [1.0, -pole], values, zi=[state])[0]
+    out = np.empty(len(values))
+    _recursion(values, float(gain), float(pole), float(state), out)
+    return out
