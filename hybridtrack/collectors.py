@@ -442,8 +442,20 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
 
 
 def aim_unit(aim) -> np.ndarray:
-    """Unit vectors ``(..., 3)`` from a mirror centre towards its aim points, refused by name
-    unless three finite coordinates, not all zero."""
+    """Unit vectors from a mirror centre towards its aim points: the ``r`` of the law of
+    reflection in `heliostat_normal`.
+
+    Parameters
+    ----------
+    aim : array_like, shape (3,) or (..., 3)
+        Aim points relative to the mirror centre, (east, north, up) metres.
+
+    Returns
+    -------
+    ndarray, shape of `aim`
+        Each aim point over its length. Anything but three finite coordinates, not all zero,
+        is refused by name (`HybridtrackError`).
+    """
     try:
         target = finite_array(aim, not_numbers="aim point", infinite="aim point")
     except HybridtrackError:  # text and ragged lists are no point ("0", "20", "100" had been read as one)

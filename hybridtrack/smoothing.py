@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import HybridtrackError
+
 try:
     import numba
 except ImportError:  # pragma: no cover - numba is a dependency; the lfilter path is tested by asking for it
@@ -34,16 +36,36 @@ if numba is not None:
 
 
 def one_pole(values: np.ndarray, gain: float, pole: float, state: float = 0.0, *, engine: str = "auto") -> np.ndarray:
-    """``scipy.signal.lfilter([gain], [1, -pole], values, zi=[state])[0]``: the first-order
-    recursive filter ``y[n] = z + gain·x[n]``, ``z = pole·y[n]``, from the state `state`.
+    """The first-order recursive filter ``y[n] = z + gain·x[n]``, then ``z = pole·y[n]``, from
+    the state `state`: ``scipy.signal.lfilter([gain], [1, -pole], values, zi=[state])[0]``.
 
-    `engine`: ``lfilter`` scipy's own; ``auto`` the compiled recursion where numba is installed.
+    Parameters
+    ----------
+    values : array_like, shape (N,)
+        The input samples.
+    gain, pole : float
+        The numerator's one coefficient and the pole (``pole = exp(-step / time constant)`` for
+        an AR(1) series or an exponential smoothing).
+    state : float
+        The filter's state before the first sample (``zi``).
+    engine : {"auto", "lfilter"}
+        ``lfilter`` scipy's own; ``auto`` the compiled recursion where numba is installed, the
+        same bits.
+
+    Returns
+    -------
+    ndarray, shape (N,)
+
+    References
+    ----------
+    Oppenheim, A. V. & Schafer, R. W. (2010). *Discrete-Time Signal Processing*, 3rd ed.,
+    Pearson, section 6.5 (the transposed direct form II, which lfilter implements).
     """
     values = np.ascontiguousarray(values, dtype=float)
     if engine not in ("auto", "lfilter"):
-        from .errors import HybridtrackError
-
         raise HybridtrackError(f"one_pole: unknown engine {engine!r}; choose auto, lfilter")
+    if values.ndim != 1:
+        raise HybridtrackError(f"one_pole: values must be one series, shape (N,); got shape {values.shape}")
     if engine == "lfilter" or numba is None:
         from scipy.signal import lfilter
 

@@ -40,3 +40,5 @@ def test_by_hand_and_refusals():
     assert one_pole(np.zeros(0), 1.0, 0.5).shape == (0,)
     with pytest.raises(HybridtrackError, match="unknown engine"):
         one_pole(np.ones(3), 1.0, 0.5, engine="scipy")
+    with pytest.raises(HybridtrackError, match=r"one series, shape \(N,\); got shape \(2, 3\)"):
+        one_pole(np.ones((2, 3)), 1.0, 0.5)
