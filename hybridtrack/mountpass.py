@@ -239,8 +239,10 @@ def derivatives(vectors: np.ndarray, lit: np.ndarray, turns: np.ndarray, heliost
     at the `lit` scans of `vectors` (N, 3), zero elsewhere, in one pass: `turns` the rotation's
     derivatives by the two pedestal terms (2, 3, 3); a single axis's by its axis's cosine and
     sine and `scale` (degrees, halved for a Fresnel row), a heliostat's by `degrees` and the
-    collimation's cosine `floor`. None without numba or for a path that is not (N, 3) floats."""
-    if numba is None or vectors.ndim != 2 or vectors.shape[1:] != (3,) or vectors.dtype != np.float64:
+    collimation's cosine `floor`. None without numba, for a path that is not (N, 3) floats or a
+    `lit` that is not one bool a scan."""
+    if numba is None or vectors.ndim != 2 or vectors.shape[1:] != (3,) or vectors.dtype != np.float64 \
+            or np.shape(lit) != vectors.shape[:1] or np.asarray(lit).dtype != np.bool_:
         return None
     out = np.zeros((len(vectors), 2 if heliostat else 1, 5 if heliostat else 3))
     _derivative_pass(np.ascontiguousarray(vectors), np.ascontiguousarray(lit, dtype=np.bool_),
@@ -275,8 +277,10 @@ def normal_errors(angles: np.ndarray, truth: np.ndarray) -> np.ndarray | None:
     """A heliostat's pointing error at each scan, degrees: the angle between the normal its
     axes stood at (`angles`, (2, N): azimuth, elevation) and its true normal (`truth`, (N, 2)),
     NaN where the truth is, as `hybridtrack.simulation`'s numpy path computes it (the
-    directions, their dot product clipped to ±1, its arccosine). None without numba."""
-    if numba is None:
+    directions, their dot product clipped to ±1, its arccosine). None without numba or for other
+    shapes or types (float32: numpy's path keeps it)."""
+    if numba is None or truth.ndim != 2 or truth.shape[1:] != (2,) or np.shape(angles) != (2, truth.shape[0]) \
+            or truth.dtype != np.float64 or np.asarray(angles).dtype != np.float64:
         return None
     out = np.empty(truth.shape[0])
     _normal_error_pass(np.ascontiguousarray(angles, dtype=float), np.ascontiguousarray(truth, dtype=float), out)

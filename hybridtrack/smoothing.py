@@ -13,6 +13,9 @@ holds the two equal bit for bit. Without numba it is ``lfilter`` itself.
 
 from __future__ import annotations
 
+import math
+import numbers
+
 import numpy as np
 
 from .errors import HybridtrackError
@@ -28,7 +31,7 @@ __all__ = ["one_pole"]
 def _recursion(values, gain, pole, state, out):
     for n in range(values.shape[0]):
         out[n] = state + gain * values[n]
-        state = pole * out[n]
+        state = 0.0 * values[n] - (-pole) * out[n]  # lfilter's b = [gain, 0]: 0·inf and -0.0 as it has them
 
 
 if numba is not None:
@@ -61,11 +64,16 @@ def one_pole(values: np.ndarray, gain: float, pole: float, state: float = 0.0, *
     Oppenheim, A. V. & Schafer, R. W. (2010). *Discrete-Time Signal Processing*, 3rd ed.,
     Pearson, section 6.5 (the transposed direct form II, which lfilter implements).
     """
-    values = np.ascontiguousarray(values, dtype=float)
     if engine not in ("auto", "lfilter"):
         raise HybridtrackError(f"one_pole: unknown engine {engine!r}; choose auto, lfilter")
-    if values.ndim != 1:
-        raise HybridtrackError(f"one_pole: values must be one series, shape (N,); got shape {values.shape}")
+    given = np.asarray(values)
+    if given.dtype.kind not in "fiub" or given.ndim != 1:
+        raise HybridtrackError(f"one_pole: values must be one series of numbers, shape (N,); got "
+                               f"{given.dtype} of shape {given.shape}")
+    for name, number in (("gain", gain), ("pole", pole), ("state", state)):
+        if isinstance(number, (bool, np.bool_)) or not isinstance(number, numbers.Real) or not math.isfinite(number):
+            raise HybridtrackError(f"one_pole: {name} must be a finite number, got {number!r:.60}")
+    values = np.ascontiguousarray(given, dtype=float)
     if engine == "lfilter" or numba is None:
         from scipy.signal import lfilter
 

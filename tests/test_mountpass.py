@@ -178,3 +178,29 @@ def test_a_heliostats_compiled_pointing_error_is_numpys_bit_for_bit():
     _same_bits(_pointing_error(collector, world), expected)
     by_hand = SimpleNamespace(truth=np.array([[180.0, 40.0], [0.0, 0.0]]), angles=np.array([[180.0, 90.0], [43.0, 0.0]]))
     np.testing.assert_allclose(_pointing_error(collector, by_hand), [3.0, 90.0], rtol=0, atol=1e-12)
+
+
+def test_derivatives_and_errors_refuse_what_does_not_fit_by_name():
+    """A `lit` mask of another length or of indices had been read past its end by the pass (rows
+    taken as lit at random); wrong shapes had raised numpy's IndexError. The pointing error's
+    pass declines angles of another length, and float32, which numpy's path keeps."""
+    from types import SimpleNamespace
+
+    from hybridtrack.control.mountfit import vector_jacobian
+    from hybridtrack.simulation import _pointing_error
+
+    vectors, collector = np.tile([0.3, 0.2, 0.93], (1000, 1)), Collector("trough-ns")
+    for lit in (np.ones(3, bool), np.array([0, 5]), np.ones(1000)):
+        with pytest.raises(HybridtrackError, match="vector_jacobian: lit must be one True or False a scan"):
+            vector_jacobian(vectors, collector, lit=lit)
+    for bad in (vectors[:, :2], vectors[None], "up"):
+        with pytest.raises(HybridtrackError, match="vector_jacobian: vectors must be"):
+            vector_jacobian(bad, collector)
+    with pytest.raises(HybridtrackError, match="unknown engine"):
+        vector_jacobian(vectors, collector, engine="fast")
+    helio = COLLECTORS["heliostat"]
+    truth = np.tile([180.0, 40.0], (10, 1))
+    with pytest.raises(IndexError):  # the numpy path's own error, as before: an internal function
+        _pointing_error(helio, SimpleNamespace(truth=truth, angles=np.zeros((2, 5))))
+    single = SimpleNamespace(truth=truth.astype(np.float32), angles=np.full((2, 10), 41.0, np.float32))
+    _same_bits(_pointing_error(helio, single), _pointing_error(helio, single, engine="numpy"))

@@ -90,6 +90,7 @@ import numpy as np
 
 from .. import mountpass
 from ..errors import HybridtrackError
+from ..collectors import checked_vectors
 from ..mounting import pointing_vectors, rotate
 from .sensing import COSINE_FLOOR
 
@@ -153,13 +154,23 @@ def vector_jacobian(vectors: np.ndarray, collector, *, lit: np.ndarray | None = 
 
     `lit`: the scans where the computed target exists (the plan's), zero elsewhere, as it comes
     out there anyway (no target, no derivative); a year's nights are half its scans. `engine`:
-    ``numpy`` the reference path; ``auto`` one compiled pass where numba is installed
-    (`hybridtrack.mountpass.derivatives`), the same bits (`tests/test_mountpass.py`).
+    ``numpy`` the reference path; ``compiled`` (where numba is installed) one compiled pass
+    (`hybridtrack.mountpass.derivatives`), the same bits (`tests/test_mountpass.py`); ``auto``
+    compiled where it can be. A `lit` of another length or type is refused by name.
     """
-    if engine not in ("auto", "numpy"):
-        raise HybridtrackError(f"vector_jacobian: unknown engine {engine!r}; choose auto, numpy")
+    if engine not in mountpass.ENGINES:
+        raise HybridtrackError(f"vector_jacobian: unknown engine {engine!r}; choose {', '.join(mountpass.ENGINES)}")
+    if engine == "compiled" and not mountpass.available():
+        raise HybridtrackError("vector_jacobian: the compiled engine needs numba, which is not installed here")
+    vectors = checked_vectors(vectors, "vector_jacobian", "vectors")
+    if vectors.ndim != 2:
+        raise HybridtrackError(f"vector_jacobian: vectors must be a path of (east, north, up) vectors, shape "
+                               f"(N, 3); got shape {vectors.shape}")
+    if lit is not None and (np.shape(lit) != vectors.shape[:1] or np.asarray(lit).dtype != np.bool_):
+        raise HybridtrackError(f"vector_jacobian: lit must be one True or False a scan, shape ({len(vectors)},); got "
+                               f"{np.asarray(lit).dtype} of shape {np.shape(lit)}")
     turns = _rotation_derivatives(collector)
-    if engine == "auto":
+    if engine != "numpy":
         b = np.radians(collector.axis)
         fast = mountpass.derivatives(vectors, np.ones(len(vectors), bool) if lit is None else lit, turns,
                                      collector.kind == "heliostat", np.cos(b), np.sin(b),
