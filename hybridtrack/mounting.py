@@ -90,7 +90,7 @@ def mount_targets(altitude, azimuth, collector: Collector, rotation: np.ndarray 
     """
     alt, az = sun_path(altitude, azimuth, "mount_targets")
     collector = as_collector(collector)
-    _check_engine(engine, "mount_targets")
+    mountpass.check_engine(engine, "mount_targets")
     if rotation is not None and np.shape(rotation) != (3, 3):  # numpy's ValueError, deep in a product
         raise HybridtrackError(f"mount_targets: rotation must be a 3 x 3 matrix (mounting_rotation), got shape "
                                f"{np.shape(rotation)}")
@@ -220,7 +220,7 @@ def angles_on_mount(vectors, collector: Collector, rotation=None, *, engine: str
     ``auto`` compiled where it applies. Either takes the reference path for what the pass
     leaves to it (other shapes, a vector on the horizon, a refusal)."""
     vectors, collector = checked_vectors(vectors, "angles_on_mount", "vectors"), as_collector(collector)
-    _check_engine(engine, "angles_on_mount")
+    mountpass.check_engine(engine, "angles_on_mount")
     if engine != "numpy":
         fast = _compiled_angles(vectors, collector, rotation, engine)
         if fast is not None:
@@ -232,13 +232,6 @@ def angles_on_mount(vectors, collector: Collector, rotation=None, *, engine: str
     if collector.kind == "fresnel":
         sun = 0.5 * (sun + receiver_angle(collector.row_distance, collector.receiver_height))
     return np.asarray(sun)[..., None]
-
-
-def _check_engine(engine, function: str) -> None:
-    if engine not in mountpass.ENGINES:
-        raise HybridtrackError(f"{function}: unknown engine {engine!r}; choose {', '.join(mountpass.ENGINES)}")
-    if engine == "compiled" and not mountpass.available():
-        raise HybridtrackError(f"{function}: the compiled engine needs numba, which is not installed here")
 
 
 def _compiled_angles(vectors: np.ndarray, collector: Collector, rotation, engine: str, altitude=None):

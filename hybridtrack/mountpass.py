@@ -29,12 +29,14 @@ import math
 
 import numpy as np
 
+from .errors import HybridtrackError
+
 try:
     import numba
 except ImportError:  # pragma: no cover - numba is a dependency; the reference path is tested by asking for it
     numba = None
 
-__all__ = ["available", "single_axis_angles", "heliostat_angles", "heliostat_normals", "heliostat_sun_angles",
+__all__ = ["available", "check_engine", "single_axis_angles", "heliostat_angles", "heliostat_normals", "heliostat_sun_angles",
            "derivatives", "normal_errors"]
 
 ENGINES = ("auto", "compiled", "numpy")
@@ -43,6 +45,14 @@ ENGINES = ("auto", "compiled", "numpy")
 def available() -> bool:
     """Whether the compiled passes can run here."""
     return numba is not None
+
+
+def check_engine(engine, function: str) -> None:
+    """Refuse an `engine` other than `ENGINES`, or ``compiled`` without numba, by `function`'s name."""
+    if engine not in ENGINES:
+        raise HybridtrackError(f"{function}: unknown engine {engine!r}; choose {', '.join(ENGINES)}")
+    if engine == "compiled" and not available():
+        raise HybridtrackError(f"{function}: the compiled engine needs numba, which is not installed here")
 
 
 def _compiled(function):

@@ -158,10 +158,7 @@ def vector_jacobian(vectors: np.ndarray, collector, *, lit: np.ndarray | None = 
     (`hybridtrack.mountpass.derivatives`), the same bits (`tests/test_mountpass.py`); ``auto``
     compiled where it can be. A `lit` of another length or type is refused by name.
     """
-    if engine not in mountpass.ENGINES:
-        raise HybridtrackError(f"vector_jacobian: unknown engine {engine!r}; choose {', '.join(mountpass.ENGINES)}")
-    if engine == "compiled" and not mountpass.available():
-        raise HybridtrackError("vector_jacobian: the compiled engine needs numba, which is not installed here")
+    mountpass.check_engine(engine, "vector_jacobian")
     vectors = checked_vectors(vectors, "vector_jacobian", "vectors")
     if vectors.ndim != 2:
         raise HybridtrackError(f"vector_jacobian: vectors must be a path of (east, north, up) vectors, shape "
