@@ -8,8 +8,8 @@ differ. Inside ``with reuse_work():`` each such piece is computed by the first r
 and handed to every later run that asks with the same inputs.
 
 A request names its inputs in a key. Scalars are compared by value; a frame or an index by identity
-(`Same`), since the runs of a field are handed the same frame object; an array by a digest of its
-values (`Content`, a few milliseconds for a year). Every request gets read-only views of the
+(`Same`), since the runs of a field are handed the same frame object; an array by its values (`Content`:
+a copy, a hash of a sample, and a byte-for-byte compare where the hashes match). Every request gets read-only views of the
 answer's arrays and its own copy of its frames, so a run that wrote into one could not change another's.
 The memory is shared by the threads of a field (`contextvars.copy_context`) and guarded by a lock;
 it keeps the pieces used most recently (`ENTRIES`) and is dropped when the block ends.
@@ -17,7 +17,6 @@ it keeps the pieces used most recently (`ENTRIES`) and is dropped when the block
 
 from __future__ import annotations
 
-import hashlib
 import threading
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -164,25 +163,35 @@ def _handed(answer):
 
 
 class Content:
-    """A key part that matches an array of the same shape, type and values (by a digest, taken when
-    the key is first looked up: outside a `reuse_work` block it never is)."""
+    """A key part that matches an array of the same shape, type and bytes. When the key is first
+    looked up (outside a `reuse_work` block it never is) it takes a copy of the values, so that
+    a later write into the caller's array cannot change the key, and hashes a sample of them;
+    keys whose hashes match compare their copies byte for byte. A year's scans (4 MB) cost
+    0.8 ms so, where a digest of all their bytes (BLAKE2) took 6 ms, twice a collector."""
 
-    __slots__ = ("_values", "_digest")
+    __slots__ = ("_values", "_kept", "_hash")
 
     def __init__(self, values) -> None:
-        self._values, self._digest = values, None
+        self._values, self._kept, self._hash = values, None, None
 
-    @property
-    def digest(self) -> tuple:
-        if self._digest is None:
-            values = np.ascontiguousarray(self._values)
-            self._digest = (values.shape, values.dtype.str,
-                            hashlib.blake2b(memoryview(values).cast("B"), digest_size=16).digest())
+    def _bytes(self) -> np.ndarray:
+        """The kept copy's bytes, as 8-byte words where they divide evenly (a faster compare)."""
+        if self._kept is None:
+            kept = np.array(self._values, order="C")
+            raw = kept.reshape(-1).view(np.uint8)
+            self._kept = (kept.shape, kept.dtype.str, raw.view(np.uint64) if raw.size % 8 == 0 else raw)
             self._values = None
-        return self._digest
+        return self._kept[2]
 
     def __eq__(self, other) -> bool:
-        return isinstance(other, Content) and other.digest == self.digest
+        if not isinstance(other, Content):
+            return False
+        mine, theirs = self._bytes(), other._bytes()
+        return self._kept[:2] == other._kept[:2] and mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
 
     def __hash__(self) -> int:
-        return hash(self.digest)
+        if self._hash is None:
+            raw = self._bytes()
+            sample = raw[::max(1, raw.size // 1024)]
+            self._hash = hash((*self._kept[:2], sample.tobytes(), raw[-1:].tobytes()))
+        return self._hash

@@ -52,6 +52,22 @@ def test_arrays_are_matched_by_their_values_and_handed_out_read_only():
     assert second[0] == 0.0 and len(calls) == 3
 
 
+def test_arrays_that_differ_where_the_hash_does_not_look_are_different_keys():
+    """`Content` hashes a sample of the values; two years' scans that differ in one unsampled value
+    must still be two pieces, and a write into the caller's array after the look-up must not
+    change the key it made."""
+    calls, compute = counted()
+    minutes = np.arange(525_600, dtype=float)
+    other = minutes.copy()
+    other[1] += 0.5  # the sample takes every 513th value: not this one
+    with reuse_work():
+        shared(("piece", Content(minutes)), compute)
+        minutes[:] = -1.0  # the caller reuses its array
+        shared(("piece", Content(other)), compute)
+        shared(("piece", Content(np.arange(525_600, dtype=float))), compute)
+    assert len(calls) == 2
+
+
 def test_frames_tuples_and_dicts_come_back_as_copies_or_read_only():
     frame = pd.DataFrame({"a": [1.0, 2.0]})
     with reuse_work():

@@ -212,13 +212,14 @@ def _grown(events: kc.EventLog) -> kc.EventLog:
 
 def _worded(controller: Controller, events: kc.EventLog, count: int) -> list:
     worded, reason = [], wording(controller.config, controller.plan_alarms, controller.axes)
+    alarms, switches = log.isEnabledFor(logging.INFO), log.isEnabledFor(logging.DEBUG)  # asked once, not 3,700
     for i, before, after, code, (value, other, third) in zip(events.scan[:count].tolist(), events.before[:count].tolist(),
                                                      events.after[:count].tolist(), events.code[:count].tolist(),
-                                                     events.value[:count].tolist()):
+                                                     events.value[:count].tolist()):  # times a row-year: 7 ms
         text = reason(code, value, other, i, third)
-        if before == after:
+        if before == after and alarms:
             log.info("scan %d: %s", i, text)
-        else:
+        elif before != after and switches:
             log.debug("scan %d: %s -> %s (%s)", i, MODES[before], MODES[after], text)
         worded.append((i, MODES[before], MODES[after], text))
     return worded
