@@ -20,7 +20,10 @@ at 1-minute steps (525,600 steps, climate weather, seed 1):
 * ``1,000 heliostats, geometry, vectorised``: the same numbers for all mirrors in one call a day
   (``HeliostatField.targets``, 1,440 x 1,000 x 3 at a time).
 
-Medians of `--repeats` runs of each (1 by default: the field-year takes minutes). Peak memory
+Medians of `--repeats` runs of each (1 by default: the field-year takes minutes), taken in
+rounds: each round runs every case once, so that SPA, the reference of the ratios, is measured
+beside the cases through the same hours (this machine's speed drifts by 30 % within an hour:
+SPA's site-year took 3.3-4.4 s over one half hour, 2026-11-29). Peak memory
 is the largest resident set of the case's process and, for the cases on workers, the parent's
 plus each worker's at most (``RUSAGE_CHILDREN`` gives the largest child's).
 """
@@ -139,12 +142,19 @@ def _child(case: str) -> None:
     print(json.dumps({"seconds": seconds, "peak_mib": peak}))
 
 
-def _measure(case: str, repeats: int) -> tuple[float, float]:
-    results = []
+def _run_case(case: str) -> dict:
+    done = subprocess.run([sys.executable, __file__, "--case", case], capture_output=True, text=True, check=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _measure(repeats: int) -> dict[str, tuple[float, float]]:
+    """Each case's median seconds and largest peak MiB over `repeats` rounds of every case."""
+    results = {case: [] for case in CASES}
     for _ in range(repeats):
-        done = subprocess.run([sys.executable, __file__, "--case", case], capture_output=True, text=True, check=True)
-        results.append(json.loads(done.stdout.strip().splitlines()[-1]))
-    return statistics.median(r["seconds"] for r in results), max(r["peak_mib"] for r in results)
+        for case in CASES:
+            results[case].append(_run_case(case))
+    return {case: (statistics.median(r["seconds"] for r in runs), max(r["peak_mib"] for r in runs))
+            for case, runs in results.items()}
 
 
 def main() -> None:
@@ -157,7 +167,7 @@ def main() -> None:
     if args.case:
         _child(args.case)
         return
-    measured = {case: _measure(case, args.repeats) for case in CASES}
+    measured = _measure(args.repeats)
     spa = measured["SPA site-year"][0]
     per_mirror = measured["1,000 heliostats, geometry, per mirror"][0]
     rows = [[case, f"{seconds:.2f}", f"{seconds / spa:.2f}x", f"{per_mirror / seconds:.1f}x" if "geometry" in case
