@@ -781,9 +781,10 @@ def _end_loss_weights(collector: Collector, dni: np.ndarray, altitude: np.ndarra
     the true sun up and direct light: the direct light on a perfect aperture (`incidence`), the end
     loss per metre of the row's distance to the receiver (``f = 1``: `fresnel_end_loss` is ``f``
     times a term of the sun and the axis alone), their sum and the light's sum."""
-    up = (altitude > 0) & (np.nan_to_num(dni) > 0)
+    dni = np.nan_to_num(dni)
+    up = (altitude > 0) & (dni > 0)
     per_metre = np.abs(fresnel_end_loss(altitude[up], azimuth[up], 0.0, 1.0, collector.axis))
-    beam = (np.nan_to_num(dni) * incidence)[up]
+    beam = (dni * incidence)[up]
     return beam, per_metre, float(beam.sum()), float(np.sum(beam * per_metre))
 
 
@@ -1014,12 +1015,12 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
             else:  # the scores alone: no log, no sky as the classifier saw it (`Tracked.scores`)
                 events = run.events()
                 scores, log = run.scores(events), None
-            scoring, sky = run.scoring(), (Same(frame), run.site, run.config.truth)
-            offered = shared(geometry_key(sky, "offered energy", collector), lambda: _energy(
+            scoring, true_sun = run.scoring(), (Same(frame), run.site, run.config.truth)  # what the keys turn on
+            offered = shared(geometry_key(true_sun, "offered energy", collector), lambda: _energy(
                 offered_light(run.world.frame_dni, scoring["sun_up"], scoring["incidence"]), frame.index))
             row = {**dataclasses.asdict(imperfect), **_metrics(scores), "offered": offered}
             if row_length is not None:
-                weights = shared(geometry_key(sky, "end loss weights", collector), lambda: _end_loss_weights(
+                weights = shared(geometry_key(true_sun, "end loss weights", collector), lambda: _end_loss_weights(
                     collector, run.world.frame_dni, run.world.altitude, run.world.azimuth, scoring["incidence"]))
                 row.update(_end_loss(collector, row_length, weights))
             done.append((i, row, events.assign(collector=name), log))

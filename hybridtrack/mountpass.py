@@ -36,8 +36,8 @@ try:
 except ImportError:  # pragma: no cover - numba is a dependency; the reference path is tested by asking for it
     numba = None
 
-__all__ = ["available", "check_engine", "single_axis_angles", "heliostat_angles", "heliostat_normals", "heliostat_sun_angles",
-           "derivatives", "normal_errors"]
+__all__ = ["available", "check_engine", "single_axis_angles", "heliostat_angles", "heliostat_normals",
+           "heliostat_sun_angles", "derivatives", "normal_errors"]
 
 ENGINES = ("auto", "compiled", "numpy")
 

@@ -8,8 +8,8 @@ differ. Inside ``with reuse_work():`` each such piece is computed by the first r
 and handed to every later run that asks with the same inputs.
 
 A request names its inputs in a key. Scalars are compared by value; a frame or an index by identity
-(`Same`), since the runs of a field are handed the same frame object; an array by its values (`Content`:
-a copy, a hash of a sample, and a byte-for-byte compare where the hashes match). Every request gets read-only views of the
+(`Same`), since the runs of a field are handed the same frame object; an array by its values
+(`Content`: a copy, a hash of a sample, and a byte-for-byte compare where the hashes match). Every request gets read-only views of the
 answer's arrays and its own copy of its frames, so a run that wrote into one could not change another's.
 The memory is shared by the threads of a field (`contextvars.copy_context`) and guarded by a lock;
 it keeps the pieces used most recently (`ENTRIES`) and is dropped when the block ends.
@@ -186,8 +186,8 @@ class Content:
     def __eq__(self, other) -> bool:
         if not isinstance(other, Content):
             return False
-        mine, theirs = self._bytes(), other._bytes()
-        return self._kept[:2] == other._kept[:2] and mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
+        mine, theirs = self._bytes(), other._bytes()  # of one type where shape and type agree
+        return self._kept[:2] == other._kept[:2] and np.array_equal(mine, theirs)
 
     def __hash__(self) -> int:
         if self._hash is None:

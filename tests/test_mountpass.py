@@ -50,14 +50,14 @@ def _numpy_rounds_as_libm() -> bool:
 BITS = _numpy_rounds_as_libm()
 
 
-def _same_bits(got, expected):
+def _as_numpys(got, expected):
+    """The pass's result against numpy's path: its bits, or on AVX-512 its NaNs and 1e-12."""
     assert got.shape == expected.shape
     if BITS:
         assert np.array_equal(got.view(np.int64), expected.view(np.int64))  # NaN's bits too
     else:
         np.testing.assert_array_equal(np.isnan(got), np.isnan(expected))
         np.testing.assert_allclose(got, expected, rtol=1e-13, atol=1e-12)
-
 
 
 @pytest.mark.parametrize("name", COLLECTORS)
@@ -70,15 +70,15 @@ def test_compiled_angles_are_numpys_bit_for_bit(name, night, mount):
     vectors = pointing_vectors(altitude, azimuth, collector, night=night)
     expected = angles_on_mount(vectors, collector, rotation, engine="numpy")
     assert np.isfinite(expected).any() and np.isnan(expected).any()
-    _same_bits(angles_on_mount(vectors, collector, rotation, engine="compiled"), expected)
-    _same_bits(angles_on_mount(vectors, collector, rotation), expected)
+    _as_numpys(angles_on_mount(vectors, collector, rotation, engine="compiled"), expected)
+    _as_numpys(angles_on_mount(vectors, collector, rotation), expected)
     given = None if collector.kind == "heliostat" else vectors
     expected = mount_targets(altitude, azimuth, collector, rotation, vectors=given, night=night, engine="numpy")
-    _same_bits(mount_targets(altitude, azimuth, collector, rotation, vectors=given, night=night,
+    _as_numpys(mount_targets(altitude, azimuth, collector, rotation, vectors=given, night=night,
                              engine="compiled"), expected)
     if collector.kind == "heliostat":  # its normals made in the pass from the sun's unit vectors
         sun = sun_vector(np.abs(altitude) if night else altitude, azimuth)
-        _same_bits(mount_targets(altitude, azimuth, collector, rotation, sun=sun, night=night), expected)
+        _as_numpys(mount_targets(altitude, azimuth, collector, rotation, sun=sun, night=night), expected)
 
 
 @pytest.mark.parametrize("night", [False, True])
@@ -96,7 +96,7 @@ def test_compiled_heliostat_normals_are_numpys_bit_for_bit(night):
         bisector = sun + unit
         expected = np.where(((np.abs(altitude) if night else altitude) < 0.0)[:, None], np.nan,
                             bisector / np.linalg.norm(bisector, axis=-1, keepdims=True))
-        _same_bits(got, expected)
+        _as_numpys(got, expected)
     np.testing.assert_allclose(heliostat_normal([90.0], [0.0], (0.0, 10.0, 0.0), sun=[[0.0, 0.0, 1.0]]),
                                [[0.0, np.sqrt(0.5), np.sqrt(0.5)]], rtol=0, atol=1e-15)
 
@@ -117,7 +117,7 @@ def test_a_vector_on_the_horizon_takes_the_reference_path():
     rule for no part across the axis), with the pass as without it."""
     vectors = np.array([[0.0, 1.0, 0.0], [0.3, 0.5, 0.8], [1.0, 0.0, 0.0]])
     got = angles_on_mount(vectors, Collector("trough-ns"), engine="compiled")
-    _same_bits(got, angles_on_mount(vectors, Collector("trough-ns"), engine="numpy"))
+    _as_numpys(got, angles_on_mount(vectors, Collector("trough-ns"), engine="numpy"))
     assert got[0, 0] == 90.0 and got[2, 0] == 0.0
 
 
@@ -182,7 +182,7 @@ def test_compiled_derivatives_are_numpys_bit_for_bit(name, lit_only):
     lit = np.isfinite(vectors).all(axis=1) & (np.arange(len(vectors)) % 5 != 0) if lit_only else None
     expected = vector_jacobian(vectors, collector, lit=lit, engine="numpy")
     assert np.isfinite(expected).all() and (expected != 0).any()
-    _same_bits(vector_jacobian(vectors, collector, lit=lit), expected)
+    _as_numpys(vector_jacobian(vectors, collector, lit=lit), expected)
 
 
 def test_a_heliostats_compiled_pointing_error_is_numpys_bit_for_bit():
@@ -203,7 +203,7 @@ def test_a_heliostats_compiled_pointing_error_is_numpys_bit_for_bit():
     world = SimpleNamespace(truth=truth, angles=angles)
     expected = _pointing_error(collector, world, engine="numpy")
     assert np.isnan(expected).any() and np.nanmax(expected) > 1.0
-    _same_bits(_pointing_error(collector, world), expected)
+    _as_numpys(_pointing_error(collector, world), expected)
     by_hand = SimpleNamespace(truth=np.array([[180.0, 40.0], [0.0, 0.0]]), angles=np.array([[180.0, 90.0], [43.0, 0.0]]))
     np.testing.assert_allclose(_pointing_error(collector, by_hand), [3.0, 90.0], rtol=0, atol=1e-12)
 
@@ -231,4 +231,4 @@ def test_derivatives_and_errors_refuse_what_does_not_fit_by_name():
     with pytest.raises(IndexError):  # the numpy path's own error, as before: an internal function
         _pointing_error(helio, SimpleNamespace(truth=truth, angles=np.zeros((2, 5))))
     single = SimpleNamespace(truth=truth.astype(np.float32), angles=np.full((2, 10), 41.0, np.float32))
-    _same_bits(_pointing_error(helio, single), _pointing_error(helio, single, engine="numpy"))
+    _as_numpys(_pointing_error(helio, single), _pointing_error(helio, single, engine="numpy"))

@@ -89,8 +89,8 @@ import math
 import numpy as np
 
 from .. import mountpass
-from ..errors import HybridtrackError
 from ..collectors import checked_vectors
+from ..errors import HybridtrackError
 from ..mounting import pointing_vectors, rotate
 from .sensing import COSINE_FLOOR
 
