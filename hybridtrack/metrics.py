@@ -173,16 +173,25 @@ def held_error(log: pd.DataFrame) -> pd.Series:
     return pd.Series(error, index=log.index, name="held_error")
 
 
+def _scored_errors(steps: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The scored steps' (weight above zero) weights, errors and |errors|."""
+    w = steps["weight"].to_numpy()
+    scored = w > 0
+    e = steps["error"].to_numpy()[scored]
+    return w[scored], e, np.abs(e)
+
+
 def _error_sums(steps: pd.DataFrame) -> dict:
     """The running sums the error metrics are made of, over the scored steps (weight above zero):
     ``weight`` Σw, ``squared`` Σw·e², ``first`` Σw·e, ``within`` Σw where |e| ≤ 0.5°, ``max``
     max |e|. Sums of two spans add (``max`` takes the larger), so a streamed run keeps only these."""
-    w = steps["weight"].to_numpy()
-    e = steps["error"].to_numpy()
-    scored = w > 0
-    w, e = w[scored], e[scored]
+    return _sums(*_scored_errors(steps))
+
+
+def _sums(w: np.ndarray, e: np.ndarray, magnitude: np.ndarray) -> dict:
+    """`_error_sums` of the scored weights, errors and |errors| (`_scored_errors`)."""
     return {"weight": float(w.sum()), "squared": float(np.sum(w * e * e)), "first": float(np.sum(w * e)),
-            "within": float(np.sum(w[np.abs(e) <= 0.5])), "max": float(np.max(np.abs(e))) if e.size else 0.0}
+            "within": float(np.sum(w[magnitude <= 0.5])), "max": float(np.max(magnitude)) if e.size else 0.0}
 
 
 def _error_from_sums(sums: dict, p95) -> tuple[dict, float | None]:
@@ -196,9 +205,8 @@ def _error_from_sums(sums: dict, p95) -> tuple[dict, float | None]:
 
 
 def _error_stats(steps: pd.DataFrame) -> tuple[dict, float | None]:
-    scored = steps["weight"].to_numpy() > 0
-    p95 = weighted_quantile(np.abs(steps["error"].to_numpy()[scored]), steps["weight"].to_numpy()[scored], 0.95)
-    return _error_from_sums(_error_sums(steps), p95)
+    w, e, magnitude = _scored_errors(steps)  # once for the sums and the p95
+    return _error_from_sums(_sums(w, e, magnitude), weighted_quantile(magnitude, w, 0.95))
 
 
 def share_counts(log: pd.DataFrame, sun_up: np.ndarray) -> tuple[dict, dict]:

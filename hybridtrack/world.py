@@ -244,9 +244,9 @@ class World:
         scene = sensor_scene(weather, None, self.sensor, rng=rng, light=light)
         self.scene = (scene.beam, scene.aureole, scene.patch, np.ascontiguousarray(scene.patch_offset.T), scene.diffuse)
         self.truth_axes = np.ascontiguousarray(np.nan_to_num(self.truth[:, :self.axes].T))
-        self.noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
+        self.noise = rng.standard_normal((self.axes, self.n))  # axis by axis, as one draw each made them
         self.current_noise = rng.standard_normal(self.n)
-        self.coarse_noise = np.array([rng.standard_normal(self.n) for _ in range(self.axes)])
+        self.coarse_noise = rng.standard_normal((self.axes, self.n))
         self.recorded_current = frame[RECORDED_COLUMN].to_numpy(float) if RECORDED_COLUMN in frame.columns else None
         self.recorded_pointing = self._recorded_pointing_columns(frame)
         self.frame_dni = frame["dni"].to_numpy(float)
