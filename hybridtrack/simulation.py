@@ -30,6 +30,7 @@ from .control.clockwatch import ClockWatch
 from .control.modes import sky_code
 from .control.mountfit import parameter_names
 from .control.plan import east_park
+from .control.wind import READABLE
 from .drive import Drive
 from .budget import check_steps
 from .errors import HybridtrackError
@@ -892,10 +893,16 @@ def _day_cycle(events: pd.DataFrame, site: sites.Site) -> list[dict]:
 
 
 def _wind_data(frame: pd.DataFrame) -> str:
-    """``measured``, ``partly missing`` or ``missing``: never calm by default."""
+    """``measured``, ``partly missing`` or ``missing``: never calm by default. A reading no
+    anemometer gives (outside `hybridtrack.control.wind.READABLE`: -5 m/s, 1e300) is missing, as
+    the wind guard counts it: such a reading had left the summary saying "measured" beside the
+    stows it caused."""
     if "wind_speed" not in frame.columns:
         return "missing"
-    present = np.isfinite(frame["wind_speed"].to_numpy(float))
+    low, high = READABLE
+    readings = frame["wind_speed"].to_numpy(float, na_value=np.nan)
+    with np.errstate(invalid="ignore"):
+        present = (readings >= low) & (readings <= high)  # NaN and ±inf fall outside
     return "measured" if present.all() else ("missing" if not present.any() else "partly missing")
 
 

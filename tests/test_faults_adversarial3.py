@@ -55,7 +55,8 @@ def test_an_anemometer_reading_no_anemometer_gives_stows_and_says_so(reading):
     """A cup anemometer reads no less than its zero offset (a few tenths below 0 in calm air) and no
     more than the strongest gust on record (113 m/s): -5 m/s is an open 4-20 mA loop, not calm, and
     1e300 m/s no wind. Both are missing readings: stow (the live controller's policy), in the same
-    scan, with a reason that names the reading; -5 m/s and -inf had been tracked through as calm."""
+    scan, with a reason that names the reading; -5 m/s and -inf had been tracked through as calm.
+    The summary says the wind data were partly missing (it had said "measured" beside the stow)."""
     frame = morning("09:00", "11:40")
     wind = frame["wind_speed"].to_numpy().copy()
     bad = at(frame, "11:00", "11:10")
@@ -68,6 +69,7 @@ def test_an_anemometer_reading_no_anemometer_gives_stows_and_says_so(reading):
     assert len(stow) == 1 and stow["time"].iloc[0] == frame.index[bad][0]
     assert stow["reason"].iloc[0] == (f"wind reading {reading:.3g} m/s is no wind (an anemometer reads -0.5 to 120 m/s): "
                                       "the instrument or its signal failed; counted as missing")
+    assert result.summary["wind_data"] == "partly missing"
 
 
 def test_a_calm_anemometers_zero_offset_is_calm():
@@ -77,6 +79,7 @@ def test_a_calm_anemometers_zero_offset_is_calm():
     assert not safety_breaches(result)
     assert not (result.log["mode"] == "stow_wind").any()
     assert not result.events["reason"].str.contains("wind").any()
+    assert result.summary["wind_data"] == "measured"
 
 
 def test_a_recorded_photocurrent_with_a_gap_leaves_the_mount_fit_whole():
