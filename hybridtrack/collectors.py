@@ -559,6 +559,12 @@ def trough_kind(axis_azimuth: float) -> str:
 #: Metres: the farthest a row, receiver or aim point may lie from a collector (a large tower
 #: field's outer heliostats are about 1.5 km from the tower).
 MAX_DISTANCE = 5_000.0
+#: Metres: the lowest a Fresnel receiver may stand above its rows. Built rows' mirrors are 0.5 m
+#: wide and more (Zhu et al. 2014, doi:10.1016/j.solener.2013.05.021) and their receivers stand
+#: metres above them; 1e-300 m had been taken, its row right below the receiver scored on a
+#: receiver lying on the mirror, and 0.01 (kilometres for metres) would have been too. Well below
+#: any built receiver, so that no real layout is refused.
+MIN_RECEIVER_HEIGHT = 0.1
 
 
 #: The kinds of collector each geometry field of `Collector` describes.
@@ -601,6 +607,9 @@ class Collector:
             number(self.axis_azimuth, "collector: axis_azimuth (degrees from north)", -360, 360)
         number(self.row_distance, "collector: row_distance (m)", -MAX_DISTANCE, MAX_DISTANCE)
         number(self.receiver_height, "collector: receiver_height (m)", 0, MAX_DISTANCE, above=True)
+        if self.receiver_height < MIN_RECEIVER_HEIGHT:
+            raise HybridtrackError(f"collector: receiver_height (m) must be at least {MIN_RECEIVER_HEIGHT:g} m above "
+                                   f"the rows (mirrors are 0.5 m wide and more), got {self.receiver_height:g}")
         object.__setattr__(self, "aim", _aim_point(self.aim))  # a tuple: a list or an array made it unhashable
         self._refuse_other_kinds_geometry()
         self._refuse_untruthful_axis()

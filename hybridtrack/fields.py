@@ -33,6 +33,7 @@ from .budget import BYTES_PER_STEP, check_steps
 from .cluster import MAX_WORKERS, check_where, cores
 from .collectors import (
     MAX_DISTANCE,
+    MIN_RECEIVER_HEIGHT,
     Collector,
     fresnel_angle,
     fresnel_end_loss,
@@ -74,6 +75,9 @@ MIN_ROW_SPACING = 0.1
 #: point). Built troughs come in modules of a few metres and more (a EuroTrough module is 12 m,
 #: small process-heat troughs some 2 to 6 m), so 1 m refuses no real loop.
 MIN_COLLECTOR_LENGTH = 1.0
+#: The shortest `FresnelField.row_length`, metres, for the same reason: built rows run tens to
+#: hundreds of metres; a row of 1e-300 m had been taken and lost all its light off its end.
+MIN_ROW_LENGTH = 1.0
 #: Metres two collectors may fall short of the least spacing and still be taken: positions written
 #: as decimals differ in binary floating point by a little less than they read (-7.2 - -8.2 is
 #: 0.9999999999999991), and "1 m apart: closer than 1 m" had refused layouts exactly at the limit.
@@ -271,9 +275,11 @@ class FresnelField:
         Each row's signed lateral distance from the receiver line, metres, positive towards
         ``axis_azimuth + 90°`` (east for a north-south field).
     receiver_height : float
-        Height of the receiver above the rows' pivots, metres.
+        Height of the receiver above the rows' pivots, metres, at least
+        `hybridtrack.collectors.MIN_RECEIVER_HEIGHT` (0.1 m).
     row_length : float
-        Length of every row, metres; the end loss is counted against it.
+        Length of every row, metres, at least `MIN_ROW_LENGTH` (1 m); the end loss is counted
+        against it.
     axis_azimuth : float
         Azimuth of the rows' axis, degrees from north (0: north-south rows).
     spread : ImperfectionSpread
@@ -294,8 +300,12 @@ class FresnelField:
         _distinct(distances, "rows", "m from the receiver line")
         _refuse_rows_too_close(distances)
         object.__setattr__(self, "row_distances", tuple(distances.tolist()))
-        for name in ("receiver_height", "row_length"):
-            object.__setattr__(self, name, _finite_number(getattr(self, name), name.replace("_", " "), positive=True))
+        for name, least in (("receiver_height", MIN_RECEIVER_HEIGHT), ("row_length", MIN_ROW_LENGTH)):
+            value = _finite_number(getattr(self, name), name.replace("_", " "), positive=True)
+            if value < least:
+                raise HybridtrackError(f"fresnel field: {name.replace('_', ' ')} must be at least {least:g} m, "
+                                       f"got {value:g}")
+            object.__setattr__(self, name, value)
         object.__setattr__(self, "axis_azimuth", _finite_number(self.axis_azimuth, "axis azimuth", bound=360.0))
 
     @property

@@ -133,6 +133,11 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
     (lambda: HeliostatField(positions=np.column_stack([np.arange(100_001.0), np.zeros(100_001)])),
      "at most 100,000 mirrors"),
     (lambda: FresnelField(receiver_height=-2), "receiver height must be finite and positive"),
+    # a receiver on the mirrors (1e-300 m) and a row of no length had been taken: end loss 1, or 1.7e-303
+    (lambda: FresnelField(receiver_height=1e-300), "^fresnel field: receiver height must be at least 0.1 m, got 1e-300$"),
+    (lambda: FresnelField(receiver_height=0.01), "receiver height must be at least 0.1 m, got 0.01"),
+    (lambda: FresnelField(row_length=1e-300), "^fresnel field: row length must be at least 1 m, got 1e-300$"),
+    (lambda: Collector("fresnel", receiver_height=1e-300), r"receiver_height \(m\) must be at least 0.1 m above the rows"),
     (lambda: TroughLoop(count=0), "count must be a whole number"),
     (lambda: TroughLoop(count=2.5), "count must be a whole number"),
     (lambda: ImperfectionSpread(encoder_offset=-0.1), "encoder_offset must be a finite number >= 0"),
