@@ -36,9 +36,11 @@ def cores() -> int:
 
 def check_where(scheduler: str | None, workers: int | None, threads: int | None = None) -> None:
     """Refuse a `scheduler` that is not an address (an empty one is an unset ``$VAR``, not a local
-    cluster), a scheduler beside `workers`, a count of `workers` out of range, and `threads` of
-    this process beside either: the checks of `dask_client` (and of a field's threads), for callers
-    that make them before their work starts."""
+    cluster) or that nothing answers at (`_refuse_unreachable`), a scheduler beside `workers`, a
+    count of `workers` out of range, and `threads` of this process beside either: the checks of
+    `dask_client` (and of a field's threads), for callers that make them before their work starts
+    (a field's command had made its weather and started its progress bar before it found that no
+    scheduler answered)."""
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
         raise HybridtrackError(f"scheduler must be an address such as 'tcp://host:8786', got {scheduler!r:.60}")
     if scheduler and workers is not None:
@@ -48,6 +50,8 @@ def check_where(scheduler: str | None, workers: int | None, threads: int | None 
     if threads is not None and (scheduler is not None or workers is not None):
         raise HybridtrackError("threads (--threads) run the collectors in this process; workers or a scheduler "
                                "(--workers, --scheduler) send them to Dask: give one or the other")
+    if scheduler:  # last: the one check that waits on the network
+        _refuse_unreachable(scheduler)
 
 
 def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
@@ -76,7 +80,6 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         raise HybridtrackError(f"{what} need dask.distributed: pip install 'dask[distributed]'") from None
     check_where(scheduler, workers)
     if scheduler:
-        _refuse_unreachable(scheduler)
         try:
             client = Client(scheduler, timeout="10s", set_as_default=False)
         # TypeError: distributed's TLS and UCX connectors refuse to start without their setup

@@ -846,8 +846,9 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
         kernel runs without Python's lock, so the threads' loops run side by side.
     workers : int, optional
         Run the collectors on a local Dask cluster of this many worker processes
-        (`hybridtrack.cluster`) instead, one at a time on each. The result is the same
-        wherever the collectors run: each collector's run depends only on its own draws.
+        (`hybridtrack.cluster`) instead, one at a time on each, and no more workers than
+        collectors. The result is the same wherever the collectors run: each collector's run
+        depends only on its own draws.
     scheduler : str, optional
         Run them on the Dask scheduler at this address instead.
 
@@ -872,9 +873,9 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     frame = _check_frame(frame)
     warn_of_nights_left_out(frame, site)
     frame = _without_attrs(frame)
-    if workers is not None:
-        params.whole(workers, "workers", 1, MAX_WORKERS)
     collectors = field.collectors()
+    if workers is not None:  # a worker with no collector to run is a process started for nothing (64 took 2 min)
+        workers = min(params.whole(workers, "workers", 1, MAX_WORKERS), len(collectors))
     config = decided(config, len(frame) * len(collectors))  # on the field's scans, not each collector's
     threads = _thread_count(threads, frame, len(collectors), keep_log, dask=workers is not None or scheduler is not None,
                             compiled=uses_kernel(config, len(frame)))

@@ -770,3 +770,19 @@ def test_a_field_that_compiles_the_kernel_first_says_so_beside_its_bar(day, monk
     monkeypatch.setattr(kernel, "compiles_first", lambda config, scans: compiles)
     simulate_field(day, "lanzhou", FresnelField(row_distances=[-2.0, 2.0]), keep_log=False, progress=progress)
     assert ("compiling the controller kernel" in capsys.readouterr().err) is said
+
+
+def test_a_field_starts_no_more_dask_workers_than_it_has_collectors(day, monkeypatch):
+    """--workers 64 for three rows had started 64 processes (2 min on two cores) for three runs."""
+    import hybridtrack.cluster
+
+    asked = []
+
+    def fake_client(scheduler, workers, **_):
+        asked.append(workers)
+        raise HybridtrackError("stop here")
+
+    monkeypatch.setattr(hybridtrack.cluster, "dask_client", fake_client)
+    with pytest.raises(HybridtrackError, match="stop here"):
+        simulate_field(day, "lanzhou", FresnelField(row_distances=[-4.0, 0.0, 4.0]), workers=64)
+    assert asked == [3]
