@@ -858,7 +858,8 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     """
     from .kernel import COMPILING, compiles_first, decided, uses_kernel
     from .reuse import reuse_work
-    from .simulation import _check_frame, check_progress, checked_config, progress_updates, warn_of_nights_left_out
+    from .simulation import (_check_frame, check_progress, checked_config, progress_updates, warn_of_another_site,
+                             warn_of_nights_left_out)
 
     if not isinstance(field, (FresnelField, TroughLoop, HeliostatField)):
         raise HybridtrackError(f"field must be a FresnelField, TroughLoop or HeliostatField, "
@@ -872,6 +873,7 @@ def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = N
     site = sites.get(site)
     frame = _check_frame(frame)
     warn_of_nights_left_out(frame, site)
+    warn_of_another_site(frame, site)
     frame = _without_attrs(frame)
     collectors = field.collectors()
     if workers is not None:  # a worker with no collector to run is a process started for nothing (64 took 2 min)

@@ -49,7 +49,8 @@ from .skyinputs import (SkyInputConfig, clear_sky, clear_sky_photocurrent, fuzzy
 from .world import Imperfections, World, controller_clock, installed_site, scan_timer
 from .times import check_dates
 
-__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS", "NightsLeftOutWarning"]
+__all__ = ["SimulationConfig", "Result", "simulate", "LOG_COLUMNS", "FAULTS", "NightsLeftOutWarning",
+           "AnotherSiteWarning"]
 #: The faults `simulate` can inject, with what each array holds.
 FAULTS = {
     "sensor": "(N,) or (N, axes): the reading the sensor gives (degrees); NaN where it works",
@@ -581,6 +582,7 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     Result
     """
     warn_of_nights_left_out(frame, site)
+    warn_of_another_site(frame, site)
     with progress_updates(progress, lambda: _step_bar(frame)) as update:
         return _scored(track(frame, site, collector=collector, strategy=strategy, config=config, classifier=classifier,
                              faults=faults, progress=update, bulk_nights=bulk_nights, warm_start=warm_start,
@@ -641,6 +643,40 @@ def warn_of_nights_left_out(frame: pd.DataFrame, site) -> None:
                       "into its morning): each such morning's slew from stow is scored, as no PLC scanning all "
                       "night would show; hybridtrack.io.fill_nights(frame, site) puts them back",
                       NightsLeftOutWarning, stacklevel=3)
+
+
+class AnotherSiteWarning(UserWarning):
+    """A weather frame made for one site (its ``attrs["site"]``) is run at another."""
+
+
+#: Degrees: a frame's site and the run's are one place when both coordinates agree within this
+#: (a built-in site passed as a `Site` of another name): 0.1° is some 10 km.
+SAME_PLACE = 0.1
+
+
+def warn_of_another_site(frame: pd.DataFrame, site) -> None:
+    """Warn (`AnotherSiteWarning`) when `frame` says it was made for another site than `site`:
+    its ``attrs["site"]`` (set by `hybridtrack.sky.synthetic` and `hybridtrack.io.read_weather`)
+    names another place. Lanzhou's weather run at Nanjing had run without a word: its sun, light
+    and wind are Lanzhou's, and only another time zone's index is refused (light at night). A
+    built-in site's name beside a `Site` at the same coordinates (within `SAME_PLACE`) is the same
+    place; a site the run refuses is left to the run to refuse."""
+    import warnings
+
+    made_for = frame.attrs.get("site") if isinstance(frame, pd.DataFrame) else None
+    try:
+        runs_at = sites.get(site)
+    except HybridtrackError:
+        return
+    if not isinstance(made_for, str) or made_for.strip().lower() == runs_at.name.strip().lower():
+        return
+    known = sites.BUILTIN.get(made_for.strip().lower())
+    if known is not None and abs(known.latitude - runs_at.latitude) <= SAME_PLACE \
+            and abs((known.longitude - runs_at.longitude + 180.0) % 360.0 - 180.0) <= SAME_PLACE:
+        return
+    warnings.warn(f"the weather frame was made for {made_for} (its attrs['site']) and runs at {runs_at.name}: "
+                  f"its sun, light and wind are {made_for}'s; make or read the weather for {runs_at.name}",
+                  AnotherSiteWarning, stacklevel=3)
 
 
 @dataclass
