@@ -916,9 +916,9 @@ def _without_attrs(frame: pd.DataFrame) -> pd.DataFrame:
 
 def _bar(total: int):
     """A tqdm bar over a field's collectors, on stderr."""
-    from tqdm import tqdm
+    from .progress import bar
 
-    return tqdm(total=total, unit="collector", file=sys.stderr, leave=False)
+    return bar(total, unit="collector")
 
 
 def _thread_count(threads: int | None, frame: pd.DataFrame, collectors: int, keep_log: bool, *, dask: bool,

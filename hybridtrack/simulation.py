@@ -611,11 +611,9 @@ def check_progress(progress) -> None:
 
 def _step_bar(frame: pd.DataFrame):
     """A tqdm bar over a frame's steps, on stderr."""
-    import sys
+    from .progress import bar
 
-    from tqdm import tqdm
-
-    return tqdm(total=len(frame), unit="step", unit_scale=True, file=sys.stderr, leave=False, mininterval=1.0)
+    return bar(len(frame), unit="step", unit_scale=True, mininterval=1.0)
 
 
 class NightsLeftOutWarning(UserWarning):

@@ -44,7 +44,6 @@ import datetime as dt
 import itertools
 import os
 import shutil
-import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -966,9 +965,9 @@ def _whole(day: dt.date, frame: pd.DataFrame, site) -> bool:
     return begin <= midnight and frame.index[-1] + step >= next_midnight
 
 
-def progress_bar(source: DaySource, *, label: str = "", file=None):
-    """A tqdm bar over the steps (or the segments, when the steps are not known) on stderr."""
-    from tqdm import tqdm
+def progress_bar(source: DaySource, *, label: str = ""):
+    """A tqdm bar over the steps (or the segments, when the steps are not known) on stderr
+    (`hybridtrack.progress.bar`)."""
+    from .progress import bar
 
-    return tqdm(total=source.steps, unit="step", unit_scale=True, desc=label or "streaming",
-                file=file or sys.stderr, leave=False, mininterval=1.0)
+    return bar(source.steps, unit="step", unit_scale=True, desc=label or "streaming", mininterval=1.0)

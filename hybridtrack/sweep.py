@@ -577,7 +577,7 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         Called with no argument once the cluster is up or the scheduler reached (and has a worker),
         before the first run is sent: a refusal of where the runs go comes before whatever it says.
     """
-    from tqdm import tqdm
+    from .progress import bar as progress_bar
 
     if not isinstance(sweep, Sweep):
         raise HybridtrackError(f"run_sweep: sweep must be a Sweep (Sweep.from_toml, Sweep.from_dict), got {sweep!r:.80}")
@@ -600,7 +600,7 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
             _say_if_compiling(sweep, runs, steps)
         futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
                                       [steps] * len(runs), pure=False), runs))
-        with tqdm(total=len(futures), unit="run", file=sys.stderr, disable=not progress, leave=False) as bar:
+        with progress_bar(len(futures), unit="run", disable=not progress) as bar:
             try:
                 for future, row, error in finished(client, futures):
                     run = futures.pop(future)  # an error here is the worker's death (killed, out of memory)

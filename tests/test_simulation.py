@@ -586,12 +586,14 @@ def test_ctrl_c_beside_the_loop_stops_the_loop_rather_than_waiting_for_it():
 def test_a_frame_whose_light_comes_while_the_sun_is_down_is_refused():
     """Another place's weather (a Denver day at Lanzhou scored 0.9999), or stamps in another zone."""
     from hybridtrack import sites
+    from hybridtrack.simulation import AnotherSiteWarning
     from hybridtrack.sky import synthetic
 
     denver = sites.custom(39.7, -105.0, "America/Denver")
     elsewhere = synthetic(denver, "2021-06-21", weather="sunny", freq="10min", seed=1)
     with pytest.raises(HybridtrackError, match=r"direct light comes while the sun is down at lanzhou: \d+ of \d+ lit "
-                                               r"steps, the first .* at 2021-06-21 "):
+                                               r"steps, the first .* at 2021-06-21 "), \
+            pytest.warns(AnotherSiteWarning, match="made for custom .* runs at lanzhou"):  # said first, then refused
         simulate(elsewhere, "lanzhou")
     assert simulate(elsewhere, denver).summary["energy_capture"] > 0.99  # at home it runs
     local = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="1min", seed=1)

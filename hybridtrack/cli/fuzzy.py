@@ -149,10 +149,10 @@ def _tune(args: argparse.Namespace) -> int:
     report_files = [Path(args.report) / name for name in ("report.json", "surfaces.png", "confusion.png")] \
         if args.report else []
     claim([args.out, *report_files])  # before the fit, not after it
-    from tqdm import tqdm
+    from ..progress import bar as progress_bar
 
     fits = 1 + args.folds + max(args.seeds - 1, 0)
-    with tqdm(total=fits, unit="fit", desc="tuning", disable=fits < 2, leave=False, file=sys.stderr) as bar:
+    with progress_bar(fits, unit="fit", desc="tuning", disable=fits < 2) as bar:
         tuned, report = tune(start, samples, method=args.method, margin=args.margin, seed=args.seed,
                              folds=args.folds, seeds=args.seeds, progress=bar.update)
     out = {".fis": tuned.to_fis, ".fcl": tuned.to_fcl, ".toml": tuned.to_toml}[suffix](args.out)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 import pandas as pd
@@ -30,13 +29,12 @@ from .base import (
 
 
 def _run(frame, site, args, strategy: str | None, config, *, label: str = ""):
-    from tqdm import tqdm
-
+    from ..progress import bar as progress_bar
     from ..simulation import simulate
 
     days = (frame.index[-1] - frame.index[0]) / pd.Timedelta(days=1)
-    with tqdm(total=len(frame), unit="step", desc=label or strategy or config.controller.strategy, disable=days < 2,
-              leave=False, file=sys.stderr) as bar:
+    with progress_bar(len(frame), unit="step", desc=label or strategy or config.controller.strategy,
+                      disable=days < 2) as bar:
         return simulate(frame, site, collector=collector_from_arguments(args), strategy=strategy, config=config,
                         progress=bar.update)
 
