@@ -21,6 +21,20 @@ def spa_calls(monkeypatch):
 
 
 @pytest.fixture
+def warned():
+    """``warned(run, category)``: the messages of the warnings of `category` that ``run()`` gives."""
+    import warnings
+
+    def messages(run, category) -> list[str]:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            run()
+        return [str(w.message) for w in caught if issubclass(w.category, category)]
+
+    return messages
+
+
+@pytest.fixture
 def engine_choices(monkeypatch):
     """A list of the engine each run asks `uses_kernel` about (its config's ``engine``), with the
     kernel neither compiled nor cached as far as ``auto`` can tell and `COMPILE_PAYS_AT` left for
