@@ -126,7 +126,8 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--folds", type=whole_number, default=5,
                         help="k of the k-fold cross-validated accuracy (default 5; 0 skips it)")
     parser.add_argument("--seeds", type=whole_number, default=3,
-                        help="fit from this many seeds and report how far the fits spread (default 3; 1 skips it)")
+                        help="fit from this many seeds, keep the fit of lowest loss and report how far the fits "
+                             "spread (default 3; 1 fits once)")
     parser.add_argument("--report", metavar="DIR",
                         help="also write report.json, surfaces.png (before/after) and confusion.png here")
     add_force_argument(parser)

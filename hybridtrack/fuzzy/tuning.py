@@ -65,8 +65,8 @@ class TuningReport:
 
     ``accuracy_after`` is measured on the readings the fit saw; ``accuracy_cv`` on readings each
     fold's fit did not see (pooled over the folds), the honest figure. ``seeds`` gives the training
-    accuracy of the fit from each seed and ``spread`` how far each term's centre moves across them
-    (normalised units). ``constraints_before``/``constraints_after`` list the physical constraints
+    accuracy of the fit from each seed, ``seed`` the seed whose fit was returned (the lowest
+    loss), and ``spread`` how far each term's centre moves across them (normalised units). ``constraints_before``/``constraints_after`` list the physical constraints
     each config breaks (empty: all hold).
     """
 
@@ -84,6 +84,7 @@ class TuningReport:
     rmse_cv: float | None = None
     accuracy_cv_folds: list = field(default_factory=list)
     seeds: dict = field(default_factory=dict)
+    seed: int | None = None
     spread: dict = field(default_factory=dict)
     constraints_before: list = field(default_factory=list)
     constraints_after: list = field(default_factory=list)
@@ -115,7 +116,8 @@ class TuningReport:
             worst = max(self.spread.items(), key=lambda item: item[1]) if self.spread else None
             lines.append(f"  across seeds {', '.join(map(str, self.seeds))}: training accuracy "
                          + (f"{min(accuracies):.1%}-{max(accuracies):.1%}" if accuracies else "-")
-                         + (f"; term centres move up to {worst[1]:.2f} units ({worst[0]})" if worst else ""))
+                         + (f"; term centres move up to {worst[1]:.2f} units ({worst[0]})" if worst else "")
+                         + f"; kept seed {self.seed}'s fit, the lowest loss")
         lines.append("  physical constraints: " + ("hold" if not self.constraints_after
                                                     else "BROKEN: " + "; ".join(self.constraints_after))
                      + (" (the starting config broke: " + "; ".join(self.constraints_before) + ")"
@@ -585,7 +587,9 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     folds : int
         With 2 or more, also report the `folds`-fold cross-validated accuracy (`cross_validate`).
     seeds : int
-        With 2 or more, also fit from seeds ``seed + 1 ...`` and report the spread of the fits.
+        With 2 or more, also fit from seeds ``seed + 1 ...``, return the fit of lowest loss (the
+        first seed's of equal ones; `TuningReport.seed` names it) and report the spread of the
+        fits: one seed's search can stop in a local optimum that another's passes.
     progress : callable, optional
         Called with 1 after each of the ``1 + folds + seeds - 1`` fits (e.g. a tqdm bar's update).
 
@@ -618,18 +622,18 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     cv = cross_validate(config, samples, folds=folds, seed=seed, progress=progress, **options.__dict__) if folds \
         else {}
     before = evaluate(config, samples, margin)
-    fitted, evaluations = _fit(config, samples, options, seed)
     step = progress if progress is not None else (lambda _: None)
-    step(1)
+    fits = []
+    for k in range(seeds):
+        fits.append(_fit(config, samples, options, seed + k))
+        step(1)
+    scored = [evaluate(fit, samples, margin) for fit, _ in fits]
+    kept = int(np.argmin([evaluation["loss"] for evaluation in scored]))  # the first of equal losses
+    fitted, evaluations = fits[kept]
     span = labelled_range(samples)
     tuned = fitted.replace(name=f"{config.name}-tuned", labelled_range=span)
     after = evaluate(tuned.replace(labelled_range=None), samples, margin)
-    others = []
-    for k in range(1, seeds):
-        others.append(_fit(config, samples, options, seed + k)[0])
-        step(1)
-    seed_accuracy = {seed: after["accuracy"]}
-    seed_accuracy.update({seed + k: evaluate(fit, samples, margin)["accuracy"] for k, fit in enumerate(others, 1)})
+    seed_accuracy = {seed + k: evaluation["accuracy"] for k, evaluation in enumerate(scored)}
     changed = {}
     for old, new in zip(config.inputs, tuned.inputs):
         for a, b in zip(old.terms, new.terms):
@@ -638,8 +642,8 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     report = TuningReport(
         len(samples), before["accuracy"], after["accuracy"], before["rmse"], after["rmse"], before["loss"],
         after["loss"], evaluations, changed, folds=folds, accuracy_cv=cv.get("accuracy"), rmse_cv=cv.get("rmse"),
-        accuracy_cv_folds=cv.get("accuracy_folds", []), seeds=seed_accuracy,
-        spread=_centre_spread([fitted, *others]) if others else {},
+        accuracy_cv_folds=cv.get("accuracy_folds", []), seeds=seed_accuracy, seed=seed + kept,
+        spread=_centre_spread([fit for fit, _ in fits]) if seeds > 1 else {},
         constraints_before=constraint_violations(config)[1], constraints_after=constraint_violations(tuned)[1],
         labelled_range={var.name: list(pair) for var, pair in zip(config.inputs, span)})
     return tuned, report
