@@ -607,11 +607,11 @@ class Collector:
             number(self.axis_azimuth, "collector: axis_azimuth (degrees from north)", -360, 360)
         number(self.row_distance, "collector: row_distance (m)", -MAX_DISTANCE, MAX_DISTANCE)
         number(self.receiver_height, "collector: receiver_height (m)", 0, MAX_DISTANCE, above=True)
-        if self.receiver_height < MIN_RECEIVER_HEIGHT:
-            raise HybridtrackError(f"collector: receiver_height (m) must be at least {MIN_RECEIVER_HEIGHT:g} m above "
-                                   f"the rows (mirrors are 0.5 m wide and more), got {self.receiver_height:g}")
         object.__setattr__(self, "aim", _aim_point(self.aim))  # a tuple: a list or an array made it unhashable
         self._refuse_other_kinds_geometry()
+        if self.receiver_height < MIN_RECEIVER_HEIGHT:  # a Fresnel row's: another kind's was refused above
+            raise HybridtrackError(f"collector: receiver_height (m) must be at least {MIN_RECEIVER_HEIGHT:g} m above "
+                                   f"the rows (mirrors are 0.5 m wide and more), got {self.receiver_height:g}")
         self._refuse_untruthful_axis()
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
