@@ -66,8 +66,9 @@ class TuningReport:
     ``accuracy_after`` is measured on the readings the fit saw; ``accuracy_cv`` on readings each
     fold's fit did not see (pooled over the folds), the honest figure. ``seeds`` gives the training
     accuracy of the fit from each seed, ``seed`` the seed whose fit was returned (the lowest
-    loss), and ``spread`` how far each term's centre moves across them (normalised units). ``constraints_before``/``constraints_after`` list the physical constraints
-    each config breaks (empty: all hold).
+    loss), and ``spread`` how far each term's centre moves across them (normalised units).
+    ``constraints_before``/``constraints_after`` list the physical constraints each config breaks
+    (empty: all hold).
     """
 
     samples: int
