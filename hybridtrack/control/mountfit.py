@@ -185,9 +185,12 @@ def vector_jacobian(vectors: np.ndarray, collector, *, lit: np.ndarray | None = 
     out = np.zeros((len(vectors), axes, len(parameter_names(collector))))
     for k, turn in enumerate(turns):
         turned = rotate(vectors, turn)  # d(vectors as the mount sees)/d(parameter)
-        # summed in this order, not einsum's own (by the machine's SIMD width: (0 + 2) + 1 here)
-        out[:, :, k] = gradient[..., 0] * turned[:, None, 0] + gradient[..., 1] * turned[:, None, 1] \
-            + gradient[..., 2] * turned[:, None, 2]
+        # summed in this order, not einsum's own (by the machine's SIMD width: (0 + 2) + 1 here);
+        # at the zenith a heliostat's infinite azimuth gradient meets a zero component: NaN, which
+        # nan_to_num below makes 0, as the compiled pass does, without a RuntimeWarning to the user
+        with np.errstate(invalid="ignore"):
+            out[:, :, k] = gradient[..., 0] * turned[:, None, 0] + gradient[..., 1] * turned[:, None, 1] \
+                + gradient[..., 2] * turned[:, None, 2]
     for a in range(axes):
         out[:, a, 2 + a] = 1.0
     if axes == 2:  # the sensor's collimation error: an angle across the face is sec(e) of azimuth
