@@ -628,12 +628,12 @@ def tune(config: FuzzyConfig | None, samples, *, method: str = "global", margin:
     for k in range(seeds):
         fits.append(_fit(config, samples, options, seed + k))
         step(1)
-    scored = [evaluate(fit, samples, margin) for fit, _ in fits]
+    # each fit judged on the labels without a labelled range, which would warn of readings outside it
+    scored = [evaluate(fit.replace(labelled_range=None), samples, margin) for fit, _ in fits]
     kept = int(np.argmin([evaluation["loss"] for evaluation in scored]))  # the first of equal losses
-    fitted, evaluations = fits[kept]
+    (fitted, evaluations), after = fits[kept], scored[kept]
     span = labelled_range(samples)
     tuned = fitted.replace(name=f"{config.name}-tuned", labelled_range=span)
-    after = evaluate(tuned.replace(labelled_range=None), samples, margin)
     seed_accuracy = {seed + k: evaluation["accuracy"] for k, evaluation in enumerate(scored)}
     changed = {}
     for old, new in zip(config.inputs, tuned.inputs):
