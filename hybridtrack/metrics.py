@@ -94,8 +94,9 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
     Columns: ``weight`` (direct light on the aperture where the error is scored, else 0),
     ``error``, ``offered`` (direct light a perfect tracker would catch), ``captured`` (what this
     one caught through the acceptance model), the light in W min/m² over each stamp's own step
-    (`hybridtrack.times.stamp_minutes`: a frame of mixed steps weighs a minute alike in each),
-    and ``moved`` (drive axes that moved this step).
+    (`hybridtrack.times.stamp_minutes`: a frame of mixed steps weighs a minute alike in each).
+    Not the moves (`moved_axes`): only the daily table counts them by step, and the summary's
+    come from the drive (8 ms of a Fresnel row-year's scoring, which never read them).
     """
     half_angle = _half_angle(collector)
     _check_log(log, sun_up, incidence)
@@ -108,7 +109,7 @@ def _steps(log: pd.DataFrame, collector: str, sun_up: np.ndarray, incidence: np.
     captured = np.zeros(len(log))
     captured[tracking] = offered[tracking] * acceptance(error[tracking], half_angle)
     return pd.DataFrame({"weight": np.where(tracking, beam * minutes, 0.0), "error": np.where(tracking, error, np.nan),
-                         "offered": offered, "captured": captured, "moved": moved_axes(log)}, index=log.index,
+                         "offered": offered, "captured": captured}, index=log.index,
                         copy=False)
 
 
@@ -271,8 +272,8 @@ def score(log: pd.DataFrame, *, collector: str, moves: int, travel: float, event
           sun_up: np.ndarray, incidence: np.ndarray) -> dict:
     """The summary's scores of a run, without its mode and sky shares: its pointing error
     (``tracking_error_deg``, ``within_0_5_deg``), ``energy_capture``, ``moves``, ``travel_deg``
-    and its `event_counts`. The log needs only its ``dni``, ``error``, ``mode`` and angle columns
-    (a field's collector that keeps no log is scored from those alone)."""
+    and its `event_counts`. The log needs only its ``dni``, ``error`` and ``mode`` columns (a
+    field's collector that keeps no log is scored from those alone)."""
     steps = _steps(log, collector, sun_up, incidence)
     stats, within = _error_stats(steps)
     return {**_scores(stats=stats, within=within, captured=float(steps["captured"].sum()),
@@ -418,6 +419,7 @@ def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidenc
     local = log.index.tz_convert(check_tz(tz))
     day = pd.Index(local.date, name="date")
     minutes = stamp_minutes(log.index)  # each stamp its own step: a gap is not time in a mode
+    moved = moved_axes(log)
     rows = []
     sky = log["sky"].astype(str).where(np.asarray(sun_up, bool), "night")
     for date, where in pd.Series(np.arange(len(log)), index=day).groupby(level=0):
@@ -430,7 +432,7 @@ def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidenc
         rows.append({
             "date": date, "energy_capture": part["captured"].sum() / offered if offered > 0 else np.nan,
             "rms": stats["rms"], "p95": stats["p95"], "max": stats["max"], "within_0_5": within,
-            "moves": int(part["moved"].sum()),
+            "moves": int(moved[idx].sum()),
             "stow_wind_min": float(minutes[idx][mode == "stow_wind"].sum()),
             "stow_night_min": float(minutes[idx][mode == "stow_night"].sum()),
             "dni_kwh_m2": float(np.nansum(log["dni"].to_numpy(float)[idx] * minutes[idx]) / 60e3),

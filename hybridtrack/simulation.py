@@ -701,8 +701,9 @@ class Tracked:
     mount : MountEstimate or None
         The commissioned mount (``astronomical-commissioned``).
     classifier : FuzzyWeatherClassifier
-    clear : pandas.DataFrame or None
-        The clear sky the controller expects at each scan (None where it expects none).
+    clear : callable or None
+        Gives the clear sky the controller expects at each scan (a frame, made when the log asks
+        for it), or None where it expects none.
     frame : pandas.DataFrame
     """
 
@@ -717,7 +718,7 @@ class Tracked:
     incidence: np.ndarray
     mount: MountEstimate | None
     classifier: FuzzyWeatherClassifier
-    clear: pd.DataFrame | None
+    clear: Callable[[], pd.DataFrame] | None
     frame: pd.DataFrame = field(repr=False)
 
     def scoring(self) -> dict:
@@ -809,7 +810,7 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
 def _scored(run: Tracked) -> Result:
     """The `Result` of a tracked run: its log, summary and events."""
     index, out, config, collector, controller = run.index, run.out, run.config, run.collector, run.controller
-    sky = _sky_seen(out.intensity, index, run.classifier, config, run.clear, run.told)
+    sky = _sky_seen(out.intensity, index, run.classifier, config, run.clear and run.clear(), run.told)
     log = _log(index, collector, run.world, out, sky)
     events = run.events()
     scoring = run.scoring()
@@ -902,7 +903,8 @@ def _controller_side(index: pd.DatetimeIndex, site: sites.Site, told: sites.Site
     clf = classifier or FuzzyWeatherClassifier(fuzzy_config(config.sky))
     clear = _expected_clear_sky(index, told, config, plan, clock)
     if clear is not None:
-        plan.clear_light = (clear_sky_photocurrent(clear, config.sensor) - config.sensor.dark_current).to_numpy()
+        plan.clear_light = shared(("expected clear light", *clear.key, config.sensor), lambda: (
+            clear_sky_photocurrent(clear(), config.sensor) - config.sensor.dark_current).to_numpy())
     return mount, memory, plan, clf, clear
 
 
@@ -1175,16 +1177,24 @@ def _axes_fault(faults: dict, name: str, n: int, axes: int, default: float) -> n
 
 
 def _expected_clear_sky(index: pd.DatetimeIndex, site: sites.Site, config: SimulationConfig, plan,
-                        clock: pd.DatetimeIndex) -> pd.DataFrame | None:
+                        clock: pd.DatetimeIndex):
     """The clear sky the controller expects at each scan, from what a PLC has: its `clock`, the
-    `site` it was told and the sun its plan computed; on the scans' `index`."""
+    `site` it was told and the sun its plan computed; on the scans' `index`. Returned as a
+    function that gives it, computed once a run (its ``key`` the piece's in `hybridtrack.reuse`),
+    or None where the controller expects none: a field's run that keeps no log never asks for the
+    frame, only for the clear light (`_controller_side`), where a copy of the shared frame and
+    the light from it had cost 14 ms a Fresnel row-year."""
     if config.sky.mode != "relative" or config.controller.sensor_only:
         return None
+    key = ("expected clear sky", Same(clock), Same(index), site, config.controller)
 
+    @functools.cache  # once a run: its clear light and its log ask for the same
     def expected():  # the plan's sun follows from the clock, the scans, the site and the controller's config
-        return clear_sky(clock, site, pd.DataFrame({"apparent_altitude": plan.apparent_altitude})).set_axis(index)
+        return shared(key, lambda: clear_sky(clock, site, pd.DataFrame({"apparent_altitude": plan.apparent_altitude}))
+                      .set_axis(index))
 
-    return shared(("expected clear sky", Same(clock), Same(index), site, config.controller), expected)
+    expected.key = key
+    return expected
 
 
 def _sky_seen(intensity: np.ndarray, index: pd.DatetimeIndex, classifier, config: SimulationConfig,
@@ -1238,15 +1248,10 @@ def _pointing_error(collector: Collector, world: World, engine: str = "auto") ->
 
 
 def _scored_columns(collector: Collector, world: World, out) -> dict:
-    """The log columns the metrics read (`hybridtrack.metrics.score`): ``dni``, ``error``,
-    ``mode``, ``angle`` (a heliostat's elevation) and a heliostat's ``angle_azimuth`` (within a
-    turn), each the run's own array; `_log` and `Tracked.scores` both take them from here."""
-    angle = world.angles
-    columns = {"angle": angle[-1].copy(), "error": _pointing_error(collector, world),
-               "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)), "dni": world.frame_dni.copy()}
-    if not collector.single_axis:
-        columns["angle_azimuth"] = within_turn(angle[0])  # the axis may have wound past a turn
-    return columns
+    """The log columns the metrics read (`hybridtrack.metrics.score`): ``dni``, ``error`` and
+    ``mode``, each the run's own array; `_log` and `Tracked.scores` both take them from here."""
+    return {"error": _pointing_error(collector, world),
+            "mode": pd.Categorical.from_codes(out.mode, categories=list(MODES)), "dni": world.frame_dni.copy()}
 
 
 def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> pd.DataFrame:
@@ -1258,7 +1263,7 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
     main = 0 if collector.single_axis else 1  # a heliostat's main columns are its elevation axis
     scored = _scored_columns(collector, world, out)
     columns = {
-        "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": scored["angle"],
+        "target_true": truth[:, main].copy(), "target": out.target[:, main], "angle": world.angles[-1].copy(),
         "error": scored["error"], "mode": scored["mode"],
         "sky": sky["sky"].array, "sky_score": sky["sky_score"].to_numpy(copy=True),
         "sensor_valid": out.sensor_status == 0,
@@ -1275,6 +1280,7 @@ def _log(index, collector: Collector, world: World, out, sky: pd.DataFrame) -> p
         columns.update({
             "target_true_azimuth": truth[:, 0].copy(),
             "target_azimuth": within_turn(out.target[:, 0]),  # the axis may have wound past a turn
-            "angle_azimuth": scored["angle_azimuth"], "calibration_azimuth": out.calibration[:, 0],
+            "angle_azimuth": within_turn(world.angles[0]),  # the axis may have wound past a turn
+            "calibration_azimuth": out.calibration[:, 0],
             "sensor_sun_azimuth": out.sun[:, 0]})
     return pd.DataFrame(columns, index=index, copy=False)

@@ -337,7 +337,8 @@ def test_the_world_computes_spa_wherever_the_sun_is_near_or_above_the_horizon(si
 def test_the_patch_offset_is_the_filtered_signed_cloud_edges_and_the_interpolated_noise_bit_for_bit():
     """A field shares the unsigned cloud-edge pattern, and noise on a 1-minute index is taken as
     drawn; each collector draws its own first side. The offset must be exactly what filtering the
-    collector's signed steps, and interpolating its noise at every stamp, gives."""
+    collector's signed steps, and interpolating its noise at every stamp, gives, wherever the
+    patch shines; 0 where it has no light (the noise still drawn at every stamp)."""
     from scipy.signal import lfilter
 
     frame, position, light = scene("mixed", seed=5)
@@ -360,4 +361,22 @@ def test_the_patch_offset_is_the_filtered_signed_cloud_edges_and_the_interpolate
     distance = low + (high - low) * 0.5 * (1.0 + np.tanh(noise(30.0)))
     direction = rng.uniform(0.0, 2.0 * np.pi) + 0.5 * noise(20.0)
     want = (side * distance)[:, None] * np.stack([np.cos(direction), np.sin(direction)], axis=1)
+    dark = light.patch == 0
+    assert 0 < dark.sum() < len(dark)
+    want[dark] = 0.0
     assert np.array_equal(light.patch_offset, want)
+
+
+@pytest.mark.parametrize("offset", [-3.0, -0.4, 0.0, 0.7, 5.0])
+def test_where_the_patch_has_no_light_its_place_changes_no_reading(offset):
+    """The scene places the patch only where it shines: with no patch light, the fine cells read
+    the same bits wherever the patch would be, with or without the sun in view."""
+    from hybridtrack.sensor import read_pointing
+
+    model = SensorModel()
+    for beam, aureole in ((800.0, 20.0), (0.0, 0.0), (150.0, 5.0)):
+        for patch_offset in (-2.0, 0.3, 9.0):
+            placed = read_pointing([offset], beam, aureole, 0.0, [patch_offset], [0.37], model)
+            unplaced = read_pointing([offset], beam, aureole, 0.0, [0.0], [0.37], model)
+            assert placed[1] == unplaced[1]
+            np.testing.assert_array_equal(placed[0], unplaced[0])
