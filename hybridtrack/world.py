@@ -132,8 +132,10 @@ def installed_site(site: sites.Site, imperfections: Imperfections) -> sites.Site
 
 
 def scan_timer(index: pd.DatetimeIndex) -> np.ndarray:
-    """The controller's scan timer at each scan: minutes since the run began."""
-    return np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float)
+    """The controller's scan timer at each scan: minutes since the run began. Computed once for
+    the world and the controller of every run of a field under one frame (`hybridtrack.reuse`;
+    handed out read-only there)."""
+    return shared(("scan timer", Same(index)), lambda: np.asarray((index - index[0]) / pd.Timedelta(minutes=1), float))
 
 
 def controller_clock(index: pd.DatetimeIndex, imperfections: Imperfections, faults: dict) -> pd.DatetimeIndex:
@@ -252,7 +254,7 @@ class World:
         self.frame_dni = frame["dni"].to_numpy(float)
         self.wind = frame["wind_speed"].to_numpy(float) if "wind_speed" in frame.columns else np.full(self.n, np.nan)
         self.true_sky = shared(("true sky", Same(frame)), lambda: self._true_sky(frame))
-        self.minutes = shared(("scan timer", Same(index)), lambda: scan_timer(index))
+        self.minutes = scan_timer(index)
         self.circular = [d.limits[1] - d.limits[0] >= 360.0 for d in drives]
         self.actual = [d.stow - imperfections.encoder_offset for d in drives]  # parked where stow reads
         self.angles = np.full((self.axes, self.n), np.nan)
