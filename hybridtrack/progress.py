@@ -5,7 +5,8 @@ blanks its line with one more. On a terminal the bar is then gone and the next l
 clean. In a file (``2> run.log``, a CI log) every redraw stays on one physical line, and
 whatever came next was appended to that line. An error (``hybridtrack: error: ...``) then
 did not start a line of its own, so ``grep '^hybridtrack: error'`` missed it. `bar` ends that line
-where standard error is not a terminal.
+where standard error is not a terminal, nor a Jupyter kernel's stream, whose front end redraws a
+line in place as a terminal does (there the ended line had shown as an empty one under the cell).
 """
 
 from __future__ import annotations
@@ -23,12 +24,17 @@ class _ClearingBar(tqdm):
     def close(self) -> None:
         shown = not self.disable  # tqdm disables a bar as it closes it: a second close writes nothing
         super().close()
-        if shown and not _is_terminal(self.fp):
+        if shown and not _redraws_in_place(self.fp):
             self.fp.write("\n")  # tqdm's wrapper of the stream ignores a closed or full one
             self.fp.flush()
 
 
-def _is_terminal(stream) -> bool:
+def _redraws_in_place(stream) -> bool:
+    """Whether `stream` (tqdm's wrapper of it, or itself) shows a carriage return as a redraw: a
+    terminal, or a Jupyter kernel's output stream."""
+    wrapped = getattr(stream, "_wrapped", stream)
+    if type(wrapped).__module__.split(".")[0] == "ipykernel":
+        return True
     try:
         return bool(stream.isatty())
     except (AttributeError, ValueError, OSError):  # no isatty, or a closed stream

@@ -32,6 +32,18 @@ def test_a_bar_on_a_terminal_clears_itself_and_adds_no_line(monkeypatch):
     assert written.endswith("\rhybridtrack: error: after the bar\n")  # the line blanked, nothing added
 
 
+class _KernelStream(io.StringIO):
+    """Stands for ipykernel's OutStream, which is no terminal, but whose front end redraws a line."""
+
+
+_KernelStream.__module__ = "ipykernel.iostream"
+
+
+def test_a_bar_in_a_notebook_clears_itself_and_adds_no_empty_line(monkeypatch):
+    written = _written(_KernelStream(), monkeypatch)
+    assert written.endswith("\rhybridtrack: error: after the bar\n")
+
+
 def test_a_disabled_bar_writes_nothing(monkeypatch):
     assert _written(io.StringIO(), monkeypatch, disable=True) == "hybridtrack: error: after the bar\n"
 
