@@ -391,7 +391,7 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     repeated = frame.columns[frame.columns.duplicated()]
     if len(repeated):  # which of the two would be the weather?
         raise HybridtrackError(f"the weather frame has the column {repeated[0]!r} more than once; keep one")
-    for column in ("dni", "dhi", "wind_speed", "photocurrent", *RECORDED_POINTING):
+    for column in ("dni", "dhi", "ghi", "wind_speed", "photocurrent", *RECORDED_POINTING):
         if column in frame.columns:
             _physical_column(frame, column)
     first, last = frame.index[0], frame.index[-1]
@@ -483,8 +483,8 @@ def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.n
 #: perihelion: 1408 W/m²; a photocurrent of 10 A where the reader's limit is 10,000 mA). A reading
 #: past it is a unit mixed up (kW/m² read as W/m², ×1000) or garbage (1e200 W/m² failed deep in the
 #: mount fit with numpy's LinAlgError); a spike below it is a sensor's fault to survive.
-NOT_LIGHT = {"dni": 14_080.0, "dhi": 14_080.0, "photocurrent": READING_LIMIT}
-_UNITS = {"dni": "W/m²", "dhi": "W/m²", "photocurrent": "mA"}
+NOT_LIGHT = {"dni": 14_080.0, "dhi": 14_080.0, "ghi": 14_080.0, "photocurrent": READING_LIMIT}
+_UNITS = {"dni": "W/m²", "dhi": "W/m²", "ghi": "W/m²", "photocurrent": "mA"}
 
 
 def _physical_column(frame: pd.DataFrame, column: str) -> None:

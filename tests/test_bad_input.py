@@ -472,10 +472,22 @@ def _small_day():
     (lambda f: f.assign(dni=f["dni"] * 1000), r"is not light \(over 14,080: a unit mixed up\?\)"),  # ran silently
     (lambda f: f.assign(dni=f["dni"].astype(complex)), "must hold numbers, got dtype complex128"),  # imaginary dropped
     (lambda f: f.assign(photocurrent=math.inf), "inf mA is not light"),
+    (lambda f: f.assign(ghi=f["ghi"].astype(str)), "column 'ghi' must hold numbers"),  # TypeError in the kW check
+    (lambda f: f.assign(ghi=f["ghi"].astype(object).where(f["ghi"] < 500, "abc")), "column 'ghi' must hold numbers"),
+    (lambda f: f.assign(ghi=math.inf), "column 'ghi' at .*: inf W/m² is not light"),  # blamed dni as kW/m²
 ])
 def test_a_weather_frame_of_no_light_or_no_names_is_refused_in_one_line(frame, message):
     with pytest.raises(HybridtrackError, match=message):
         simulate(frame(_small_day()), "lanzhou")
+
+
+def test_a_field_refuses_a_ghi_of_no_numbers_by_name():
+    from hybridtrack import simulate_field
+    from hybridtrack.fields import TroughLoop
+
+    day = _small_day()
+    with pytest.raises(HybridtrackError, match="column 'ghi' must hold numbers"):
+        simulate_field(day.assign(ghi=day["ghi"].astype(str)), "lanzhou", TroughLoop(count=2))
 
 
 @pytest.mark.parametrize("options, message", [
