@@ -407,14 +407,41 @@ class RunningSummary:
                         shares=_shares_from_counts(self.modes, self.sky, self.steps))
 
 
+#: The log columns the daily table reads besides the scored ones (`SCORED_COLUMNS`).
+DAILY_COLUMNS = ("sky", "wind_speed")
+
+
+def _check_daily_log(log) -> None:
+    """Refuse what `daily` cannot make days of, by name: a log that is no frame on a time index,
+    has no steps, or lacks a column it reads (pandas' KeyError and AttributeError had come out)."""
+    if not isinstance(log, pd.DataFrame) or not isinstance(log.index, pd.DatetimeIndex):
+        raise HybridtrackError(f"daily: the log must be a run's log, a DataFrame on a DatetimeIndex; got "
+                               f"{type(log).__name__}")
+    if not len(log):
+        raise HybridtrackError("daily: the log has no steps, so no day to count")
+    missing = [c for c in (*SCORED_COLUMNS, *DAILY_COLUMNS) if c not in log.columns]
+    if missing:
+        raise HybridtrackError(f"daily: the log has no {', '.join(map(repr, missing))} column; a run's log has "
+                               f"{', '.join((*SCORED_COLUMNS, *DAILY_COLUMNS))}")
+
+
+def _highest(values: np.ndarray) -> float:
+    """The largest of `values` that is a number, NaN where none is (without numpy's warning of an
+    all-NaN slice, which a day without a wind reading had shown the user)."""
+    numbers = values[~np.isnan(values)]
+    return float(numbers.max()) if numbers.size else np.nan
+
+
 def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidence: np.ndarray) -> pd.DataFrame:
     """One row per local day, with the run summary's definitions applied to that day.
 
     Columns: ``energy_capture``, ``rms``/``p95``/``max`` (degrees, DNI-weighted), ``moves``,
     ``stow_wind_min`` and ``stow_night_min`` (minutes in each mode), ``dni_kwh_m2`` (direct
-    normal irradiation), ``max_wind`` (m/s) and the sky shares (``sky_sunny`` ... ``sky_night``,
-    over the day's steps).
+    normal irradiation), ``max_wind`` (m/s; NaN for a day without a reading) and the sky shares
+    (``sky_sunny`` ... ``sky_night``, over the day's steps). The days' ``moves`` are counted from
+    the logged angles (`moved_axes`): they add up to the run's less any made at its first step.
     """
+    _check_daily_log(log)
     steps = _steps(log, collector, sun_up, incidence)
     local = log.index.tz_convert(check_tz(tz))
     day = pd.Index(local.date, name="date")
@@ -436,7 +463,7 @@ def daily(log: pd.DataFrame, *, collector: str, tz, sun_up: np.ndarray, incidenc
             "stow_wind_min": float(minutes[idx][mode == "stow_wind"].sum()),
             "stow_night_min": float(minutes[idx][mode == "stow_night"].sum()),
             "dni_kwh_m2": float(np.nansum(log["dni"].to_numpy(float)[idx] * minutes[idx]) / 60e3),
-            "max_wind": float(np.nanmax(log["wind_speed"].to_numpy(float)[idx])) if len(idx) else np.nan,
+            "max_wind": _highest(log["wind_speed"].to_numpy(float)[idx]),
             **{f"sky_{k}": float(counts.get(k, 0.0)) for k in ("sunny", "cloudy", "overcast", "unknown", "night")},
         })
     return pd.DataFrame(rows).set_index("date").astype(float).astype({"moves": int})

@@ -115,3 +115,27 @@ def test_the_daily_table_of_one_day_is_the_summary_by_hand(summary):
     assert row["dni_kwh_m2"] == pytest.approx(2300 / 60 / 1000)
     assert row["max_wind"] == 20.0
     assert row["sky_sunny"] == pytest.approx(0.5) and row["sky_night"] == pytest.approx(1 / 6)
+
+
+def test_a_day_without_a_wind_reading_has_no_highest_wind_and_no_warning():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's "All-NaN slice encountered" had reached the user
+        table = daily(LOG.assign(wind_speed=np.nan), collector="trough-ns", tz="Asia/Shanghai", sun_up=SUN_UP,
+                      incidence=INCIDENCE)
+    assert np.isnan(table.iloc[0]["max_wind"]) and table.iloc[0]["moves"] == 2
+
+
+@pytest.mark.parametrize("log, message", [
+    (LOG.iloc[:0], "the log has no steps"),  # KeyError: "None of ['date'] are in the columns"
+    (LOG.drop(columns="sky"), "the log has no 'sky' column"),  # KeyError: 'sky'
+    (LOG.drop(columns=["wind_speed", "dni"]), "the log has no 'dni', 'wind_speed' column"),
+    (LOG.to_dict("list"), "the log must be a run's log, a DataFrame on a DatetimeIndex; got dict"),  # AttributeError
+    (LOG.reset_index(drop=True), "a DataFrame on a DatetimeIndex; got DataFrame"),
+])
+def test_a_log_the_daily_table_cannot_count_is_refused_by_name(log, message):
+    from hybridtrack.errors import HybridtrackError
+
+    with pytest.raises(HybridtrackError, match=message):
+        daily(log, collector="trough-ns", tz="Asia/Shanghai", sun_up=SUN_UP[:len(log)], incidence=INCIDENCE)
