@@ -239,3 +239,21 @@ def test_the_components_of_a_clear_day_add_up_and_a_dead_pyrheliometer_is_named(
 def test_hourly_components_are_not_judged_for_closure():
     report = read_weather("tests/records/lanzhou.epw", site="lanzhou").attrs["validation"]
     assert report["closure"].startswith("not judged (steps of 1h")
+
+
+@pytest.mark.parametrize("options, message", [
+    (dict(columns=5), "--map must map quantities to text, e.g. {'ghi': 'Global'}; got int"),  # TypeError
+    (dict(columns=["ghi"]), "--map must map quantities to text.*got list"),  # ValueError
+    (dict(columns={"dni": 3}), "--map dni: give text.*got 3"),  # AttributeError
+    (dict(units="kW/m2"), "--units must map quantities to text, e.g. {'ghi': 'kW/m2'}; got str"),  # "column 'k'"
+    (dict(units={"ghi": 1000}), "--units ghi: give text"),
+    (dict(strict="no"), "read_weather: strict must be True or False, got 'no'"),  # read as True
+    (dict(lenient="no"), "read_weather: lenient must be True or False, got 'no'"),  # taken as it came
+    (dict(dayfirst="no"), r"read_weather: dayfirst must be True or False \(or None\), got 'no'"),
+])
+def test_read_weathers_options_of_another_kind_are_refused_by_name(tmp_path, options, message):
+    path = tmp_path / "plain.csv"
+    path.write_text(PLAIN)
+    with pytest.raises(HybridtrackError, match=message):
+        read_weather(path, tz="UTC", **options)
+    read_weather(path, tz="UTC", columns={"ghi": "ghi"}, units={"ghi": "W/m2"}, strict=False, dayfirst=None)

@@ -97,11 +97,19 @@ def split_header(header: str) -> tuple[str, str | None, str | None]:
 
 
 def check_names(mapping: Mapping[str, str], flag: str) -> None:
-    """Refuse a mapping that names an unknown quantity (``--units beam=...``)."""
+    """Refuse a mapping that names an unknown quantity (``--units beam=...``), or is no mapping of
+    quantities to text (from Python: ``units="kW/m2"`` had been read letter by letter, a list or a
+    number raised Python's own errors)."""
+    example = "{'ghi': 'Global'}" if flag == "--map" else "{'ghi': 'kW/m2'}"
+    if not isinstance(mapping, Mapping):
+        raise HybridtrackError(f"{flag} must map quantities to text, e.g. {example}; got {type(mapping).__name__} "
+                               f"{mapping!r:.40}")
     allowed = ("time", *WEATHER_COLUMNS) if flag == "--map" else WEATHER_COLUMNS
-    for name in mapping:
+    for name, value in mapping.items():
         if name not in allowed:
-            raise HybridtrackError(f"unknown column name {name!r} in {flag}; use {', '.join(allowed)}")
+            raise HybridtrackError(f"unknown column name {name!r:.40} in {flag}; use {', '.join(allowed)}")
+        if not isinstance(value, str):
+            raise HybridtrackError(f"{flag} {name}: give text, e.g. {example}; got {value!r:.40}")
 
 
 #: The longest column name read as a quantity's: the longest aliases with a unit and a note

@@ -375,6 +375,16 @@ def _wind(frame: pd.DataFrame, attrs: dict, report: dict) -> pd.DataFrame:
     return frame
 
 
+def _check_switches(*, dayfirst, **switches) -> None:
+    """Refuse a switch of `read_weather` that is not True or False (`dayfirst` may be None): ``strict="no"``
+    had been read as True, ``lenient="no"`` and ``dayfirst="no"`` taken as they came."""
+    given = {**switches, **({} if dayfirst is None else {"dayfirst": dayfirst})}
+    for name, value in given.items():
+        if not isinstance(value, (bool, np.bool_)):
+            raise HybridtrackError(f"read_weather: {name} must be True or False"
+                                   f"{' (or None)' if name == 'dayfirst' else ''}, got {value!r:.40}")
+
+
 def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | None = None, format: str | None = None,
                  site=None, units: Mapping[str, str] | None = None, freq: str | None = None,
                  decomposition: str = "erbs", strict: bool = False, dayfirst: bool | None = None,
@@ -427,7 +437,10 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
     path = input_path(path, "weather file")
     if tz is not None:
         check_tz(tz)
-    check_names(units or {}, "--units")
+    check_names({} if units is None else units, "--units")
+    if columns is not None:
+        check_names(columns, "--map")
+    _check_switches(strict=strict, lenient=lenient, dayfirst=dayfirst)
     site = get(site) if site is not None else None
     report: dict = {"source": str(path)}
     text, report["read_as"] = file_text(path, report=report)
