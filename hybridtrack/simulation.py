@@ -545,7 +545,9 @@ def simulate(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-
     ----------
     frame : pandas.DataFrame
         A weather frame (``dni``; ``dhi``, ``wind_speed``, a recorded ``photocurrent`` and the
-        true ``sky`` when there are) on a tz-aware, increasing index.
+        true ``sky`` when there are) on a tz-aware, increasing index. Without ``dhi`` (or where it
+        is NaN) the sky gives no diffuse light: no bright cloud patch in the sensor's view
+        (`hybridtrack.io.read_weather` derives a file's DHI from its GHI and DNI, and counts it).
     site : Site or str
     collector : str or Collector
         ``trough-ns``, ``trough-ew``, ``fresnel`` or ``heliostat``, or a `Collector` with

@@ -897,6 +897,10 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
 
 #: The columns whose missing readings a streamed run counts (`KeptAsRead`).
 COUNTED_COLUMNS = ("dni", "dhi", "ghi", "wind_speed", "photocurrent")
+#: Columns the run takes as a missing reading at every step when the file has none: the world's
+#: sky then gives no diffuse light, as for a NaN reading (a file without DHI had run with its
+#: missing counts empty, where 21 NaN DHI rows of another were counted).
+ABSENT_AS_MISSING = ("dhi",)
 #: A step longer than this many times the weather's typical step is a gap, as the record reader
 #: counts them (`hybridtrack.io.checks`).
 GAP_STEPS = 1.5
@@ -921,8 +925,8 @@ class KeptAsRead:
     def add(self, frame: pd.DataFrame) -> None:
         """Count a day's frame, the day after the one counted before it."""
         for column in COUNTED_COLUMNS:
-            if column in frame:
-                missing = frame[column].isna().to_numpy()
+            if column in frame or column in ABSENT_AS_MISSING:
+                missing = frame[column].isna().to_numpy() if column in frame else np.ones(len(frame), bool)
                 if missing.any():
                     count, first = self.missing.get(column, (0, frame.index[int(np.argmax(missing))]))
                     self.missing[column] = (count + int(missing.sum()), first)

@@ -760,3 +760,18 @@ def test_a_span_of_part_days_is_refused_holding_one_day_at_a_time(tmp_path):
         stream(source, tmp_path / "run")
     assert len(alive) == 5 and max(alive) <= 1, alive  # the day before at most, while the next is read
     assert not (tmp_path / "run").exists()
+
+
+def test_a_streamed_file_without_dhi_counts_every_reading_missing(tmp_path, capsys):
+    """The run takes a file's absent DHI as no diffuse light at every step, as a NaN reading: each
+    is counted (a file without the column had run with nothing counted, helper-35)."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-20", "2021-06-21", weather="mixed", freq="15min", seed=1)
+    frame.drop(columns=["dhi"]).to_csv(tmp_path / "weather.csv", index_label="time")
+    assert main(["replay", str(tmp_path / "weather.csv"), "--site", SITE, "--stream", "--out",
+                 str(tmp_path / "run")]) == 0
+    assert f"kept as read: {len(frame)} missing dhi readings (the first at 2021-06-20 00:00:00+08:00)" \
+        in capsys.readouterr().out
+    report = json.loads((tmp_path / "run" / "summary.json").read_text())["streamed"]["kept_as_read"]
+    assert report["missing"]["dhi"] == {"count": len(frame), "first": "2021-06-20 00:00:00+08:00"}
