@@ -11,6 +11,7 @@ import gzip
 import io
 import zipfile
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -257,3 +258,36 @@ def test_read_weathers_options_of_another_kind_are_refused_by_name(tmp_path, opt
     with pytest.raises(HybridtrackError, match=message):
         read_weather(path, tz="UTC", **options)
     read_weather(path, tz="UTC", columns={"ghi": "ghi"}, units={"ghi": "W/m2"}, strict=False, dayfirst=None)
+
+
+def _two_days(tmp_path, second_day_factor: float, dni_second_day: float | None = None):
+    """Two clear days at Lanzhou, 30 min, in W/m²; the second day's light times a factor."""
+    rows = []
+    for day, factor in (("2021-06-21", 1.0), ("2021-06-22", second_day_factor)):
+        for half in range(48):
+            hour = half / 2
+            light = max(0.0, 1000.0 * np.sin(np.pi * (hour - 6.5) / 14.0)) if 6.5 <= hour <= 20.5 else 0.0
+            dni = 0.85 * light if dni_second_day is None or day == "2021-06-21" else dni_second_day * (light > 0)
+            rows.append(f"{day} {int(hour):02d}:{30 * (half % 2):02d},{light * factor:.4f},{dni * factor:.4f},"
+                        f"{0.12 * light * factor:.4f},2.0\n")
+    path = tmp_path / "two_days.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed\n" + "".join(rows))
+    return path
+
+
+def test_a_file_whose_second_day_is_in_kw_is_refused_at_that_days_line(tmp_path, capsys):
+    """Judged over the whole file, a second day in kW/m² hid behind the first's W/m²: the file was
+    called clean and its replay refused by the run without a file or line (helper-35)."""
+    path = _two_days(tmp_path, 1e-3)
+    with pytest.raises(HybridtrackError, match=r"two_days\.csv: line (6[6-9]|[7-9]\d), column 'ghi': ghi is at most "
+                                               r"[\d.]+ while the clear sky reaches \d+ W/m².*unit changes within it"):
+        read_weather(path, site="lanzhou", tz="Asia/Shanghai")
+    assert main(["check", str(path), "--site", "lanzhou", "--tz", "Asia/Shanghai"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_a_day_of_a_dead_pyrheliometer_in_a_longer_file_is_still_read(tmp_path):
+    """The day-by-day judgement is of kW/m² only: a day of DNI at 0 beside a W/m² GHI and DHI (a
+    pyrheliometer off for a day) is a sensor's outage the closure check counts, not a unit."""
+    frame = read_weather(_two_days(tmp_path, 1.0, dni_second_day=0.0), site="lanzhou", tz="Asia/Shanghai")
+    assert len(frame) == 96

@@ -30,7 +30,7 @@ from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
 __all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude",
-           "check_derived", "refuse_repairs"]
+           "check_magnitude_by_day", "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
 LIMITS = {"ghi": (-50.0, 1500.0), "dni": (-50.0, 1400.0), "dhi": (-50.0, 1000.0), "wind_speed": (-0.5, 75.0),
@@ -210,7 +210,7 @@ JUDGED_FROM = 300.0
 
 
 def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
-                    remedy: str = "give the unit (--units {name}=kW/m2)") -> None:
+                    remedy: str = "give the unit (--units {name}=kW/m2)", dark: bool = True) -> None:
     """Refuse irradiance a thousand times too small (kW/m² read as W/m²), or darker than any sky.
 
     In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
@@ -219,9 +219,11 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
     reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
     judged so only in a file without GHI and DHI, since an overcast day has none. With a site,
     GHI or DHI that stays darker than any sky while the sun is high is refused too
-    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column).
+    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column). Without
+    `dark`, only kW/m² is judged: not a sky too dark nor a dead pyrheliometer, which a day of a
+    sensor's outage in a longer file shows (`check_magnitude_by_day`).
     """
-    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi)
+    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi, dead=dark)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
     judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
     for name in judged:
@@ -242,8 +244,24 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
         if suspicious:
             raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
                                    f"{remedy.format(name=name)}")
-        if clear_ghi is not None:
+        if clear_ghi is not None and dark:
             _refuse_too_dark(where, frame, name, top, clear_ghi)
+
+
+def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz) -> None:
+    """`check_magnitude`'s kW/m² judgement on each local day (in zone `tz`) of a file longer than
+    a day, as `hybridtrack.simulate` judges a frame: a file whose second day was in kW/m² had been
+    called clean (the first day's W/m² above the limit), and its replay then refused by the run
+    with no file or line named. A unit that changes within a day is not seen."""
+    days = np.asarray(frame.index.tz_convert(tz).normalize().asi8)
+    if len(days) < 2 or days[0] == days[-1]:
+        return
+    starts = np.concatenate([[0], np.flatnonzero(days[1:] != days[:-1]) + 1, [len(days)]])
+    for start, stop in zip(starts[:-1], starts[1:]):
+        if stop - start >= 2:  # the whole file passed: some other day is in W/m²
+            check_magnitude(path, frame.iloc[start:stop], report, clear_ghi[start:stop], dark=False,
+                            remedy="the file's other days are in W/m², so its unit changes within it: convert "
+                                   "this day's {name} to W/m² (×1000)")
 
 
 def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, clear_ghi: np.ndarray) -> None:
@@ -287,12 +305,12 @@ def horizontal_beam(frame: pd.DataFrame, clear_ghi: np.ndarray | None) -> tuple[
 
 
 def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict, remedy: str,
-                                  clear_ghi: np.ndarray | None) -> None:
+                                  clear_ghi: np.ndarray | None, *, dead: bool = True) -> None:
     """Refuse DNI of at most 1.5 while GHI shows a direct beam of `BEAM_SEEN` W/m² or more
     (`horizontal_beam`): kW/m² beside W/m² columns had been read as W/m², the file called clean,
     and a clear day replayed as overcast (the magnitude check judges DNI alone only without GHI
-    and DHI). Without DHI a DNI of 0 all day is refused too (a dead pyrheliometer): DHI derived
-    from it is GHI itself, and no closure check can see it."""
+    and DHI). Without DHI a DNI of 0 all day is refused too (a dead pyrheliometer), unless not
+    `dead`: DHI derived from it is GHI itself, and no closure check can see it."""
     if not {"ghi", "dni"} <= set(frame.columns):
         return
     beam = horizontal_beam(frame, clear_ghi)
@@ -300,7 +318,7 @@ def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict,
     if beam is None or not (np.isfinite(dni).any() and np.isfinite(beam[0]).any()):
         return
     top, seen = float(np.nanmax(dni)), float(np.nanmax(beam[0]))
-    lowest = 0.0 if "dhi" in frame else -np.inf
+    lowest = 0.0 if "dhi" in frame or not dead else -np.inf
     if lowest < top <= KILOWATT_TOP and seen >= BEAM_SEEN:
         header = report.get("columns", {}).get("dni", "dni")
         why = ("is the pyrheliometer dead or off the sun? remove the column from the file to derive DNI from GHI"

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
-from .checks import check_frame, check_magnitude, refuse_repairs
+from .checks import check_frame, check_magnitude, check_magnitude_by_day, refuse_repairs
 from .closure import closure_check
 from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, name_shown,
                       not_read, resolve_columns, split_header)
@@ -478,6 +478,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         zenith = solar_position(frame.index, site, model="plc")["apparent_zenith"]  # a magnitude check: PLC is ample
         clear = pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float)
         check_magnitude(path, frame, report, clear)
+        check_magnitude_by_day(path, frame, report, clear, site.tz)
         sun_check(path, frame, site, report, lenient=lenient)
         closure_check(path, frame, zenith.to_numpy(float), report, strict=strict)
     else:
