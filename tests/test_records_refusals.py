@@ -291,3 +291,24 @@ def test_a_day_of_a_dead_pyrheliometer_in_a_longer_file_is_still_read(tmp_path):
     pyrheliometer off for a day) is a sensor's outage the closure check counts, not a unit."""
     frame = read_weather(_two_days(tmp_path, 1.0, dni_second_day=0.0), site="lanzhou", tz="Asia/Shanghai")
     assert len(frame) == 96
+
+
+def test_sky_labels_rewritten_or_blank_are_counted_and_labels_of_no_sky_found(tmp_path, capsys):
+    """The reader writes a file's true-sky labels in lower case without spaces and reads a blank
+    one as missing: each is counted in the report (it had said "changes: none"), and labels that
+    name no sky are found, kept (helper-35)."""
+    labels = ["Sunny", " cloudy ", "", "partly cloudy", "overcast"]
+    path = tmp_path / "sky.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed,sky\n" + "".join(
+        f"{row.split(',', 1)[0]},{row.split(',', 1)[1].strip()},{label}\n"
+        for row, label in zip(ROWS.splitlines(), labels)))
+    frame = read_weather(path, tz="UTC")
+    assert frame["sky"].tolist()[:2] == ["sunny", "cloudy"] and pd.isna(frame["sky"].iloc[2])
+    report = frame.attrs["validation"]
+    assert report["sky_rewritten"]["count"] == 2 and report["sky_rewritten"]["lines"] == [2, 3]
+    assert report["sky_blank"] == {"count": 1, "lines": [4], "action": "read as missing"}
+    assert report["sky_unknown"]["count"] == 1 and report["sky_unknown"]["first"] == "'partly cloudy' (line 5)"
+    assert main(["check", str(path), "--tz", "UTC"]) == 0
+    out = capsys.readouterr().out
+    assert "rewritten (sky labels in lower case, without spaces): count 2, lines 2, 3" in out
+    assert "sky labels that name no sky: count 1, first 'partly cloudy' (line 5)" in out

@@ -19,7 +19,7 @@ ISSUES = ("unreadable", "missing_markers", "truncated", "short_rows", "dst_dropp
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
              "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING",
-             "nights_left_out": "nights left out"}
+             "nights_left_out": "nights left out", "sky_unknown": "sky labels that name no sky"}
 
 _CHANGES = {
     "padding": "dropped (NUL bytes after the text: a logger card's unwritten tail)",
@@ -32,6 +32,8 @@ _CHANGES = {
     "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",
     "empty_dropped": "dropped (irradiance column without a readable value)", "filled": "filled",
     "nights_filled": "put back (the nights the logger left out, --fill-nights)",
+    "sky_rewritten": "rewritten (sky labels in lower case, without spaces)",
+    "sky_blank": "set to missing (blank sky labels)",
 }
 
 

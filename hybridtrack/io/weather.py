@@ -332,9 +332,34 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
         report["header_notes"] = notes
     label = next((h for h in table.headers if split_header(h)[0] == LABEL_COLUMN), None)
     if label is not None:
-        frame[LABEL_COLUMN] = pd.Series(cells(label)).str.strip().str.lower().replace({"": np.nan}).to_numpy()
+        frame[LABEL_COLUMN] = _sky_labels(cells(label), np.asarray(table.lines), report)
     frame["_line"] = table.lines.astype(float)
     return frame[keep], meta
+
+
+def _sky_labels(cells: list, lines: np.ndarray, report: dict) -> np.ndarray:
+    """A file's true-sky labels as the runs read them, written in lower case without the spaces
+    around them, a blank one missing; each change counted in `report` (``sky_rewritten``,
+    ``sky_blank``), and labels that name no sky (`SKY_CODES`: kept, a run reads them as unknown
+    and the hybrid-oracle policy refuses them) found (``sky_unknown``). They had been rewritten
+    without a word ("changes: none")."""
+    from ..control import SKY_CODES
+
+    raw = pd.Series(cells, dtype=object)
+    labels = raw.str.strip().str.lower()
+    given = raw.notna().to_numpy()
+    blank = given & (labels == "").to_numpy()
+    rewritten = given & ~blank & (labels != raw).to_numpy()
+    unknown = given & ~blank & ~labels.isin(SKY_CODES).to_numpy()
+    for key, where, action in (("sky_rewritten", rewritten, "written in lower case without spaces"),
+                               ("sky_blank", blank, "read as missing")):
+        if where.any():
+            report[key] = {"count": int(where.sum()), "lines": [int(v) for v in lines[where][:5]], "action": action}
+    if unknown.any():
+        first = int(np.argmax(unknown))
+        report["sky_unknown"] = {"count": int(unknown.sum()), "first": f"{labels.iloc[first]!r:.40} (line {lines[first]})",
+                                 "action": "kept (read as unknown; the hybrid-oracle policy refuses them)"}
+    return labels.where(~blank, np.nan).to_numpy(object)
 
 
 def _read_pvlib_as_told(path: Path, fmt: str, tz, report: dict, text: str, encoding: str):
