@@ -316,8 +316,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     separator = csv_separator(path) if suffix == ".csv" else None
     measured = _measured(path, separator, ("dni", "wind_speed"))
     if "dni" not in measured:
-        raise HybridtrackError(f"{path}: column 'dni' is missing or holds no number; {CONVERT_ONCE}, which derives "
-                               "it from GHI and DHI")
+        raise HybridtrackError(_without_dni(path, separator))
     steps = None
     if suffix == ".csv":
 
@@ -359,6 +358,35 @@ SEPARATORS = (",", ";", "\t")
 #: What a streamed file's stamp trouble is refused with: the way to a file that streams.
 CONVERT_ONCE = ("a streamed file is read as written: convert a record once with hybridtrack check FILE --out "
                 "clean.parquet (hybridtrack.io.read_weather(...).to_parquet(...) from Python)")
+
+
+def _without_dni(path: Path, separator: str | None) -> str:
+    """Why a streamed file has no DNI to run on, in its own words: no column named ``dni`` (a
+    header with a unit, ``dni [kW/m2]``, names none), or one whose first value is not a number
+    (a decimal comma), or one with no value at all. The one reason given for each ("missing or
+    holds no number ... which derives it from GHI and DHI") had sent a file of decimal commas to
+    derive a DNI it had."""
+    try:
+        if separator is None:
+            import pyarrow.parquet as pq
+
+            head = pq.ParquetFile(path).schema_arrow.names
+            first = None
+        else:
+            table = pd.read_csv(path, sep=separator, nrows=CHUNK_ROWS, dtype=str, keep_default_na=False)
+            head = list(table.columns)
+            given = table["dni"][table["dni"].str.strip() != ""] if "dni" in table.columns else table.iloc[:0, 0]
+            first = (int(given.index[0]) + 2, given.iloc[0]) if len(given) else None
+    except Exception:  # the run's own read says what is wrong, by row
+        head, first = [], None
+    if "dni" not in head:
+        shown = ", ".join(repr(name) for name in head[:8]) + (", ..." if len(head) > 8 else "")
+        return (f"{path}: no column 'dni' (the columns are {shown or 'unreadable'}): a streamed file names its columns "
+                f"as a weather frame does, in its units (W/m², no unit in the name); {CONVERT_ONCE}")
+    if first is not None:
+        return (f"{path}: row {first[0]}, column 'dni': {first[1]!r:.40} is not a number (a decimal comma, or a "
+                f"unit in the cell?); {CONVERT_ONCE}")
+    return f"{path}: column 'dni' holds no number; {CONVERT_ONCE}, which derives it from GHI and DHI"
 
 
 def csv_separator(path: Path) -> str:

@@ -449,9 +449,15 @@ def test_stamps_whose_offset_changes_are_instants_and_a_semicolon_file_streams(t
 
 @pytest.mark.parametrize("name, text, message", [
     ("header.csv", "time,dni\n", "header.csv: holds no time steps"),
-    ("no-dni.csv", "time,ghi\n2021-06-21T00:00:00+08:00,0\n", "column 'dni' is missing or holds no number"),
+    ("no-dni.csv", "time,ghi\n2021-06-21T00:00:00+08:00,0\n", "no column 'dni' (the columns are 'time', 'ghi')"),
     ("dead-dni.csv", "time,dni,ghi\n2021-06-21T00:00:00+08:00,,0\n2021-06-21T00:01:00+08:00,,0\n",
-     "column 'dni' is missing or holds no number"),
+     "column 'dni' holds no number"),
+    # a decimal comma and a unit in the header had been sent to derive DNI from GHI and DHI (helper-35)
+    ("comma.csv", "time;dni;ghi\n2021-06-21T00:00:00+08:00;;0\n2021-06-21T00:01:00+08:00;0,5;0\n",
+     "comma.csv: row 3, column 'dni': '0,5' is not a number (a decimal comma, or a unit in the cell?)"),
+    ("unit.csv", "time,dni [kW/m2]\n2021-06-21T00:00:00+08:00,0.5\n",
+     "no column 'dni' (the columns are 'time', 'dni [kW/m2]'): a streamed file names its columns as a weather frame "
+     "does, in its units"),
     ("folder.csv", None, "is a folder, not a weather file"),
 ])
 def test_an_empty_or_folder_streamed_file_is_one_line(tmp_path, capsys, name, text, message):
