@@ -87,7 +87,7 @@ class Sweep:
     def from_toml(cls, path) -> Sweep:
         from .io import read_toml
 
-        return cls.from_dict(read_toml(path, "sweep"), source=str(path))
+        return cls.from_dict(read_toml(path, "sweep", optional=False), source=str(path))
 
     @classmethod
     def from_dict(cls, data: dict, *, source: str = "sweep") -> Sweep:
@@ -107,7 +107,8 @@ class Sweep:
         _refuse_given_twice(base, config, source)
         _check_base(base, config, grid, source)
         if not grid:
-            raise HybridtrackError(f"{source}: [grid] is empty; give at least one key with a list of values")
+            said = "is empty" if "grid" in data else "is missing"
+            raise HybridtrackError(f"{source}: [grid] {said}; give at least one key with a list of values")
         for key, values in grid.items():
             _check_key(key, source, "grid")
             if not isinstance(values, list) or not values:

@@ -93,6 +93,18 @@ def test_bad_sweeps_are_refused_before_any_run(data, message):
         Sweep.from_dict(data, source="s.toml")
 
 
+@pytest.mark.parametrize("text, message", [
+    ("", r"s.toml: the sweep file is empty; a sweep file needs its tables"),  # "leave it out for the defaults"
+    ("[base]\nseed = 1\n", r"s.toml: \[grid\] is missing; give at least one key"),  # "[grid] is empty"
+    ("[grid]\n", r"s.toml: \[grid\] is empty; give at least one key"),
+])
+def test_an_empty_sweep_file_or_grid_is_told_what_it_needs(tmp_path, text, message):
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    with pytest.raises(HybridtrackError, match=message):
+        Sweep.from_toml(path)
+
+
 @pytest.mark.parametrize("key, value, message", [
     ("days", [1], "HybridtrackError: grid.days = [1]: days must be a whole number from 1 to 3660, got [1]"),
     ("freq", ["1min"], "HybridtrackError: grid.freq = ['1min']: freq must be a step such as '1min' or '10s', "

@@ -241,9 +241,11 @@ def _tomllib():
     return tomllib
 
 
-def read_toml(path, what: str = "config") -> dict:
+def read_toml(path, what: str = "config", *, optional: bool = True) -> dict:
     """A TOML file as a dict, or one clear error naming the file (missing, empty, not UTF-8, bad
-    TOML). A file of comments alone is read, as an empty table: someone wrote it."""
+    TOML). A file of comments alone is read, as an empty table: someone wrote it. An empty file
+    of a kind the command can do without (`optional`, a config) is told to be left out; one it
+    cannot (a sweep) is told what it needs."""
     tomllib = _tomllib()
     path = input_path(path, f"{what} file")
     raw = read_bytes(path, f"{what} file", MAX_CONFIG_BYTES)
@@ -253,7 +255,8 @@ def read_toml(path, what: str = "config") -> dict:
     except UnicodeDecodeError as exc:
         raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start + mark})") from None
     if not text.strip():  # a write cut short, or `> run.toml` by mistake: it had run the defaults unsaid
-        raise HybridtrackError(f"{path}: the {what} file is empty; leave it out for the defaults")
+        raise HybridtrackError(f"{path}: the {what} file is empty; "
+                               + ("leave it out for the defaults" if optional else f"a {what} file needs its tables"))
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
