@@ -64,7 +64,8 @@ def test_dst_fall_back_and_spring_forward(tmp_path):
     frame = read_weather(path, tz="America/New_York")
     dropped = frame.attrs["validation"]["dst_dropped"]
     assert dropped["count"] == 2 and dropped["lines"] == [6, 7] and len(frame) == 7
-    assert "dropped (DST: stamps that do not exist): count 2, lines 6, 7" in validation_report(frame)
+    assert ("dropped (DST: stamps that do not exist, or repeated ones their order could not place): count 2, "
+            "lines 6, 7") in validation_report(frame)
 
 
 def test_missing_dni_by_closure_or_decomposition(tmp_path):
