@@ -280,7 +280,7 @@ def test_a_file_whose_second_day_is_in_kw_is_refused_at_that_days_line(tmp_path,
     called clean and its replay refused by the run without a file or line (helper-35)."""
     path = _two_days(tmp_path, 1e-3)
     with pytest.raises(HybridtrackError, match=r"two_days\.csv: line (6[6-9]|[7-9]\d), column 'ghi': ghi is at most "
-                                               r"[\d.]+ while the clear sky reaches \d+ W/m².*unit changes within it"):
+                                               r"[\d.]+ while the clear sky reaches \d+ W/m².*if its unit changes within the file"):
         read_weather(path, site="lanzhou", tz="Asia/Shanghai")
     assert main(["check", str(path), "--site", "lanzhou", "--tz", "Asia/Shanghai"]) == 2
     assert capsys.readouterr().err.count("\n") == 1

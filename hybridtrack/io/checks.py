@@ -252,7 +252,8 @@ def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_
     """`check_magnitude`'s kW/m² judgement on each local day (in zone `tz`) of a file longer than
     a day, as `hybridtrack.simulate` judges a frame: a file whose second day was in kW/m² had been
     called clean (the first day's W/m² above the limit), and its replay then refused by the run
-    with no file or line named. A unit that changes within a day is not seen."""
+    with no file or line named (a day of a dead sensor's noise, 1 W/m² at most, is refused so too,
+    by the reader as by the run). A unit that changes within a day is not seen."""
     days = np.asarray(frame.index.tz_convert(tz).normalize().asi8)
     if len(days) < 2 or days[0] == days[-1]:
         return
@@ -260,8 +261,8 @@ def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_
     for start, stop in zip(starts[:-1], starts[1:]):
         if stop - start >= 2:  # the whole file passed: some other day is in W/m²
             check_magnitude(path, frame.iloc[start:stop], report, clear_ghi[start:stop], dark=False,
-                            remedy="the file's other days are in W/m², so its unit changes within it: convert "
-                                   "this day's {name} to W/m² (×1000)")
+                            remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
+                                   "if its unit changes within the file, or make it empty if the sensor was dead")
 
 
 def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, clear_ghi: np.ndarray) -> None:
