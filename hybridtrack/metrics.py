@@ -407,22 +407,35 @@ class RunningSummary:
                         shares=_shares_from_counts(self.modes, self.sky, self.steps))
 
 
-#: The log columns the daily table reads besides the scored ones (`SCORED_COLUMNS`).
-DAILY_COLUMNS = ("sky", "wind_speed")
+#: The log columns the daily table reads besides the scored ones (`SCORED_COLUMNS`): a heliostat's
+#: ``angle_azimuth`` too, where the log has it (`moved_axes`).
+DAILY_COLUMNS = ("sky", "wind_speed", "angle")
+#: The columns of those that hold numbers.
+_NUMBER_COLUMNS = ("dni", "error", "wind_speed", "angle")
 
 
 def _check_daily_log(log) -> None:
-    """Refuse what `daily` cannot make days of, by name: a log that is no frame on a time index,
-    has no steps, or lacks a column it reads (pandas' KeyError and AttributeError had come out)."""
+    """Refuse what `daily` cannot make days of, by name: a log that is no frame on a tz-aware,
+    increasing time index, has no steps, lacks a column it reads (without ``angle`` every day's
+    moves had been 0), names one twice, or holds text where numbers belong (pandas' KeyError,
+    TypeError and ValueError had come out; a reversed log gave NaN energy capture each day)."""
     if not isinstance(log, pd.DataFrame) or not isinstance(log.index, pd.DatetimeIndex):
         raise HybridtrackError(f"daily: the log must be a run's log, a DataFrame on a DatetimeIndex; got "
                                f"{type(log).__name__}")
     if not len(log):
         raise HybridtrackError("daily: the log has no steps, so no day to count")
+    if log.index.tz is None or not log.index.is_monotonic_increasing:
+        raise HybridtrackError("daily: the log's index must be tz-aware and increasing, as a run's is")
     missing = [c for c in (*SCORED_COLUMNS, *DAILY_COLUMNS) if c not in log.columns]
     if missing:
         raise HybridtrackError(f"daily: the log has no {', '.join(map(repr, missing))} column; a run's log has "
                                f"{', '.join((*SCORED_COLUMNS, *DAILY_COLUMNS))}")
+    repeated = log.columns[log.columns.duplicated()]
+    if len(repeated):
+        raise HybridtrackError(f"daily: the log has the column {repeated[0]!r} more than once")
+    for column in _NUMBER_COLUMNS:
+        if not pd.api.types.is_numeric_dtype(log[column].dtype) or pd.api.types.is_bool_dtype(log[column].dtype):
+            raise HybridtrackError(f"daily: the log's column {column!r} must hold numbers, got dtype {log[column].dtype}")
 
 
 def _highest(values: np.ndarray) -> float:

@@ -496,6 +496,9 @@ def daily(result, log: pd.DataFrame | None = None) -> pd.DataFrame:
     from .metrics import daily as daily_table
 
     log = result.log if log is None else log
+    if not isinstance(log, pd.DataFrame) or not isinstance(log.index, pd.DatetimeIndex):
+        raise HybridtrackError(f"daily: log must be part of the run's log, a DataFrame on its time index; got "
+                               f"{type(log).__name__}")
     sun_up, incidence = _true_sun(result, log.index)
     return daily_table(log, collector=result.collector.kind, tz=result.site.tz, sun_up=sun_up, incidence=incidence)
 

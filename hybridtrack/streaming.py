@@ -375,7 +375,7 @@ def _without_dni(path: Path, separator: str | None) -> str:
         else:
             table = pd.read_csv(path, sep=separator, nrows=CHUNK_ROWS, dtype=str, keep_default_na=False)
             head = list(table.columns)
-            given = table["dni"][table["dni"].str.strip() != ""] if "dni" in table.columns else table.iloc[:0, 0]
+            given = table["dni"][~table["dni"].map(_reads_as_number)] if "dni" in table.columns else table.iloc[:0, 0]
             first = (int(given.index[0]) + 2, given.iloc[0]) if len(given) else None
     except Exception:  # the run's own read says what is wrong, by row
         head, first = [], None
@@ -387,6 +387,16 @@ def _without_dni(path: Path, separator: str | None) -> str:
         return (f"{path}: row {first[0]}, column 'dni': {first[1]!r:.40} is not a number (a decimal comma, or a "
                 f"unit in the cell?); {CONVERT_ONCE}")
     return f"{path}: column 'dni' holds no number; {CONVERT_ONCE}, which derives it from GHI and DHI"
+
+
+def _reads_as_number(cell: str) -> bool:
+    """Whether a CSV cell is a number to pandas, or empty: ``NaN`` and ``inf`` are numbers, if no
+    reading; ``0,5`` is not."""
+    try:
+        float(cell.strip() or "nan")
+    except ValueError:
+        return False
+    return True
 
 
 def csv_separator(path: Path) -> str:

@@ -133,6 +133,12 @@ def test_a_day_without_a_wind_reading_has_no_highest_wind_and_no_warning():
     (LOG.drop(columns=["wind_speed", "dni"]), "the log has no 'dni', 'wind_speed' column"),
     (LOG.to_dict("list"), "the log must be a run's log, a DataFrame on a DatetimeIndex; got dict"),  # AttributeError
     (LOG.reset_index(drop=True), "a DataFrame on a DatetimeIndex; got DataFrame"),
+    (LOG.tz_localize(None), "the log's index must be tz-aware and increasing"),  # TypeError (helper-36)
+    (LOG.iloc[::-1], "the log's index must be tz-aware and increasing"),  # NaN energy capture each day
+    (LOG.drop(columns="angle"), "the log has no 'angle' column"),  # every day's moves 0
+    (LOG.assign(dni="x"), "the log's column 'dni' must hold numbers"),  # ValueError
+    (LOG.assign(wind_speed="calm"), "the log's column 'wind_speed' must hold numbers"),
+    (pd.concat([LOG, LOG[["dni"]]], axis=1), "the log has the column 'dni' more than once"),  # broadcast error
 ])
 def test_a_log_the_daily_table_cannot_count_is_refused_by_name(log, message):
     from hybridtrack.errors import HybridtrackError

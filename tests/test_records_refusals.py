@@ -312,3 +312,57 @@ def test_sky_labels_rewritten_or_blank_are_counted_and_labels_of_no_sky_found(tm
     out = capsys.readouterr().out
     assert "rewritten (sky labels in lower case, without spaces): count 2, lines 2, 3" in out
     assert "sky labels that name no sky: count 1, first 'partly cloudy' (line 5)" in out
+
+
+def _days_file(tmp_path, name: str, frame: pd.DataFrame, columns: list[str]) -> "Path":
+    path = tmp_path / name
+    frame[columns].to_csv(path, index_label="time")
+    return path
+
+
+def _lanzhou_days(days: int = 4) -> pd.DataFrame:
+    from hybridtrack.sky import synthetic
+
+    return synthetic("lanzhou", "2021-06-20", pd.Timestamp("2021-06-20") + pd.Timedelta(days=days - 1),
+                     weather="sunny", freq="30min", seed=2)
+
+
+def test_a_utc_loggers_day_in_kw_is_refused_at_its_line(tmp_path):
+    """A logger on UTC at a site eight hours east changes its unit on its own day, whose W/m² hours
+    had kept each of the site's days above the limit: judged on the logger's days too (helper-36)."""
+    frame = _lanzhou_days().tz_convert("UTC")
+    day = frame.index.normalize() == pd.Timestamp("2021-06-21", tz="UTC")
+    frame.loc[day, ["ghi", "dni", "dhi"]] /= 1000.0
+    path = _days_file(tmp_path, "utc.csv", frame.tz_localize(None), ["ghi", "dni", "dhi", "wind_speed"])
+    with pytest.raises(HybridtrackError, match=r"utc\.csv: line \d+, column 'ghi': ghi is at most"):
+        read_weather(path, site="lanzhou", tz="UTC")
+
+
+def test_a_kw_dni_day_beside_ghi_is_refused_at_its_line(tmp_path):
+    frame = _lanzhou_days()
+    day = frame.index.normalize() == pd.Timestamp("2021-06-21", tz=frame.index.tz)
+    frame.loc[day, "dni"] /= 1000.0
+    path = _days_file(tmp_path, "dni.csv", frame, ["ghi", "dni", "dhi", "wind_speed"])
+    with pytest.raises(HybridtrackError, match=r"dni\.csv: line \d+, column 'dni': dni is at most [\d.]+ while ghi - dhi"):
+        read_weather(path, site="lanzhou")
+
+
+def test_a_dni_only_file_with_an_overcast_day_of_noise_gets_its_own_reason(tmp_path):
+    """DNI alone is not judged day by day (an overcast day has none): the file is refused for what
+    it lacks, as before the day-by-day check (which had called it kW/m², helper-36)."""
+    frame = _lanzhou_days()
+    day = frame.index.normalize() == pd.Timestamp("2021-06-21", tz=frame.index.tz)
+    frame.loc[day, "dni"] = np.where(frame.loc[day, "dni"] > 0, 1.2, 0.0)
+    path = _days_file(tmp_path, "dni_only.csv", frame, ["dni", "wind_speed"])
+    with pytest.raises(HybridtrackError, match="only dni given; need GHI, or two of GHI, DNI, DHI"):
+        read_weather(path, site="lanzhou")
+
+
+def test_strict_refuses_rewritten_sky_labels_and_labels_of_no_sky_are_an_issue(tmp_path, capsys):
+    path = tmp_path / "sky.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed,sky\n" + "".join(
+        f"{row},{label}\n" for row, label in zip(ROWS.splitlines(), ["Sunny", "cloudy", "0", "sunny", "sunny"])))
+    with pytest.raises(HybridtrackError, match="a sky label in capitals or with spaces"):
+        read_weather(path, tz="UTC", strict=True)
+    assert main(["check", str(path), "--tz", "UTC"]) == 0
+    assert "verdict: usable, with 1 kind of issue noted above" in capsys.readouterr().out

@@ -455,6 +455,8 @@ def test_stamps_whose_offset_changes_are_instants_and_a_semicolon_file_streams(t
     # a decimal comma and a unit in the header had been sent to derive DNI from GHI and DHI (helper-35)
     ("comma.csv", "time;dni;ghi\n2021-06-21T00:00:00+08:00;;0\n2021-06-21T00:01:00+08:00;0,5;0\n",
      "comma.csv: row 3, column 'dni': '0,5' is not a number (a decimal comma, or a unit in the cell?)"),
+    ("nan.csv", "time,dni\n2021-06-21T00:00:00+08:00,NaN\n2021-06-21T00:01:00+08:00,inf\n",
+     "column 'dni' holds no number"),  # had been "'NaN' is not a number" (helper-36)
     ("unit.csv", "time,dni [kW/m2]\n2021-06-21T00:00:00+08:00,0.5\n",
      "no column 'dni' (the columns are 'time', 'dni [kW/m2]'): a streamed file names its columns as a weather frame "
      "does, in its units"),

@@ -94,7 +94,7 @@ def test_bad_sweeps_are_refused_before_any_run(data, message):
 
 
 @pytest.mark.parametrize("text, message", [
-    ("", r"s.toml: the sweep file is empty; a sweep file needs its tables"),  # "leave it out for the defaults"
+    ("", r"s.toml: the sweep file is empty; a sweep file needs a \[grid\] table at least"),  # "leave it out for the defaults"
     ("[base]\nseed = 1\n", r"s.toml: \[grid\] is missing; give at least one key"),  # "[grid] is empty"
     ("[grid]\n", r"s.toml: \[grid\] is empty; give at least one key"),
 ])

@@ -60,6 +60,7 @@ REPAIRS = {
     "short_rows": "a line with fewer fields than the header",
     "missing_markers": "a logger's missing-value marker",
     "dst_dropped": "a time stamp that does not exist in the time zone",
+    "sky_rewritten": "a sky label in capitals or with spaces", "sky_blank": "a blank sky label",
     "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",
     "impossible": "a physically impossible value", "negative_clipped": "a negative irradiance",
     "calm_clipped": "a negative wind reading", "empty_dropped": "an irradiance column without a readable value",
@@ -221,11 +222,12 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
     GHI or DHI that stays darker than any sky while the sun is high is refused too
     (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column). Without
     `dark`, only kW/m² is judged: not a sky too dark nor a dead pyrheliometer, which a day of a
-    sensor's outage in a longer file shows (`check_magnitude_by_day`).
+    sensor's outage in a longer file shows (`check_magnitude_by_day`), nor DNI alone, which an
+    overcast day of a DNI-only file has none of.
     """
     _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi, dead=dark)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
-    judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame]
+    judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame and dark]
     for name in judged:
         values = frame[name].to_numpy(float)
         if not np.isfinite(values).any():
@@ -249,6 +251,15 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
 
 
 def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz) -> None:
+    """`_check_days` in the site's zone `tz` and, where the file's stamps are in another (a logger
+    on UTC at a site eight hours east), in theirs: a logger changes its unit on its own day, whose
+    W/m² hours had kept each of the site's days above the limit."""
+    zones = [tz] + ([frame.index.tz] if str(frame.index.tz) != str(tz) else [])
+    for zone in zones:
+        _check_days(path, frame, report, clear_ghi, zone)
+
+
+def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz) -> None:
     """`check_magnitude`'s kW/m² judgement on each local day (in zone `tz`) of a file longer than
     a day, as `hybridtrack.simulate` judges a frame: a file whose second day was in kW/m² had been
     called clean (the first day's W/m² above the limit), and its replay then refused by the run
@@ -324,8 +335,10 @@ def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict,
         header = report.get("columns", {}).get("dni", "dni")
         why = ("is the pyrheliometer dead or off the sun? remove the column from the file to derive DNI from GHI"
                if top <= 0.0 else f"the values look like kW/m² read as W/m²: {remedy.format(name='dni')}")
-        raise HybridtrackError(f"{path}: column {header!r}: dni is at most {top:g} while {beam[1]} {seen:.0f} "
-                               f"W/m² (a direct beam); {why}")
+        line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(beam[0]))) if "_line" in frame else []
+        where = f"{path}: line {line[0]}, column {header!r}" if line else f"{path}: column {header!r}"
+        raise HybridtrackError(f"{where}: dni is at most {top:g} while {beam[1]} {seen:.0f} W/m² (a direct beam); "
+                               f"{why}")
 
 
 def check_derived(path: Path, frame: pd.DataFrame, name: str, report: dict) -> None:

@@ -102,8 +102,9 @@ def check_names(mapping: Mapping[str, str], flag: str) -> None:
     number raised Python's own errors)."""
     example = "{'ghi': 'Global'}" if flag == "--map" else "{'ghi': 'kW/m2'}"
     if not isinstance(mapping, Mapping):
+        shown = " ".join(repr(mapping).split())  # one line, whatever its repr spans
         raise HybridtrackError(f"{flag} must map quantities to text, e.g. {example}; got {type(mapping).__name__} "
-                               f"{mapping!r:.40}")
+                               f"{shown:.40}")
     allowed = ("time", *WEATHER_COLUMNS) if flag == "--map" else WEATHER_COLUMNS
     for name, value in mapping.items():
         if name not in allowed:

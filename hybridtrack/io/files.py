@@ -256,7 +256,7 @@ def read_toml(path, what: str = "config", *, optional: bool = True) -> dict:
         raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start + mark})") from None
     if not text.strip():  # a write cut short, or `> run.toml` by mistake: it had run the defaults unsaid
         raise HybridtrackError(f"{path}: the {what} file is empty; "
-                               + ("leave it out for the defaults" if optional else f"a {what} file needs its tables"))
+                               + ("leave it out for the defaults" if optional else f"a {what} file needs a [grid] table at least"))
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

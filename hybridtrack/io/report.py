@@ -15,7 +15,7 @@ __all__ = ["validation_report", "ISSUES"]
 
 #: Report keys that make the verdict "usable, with issues" rather than "clean".
 ISSUES = ("unreadable", "missing_markers", "truncated", "short_rows", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
-          "impossible", "light_at_night", "wind_missing", "empty_dropped")
+          "impossible", "light_at_night", "wind_missing", "empty_dropped", "sky_unknown")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
              "light_at_night": "light while the sun is down (kept)", "wind_missing": "wind: MISSING",
