@@ -434,7 +434,7 @@ def _check_daily_log(log) -> None:
     if len(repeated):
         raise HybridtrackError(f"daily: the log has the column {repeated[0]!r} more than once")
     for column in _NUMBER_COLUMNS:
-        if not pd.api.types.is_numeric_dtype(log[column].dtype) or pd.api.types.is_bool_dtype(log[column].dtype):
+        if not params.real_numbers(log[column].dtype):
             raise HybridtrackError(f"daily: the log's column {column!r} must hold numbers, got dtype {log[column].dtype}")
 
 

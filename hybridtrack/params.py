@@ -146,6 +146,13 @@ def path(value, what: str) -> Path:
     return Path(os.path.expanduser(text))
 
 
+def real_numbers(dtype) -> bool:
+    """Whether a column of `dtype` holds real numbers: numeric, and neither True/False nor complex
+    (both pass pandas' ``is_numeric_dtype``)."""
+    types = pd.api.types
+    return types.is_numeric_dtype(dtype) and not types.is_bool_dtype(dtype) and not types.is_complex_dtype(dtype)
+
+
 def _real(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 

@@ -493,8 +493,7 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
     controller must survive (`hybridtrack.faults`), so it runs; `hybridtrack.io.read_weather`
     repairs files."""
     values = frame[column]
-    if not pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(values.dtype) \
-            or pd.api.types.is_complex_dtype(values.dtype):
+    if not params.real_numbers(values.dtype):
         raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
     if column in RECORDED_POINTING:
         _pointing_column(frame, column)

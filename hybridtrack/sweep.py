@@ -87,7 +87,7 @@ class Sweep:
     def from_toml(cls, path) -> Sweep:
         from .io import read_toml
 
-        return cls.from_dict(read_toml(path, "sweep", optional=False), source=str(path))
+        return cls.from_dict(read_toml(path, "sweep", if_empty="a sweep file needs a [grid] table at least"), source=str(path))
 
     @classmethod
     def from_dict(cls, data: dict, *, source: str = "sweep") -> Sweep:

@@ -26,6 +26,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from ..sky import LIGHT_AT_NIGHT
+from ..times import DAY_NS, clock_nanoseconds
 from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
@@ -211,7 +212,7 @@ JUDGED_FROM = 300.0
 
 
 def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,
-                    remedy: str = "give the unit (--units {name}=kW/m2)", dark: bool = True) -> None:
+                    remedy: str = "give the unit (--units {name}=kW/m2)", whole_file: bool = True) -> None:
     """Refuse irradiance a thousand times too small (kW/m² read as W/m²), or darker than any sky.
 
     In kW/m² a day's largest reading is at most 1.4; in W/m² the darkest overcast still gives
@@ -220,14 +221,14 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
     reaches 300 W/m² during the file, or, without a site, when the file spans six hours. DNI is
     judged so only in a file without GHI and DHI, since an overcast day has none. With a site,
     GHI or DHI that stays darker than any sky while the sun is high is refused too
-    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column). Without
-    `dark`, only kW/m² is judged: not a sky too dark nor a dead pyrheliometer, which a day of a
+    (`_refuse_too_dark`). `remedy` ends the kW/m² message (``{name}`` is the column). Not on the
+    `whole_file` (on one day of it), only kW/m² is judged: not a sky too dark nor a dead pyrheliometer, which a day of a
     sensor's outage in a longer file shows (`check_magnitude_by_day`), nor DNI alone, which an
     overcast day of a DNI-only file has none of.
     """
-    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi, dead=dark)
+    _refuse_dni_in_kw_beside_beam(path, frame, report, remedy, clear_ghi, whole_file=whole_file)
     hours = (frame.index[-1] - frame.index[0]) / pd.Timedelta(hours=1)
-    judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame and dark]
+    judged = [name for name in ("ghi", "dhi") if name in frame] or [name for name in ("dni",) if name in frame and whole_file]
     for name in judged:
         values = frame[name].to_numpy(float)
         if not np.isfinite(values).any():
@@ -246,7 +247,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
         if suspicious:
             raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
                                    f"{remedy.format(name=name)}")
-        if clear_ghi is not None and dark:
+        if clear_ghi is not None and whole_file:
             _refuse_too_dark(where, frame, name, top, clear_ghi)
 
 
@@ -265,13 +266,13 @@ def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nda
     called clean (the first day's W/m² above the limit), and its replay then refused by the run
     with no file or line named (a day of a dead sensor's noise, 1 W/m² at most, is refused so too,
     by the reader as by the run). A unit that changes within a day is not seen."""
-    days = np.asarray(frame.index.tz_convert(tz).normalize().asi8)
+    days = clock_nanoseconds(frame.index.tz_convert(tz)) // DAY_NS  # the local calendar's day
     if len(days) < 2 or days[0] == days[-1]:
         return
     starts = np.concatenate([[0], np.flatnonzero(days[1:] != days[:-1]) + 1, [len(days)]])
     for start, stop in zip(starts[:-1], starts[1:]):
         if stop - start >= 2:  # the whole file passed: some other day is in W/m²
-            check_magnitude(path, frame.iloc[start:stop], report, clear_ghi[start:stop], dark=False,
+            check_magnitude(path, frame.iloc[start:stop], report, clear_ghi[start:stop], whole_file=False,
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
 
@@ -317,12 +318,12 @@ def horizontal_beam(frame: pd.DataFrame, clear_ghi: np.ndarray | None) -> tuple[
 
 
 def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict, remedy: str,
-                                  clear_ghi: np.ndarray | None, *, dead: bool = True) -> None:
+                                  clear_ghi: np.ndarray | None, *, whole_file: bool = True) -> None:
     """Refuse DNI of at most 1.5 while GHI shows a direct beam of `BEAM_SEEN` W/m² or more
     (`horizontal_beam`): kW/m² beside W/m² columns had been read as W/m², the file called clean,
     and a clear day replayed as overcast (the magnitude check judges DNI alone only without GHI
-    and DHI). Without DHI a DNI of 0 all day is refused too (a dead pyrheliometer), unless not
-    `dead`: DHI derived from it is GHI itself, and no closure check can see it."""
+    and DHI). Without DHI a DNI of 0 all day is refused too (a dead pyrheliometer), on the
+    `whole_file` only: DHI derived from it is GHI itself, and no closure check can see it."""
     if not {"ghi", "dni"} <= set(frame.columns):
         return
     beam = horizontal_beam(frame, clear_ghi)
@@ -330,7 +331,7 @@ def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict,
     if beam is None or not (np.isfinite(dni).any() and np.isfinite(beam[0]).any()):
         return
     top, seen = float(np.nanmax(dni)), float(np.nanmax(beam[0]))
-    lowest = 0.0 if "dhi" in frame or not dead else -np.inf
+    lowest = 0.0 if "dhi" in frame or not whole_file else -np.inf
     if lowest < top <= KILOWATT_TOP and seen >= BEAM_SEEN:
         header = report.get("columns", {}).get("dni", "dni")
         why = ("is the pyrheliometer dead or off the sun? remove the column from the file to derive DNI from GHI"

@@ -241,11 +241,11 @@ def _tomllib():
     return tomllib
 
 
-def read_toml(path, what: str = "config", *, optional: bool = True) -> dict:
+def read_toml(path, what: str = "config", *, if_empty: str = "leave it out for the defaults") -> dict:
     """A TOML file as a dict, or one clear error naming the file (missing, empty, not UTF-8, bad
     TOML). A file of comments alone is read, as an empty table: someone wrote it. An empty file
-    of a kind the command can do without (`optional`, a config) is told to be left out; one it
-    cannot (a sweep) is told what it needs."""
+    is told `if_empty`: to be left out, for a file the command can do without (a config); what it
+    needs, for one it cannot (a sweep)."""
     tomllib = _tomllib()
     path = input_path(path, f"{what} file")
     raw = read_bytes(path, f"{what} file", MAX_CONFIG_BYTES)
@@ -255,8 +255,7 @@ def read_toml(path, what: str = "config", *, optional: bool = True) -> dict:
     except UnicodeDecodeError as exc:
         raise HybridtrackError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start + mark})") from None
     if not text.strip():  # a write cut short, or `> run.toml` by mistake: it had run the defaults unsaid
-        raise HybridtrackError(f"{path}: the {what} file is empty; "
-                               + ("leave it out for the defaults" if optional else f"a {what} file needs a [grid] table at least"))
+        raise HybridtrackError(f"{path}: the {what} file is empty; {if_empty}")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
