@@ -111,6 +111,9 @@ def check_names(mapping: Mapping[str, str], flag: str) -> None:
             raise HybridtrackError(f"unknown column name {name!r:.40} in {flag}; use {', '.join(allowed)}")
         if not isinstance(value, str):
             raise HybridtrackError(f"{flag} {name}: give text, e.g. {example}; got {value!r:.40}")
+        if flag == "--units" and not value.strip():  # had been taken as no unit given, without a word
+            raise HybridtrackError(f"{flag} {name}: the unit is empty; give one, e.g. {example}, or leave {name} out "
+                                   "to read the header's")
 
 
 #: The longest column name read as a quantity's: the longest aliases with a unit and a note
