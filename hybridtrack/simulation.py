@@ -503,9 +503,12 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
     with np.errstate(invalid="ignore"):
         bad = np.flatnonzero(np.isinf(array) | (array > NOT_LIGHT[column]))
     if len(bad):
-        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g} "
-                               f"{_UNITS[column]} is not light (over {NOT_LIGHT[column]:,.0f}: a unit mixed up?); read "
-                               "files with hybridtrack.io.read_weather, which flags and counts such values")
+        value = array[bad[0]]
+        why = "no reading (infinite)" if value == -np.inf else \
+            f"not light (over {NOT_LIGHT[column]:,.0f}: a unit mixed up?)"  # -inf had been called "over 14,080"
+        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {value:g} "
+                               f"{_UNITS[column]} is {why}; read files with hybridtrack.io.read_weather, which flags "
+                               "and counts such values")
 
 
 #: Degrees: the largest offset a recorded pointing signal can give, the sun at the horizon of a

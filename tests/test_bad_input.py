@@ -475,6 +475,7 @@ def _small_day():
     (lambda f: f.assign(ghi=f["ghi"].astype(str)), "column 'ghi' must hold numbers"),  # TypeError in the kW check
     (lambda f: f.assign(ghi=f["ghi"].astype(object).where(f["ghi"] < 500, "abc")), "column 'ghi' must hold numbers"),
     (lambda f: f.assign(ghi=math.inf), "column 'ghi' at .*: inf W/m² is not light"),  # blamed dni as kW/m²
+    (lambda f: f.assign(ghi=-math.inf), r"column 'ghi' at .*: -inf W/m² is no reading \(infinite\)"),  # "over 14,080"
 ])
 def test_a_weather_frame_of_no_light_or_no_names_is_refused_in_one_line(frame, message):
     with pytest.raises(HybridtrackError, match=message):
