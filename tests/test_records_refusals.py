@@ -315,6 +315,17 @@ def test_sky_labels_rewritten_or_blank_are_counted_and_labels_of_no_sky_found(tm
     assert "sky labels that name no sky: count 1, first 'partly cloudy' (line 5)" in out
 
 
+def test_a_second_sky_column_is_said_not_read(tmp_path):
+    """Of two sky columns (``sky`` and ``Sky``) the first is read; the second had been passed over
+    without a word, listed neither as read nor as not read."""
+    path = tmp_path / "skies.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed,sky,Sky\n" + "".join(
+        f"{row.split(',', 1)[0]},{row.split(',', 1)[1].strip()},sunny,OVERCAST\n" for row in ROWS.splitlines()))
+    frame = read_weather(path, tz="UTC")
+    assert set(frame["sky"]) == {"sunny"}
+    assert frame.attrs["validation"]["not_read"] == ["'Sky' (looks like sky; the first, 'sky', is read)"]
+
+
 def _days_file(tmp_path, name: str, frame: pd.DataFrame, columns: list[str]) -> "Path":
     path = tmp_path / name
     frame[columns].to_csv(path, index_label="time")

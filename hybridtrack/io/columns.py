@@ -19,7 +19,7 @@ from ..errors import HybridtrackError, quoted_cut
 from .units import any_known_unit
 
 __all__ = ["WEATHER_COLUMNS", "IRRADIANCE", "LABEL_COLUMN", "ALIASES", "UNNAMED", "STAMP_PARTS", "split_header",
-           "resolve_columns", "check_names", "not_read"]
+           "resolve_columns", "check_names", "not_read", "label_header"]
 
 #: The columns of a weather frame, in order.
 WEATHER_COLUMNS = ("ghi", "dni", "dhi", "wind_speed", "temp_air", "photocurrent", "pointing", "pointing_2")
@@ -179,14 +179,21 @@ def not_read(headers: list[str], mapping: Mapping[str, str]) -> list[str]:
     """The named columns no quantity was read from, each with the quantity its name looks like
     when it has one (``'ghi' (looks like ghi)``: a ``--map ghi=OTHER`` left the file's own ghi
     unread), for the report: a column the reading passes over is said, not dropped unseen."""
-    taken = set(mapping.values())
+    taken = {*mapping.values(), label_header(headers)}  # a second sky column had been passed over unsaid
     shown = []
     for header in headers:
-        if header in taken or not header.strip() or split_header(header)[0] == LABEL_COLUMN:
+        if header in taken or not header.strip():
             continue
         like = next((name for name in WEATHER_COLUMNS if _matches(header, name)), None)
+        if like is None and split_header(header)[0] == LABEL_COLUMN:
+            like = f"{LABEL_COLUMN}; the first, {name_shown(label_header(headers))}, is read"
         shown.append(name_shown(header) + (f" (looks like {like})" if like else ""))
     return shown
+
+
+def label_header(headers: list[str]) -> str | None:
+    """The header of the true-sky labels: the first named `LABEL_COLUMN` (``'Sky'``, ``'sky [label]'``)."""
+    return next((h for h in headers if split_header(h)[0] == LABEL_COLUMN), None)
 
 
 def _stamp_parts(headers: list[str], taken: set, mapping: dict[str, str]) -> bool:

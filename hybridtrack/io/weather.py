@@ -19,8 +19,8 @@ import pandas as pd
 from ..errors import HybridtrackError
 from .checks import check_frame, check_magnitude, check_magnitude_by_day, refuse_repairs
 from .closure import closure_check
-from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, name_shown,
-                      not_read, resolve_columns, split_header)
+from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, label_header,
+                      name_shown, not_read, resolve_columns, split_header)
 from .files import file_text
 from .formats import PVLIB_FORMATS, RECOGNISED_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
@@ -330,7 +330,7 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
         report["units_converted"] = conversions
     if notes:
         report["header_notes"] = notes
-    label = next((h for h in table.headers if split_header(h)[0] == LABEL_COLUMN), None)
+    label = label_header(table.headers)
     if label is not None:
         frame[LABEL_COLUMN] = _sky_labels(cells(label), np.asarray(table.lines), report)
     frame["_line"] = table.lines.astype(float)
