@@ -7,6 +7,8 @@ pyranometer's raw millivolts (9.52 µV per W/m², a CMP11's sensitivity), hourly
 
 from __future__ import annotations
 
+import re
+
 import pandas as pd
 import pvlib
 import pytest
@@ -130,3 +132,36 @@ def test_a_derived_component_beyond_the_limits_is_counted_and_most_of_it_refused
     with pytest.raises(HybridtrackError, match=r"^x\.csv: line 2, dhi derived from the other components is outside "
                                                r"-50\.\.1000 W/m² in 2 of 3 daylight rows, first 1100"):
         check_derived("x.csv", bright, "dhi", {})
+
+
+def _clear_day_ghi() -> pd.Series:
+    return clear_sky("2021-06-21", "2021-06-22", "10min")["ghi"].iloc[:-1]
+
+
+def test_a_morning_in_kilowatts_beside_an_afternoon_in_watts_is_refused(tmp_path, capsys):
+    """A logger whose unit changed within the day (its morning in kW/m², its afternoon in W/m²)
+    had passed as a dark morning: the day's top in W/m² kept the whole-day judgements quiet. The
+    hours in kW/m² are refused naming the first of their lines and a line in W/m² beside them."""
+    ghi = _clear_day_ghi()
+    morning = ghi.index.hour < 12
+    path = write(tmp_path / "changed.csv", ghi.where(~morning, ghi / 1000.0).round(4))
+    message = refused(path, capsys, "changed.csv: line ", "column 'GHI': ghi reads ",
+                      "hours of a high sun, while the same day reads", "those hours look like kW/m² (a unit "
+                      "changed within the day): convert them to W/m² (×1000), or make them empty if the sensor failed")
+    lines = path.read_text().splitlines()
+    named = lines[int(re.search(r"line (\d+),", message).group(1)) - 1].split(",")
+    beside = lines[int(re.search(r"W/m² \(line (\d+)\)", message).group(1)) - 1].split(",")
+    assert pd.Timestamp(named[0]).hour < 12 and 0.02 <= float(named[1]) <= 1.5  # a morning line in kW/m²
+    assert pd.Timestamp(beside[0]).hour >= 12 and float(beside[1]) > 500  # an afternoon line in W/m²
+
+
+def test_hours_of_a_dead_sensor_beside_a_day_in_watts_are_read(tmp_path):
+    """A sensor that died for the morning reads its noise, zero and a little either side (here 0 to
+    0.9 W/m², negatives clipped): it is no unit, reads below 0.02 at times, and is read."""
+    ghi = _clear_day_ghi()
+    noise = pd.Series([0.0, 0.4, 0.9, 0.0, 0.2, 0.0], dtype=float)
+    dead = ghi.copy()
+    morning = (ghi.index.hour >= 8) & (ghi.index.hour < 12)
+    dead[morning] = noise.sample(int(morning.sum()), replace=True, random_state=1).to_numpy()
+    frame = read_weather(write(tmp_path / "dead.csv", dead.round(4)), site="lanzhou")
+    assert frame["ghi"].max() > 1000

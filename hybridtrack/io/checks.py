@@ -265,16 +265,58 @@ def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nda
     a day, as `hybridtrack.simulate` judges a frame: a file whose second day was in kW/m² had been
     called clean (the first day's W/m² above the limit), and its replay then refused by the run
     with no file or line named (a day of a dead sensor's noise, 1 W/m² at most, is refused so too,
-    by the reader as by the run). A unit that changes within a day is not seen."""
+    by the reader as by the run); then hours of a day in kW/m² (`_check_hours`)."""
     days = clock_nanoseconds(frame.index.tz_convert(tz)) // DAY_NS  # the local calendar's day
-    if len(days) < 2 or days[0] == days[-1]:
-        return
     starts = np.concatenate([[0], np.flatnonzero(days[1:] != days[:-1]) + 1, [len(days)]])
     for start, stop in zip(starts[:-1], starts[1:]):
-        if stop - start >= 2:  # the whole file passed: some other day is in W/m²
+        if stop - start >= 2 and len(starts) > 2:  # the whole file passed: some other day is in W/m²
             check_magnitude(path, frame.iloc[start:stop], report, clear_ghi[start:stop], whole_file=False,
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
+    _check_hours(path, frame, report, clear_ghi, days)
+
+
+def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, days: np.ndarray) -> None:
+    """Refuse GHI or DHI that reads like kW/m² (`DARKEST` / 1000 to `KILOWATT_TOP`) through
+    `HOURS_WELL_UP` hours of a high sun (clear sky `SUN_WELL_UP` W/m² or more) of a day (`days`,
+    a label per row) whose other readings under that sun are W/m² (above `KILOWATT_TOP`): a
+    logger whose unit changed within the day. No sky is so dark for so long (`_refuse_too_dark`),
+    and a dead sensor's noise reads below `DARKEST` / 1000 at times; such hours had passed as a
+    dark morning, the day's top in W/m² keeping the whole-day judgements quiet."""
+    high = np.asarray(clear_ghi) >= SUN_WELL_UP
+    hours = frame.index.as_unit("ns").asi8 // 3_600_000_000_000  # the hour each stamp is in
+    for name in [name for name in ("ghi", "dhi") if name in frame]:
+        values = frame[name].to_numpy(float)
+        judged = high & np.isfinite(values)
+        kilowatt = judged & (values >= DARKEST / 1000.0) & (values <= KILOWATT_TOP)
+        watts = judged & (values > KILOWATT_TOP)
+        if not (kilowatt.any() and watts.any()):
+            continue
+        counts = pd.DataFrame({"hour": hours, "day": days, "judged": judged, "kilowatt": kilowatt, "watts": watts}
+                              ).groupby("hour").agg(day=("day", "first"), judged=("judged", "sum"),
+                                                    kilowatt=("kilowatt", "sum"), watts=("watts", "sum"))
+        counts["in_kilowatts"] = (counts["judged"] > 0) & (counts["judged"] == counts["kilowatt"])
+        by_day = counts.groupby("day").agg(hours=("in_kilowatts", "sum"), watts=("watts", "sum"))
+        mixed = by_day.index[(by_day["hours"] >= HOURS_WELL_UP) & (by_day["watts"] > 0)]
+        if len(mixed):
+            _refuse_hours_in_kilowatts(path, frame, report, name, days == mixed[0],
+                                       np.isin(hours, counts.index[counts["in_kilowatts"]]) & kilowatt, watts)
+
+
+def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, day: np.ndarray,
+                               stretch: np.ndarray, watts: np.ndarray) -> None:
+    """`_check_hours`' refusal of `day`'s hours in kW/m² (`stretch`) beside its readings in W/m²."""
+    values = frame[name].to_numpy(float)
+    stretch, watts = stretch & day, watts & day
+    lines, other = first_lines(frame, stretch), first_lines(frame, watts)
+    header = report.get("columns", {}).get(name, name)
+    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    hours = len(np.unique(frame.index[stretch].as_unit("ns").asi8 // 3_600_000_000_000))
+    raise HybridtrackError(
+        f"{where}: {name} reads {np.min(values[stretch]):g} to {np.max(values[stretch]):g} through {hours} hours of "
+        f"a high sun, while the same day reads {np.max(values[watts]):g} W/m²{f' (line {other[0]})' if other else ''}: "
+        "those hours look like kW/m² (a unit changed within the day): convert them to W/m² (×1000), or make them "
+        "empty if the sensor failed")
 
 
 def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, clear_ghi: np.ndarray) -> None:
