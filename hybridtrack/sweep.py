@@ -791,9 +791,9 @@ def plot_tradeoff(table: pd.DataFrame, x: str = "moves", y: str = "rms", *, colo
         means = ok.groupby(colour, sort=True)[[x, y]].mean()
         ax.plot(means[x], means[y], marker="X", color="black", ls=":", lw=0.8, markersize=8,
                 label=f"mean over {ok['seed'].nunique()} seeds")
-        ax.legend(loc="best", fontsize="small")
     front = pareto_front(ok, x, y)
     ax.plot(front[x], front[y], color="tab:red", lw=1.2, drawstyle="steps-post", label="Pareto front", zorder=0)
+    ax.legend(loc="best", fontsize="small")  # after the front: its red line had gone unexplained
     ax.set_xlabel(x + (" (more is better)" if x in MAXIMISED else ""))
     ax.set_ylabel(y + (" (more is better)" if y in MAXIMISED else ""))
     failed = int(table["error"].notna().sum()) if "error" in table else 0

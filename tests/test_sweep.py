@@ -885,3 +885,14 @@ def test_compiles_first_is_the_kernel_taken_neither_compiled_nor_cached(monkeypa
         monkeypatch.setattr(kernel, "cached", lambda: cached_on_disk)
         assert kernel.compiles_first(config, 10) is expected
     assert kernel.compiles_first(SimulationConfig(engine="reference"), 10**9) is False
+
+
+@pytest.mark.parametrize("seeds", [[1], [1, 2]])
+def test_the_plots_legend_names_the_pareto_front(seeds):
+    """The front's red line is in the legend, with or without the mean over seeds (the legend had
+    been drawn before the front, and only where there were seeds to average)."""
+    table = pd.DataFrame([{"moves": 100 * (k + 1) + s, "rms": 0.3 / (k + 1) + 0.01 * s, "drive.deadband": 0.1 * k,
+                           "seed": s, "error": None} for k in range(3) for s in seeds])
+    figure = plot_tradeoff(table, "moves", "rms", colour="drive.deadband")
+    legend = figure.axes[0].get_legend()
+    assert legend is not None and "Pareto front" in [text.get_text() for text in legend.get_texts()]
