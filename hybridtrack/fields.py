@@ -476,7 +476,9 @@ class HeliostatField:
               aim: tuple[float, float, float] = DEFAULT_AIM, spread: ImperfectionSpread | None = None
               ) -> HeliostatField:
         """`count` heliostats on concentric rings round the tower's foot, `spacing` metres apart
-        along and between the rings, every other ring turned by half a place (a radial stagger)."""
+        along and between the rings, every other ring turned by half a place (a radial stagger).
+        The last ring's mirrors, fewer than it holds, stand evenly round it (they had filled its
+        places from north clockwise: the default dozen stood on an arc east of the tower)."""
         whole = isinstance(count, (int, np.integer)) and not isinstance(count, bool)
         if not whole or not 1 <= count <= MAX_HELIOSTATS:
             raise HybridtrackError(f"heliostat count must be a whole number from 1 to {MAX_HELIOSTATS}, got {count!r}")
@@ -485,15 +487,16 @@ class HeliostatField:
         if spacing < MIN_SPACING:
             raise HybridtrackError(f"heliostat spacing must be at least {MIN_SPACING:g} m (heliostats are built from "
                                    f"about 1 m² up: closer, mirrors would overlap), got {spacing:g}")
-        placed, ring = [], 0
-        while sum(len(p) for p in placed) < count:
+        placed, ring, left = [], 0, count
+        while left > 0:
             radius = first_radius + ring * spacing
-            places = _ring_places(radius, spacing)
+            places = min(_ring_places(radius, spacing), left)  # fewer: evenly round, farther apart
             angle = 2 * np.pi * (np.arange(places) + 0.5 * (ring % 2)) / places
+            left -= places
             placed.append(np.column_stack([radius * np.sin(angle), radius * np.cos(angle)]))
             ring += 1
         spread = spread if spread is not None else ImperfectionSpread()
-        positions = np.round(np.concatenate(placed)[:count], 9) + 0.0  # no 1e-15 m east of a mirror due south
+        positions = np.round(np.concatenate(placed), 9) + 0.0  # no 1e-15 m east of a mirror due south
         return cls(positions=positions, aim=aim, spread=spread)
 
     @property

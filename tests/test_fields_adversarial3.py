@@ -28,3 +28,15 @@ def test_rings_put_no_rounding_dust_in_positions():
     """A mirror due south had stood 7e-16 m east of the tower's line (the sine of a half turn)."""
     field = HeliostatField.rings(2, first_radius=6.0, spacing=12.0)
     np.testing.assert_array_equal(field.positions, [[0.0, 6.0, 0.0], [0.0, -6.0, 0.0]])
+
+
+def test_a_partial_last_ring_stands_evenly_round_the_tower():
+    """The default dozen had filled the first ring's 31 places from north clockwise: an arc east
+    of the tower. A ring with fewer mirrors than places spreads them evenly round it."""
+    field = HeliostatField.rings(12, first_radius=60.0, spacing=12.0)
+    bearings = np.sort(np.degrees(np.arctan2(*field.positions[:, :2].T)) % 360.0)
+    np.testing.assert_allclose(bearings, np.arange(12) * 30.0, atol=1e-9)
+    full_then_partial = HeliostatField.rings(31 + 5, first_radius=60.0, spacing=12.0)  # 2 r sin(π/31) = 12.13 m
+    outer = full_then_partial.positions[31:, :2]
+    np.testing.assert_allclose(np.hypot(*outer.T), 72.0)
+    np.testing.assert_allclose(np.sort(np.degrees(np.arctan2(*outer.T)) % 360.0), 36.0 + 72.0 * np.arange(5))
