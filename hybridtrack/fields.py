@@ -436,6 +436,7 @@ class HeliostatField:
                                    "position is not finite")
         if len(xyz) > MAX_HELIOSTATS:
             raise HybridtrackError(f"a heliostat field has at most {MAX_HELIOSTATS:,} mirrors, got {len(xyz):,}")
+        _refuse_far(np.abs(xyz) > MAX_DISTANCE)  # first: the overlap check squares them (1e200 m overflowed)
         _distinct(xyz, "heliostats", "m (east, north, up)")
         _refuse_overlapping(xyz)
         object.__setattr__(self, "positions", xyz)
@@ -456,10 +457,7 @@ class HeliostatField:
             got = f"shape {aims.shape}" if aims is not None else _brief(self.aims)
             raise HybridtrackError(f"heliostat aim points must be one (east, north, up) per heliostat, shape "
                                    f"{xyz.shape}; got {got}")
-        far = (np.abs(xyz) > MAX_DISTANCE).any(axis=1) | (np.abs(aims) > MAX_DISTANCE).any(axis=1)
-        if far.any():
-            raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
-                                   f"beyond {MAX_DISTANCE:g} m")
+        _refuse_far(np.abs(aims) > MAX_DISTANCE)
         aim = aims[0] if self.aims is None else aims.mean(axis=0)  # once near: a mean of 1e308s overflows
         relative = aims - xyz
         bad = ~np.isfinite(relative).all(axis=1) | (np.linalg.norm(relative, axis=1) == 0)
@@ -523,6 +521,14 @@ class HeliostatField:
     def targets(self, altitude, azimuth) -> np.ndarray:
         """Every mirror's nominal normal azimuth and elevation (T, N, 2), degrees."""
         return np.stack(normal_angles(self.normals(altitude, azimuth)), axis=-1)
+
+
+def _refuse_far(beyond: np.ndarray) -> None:
+    """Refuse the first heliostat with a coordinate (of its position or aim point) `beyond` the limit."""
+    far = beyond.any(axis=1)
+    if far.any():
+        raise HybridtrackError(f"heliostat {int(np.flatnonzero(far)[0]) + 1}: its position or aim point lies "
+                               f"beyond {MAX_DISTANCE:g} m")
 
 
 def _ring_places(radius: float, spacing: float) -> int:

@@ -71,6 +71,8 @@ def test_positions_files_in_a_spreadsheets_shapes_read_the_same(tmp_path):
     ("east,north\n0,-100\n50,1e400\n", [], "row 3, column 'north': inf is not a finite number"),
     ("east,north\nTrue,0\n", [], "row 2, column 'east': 'True' is not a number"),  # pandas read it as 1 m east
     ("east,north\n0,-100\n6000,0\n", [], "mirrors.csv: heliostat 2: its position or aim point lies beyond"),
+    # 1e200 m: the overlap check had squared it first (scipy's overflow ValueError, a traceback; helper-37)
+    ("east,north\n1e200,60\n-10,60\n", [], "mirrors.csv: heliostat 1: its position or aim point lies beyond"),
     ("# mirrors\neast,north\n0,-100\n50,abc\n", [], "row 4, column 'north': 'abc' is not a number"),
     # a row longer than its header had been read with its first field as the index: every mirror moved
     ("east,north\n0,-100,5\n30,-90,5\n", [], "line 2: 3 fields, but the header on line 1 names 2"),

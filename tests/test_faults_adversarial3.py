@@ -50,8 +50,9 @@ def test_an_encoder_frozen_before_the_first_move_still_stows_for_a_gust(engine):
     assert np.allclose(stowed, true_stow, atol=config.drive.resolution)
 
 
-@pytest.mark.parametrize("reading", [-5.0, -np.inf, 1e300, np.inf])
-def test_an_anemometer_reading_no_anemometer_gives_stows_and_says_so(reading):
+@pytest.mark.parametrize("reading, shown", [(-5.0, "-5.0"), (-np.inf, "-inf"), (1e300, "1e+300"), (np.inf, "inf"),
+                                            (-0.50001, "-0.50001"), (120.0001, "120.0001")])  # had read -0.5, 120
+def test_an_anemometer_reading_no_anemometer_gives_stows_and_says_so(reading, shown):
     """A cup anemometer reads no less than its zero offset (a few tenths below 0 in calm air) and no
     more than the strongest gust on record (113 m/s): -5 m/s is an open 4-20 mA loop, not calm, and
     1e300 m/s no wind. Both are missing readings: stow (the live controller's policy), in the same
@@ -67,7 +68,7 @@ def test_an_anemometer_reading_no_anemometer_gives_stows_and_says_so(reading):
     assert (modes[bad] == "stow_wind").all()
     stow = result.events[result.events["to"] == "stow_wind"]
     assert len(stow) == 1 and stow["time"].iloc[0] == frame.index[bad][0]
-    assert stow["reason"].iloc[0] == (f"wind reading {reading:.3g} m/s is no wind (an anemometer reads -0.5 to 120 m/s): "
+    assert stow["reason"].iloc[0] == (f"wind reading {shown} m/s is no wind (an anemometer reads -0.5 to 120 m/s): "
                                       "the instrument or its signal failed; counted as missing")
     assert result.summary["wind_data"] == "partly missing"
 

@@ -627,6 +627,14 @@ def test_a_far_aim_point_is_refused_before_any_arithmetic_overflows():
             HeliostatField(aim=(0.0, 0.0, 1e308))
 
 
+@pytest.mark.parametrize("positions", [[[1e200, 60.0], [-10.0, 60.0]], [[0.0, 60.0, 0.0], [10.0, 60.0, 1e300]]])
+def test_far_heliostats_are_refused_before_their_overlap_is_checked(positions):
+    """Mirrors 1e155 m and more away raised scipy's floating-point overflow from the overlap
+    check (a ValueError; helper-37): the distance is judged first."""
+    with pytest.raises(HybridtrackError, match="its position or aim point lies beyond 5000 m"):
+        HeliostatField(positions=positions)
+
+
 def test_a_table_of_heliostat_positions_is_read_by_its_columns_names():
     """It was read by the columns' order: id, east, north put every mirror 100 m underground."""
     table = pd.DataFrame({"id": [1, 2], "North": [-100.0, -90.0], "east": [0.0, 50.0]})

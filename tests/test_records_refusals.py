@@ -249,6 +249,9 @@ def test_hourly_components_are_not_judged_for_closure():
     (dict(units="kW/m2"), "--units must map quantities to text, e.g. {'ghi': 'kW/m2'}; got str"),  # "column 'k'"
     (dict(units={"ghi": 1000}), "--units ghi: give text"),
     (dict(units={"ghi": " "}), "--units ghi: the unit is empty; give one, e.g. {'ghi': 'kW/m2'}, or leave ghi out"),
+    (dict(columns={pd.NA: "dni"}), "unknown column name <NA> in --map"),  # TypeError (helper-37)
+    (dict(decomposition=pd.NA), "unknown decomposition <NA>; choose 'erbs' or 'dirint'"),  # TypeError
+    (dict(decomposition=np.array(["erbs", "x"])), "unknown decomposition array"),  # ValueError
     (dict(strict="no"), "read_weather: strict must be True or False, got 'no'"),  # read as True
     (dict(lenient="no"), "read_weather: lenient must be True or False, got 'no'"),  # taken as it came
     (dict(dayfirst="no"), r"read_weather: dayfirst must be True or False \(or None\), got 'no'"),

@@ -28,9 +28,10 @@ def unreadable(wind: float) -> bool:
 
 
 def unreadable_reason(wind: float) -> str:
-    """The stow's reason for a reading outside `READABLE`."""
-    return (f"wind reading {wind:.3g} m/s is no wind (an anemometer reads {READABLE[0]:g} to {READABLE[1]:g} m/s): "
-            "the instrument or its signal failed; counted as missing")
+    """The stow's reason for a reading outside `READABLE`, the reading written out exactly (in
+    three figures, -0.50001 and 120.0001 m/s had read as -0.5 and 120, readings that are wind)."""
+    return (f"wind reading {float(wind)!r} m/s is no wind (an anemometer reads {READABLE[0]:g} to "
+            f"{READABLE[1]:g} m/s): the instrument or its signal failed; counted as missing")
 
 
 class WindGuard:

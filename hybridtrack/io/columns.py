@@ -107,7 +107,7 @@ def check_names(mapping: Mapping[str, str], flag: str) -> None:
                                f"{shown:.40}")
     allowed = ("time", *WEATHER_COLUMNS) if flag == "--map" else WEATHER_COLUMNS
     for name, value in mapping.items():
-        if name not in allowed:
+        if not isinstance(name, str) or name not in allowed:  # pd.NA had raised TypeError
             raise HybridtrackError(f"unknown column name {name!r:.40} in {flag}; use {', '.join(allowed)}")
         if not isinstance(value, str):
             raise HybridtrackError(f"{flag} {name}: give text, e.g. {example}; got {value!r:.40}")

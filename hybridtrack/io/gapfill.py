@@ -100,7 +100,7 @@ def fill_components(path: Path, frame: pd.DataFrame, site, decomposition: str, a
     Perez, Ineichen, Maxwell, Seals & Zelenka (1992), ASHRAE Transactions 98(1) 354-369 (DIRINT);
     Holmgren, Hansen & Mikofski (2018), JOSS 3(29) 884, doi:10.21105/joss.00884 (pvlib).
     """
-    if decomposition not in DECOMPOSITIONS:
+    if not isinstance(decomposition, str) or decomposition not in DECOMPOSITIONS:  # pd.NA, an array: TypeError
         raise HybridtrackError(f"unknown decomposition {decomposition!r}; choose 'erbs' or 'dirint'")
     present = [name for name in IRRADIANCE if name in frame]
     for name in present:
