@@ -381,3 +381,39 @@ def test_strict_refuses_rewritten_sky_labels_and_labels_of_no_sky_are_an_issue(t
         read_weather(path, tz="UTC", strict=True)
     assert main(["check", str(path), "--tz", "UTC"]) == 0
     assert "verdict: usable, with 1 kind of issue noted above" in capsys.readouterr().out
+
+
+def _jittering_logger(tmp_path) -> "Path":
+    """A 1-minute logger whose clock stamps a second or two late now and then (median step 61 s)."""
+    start = pd.Timestamp("2021-06-21 10:00", tz="Asia/Shanghai")
+    late = [0, 1, 2, 0, 1, 0, 2, 1, 0, 1] * 6
+    rows = [f"{(start + pd.Timedelta(minutes=k, seconds=late[k])).isoformat()},{600 + k},{700 + k},{100 + k},2.0"
+            for k in range(60)]
+    path = tmp_path / "jitter.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def test_a_jittering_loggers_stamps_go_on_its_minute_not_on_their_median(tmp_path, capsys):
+    """Stamps a second or two late had made a 61 s median step, and the file was averaged onto
+    61-second steps (60 rows to 59, neighbouring minutes mixed; helper-37). They are put on the
+    logger's minute, each minute's value interpolated between the readings either side of it."""
+    frame = read_weather(_jittering_logger(tmp_path), site="lanzhou")
+    assert len(frame) == 60 and (frame.index == pd.date_range("2021-06-21 10:00", periods=60, freq="1min",
+                                                               tz="Asia/Shanghai")).all()
+    assert frame["ghi"].iloc[0] == 600.0  # on the grid already
+    # minute 2 (10:02): readings 602 at 10:02:02 and 601 at 10:01:01; 61 s apart, 59 s after the first
+    assert frame["ghi"].iloc[2] == pytest.approx(601 + 59 / 61)
+    resampled = frame.attrs["validation"]["resampled"]
+    assert resampled["method"].startswith("irregular stamps (median step 61s, a logger's 1min step): linear in time")
+    assert main(["check", str(_jittering_logger(tmp_path)), "--site", "lanzhou"]) == 0
+    assert "60 rows read, 60 rows out, step 61s read, 1min out" in capsys.readouterr().out
+
+
+def test_strict_refuses_stamps_it_would_put_on_a_grid(tmp_path):
+    """`--strict` refuses the first thing the reader would repair; irregular stamps, resampled
+    unasked, had passed it."""
+    with pytest.raises(HybridtrackError, match=r"jitter.csv: line 3: a time stamp off the file's 1min steps "
+                                               r"\(irregular stamps, which the reader would put on a grid\) \(strict\)"):
+        read_weather(_jittering_logger(tmp_path), strict=True)  # no site: its made-up light is not judged
+    read_weather(_jittering_logger(tmp_path), strict=True, freq="1min")  # asked for: taken

@@ -9,7 +9,10 @@ interpolated, resampled.
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
+
+from .checks import span
 
 __all__ = ["validation_report", "ISSUES"]
 
@@ -46,9 +49,19 @@ def _describe(value) -> str:
     return str(value)
 
 
+def _steps(report: dict, frame: pd.DataFrame) -> str:
+    """The file's step and, where the frame's differs (resampled), the frame's: the header had
+    named the file's step alone beside the rows put on another."""
+    read = report.get("step", "?")
+    if len(frame) < 2:
+        return f"step {read}"
+    out = span(pd.Timedelta(int(np.median(np.diff(frame.index.as_unit("ns").asi8))), "ns"))
+    return f"step {read}" if out == read else f"step {read} read, {out} out"
+
+
 def _head(report: dict, frame: pd.DataFrame) -> list[str]:
     lines = [f"{report.get('source', 'frame')}: {report.get('rows_read', len(frame))} rows read, "
-             f"{report.get('rows_out', len(frame))} rows out, step {report.get('step', '?')}",
+             f"{report.get('rows_out', len(frame))} rows out, {_steps(report, frame)}",
              f"  dates: {report.get('date_range', '?')}"]
     if "format" in report:
         lines.append(f"  format: {report['format'].upper()} (through pvlib), read as {report.get('read_as', '?')}")

@@ -25,7 +25,7 @@ from ..errors import HybridtrackError
 from .checks import span
 from .columns import LABEL_COLUMN, WEATHER_COLUMNS
 
-__all__ = ["resample"]
+__all__ = ["resample", "native_step", "logger_step", "LOGGER_STEPS"]
 
 
 def _segments(index: pd.DatetimeIndex, longest: pd.Timedelta) -> list[tuple[pd.Timestamp, pd.Timestamp]]:
@@ -73,14 +73,35 @@ def _left_empty(out: pd.DataFrame) -> dict:
     return {"empty": sum(by_column.values()), "empty_by_column": by_column}
 
 
+#: The steps loggers record at. Stamps that jitter about one of them (a logger's clock stamping a
+#: second late now and then) have a median step beside it (61 s): they are put on its grid, not on
+#: one of their median (a 1-minute file had been averaged onto 61-second steps, 300 rows to 295).
+LOGGER_STEPS = tuple(pd.Timedelta(step) for step in (
+    "1s", "2s", "5s", "10s", "15s", "20s", "30s", "1min", "2min", "3min", "5min", "10min", "15min", "20min",
+    "30min", "1h", "2h", "3h", "6h", "12h", "1D"))
+#: How far a median step may lie from a logger's step and be taken for it: a twentieth of it.
+LOGGER_STEP_TOLERANCE = 0.05
+
+
+def native_step(index: pd.DatetimeIndex) -> tuple[pd.Timedelta, bool]:
+    """The median step of `index` and whether every step is a whole number of it (gaps allowed)."""
+    steps = np.diff(index.as_unit("ns").asi8)
+    native = pd.Timedelta(int(np.median(steps)), "ns")
+    return native, bool(np.all(steps % native.value == 0))
+
+
+def logger_step(native: pd.Timedelta) -> pd.Timedelta:
+    """The logger's step (`LOGGER_STEPS`) within `LOGGER_STEP_TOLERANCE` of a median step, or the median."""
+    near = [step for step in LOGGER_STEPS if abs(native - step) <= LOGGER_STEP_TOLERANCE * step]
+    return near[0] if near else native
+
+
 def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -> pd.DataFrame:
     """`frame` on a regular grid of step `freq` (its own median step if None); see the module's notes."""
     from ..times import parse_freq
 
-    steps = np.diff(frame.index.as_unit("ns").asi8)
-    native = pd.Timedelta(int(np.median(steps)), "ns")
-    regular = bool(np.all(steps % native.value == 0))  # whole steps, gaps allowed
-    target = parse_freq(freq) if freq is not None else native
+    native, regular = native_step(frame.index)
+    target = parse_freq(freq) if freq is not None else (native if regular else logger_step(native))
     if pd.isna(target):
         raise HybridtrackError(f"step {freq!r} is not a duration such as '1min' or '10s'")
     if regular and target == native:
@@ -103,6 +124,8 @@ def resample(frame: pd.DataFrame, freq: str | None, report: dict, attrs: dict) -
         counts = {"rows": int(len(out)), "interpolated": int((new & out[columns].notna().any(axis=1)).sum())}
     if not regular:
         method = f"irregular stamps (median step {span(native)}): " + method
+        if freq is None and target != native:
+            method = method.replace("): ", f", a logger's {span(target)} step): ", 1)
     if out[columns].isna().all(axis=None):
         raise HybridtrackError(f"resampling to {span(target)} left no values; check the step (--freq/--step)")
     counts.update(_left_empty(out[columns]))

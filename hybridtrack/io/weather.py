@@ -17,14 +17,14 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
-from .checks import check_frame, check_magnitude, check_magnitude_by_day, refuse_repairs
+from .checks import check_frame, check_magnitude, check_magnitude_by_day, first_lines, refuse_repairs, span
 from .closure import closure_check
 from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, label_header,
                       name_shown, not_read, resolve_columns, split_header)
 from .files import file_text
 from .formats import PVLIB_FORMATS, RECOGNISED_FORMATS, detect_format, header_site, one_typical_year, read_pvlib
 from .gapfill import fill_components
-from .resample import resample
+from .resample import logger_step, native_step, resample
 from .stamps import CLOCK_ZONES, offset_in_name, parse_stamps
 from .suncheck import meta_name
 from .tables import COMMA_GROUPED, MISSING, UNITS_ROW_ZONE, Table, locate_table
@@ -337,6 +337,22 @@ def _read_csv(path: Path, text: str, columns, tz, units, site, dayfirst, strict,
     return frame[keep], meta
 
 
+def _refuse_irregular(path: Path, frame: pd.DataFrame) -> None:
+    """In strict mode, stamps off a regular grid (which `resample` would put on one, interpolating
+    their values) are refused at the first line off it: they had been resampled unasked."""
+    if len(frame) < 3:
+        return
+    native, regular = native_step(frame.index)
+    if regular:
+        return
+    step = logger_step(native)  # a jittering logger's: 61 s of median is its minute
+    stamps = frame.index.as_unit("ns").asi8
+    lines = first_lines(frame, (stamps - stamps[0]) % step.value != 0)
+    where = f"line {lines[0]}: " if lines else ""
+    raise HybridtrackError(f"{path}: {where}a time stamp off the file's {span(step)} steps (irregular stamps, which "
+                           "the reader would put on a grid) (strict)")
+
+
 def _sky_labels(cells: list, lines: np.ndarray, report: dict) -> np.ndarray:
     """A file's true-sky labels as the runs read them, written in lower case without the spaces
     around them, a blank one missing; each change counted in `report` (``sky_rewritten``,
@@ -510,6 +526,8 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         check_magnitude(path, frame, report, None)
     attrs: dict = {}
     frame = fill_components(path, frame, site, decomposition, attrs, report)
+    if strict and freq is None:
+        _refuse_irregular(path, frame)
     frame = resample(frame, freq, report, attrs)
     frame = _wind(frame, attrs, report)
     frame = frame[[c for c in (*WEATHER_COLUMNS, LABEL_COLUMN) if c in frame.columns]]
