@@ -625,3 +625,18 @@ def test_a_site_by_coordinates_is_refused_by_its_flag(flags, message, capsys):
 def test_replays_step_is_refused_by_its_flag_before_the_file_is_read(capsys):
     assert main(["replay", "no-such-file.csv", "--site", "lanzhou", "--step", "0min"]) == 2
     assert capsys.readouterr().err == "hybridtrack: error: --step: step '0min' must be positive\n"
+
+
+def test_a_replay_step_no_run_takes_is_refused_by_its_flag(tmp_path, capsys):
+    """`--step 1W` had printed the report of a file averaged onto weeks, then the run's refusal
+    naming the frame's median step; a step that leaves one row had said "the weather frame needs
+    at least two steps" (helper-37). Both name --step."""
+    assert main(["replay", "no-such-file.csv", "--site", "lanzhou", "--step", "1W"]) == 2
+    assert capsys.readouterr() == ("", "hybridtrack: error: --step 1W: a tracking controller is replayed at steps of "
+                                       "1 h or finer\n")
+    two = tmp_path / "two.csv"
+    two.write_text("time,ghi,dni,dhi,wind_speed\n2021-06-21T12:00:00+08:00,900,800,100,2\n"
+                   "2021-06-21T12:20:00+08:00,900,800,100,2\n")
+    assert main(["replay", str(two), "--site", "lanzhou", "--step", "1h"]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: --step 1h: {two} makes 1 step at that step; a run needs at "
+                                       "least two: give a shorter --step\n")

@@ -52,7 +52,7 @@ def test_the_report_gives_the_dates_and_every_change_with_where(capsys):
     """A messy file at a 5-minute step: each kind of change is listed with its count and file lines."""
     assert main(["check", "tests/records/messy.csv", "--site", "lanzhou", "--freq", "5min", "--map", "dhi=DHI"]) == 0
     out = capsys.readouterr().out
-    assert "98 rows read, 193 rows out, step 10min" in out
+    assert "98 rows read, 193 rows out, step 10min read, 5min out\n" in out
     assert "dates: 2021-06-05 05:00:00+08:00 to 2021-06-05 21:00:00+08:00" in out
     assert "renamed: 'DHI' -> dhi, 'GHI' -> ghi, 'DNI' -> dni" in out
     assert "sorted (stamps out of order): count 1, lines 33" in out

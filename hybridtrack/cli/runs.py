@@ -192,11 +192,19 @@ def _replay_frame(args: argparse.Namespace):
         from ..times import parse_freq
 
         with flag_named("--step"):  # before the file is read; 'step '0min' must be positive' had named no flag
-            parse_freq(args.step)
+            step = parse_freq(args.step)
+        from ..simulation import LONGEST_STEP
+
+        if step > LONGEST_STEP:  # the run's refusal came after the report, naming the frame's median, not the flag
+            raise HybridtrackError(f"--step {args.step}: a tracking controller is replayed at steps of "
+                                   f"{LONGEST_STEP / pd.Timedelta(hours=1):g} h or finer")
     site = site_from_arguments(args)
     frame = read_record(args, args.file, site=site, freq=args.step or "1min")
     from ..io import validation_report
 
+    if len(frame) < 2:  # the run's own refusal had named no flag
+        raise HybridtrackError(f"--step {args.step or '1min'}: {args.file} makes {len(frame)} step at that step; a run "
+                               "needs at least two: give a shorter --step")
     print(validation_report(frame))
     return site, frame
 
