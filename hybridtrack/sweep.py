@@ -578,6 +578,8 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         Called with no argument once the cluster is up or the scheduler reached (and has a worker),
         before the first run is sent: a refusal of where the runs go comes before whatever it says.
     """
+    import dask
+
     from .progress import bar as progress_bar
 
     if not isinstance(sweep, Sweep):
@@ -599,8 +601,11 @@ def run_sweep(sweep: Sweep, *, scheduler: str | None = None, workers: int | None
         steps = _all_steps(sweep, runs)
         if progress:
             _say_if_compiling(sweep, runs, steps)
-        futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
-                                      [steps] * len(runs), pure=False), runs))
+        # a big grid's graph is large (11 MB at 100,000 runs): Dask's advice about it had printed a
+        # five-line UserWarning beside the progress bar, which a sweep's user can do nothing about
+        with dask.config.set({"distributed.admin.large-graph-warning-threshold": "1 TiB"}):
+            futures = dict(zip(client.map(run_one, [sweep.base] * len(runs), runs, [sweep.source] * len(runs),
+                                          [steps] * len(runs), pure=False), runs))
         with progress_bar(len(futures), unit="run", disable=not progress) as bar:
             try:
                 for future, row, error in finished(client, futures):

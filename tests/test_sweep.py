@@ -896,3 +896,18 @@ def test_the_plots_legend_names_the_pareto_front(seeds):
     figure = plot_tradeoff(table, "moves", "rms", colour="drive.deadband")
     legend = figure.axes[0].get_legend()
     assert legend is not None and "Pareto front" in [text.get_text() for text in legend.get_texts()]
+
+
+def test_dasks_advice_about_a_large_graph_is_not_printed_beside_the_bar():
+    """A grid of 100,000 runs makes an 11 MB graph, and Dask printed its five-line advice about it
+    (a UserWarning) beside the progress bar (helper-37). Here its threshold is lowered to a byte,
+    so that any graph would draw it."""
+    import warnings
+
+    import dask
+
+    with dask.config.set({"distributed.admin.large-graph-warning-threshold": "1B"}), \
+            warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run_sweep(Sweep.from_dict({**TINY, "grid": {"seed": [0, 1]}}), workers=1, progress=False)
+    assert not [w for w in caught if "large graph" in str(w.message)]
