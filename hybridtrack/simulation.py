@@ -183,6 +183,8 @@ class SimulationConfig:
             for name, value in values.items():
                 key = f"{where}.{name}" if where else name
                 current = getattr(default, name)
+                if isinstance(value, np.generic):  # numpy's scalars as Python's: np.int64 had been no whole number
+                    value = value.item()
                 if dataclasses.is_dataclass(current):
                     changes[name] = build(current, value, key)
                 elif isinstance(current, tuple):

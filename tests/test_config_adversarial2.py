@@ -98,3 +98,23 @@ def test_a_controller_timing_longer_than_a_day_is_refused(name, value):
     with pytest.raises(HybridtrackError, match=f"controller: {name} '{value}' is longer than a day"):
         ControllerConfig(**{name: value})
     assert ControllerConfig(**{name: "24h"}).minutes(name) == 1440.0
+
+
+def test_numpys_scalars_are_taken_as_pythons_numbers():
+    """np.int64 had been refused as "no whole number" where np.float64 was taken, and where
+    simulate_field and sweeps take it (helper-37); np.bool_ stays no number."""
+    import numpy as np
+
+    from hybridtrack.fuzzy import FuzzyConfig
+    from hybridtrack.simulation import SimulationConfig
+
+    config = SimulationConfig.from_dict({"seed": np.int64(3), "drive": {"deadband": np.float32(0.25)}})
+    assert config.seed == 3 and type(config.seed) is int and config.drive.deadband == 0.25
+    with pytest.raises(HybridtrackError, match="seed: must be int, got True"):
+        SimulationConfig.from_dict({"seed": np.bool_(True)})
+    data = FuzzyConfig().to_dict()
+    data["resolution"] = {"input": np.int64(1001), "output": np.int32(3001)}
+    assert FuzzyConfig.from_dict(data) == FuzzyConfig()
+    data["resolution"]["input"] = np.bool_(True)
+    with pytest.raises(HybridtrackError, match="resolution.input: must be a whole number"):
+        FuzzyConfig.from_dict(data)

@@ -17,6 +17,7 @@ classes at least 1.1 score units inside the band.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -610,14 +611,15 @@ class _Reader:
         return dict(value)
 
     def number(self, value, where: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
             self.fail(where, f"must be a number, got {value!r}")
         return float(value)
 
     def integer(self, value, where: str) -> int:
-        if isinstance(value, bool) or not isinstance(value, int):
+        """A whole number, numpy's too (np.int64 had been refused where np.float64 was taken)."""
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
             self.fail(where, f"must be a whole number, got {value!r}")
-        return value
+        return int(value)
 
     def pair(self, value, where: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
