@@ -195,8 +195,9 @@ def _written(value, where: str, source: str):
         return {k: _written(v, f"{where}.{k}", source) for k, v in value.items()}
     if isinstance(value, (bool, int, float, str, dt.date, dt.time)):
         return value
-    raise HybridtrackError(f"{source}: {where}: {value!r:.60} cannot be written in a sweep file; a sweep holds "
-                           "text, numbers, true or false, dates and times, lists and tables (as TOML)")
+    shown = " ".join(repr(value).split())  # one line: a Series' repr runs over several
+    raise HybridtrackError(f"{source}: {where}: {shown:.60} cannot be written in a sweep file; a sweep holds text, "
+                           "numbers, true or false, dates and times, lists and tables (as TOML)")
 
 
 def _alike(value):

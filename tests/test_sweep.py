@@ -747,10 +747,13 @@ def test_a_grid_made_with_numpy_is_taken_as_the_numbers_it_holds_and_round_trips
     ({"base": {"weather": object}, "grid": {"seed": [0]}}, r"s.toml: base.weather: <class 'object'> cannot be written"),
     ({"base": {"config": {"drive": {"deadband": np.float64(0.3), "period": None}}}, "grid": {"seed": [0]}},
      r"s.toml: base.config.drive.period: None cannot be written in a sweep file"),
+    # a Series' repr had run over three lines (helper-37)
+    ({"grid": {"seed": pd.Series([1, 2])}}, r"s.toml: grid.seed: 0 1 1 2 dtype: int64 cannot be written in a sweep"),
 ])
 def test_a_value_a_sweep_file_cannot_hold_is_refused_before_any_run(data, message):
-    with pytest.raises(HybridtrackError, match=message):
+    with pytest.raises(HybridtrackError, match=message) as refused:
         Sweep.from_dict(data, source="s.toml")
+    assert "\n" not in str(refused.value)
 
 
 @pytest.mark.parametrize("workers, runs, started", [(None, 2, 2), (8, 3, 3), (1, 3, 1), (2, 5, 2)])
