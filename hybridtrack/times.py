@@ -249,6 +249,9 @@ def local_range(start_date, tz: str, *, end_date=None, start: str = "00:00", end
         t1 = _localise(last_day + dt.timedelta(days=1), dt.time(0), tz) - pd.Timedelta(1, "ns")
     else:
         t1 = _localise(last_day, parse_clock(end), tz)
+    if t1 < t0 and t0.date() > last_day:  # Apia skipped 2011-12-30 crossing the date line
+        raise HybridtrackError(f"{last_day} does not exist on the local clock of {tz}: the zone skipped that day; "
+                               "choose another date")
     if t1 < t0:
         raise HybridtrackError(f"the range ends ({t1}) before it starts ({t0})")
     check_steps(t0, t1, step, what=f"{first_day} to {last_day}")

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from hybridtrack import HybridtrackError
-from hybridtrack.times import calendar_days, clock_hours, parse_clock, parse_date
+from hybridtrack.times import calendar_days, clock_hours, local_range, parse_clock, parse_date
 
 
 @pytest.mark.parametrize("tz", ["Asia/Shanghai", "America/New_York", "Australia/Lord_Howe", "Etc/GMT+12"])
@@ -117,3 +117,13 @@ def test_each_stamp_stands_for_half_of_each_step_beside_it_and_a_gap_for_none():
     span = (jittered[-1] - jittered[0]) / pd.Timedelta(minutes=1)
     ends = (jittered[1] - jittered[0] + jittered[-1] - jittered[-2]) / pd.Timedelta(minutes=2)  # the ends' halves
     assert stamp_minutes(jittered).sum() == pytest.approx(span + ends, rel=1e-12)
+
+
+def test_a_day_its_zone_skipped_is_named():
+    """Samoa skipped 30 December 2011 crossing the date line: a run of that day had been refused
+    as "the range ends (...) before it starts (...)" (helper-37)."""
+    with pytest.raises(HybridtrackError, match="2011-12-30 does not exist on the local clock of Pacific/Apia: the "
+                                               "zone skipped that day; choose another date"):
+        local_range("2011-12-30", "Pacific/Apia")
+    both = local_range("2011-12-29", "Pacific/Apia", end_date="2011-12-30", freq="1h")
+    assert len(both) == 24 and both[-1] == pd.Timestamp("2011-12-29 23:00", tz="Pacific/Apia")
