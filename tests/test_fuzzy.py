@@ -272,6 +272,18 @@ def target_table(n=25, seed=3):
                          "weather": clf.label(scores)})
 
 
+def test_one_seed_of_tuning_fits_a_table_of_target_scores_well():
+    """One seed of the default search: at least three times closer than the published set, its
+    terms in order (a local optimum near RMSE 0.31 is where seed 0 stops on an AVX-512 machine;
+    the close fit from three seeds is `test_tuning_fits_a_table_of_target_scores_closely`, slow)."""
+    table = target_table()[["intensity", "variation", "score"]]
+    tuned, report = tune(None, table)
+    assert report.rmse_before > 1.0 and report.rmse_after < report.rmse_before / 3
+    centres = [t.centre for t in tuned.variable("intensity").terms]
+    assert centres == sorted(centres)
+
+
+@pytest.mark.slow  # 85 s: three seeds of the default search
 def test_tuning_fits_a_table_of_target_scores_closely():
     """A close fit from three seeds of the default search, the best kept. One seed's 60
     generations of 8 can stop in a local optimum near RMSE 0.31: seeds 0 and 1 did on an AVX-512
