@@ -284,7 +284,7 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
     and a dead sensor's noise reads below `DARKEST` / 1000 at times; such hours had passed as a
     dark morning, the day's top in W/m² keeping the whole-day judgements quiet."""
     high = np.asarray(clear_ghi) >= SUN_WELL_UP
-    hours = frame.index.as_unit("ns").asi8 // 3_600_000_000_000  # the hour each stamp is in
+    hours = frame.index.as_unit("ns").asi8 // pd.Timedelta(hours=1).value  # the hour each stamp is in
     for name in [name for name in ("ghi", "dhi") if name in frame]:
         values = frame[name].to_numpy(float)
         judged = high & np.isfinite(values)
@@ -299,19 +299,18 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
         by_day = counts.groupby("day").agg(hours=("in_kilowatts", "sum"), watts=("watts", "sum"))
         mixed = by_day.index[(by_day["hours"] >= HOURS_WELL_UP) & (by_day["watts"] > 0)]
         if len(mixed):
-            _refuse_hours_in_kilowatts(path, frame, report, name, days == mixed[0],
-                                       np.isin(hours, counts.index[counts["in_kilowatts"]]) & kilowatt, watts)
+            in_kilowatts = counts.index[counts["in_kilowatts"] & (counts["day"] == mixed[0])]
+            _refuse_hours_in_kilowatts(path, frame, report, name, np.isin(hours, in_kilowatts) & kilowatt,
+                                       watts & (days == mixed[0]), len(in_kilowatts))
 
 
-def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, day: np.ndarray,
-                               stretch: np.ndarray, watts: np.ndarray) -> None:
-    """`_check_hours`' refusal of `day`'s hours in kW/m² (`stretch`) beside its readings in W/m²."""
+def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,
+                               watts: np.ndarray, hours: int) -> None:
+    """`_check_hours`' refusal of a day's `hours` in kW/m² (`stretch`) beside its readings in W/m²."""
     values = frame[name].to_numpy(float)
-    stretch, watts = stretch & day, watts & day
     lines, other = first_lines(frame, stretch), first_lines(frame, watts)
     header = report.get("columns", {}).get(name, name)
     where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
-    hours = len(np.unique(frame.index[stretch].as_unit("ns").asi8 // 3_600_000_000_000))
     raise HybridtrackError(
         f"{where}: {name} reads {np.min(values[stretch]):g} to {np.max(values[stretch]):g} through {hours} hours of "
         f"a high sun, while the same day reads {np.max(values[watts]):g} W/m²{f' (line {other[0]})' if other else ''}: "

@@ -9,10 +9,10 @@ interpolated, resampled.
 
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 
 from .checks import span
+from .resample import native_step
 
 __all__ = ["validation_report", "ISSUES"]
 
@@ -55,7 +55,7 @@ def _steps(report: dict, frame: pd.DataFrame) -> str:
     read = report.get("step", "?")
     if len(frame) < 2:
         return f"step {read}"
-    out = span(pd.Timedelta(int(np.median(np.diff(frame.index.as_unit("ns").asi8))), "ns"))
+    out = span(native_step(frame.index)[0])
     return f"step {read}" if out == read else f"step {read} read, {out} out"
 
 
