@@ -230,8 +230,10 @@ def test_without_numba_the_numpy_engine_runs_with_one_warning(monkeypatch):
     import sys
 
     from hybridtrack.fuzzy import compiled
+    from hybridtrack.kernel import jit
 
     monkeypatch.setattr(compiled, "_STATE", {"compiled": compiled._STATE.get("compiled")})
+    monkeypatch.setattr(jit, "_WARNED", [])  # the process's one warning not yet given
     monkeypatch.setitem(sys.modules, "numba", None)  # what a missing package looks like to import
     clf = FuzzyWeatherClassifier()
     with pytest.warns(RuntimeWarning, match="numba is not installed") as record:

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import threading
 import types
-import warnings
 
 import numpy as np
 
@@ -62,8 +61,9 @@ def _set_up() -> bool:
             import numba
         except ImportError:
             _STATE["numba"] = False
-            warnings.warn("numba is not installed: the fuzzy engine falls back to numpy (slower, same results)",
-                          RuntimeWarning, stacklevel=3)
+            from ..kernel.jit import warn_missing
+
+            warn_missing()
         else:
             if not _STATE.get("compiled"):
                 # kernels call helpers through module globals: compile helpers first, then kernels

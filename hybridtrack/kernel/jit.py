@@ -82,10 +82,21 @@ def kernel(function=None, *, allocates: bool = False, entry: bool = False, inlin
                       inline="always" if inline else "never")(function)
 
 
-def available() -> bool:
-    """Whether the compiled kernel can run here; warns once when numba is missing."""
-    if numba is None and not _WARNED:
+#: The one warning a process gets where numba is missing, whichever compiled part asks first: one
+#: missing compiler, one warning (the controller's loop and the fuzzy engine had given one each).
+MISSING = ("numba is not installed: simulations run the reference controller loop and the fuzzy engine "
+           "numpy (slower, same results)")
+
+
+def warn_missing(stacklevel: int = 3) -> None:
+    """Warn, once a process, that numba is missing (`MISSING`)."""
+    if not _WARNED:
         _WARNED.append(True)
-        warnings.warn("numba is not installed: simulations run the reference controller loop "
-                      "(slower, same results)", RuntimeWarning, stacklevel=3)
+        warnings.warn(MISSING, RuntimeWarning, stacklevel=stacklevel + 1)
+
+
+def available() -> bool:
+    """Whether the compiled kernel can run here; warns once when numba is missing (`warn_missing`)."""
+    if numba is None:
+        warn_missing()
     return numba is not None
