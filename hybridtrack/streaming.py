@@ -54,7 +54,7 @@ import pandas as pd
 from . import params, sites
 from .collectors import Collector, as_collector
 from .errors import HybridtrackError
-from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude
+from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude, check_magnitude_by_day
 from .io.files import input_path
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
@@ -349,7 +349,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 
     rows = lambda: itertools.count(first_row, chunk_rows)  # noqa: E731 - each piece's first row
     return DaySource(site, f"{path}", steps, None,
-                     lambda: _by_day(_magnitude_checked(pieces(), path, rows()), site, str(path)),
+                     lambda: _by_day(_magnitude_checked(pieces(), path, rows(), site), site, str(path)),
                      wind_measured="wind_speed" in measured)
 
 
@@ -518,29 +518,55 @@ MAGNITUDE_SPAN = pd.Timedelta(days=1)
 _IRRADIANCE = ("ghi", "dhi", "dni")
 
 
-def _magnitude_checked(pieces: Iterator[pd.DataFrame], path: Path, first_rows: Iterator[int]) -> Iterator[pd.DataFrame]:
+def _magnitude_checked(pieces: Iterator[pd.DataFrame], path: Path, first_rows: Iterator[int],
+                       site: sites.Site) -> Iterator[pd.DataFrame]:
     """`pieces` (each starting at the file's row from `first_rows`) passed on unchanged, with
     irradiance in kW/m² refused (`check_magnitude`) over spans of at least `MAGNITUDE_SPAN` (or
     the whole file, if shorter), each judged before its last piece is passed on. Judged a piece at
-    a time, a file read in small chunks (``chunk_rows`` of six hours or less) had never been."""
+    a time, a file read in small chunks (``chunk_rows`` of six hours or less) had never been.
+    Each whole local day is judged as the record reader judges it too (`_days_checked`)."""
     window: list[pd.DataFrame] = []
+    held: list[pd.DataFrame] = []  # the span's last local day, whole only with the next span
 
-    def judge():
+    def judge(last: bool):
         lines = pd.concat(window)
         if len(lines) >= 2:
             check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack check FILE "
                                                           "--units {name}=kW/m2 --out clean.parquet")
+        held[:] = [_days_checked(path, pd.concat([*held, lines]), site, last)]
 
     for piece, first_row in zip(pieces, first_rows):
         if len(piece):  # an empty piece (a header alone) has no span
             columns = [name for name in _IRRADIANCE if name in piece]
             window.append(piece[columns].assign(_line=np.arange(first_row, first_row + len(piece), dtype=float)))
             if window[-1].index[-1] - window[0].index[0] >= MAGNITUDE_SPAN:
-                judge()
+                judge(last=False)
                 window = []
         yield piece
-    if window:
-        judge()
+    if window or held:
+        window = window or [held[0].iloc[:0]]
+        judge(last=True)
+
+
+def _days_checked(path: Path, lines: pd.DataFrame, site: sites.Site, last: bool) -> pd.DataFrame:
+    """Judge the whole local days of `lines` (all of them if `last`) as the record reader judges a
+    file's days (`hybridtrack.io.checks.check_magnitude_by_day`, on the site's clear sky): a day in
+    kW/m² beside days in W/m², or hours of a day in kW/m² beside its hours in W/m² (a logger whose
+    unit changed within the day, which a streamed replay had run as a dark morning). Return the
+    rows of the day still open, for the next span."""
+    if not len(lines) or lines.index.tz is None or not any(name in lines for name in ("ghi", "dhi")):
+        return lines.iloc[:0]  # naive stamps are refused by the day cutter; DNI alone is judged above
+    days = _local_days(lines.index, site.tz)
+    whole = np.ones(len(lines), bool) if last else days < days[-1]
+    if whole.any():
+        import pvlib
+
+        from .sun import solar_position
+
+        judged = lines[whole]
+        zenith = solar_position(judged.index, site, model="plc")["apparent_zenith"]  # as the reader's: PLC is ample
+        check_magnitude_by_day(path, judged, {}, pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float), site.tz)
+    return lines[~whole]
 
 
 # -- the run -------------------------------------------------------------------------------------

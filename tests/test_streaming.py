@@ -783,3 +783,33 @@ def test_a_streamed_file_without_dhi_counts_every_reading_missing(tmp_path, caps
         in capsys.readouterr().out
     report = json.loads((tmp_path / "run" / "summary.json").read_text())["streamed"]["kept_as_read"]
     assert report["missing"]["dhi"] == {"count": len(frame), "first": "2021-06-20 00:00:00+08:00"}
+
+
+@pytest.mark.parametrize("chunk_rows", [50, 200_000])
+def test_a_morning_in_kw_per_m2_is_refused_in_a_streamed_file_as_the_reader_refuses_it(tmp_path, chunk_rows):
+    """A logger whose unit changed within a day (the second day's morning in kW/m², its afternoon
+    in W/m²) had streamed as a dark morning: the day's W/m² top kept the span's judgement quiet.
+    Its hours in kW/m² are refused naming the first of their lines, whatever the chunks."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-20", "2021-06-22", weather="sunny", freq="10min", seed=1)[["ghi", "dni", "dhi"]]
+    morning = (frame.index.day == 21) & (frame.index.hour < 12)
+    frame.loc[morning, ["ghi", "dni", "dhi"]] /= 1000.0
+    frame.round(4).to_csv(tmp_path / "changed.csv", index_label="time")
+    with pytest.raises(HybridtrackError, match=r"changed\.csv: line (\d+), column 'ghi': ghi reads .* through \d+ hours "
+                                               r"of a high sun, while the same day reads .* look like kW/m²") as caught:
+        list(recorded_days(tmp_path / "changed.csv", SITE, chunk_rows=chunk_rows))
+    line = int(re.search(r"line (\d+),", str(caught.value)).group(1))
+    named = (tmp_path / "changed.csv").read_text().splitlines()[line - 1].split(",")
+    assert named[0].startswith("2021-06-21") and 0.02 <= float(named[1]) <= 1.5  # a morning line in kW/m²
+
+
+def test_a_streamed_file_of_clear_and_overcast_days_in_watts_streams(tmp_path):
+    """The streamed day judgement leaves W/m² days of any sky alone, a last day cut short included."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-20", "2021-06-23 14:00", weather=["sunny", "overcast", "mixed", "cloudy"],
+                      freq="10min", seed=2)[["ghi", "dni", "dhi"]]
+    frame.round(3).to_csv(tmp_path / "watts.csv", index_label="time")
+    days = list(recorded_days(tmp_path / "watts.csv", SITE, chunk_rows=70))
+    assert sum(len(day) for _, day in days) == len(frame)
