@@ -627,13 +627,21 @@ def test_replays_step_is_refused_by_its_flag_before_the_file_is_read(capsys):
     assert capsys.readouterr().err == "hybridtrack: error: --step: step '0min' must be positive\n"
 
 
+def test_a_check_step_no_run_takes_is_refused_by_its_flag(tmp_path, capsys):
+    """`check --freq 1d` had averaged 300 minutes into one row and called it clean: a file no
+    replay can run. The step is refused, by its flag, before the file is read, as replay's is."""
+    assert main(["check", "no-such-file.csv", "--freq", "1d"]) == 2
+    assert capsys.readouterr() == ("", "hybridtrack: error: --freq: step '1d' is longer than a run's longest, 1 h (a "
+                                       "tracking controller is replayed at steps of an hour or finer)\n")
+
+
 def test_a_replay_step_no_run_takes_is_refused_by_its_flag(tmp_path, capsys):
     """`--step 1W` had printed the report of a file averaged onto weeks, then the run's refusal
     naming the frame's median step; a step that leaves one row had said "the weather frame needs
     at least two steps" (helper-37). Both name --step."""
     assert main(["replay", "no-such-file.csv", "--site", "lanzhou", "--step", "1W"]) == 2
-    assert capsys.readouterr() == ("", "hybridtrack: error: --step 1W: a tracking controller is replayed at steps of "
-                                       "1 h or finer\n")
+    assert capsys.readouterr() == ("", "hybridtrack: error: --step: step '1W' is longer than a run's longest, 1 h (a "
+                                       "tracking controller is replayed at steps of an hour or finer)\n")
     two = tmp_path / "two.csv"
     two.write_text("time,ghi,dni,dhi,wind_speed\n2021-06-21T12:00:00+08:00,900,800,100,2\n"
                    "2021-06-21T12:20:00+08:00,900,800,100,2\n")

@@ -24,7 +24,7 @@ def _check_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", help="recorded weather file")
     add_site_arguments(parser, record=True)
     add_record_arguments(parser)
-    parser.add_argument("--freq", help="resample to this step, e.g. 1min")
+    parser.add_argument("--freq", help="resample to this step, e.g. 1min (1h at most: the longest step a replay runs)")
     parser.add_argument("--out", metavar="FILE", help="write the checked (cleaned) frame: Parquet for a .parquet "
                                                       "name, else CSV")
     add_force_argument(parser)
@@ -37,10 +37,12 @@ def _check(args: argparse.Namespace) -> int:
 
     site = site_from_arguments(args, clock_required=False)
     if args.freq is not None:
-        from ..times import parse_freq
+        from ..simulation import run_step
 
-        with flag_named("--freq"):  # before the file is read; the refusal names the flag
-            parse_freq(args.freq)
+        # before the file is read, naming the flag; a step no run takes (1d: 300 minutes in one row,
+        # called clean) is refused as replay refuses it, since the checked file is for replays
+        with flag_named("--freq"):
+            run_step(args.freq)
     if args.out:  # before the file is read, not after its report: an --out there already had been refused last
         _refuse_other_formats(args.out)
         claim([args.out])
