@@ -648,3 +648,22 @@ def test_a_replay_step_no_run_takes_is_refused_by_its_flag(tmp_path, capsys):
     assert main(["replay", str(two), "--site", "lanzhou", "--step", "1h"]) == 2
     assert capsys.readouterr().err == (f"hybridtrack: error: --step 1h: {two} makes 1 step at that step; a run needs at "
                                        "least two: give a shorter --step\n")
+
+
+@pytest.mark.parametrize("command", [["replay", "--strategy", "hybrid-oracle"], ["compare"]])
+def test_a_files_sky_label_the_oracle_cannot_read_is_refused_by_line_and_column(tmp_path, capsys, command):
+    """The hybrid-oracle policy's refusal of a file's label that names no sky had named a time stamp
+    of the frame ("the frame's 'sky' column at 2021-06-21 11:40:00+08:00"), after compare had run
+    every other policy. It names the file's line and column, before any run."""
+    frame = synthetic("lanzhou", "2021-06-21", "2021-06-21", weather="mixed", freq="10min", seed=1)
+    frame = frame[["ghi", "dni", "dhi", "wind_speed", "sky"]].assign(sky=lambda f: f["sky"].astype(str))
+    frame.loc[frame.index[70:72], "sky"] = "foggy"
+    frame.to_csv(tmp_path / "w.csv", index_label="Time")
+    lines = (tmp_path / "w.csv").read_text().splitlines()
+    first = next(n for n, line in enumerate(lines, 1) if line.endswith(",foggy"))
+    assert main([command[0], str(tmp_path / "w.csv"), "--site", "lanzhou", *command[1:],
+                 "--out", str(tmp_path / "run")]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {tmp_path / 'w.csv'}: column 'sky': 'foggy' (line {first}) "
+                                       "is no sky label (2 such); the hybrid-oracle policy reads 'sunny', 'cloudy', "
+                                       "'overcast', 'unknown'\n")
+    assert not (tmp_path / "run").exists()

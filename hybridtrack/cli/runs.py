@@ -220,6 +220,19 @@ def replay_config(args: argparse.Namespace, has_wind: bool):
     return config
 
 
+def _refuse_unknown_sky(frame, path: str) -> None:
+    """Refuse, for the hybrid-oracle policy, a file's sky labels that name no sky, by the file's line
+    and column (the reader found them: ``sky_unknown``), before any run; the run's own refusal had
+    named a time stamp of the frame."""
+    unknown = frame.attrs.get("validation", {}).get("sky_unknown")
+    if unknown:
+        from ..control import SKY_CODES
+
+        header = frame.attrs["validation"].get("columns", {}).get("sky", "sky")
+        raise HybridtrackError(f"{path}: column {header!r}: {unknown['first']} is no sky label ({unknown['count']} "
+                               f"such); the hybrid-oracle policy reads {', '.join(map(repr, SKY_CODES))}")
+
+
 def _has_wind(frame) -> bool:
     return "wind_speed" in frame.columns and bool(np.isfinite(frame["wind_speed"].to_numpy(float)).any())
 
@@ -257,8 +270,11 @@ def _replay(args: argparse.Namespace) -> int:
                        heading=f"replay of {args.file} at {site.name}, {collector_from_arguments(args).kind}, "
                                f"{config.controller.strategy}")
     site, frame = _replay_frame(args)
+    config = replay_config(args, _has_wind(frame))
+    if (args.strategy or config.controller.strategy) == "hybrid-oracle":
+        _refuse_unknown_sky(frame, args.file)
     _claim_run_folder(args)
-    result = _run(frame, site, args, args.strategy, replay_config(args, _has_wind(frame)))
+    result = _run(frame, site, args, args.strategy, config)
     _finish(result, args, heading=f"replay of {args.file} at {site.name}, {result.collector.kind}, "
                                   f"{result.summary['strategy']}")
     return 0
@@ -300,6 +316,8 @@ def _compare(args: argparse.Namespace) -> int:
         frame = synthetic_frame(args, site)
         config = simulation_config(args, args.seed)
     policies = [s for s in STRATEGIES if s != "hybrid-oracle" or "sky" in frame.columns]
+    if args.file is not None and "hybrid-oracle" in policies:  # before the other policies' runs
+        _refuse_unknown_sky(frame, args.file)
     if len(policies) < len(STRATEGIES):
         print("hybrid-oracle left out: the frame has no true 'sky' column")
     if args.out:
