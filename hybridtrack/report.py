@@ -479,12 +479,12 @@ def describe_html(result, *, events: int = 12) -> str:
 
 
 def _true_sun(result, index=None):
-    """Sun-up flags and the incidence cosine on a perfect aperture at every step (SPA)."""
-    from .sun import solar_position
+    """Sun-up flags and the incidence cosine on a perfect aperture at every step: the run's true
+    sun, as it appears (`hybridtrack.world.true_sun`), as the run scored it."""
     from .mounting import incidence_cosine
+    from .world import true_sun
 
-    sun = solar_position(result.log.index if index is None else index, result.site, "spa")
-    altitude, azimuth = sun["altitude"].to_numpy(), sun["azimuth"].to_numpy()
+    altitude, azimuth = true_sun(result.log.index if index is None else index, result.site, result.config.truth)
     return altitude > 0, incidence_cosine(altitude, azimuth, result.collector)
 
 

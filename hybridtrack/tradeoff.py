@@ -144,12 +144,11 @@ def held_error(result) -> tuple[float, float]:
     from .collectors import direction_vectors
     from .metrics import TRACKING_MODES, weighted_quantile
     from .mounting import incidence_cosine
-    from .sun import solar_position
+    from .world import true_sun
 
     log = result.log
-    sun = solar_position(log.index, result.site, "spa")
-    beam = np.nan_to_num(log["dni"].to_numpy(float)) * incidence_cosine(sun["altitude"], sun["azimuth"],
-                                                                           result.collector)
+    altitude, azimuth = true_sun(log.index, result.site, result.config.truth)  # the sun the run scored against
+    beam = np.nan_to_num(log["dni"].to_numpy(float)) * incidence_cosine(altitude, azimuth, result.collector)
     single = result.collector.single_axis
     columns = ("",) if single else ("", "_azimuth")
     truth = [log[f"target_true{c}"].to_numpy(float) for c in columns]

@@ -155,10 +155,16 @@ def controller_clock(index: pd.DatetimeIndex, imperfections: Imperfections, faul
 
 
 def true_sun(index: pd.DatetimeIndex, site: sites.Site, model: str) -> tuple[np.ndarray, np.ndarray]:
-    """The true sun's altitude and azimuth at each stamp, degrees: `model`'s (SPA) where the sun
-    can be up (a cheap model finds where), the sun far below (-90°) elsewhere. Computed once for
-    the runs of a field and its table (`hybridtrack.reuse`), and handed to each as read-only
-    arrays."""
+    """The true sun's apparent altitude and azimuth at each stamp, degrees: `model`'s (SPA) where
+    the sun can be up (a cheap model finds where), the sun far below (-90°) elsewhere. Computed
+    once for the runs of a field and its table (`hybridtrack.reuse`), and handed to each as
+    read-only arrays.
+
+    The altitude is the apparent one, refraction included (SPA's, at the site's pressure and
+    12 °C): the light comes from where the sun appears, and that is where a sensor sees it and
+    a collector must point. The geometric sun had been the truth, so a controller that leaves
+    refraction out was scored as tracking perfectly at a low sun, 0.48° below the true one at the
+    horizon and 0.09° at 10° at sea level (docs/world.md, "Refraction")."""
     return shared(("true sun", Same(index), site, model), lambda: _sun_where_up(index, site, model))
 
 
@@ -167,7 +173,7 @@ def _sun_where_up(index: pd.DatetimeIndex, site: sites.Site, model: str) -> tupl
     altitude, azimuth = np.full(len(index), -90.0), np.zeros(len(index))
     if candidate.any():
         spa = solar_position(index[candidate], site, model)
-        altitude[candidate], azimuth[candidate] = spa["altitude"].to_numpy(), spa["azimuth"].to_numpy()
+        altitude[candidate], azimuth[candidate] = spa["apparent_altitude"].to_numpy(), spa["azimuth"].to_numpy()
     return altitude, azimuth
 
 

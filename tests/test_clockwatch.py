@@ -64,7 +64,10 @@ def test_a_heliostat_shows_a_clock_set_five_minutes_wrong_in_two_sunny_days(seed
 
 def test_a_troughs_sensor_cannot_tell_a_clock_error_from_its_mount():
     """A clock error turns the sky about the polar axis: for a north-south trough, to first order an
-    encoder zero of ω·τ·cos(latitude) and an axis azimuth error of ω·τ·sin(latitude) in size."""
+    encoder zero of ω·τ·cos(latitude) and an axis azimuth error of ω·τ·sin(latitude) in size. Only
+    the refraction of a low sun, which does not turn with the sky, tells them apart a little: a
+    day's 1σ of 266 s (the prior's 600 s; 373 s with the geometric sun as the truth), so no
+    alarm, and a minute's error is not told."""
     site, collector, tau = sites.get("lanzhou"), Collector("trough-ns"), 60.0
     index = pd.date_range("2021-06-21 07:00", "2021-06-21 19:00", freq="10min", tz=site.tz)
     sun, later = (solar_position(index + pd.Timedelta(seconds=s), site, "spa") for s in (0.0, tau))
@@ -80,7 +83,7 @@ def test_a_troughs_sensor_cannot_tell_a_clock_error_from_its_mount():
     assert abs(fit[2]) == pytest.approx(turn * np.cos(latitude), rel=0.05)  # encoder zero
     result = _run("lanzhou", "2021-06-21", "2021-06-21", "trough-ns", clock_error=60.0, clock_drift=0.0)
     assert not _clock_alarms(result)
-    assert result.summary["clock"]["error_std_s"] > 300.0  # the sun leaves it at its prior
+    assert result.summary["clock"]["error_std_s"] > 200.0  # 4σ is over 13 minutes: a minute's error is not told
 
 
 @pytest.mark.parametrize("collector,site,start,end", [("trough-ns", "nanjing", "2013-06-21", "2013-06-23"),

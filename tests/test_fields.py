@@ -705,9 +705,9 @@ def test_an_east_west_fresnel_field_reports_its_end_loss(day):
     result = simulate_field(day, "lanzhou", field, keep_log=False)
     assert list(result.collectors.columns) == collector_columns(field)
     # by hand: light-weighted |L_end| over the day, each step's L_end = f tan(θ) (docs/fields.md)
-    sun = solar_position(day.index, "lanzhou")
-    up = (sun["altitude"] > 0) & (day["dni"] > 0)
-    a, g = np.radians(sun["altitude"][up]), np.radians(sun["azimuth"][up] - 90.0)
+    sun = solar_position(day.index, "lanzhou")  # the true sun as it appears (refracted), the world's
+    up = (sun["apparent_altitude"] > 0) & (day["dni"] > 0)
+    a, g = np.radians(sun["apparent_altitude"][up]), np.radians(sun["azimuth"][up] - 90.0)
     s_along = np.cos(a) * np.cos(g)
     loss = np.hypot(2.0, 10.0) * np.abs(s_along) / np.sqrt(1.0 - s_along**2)
     beam = day["dni"][up] * np.sqrt(1.0 - s_along**2)

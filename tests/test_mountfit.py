@@ -176,8 +176,10 @@ def test_the_pull_gain_round_trips_through_toml(tmp_path):
 #: 0.3372 -> 0.3502° and 0.3435 -> 0.3511°. Over the 96 acceptance runs the change moved p95 by
 #: +0.0006° on average (sd 0.0044°), and over 160 runs on seeds 6-15 by +0.0001° (sd 0.0027°) with
 #: the same 10 runs above 0.35°: noise at the bar's thin margin, not a trend; kept strict, so a
-#: change that brings them back under the bar says so.
-_OVER_THE_BAR = {("2013-03-20", "fresnel"): 0.35019, ("2013-06-21", "fresnel"): 0.35114}
+#: change that brings them back under the bar says so. The true sun with refraction (the world's
+#: and the controller's) did: 0.3416° and 0.3382° (September's Fresnel row, 0.3485°, is now the
+#: closest to the bar). Empty, and kept for the next change that moves a run over it.
+_OVER_THE_BAR: dict = {}
 
 
 @pytest.mark.parametrize("date, collector", [

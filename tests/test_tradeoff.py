@@ -9,6 +9,7 @@ import pytest
 from hybridtrack import HybridtrackError, sites
 from hybridtrack.cli import main
 from hybridtrack.collectors import Collector
+from hybridtrack.simulation import SimulationConfig
 from hybridtrack.tradeoff import SUBSTEPS, TradeoffPlan, held_error, tradeoff
 
 #: Degrees: how much a sunny day's RMS moves with the seed alone at one deadband (standard
@@ -31,7 +32,8 @@ def test_the_held_error_is_the_ramp_of_a_sun_running_away_between_scans():
     step = 0.5
     target = 40.0 + step * np.arange(len(index))
     log = pd.DataFrame({"target_true": target, "angle": target, "mode": "sensor", "dni": 900.0}, index=index)
-    result = SimpleNamespace(log=log, site=sites.get("lanzhou"), collector=Collector("trough-ns"))
+    result = SimpleNamespace(log=log, site=sites.get("lanzhou"), collector=Collector("trough-ns"),
+                             config=SimulationConfig())
     rms, p95 = held_error(result)
     lags = step * np.arange(SUBSTEPS) / SUBSTEPS
     assert rms == pytest.approx(np.sqrt(np.mean(lags**2)))

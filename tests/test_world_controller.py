@@ -318,7 +318,8 @@ def test_the_plan_wakes_where_the_sun_ahead_or_behind_says_at_every_scan(site, m
                                   sites.Site("quito", -0.18, -78.47, 2850.0, "America/Guayaquil")])
 def test_the_world_computes_spa_wherever_the_sun_is_near_or_above_the_horizon(site):
     """The world runs SPA only where a cheap look at the sun, at hourly knots, says it may be up:
-    wherever pvlib's SPA puts the sun above -2°, the world's sun is SPA's (a year at 5 min)."""
+    wherever pvlib's SPA puts the sun above -2°, the world's sun is SPA's apparent one, refraction
+    at the site's pressure and 12 °C included (a year at 5 min)."""
     import pvlib
 
     index = pd.date_range("2021-01-01", "2021-12-31 23:55", freq="5min", tz=site.tz)
@@ -327,10 +328,12 @@ def test_the_world_computes_spa_wherever_the_sun_is_near_or_above_the_horizon(si
     collector = Collector("trough-ns")
     world = World(frame, site, collector, config.imperfections, config.sensor, _drives(collector, config), 0, {},
                   truth="spa")
-    spa = pvlib.solarposition.spa_python(index, site.latitude, site.longitude, site.altitude, delta_t=67.0)
+    spa = pvlib.solarposition.spa_python(index, site.latitude, site.longitude, site.altitude, delta_t=67.0,
+                                         pressure=pvlib.atmosphere.alt2pres(site.altitude), temperature=12.0)
     near = spa["elevation"].to_numpy() > -2.0
     assert near.sum() > 0.4 * len(index)
-    np.testing.assert_allclose(world.altitude[near], spa["elevation"].to_numpy()[near], atol=1e-9)
+    np.testing.assert_allclose(world.altitude[near], spa["apparent_elevation"].to_numpy()[near], atol=1e-9)
+    np.testing.assert_allclose(world.azimuth[near], spa["azimuth"].to_numpy()[near], atol=1e-9)
     assert (world.altitude[~near] < -2.0 + 1e-9).all()
 
 
@@ -380,3 +383,50 @@ def test_where_the_patch_has_no_light_its_place_changes_no_reading(offset):
             unplaced = read_pointing([offset], beam, aureole, 0.0, [0.0], [0.37], model)
             assert placed[1] == unplaced[1]
             np.testing.assert_array_equal(placed[0], unplaced[0])
+
+
+@pytest.mark.parametrize("refraction", [True, False])
+def test_the_controller_points_at_the_sun_as_it_appears_unless_told_to_leave_refraction_out(refraction):
+    """A controller on SPA with a true clock and a nominal mount aims a trough at pvlib's apparent
+    sun (its refraction at the site's pressure and 12 °C), the world's truth; without refraction at
+    its geometric sun, below the truth by the refraction a low sun shows (0.2-0.4° under 3°)."""
+    import pvlib
+
+    from hybridtrack.control import ControllerConfig
+    from hybridtrack.collectors import trough_angle
+
+    site = sites.get("lanzhou")
+    index = pd.date_range("2021-06-21 05:30", "2021-06-21 09:00", freq="1min", tz=site.tz)
+    minutes = np.arange(len(index), dtype=float)
+    plan = make_plan(index, minutes, site, Collector("trough-ns"),
+                     ControllerConfig(strategy="astronomical", sun_model="spa", refraction=refraction))
+    spa = pvlib.solarposition.spa_python(index, site.latitude, site.longitude, site.altitude, delta_t=67.0,
+                                         pressure=pvlib.atmosphere.alt2pres(site.altitude), temperature=12.0)
+    low = (spa["elevation"] > 0.5).to_numpy() & (spa["elevation"] < 3.0).to_numpy()
+    aimed = spa["apparent_elevation"] if refraction else spa["elevation"]
+    expected = trough_angle(aimed.to_numpy(), spa["azimuth"].to_numpy(), 0.0)
+    up = np.isfinite(expected)  # below the horizon the plan follows the geometry on; trough_angle gives NaN
+    assert up.sum() > 150
+    np.testing.assert_allclose(plan.model[up, 0], expected[up], atol=2e-6)  # SPA's own Δt against pvlib's 67 s
+    truth = trough_angle(spa["apparent_elevation"].to_numpy(), spa["azimuth"].to_numpy(), 0.0)
+    short = np.abs(plan.model[low, 0] - truth[low])
+    assert short.max() < 1e-5 if refraction else 0.2 < short.min() and short.max() < 0.45
+
+
+@pytest.mark.parametrize("name", ["refraction", "lead"])
+def test_a_controller_switch_that_is_not_true_or_false_is_refused(name):
+    """``ControllerConfig(refraction="no")`` had been taken as True, as any text is."""
+    from hybridtrack import HybridtrackError
+    from hybridtrack.control import ControllerConfig
+
+    with pytest.raises(HybridtrackError, match=f"controller: {name} must be true or false, got 'no'"):
+        ControllerConfig(**{name: "no"})
+
+
+def test_a_controller_without_refraction_round_trips_through_toml(tmp_path):
+    import dataclasses
+
+    config = SimulationConfig()
+    config = dataclasses.replace(config, controller=dataclasses.replace(config.controller, refraction=False))
+    assert SimulationConfig.from_toml(config.to_toml(tmp_path / "run.toml")).controller.refraction is False
+    assert SimulationConfig().controller.refraction is True

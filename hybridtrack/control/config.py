@@ -56,6 +56,13 @@ class ControllerConfig:
         mounting from a clear day of sensor readings; ``sensor``: closed loop only, as sold.
     sun_model : {"plc", "spa"}
         The controller's sun model.
+    refraction : bool
+        Whether the controller points at the sun as it appears, its model's altitude raised by
+        atmospheric refraction (`hybridtrack.sun.refraction`, SPA's formula at the site's
+        pressure and 12 °C), as a tracker built on SPA does; False for a controller whose sun
+        model leaves it out (the published PLC model is geometric), which points below the true
+        sun near the horizon: at sea level 0.28° at 2°, 0.09° at 10°, 0.02° at 45° (Meeus 1998,
+        ch. 16; docs/world.md, "Refraction").
     dwell : str
         Minimum time between switches of sensor and astronomical mode.
     wind_stow, wind_release : float
@@ -134,6 +141,7 @@ class ControllerConfig:
 
     strategy: str = "hybrid"
     sun_model: str = "plc"
+    refraction: bool = True
     dwell: str = "5min"
     wind_stow: float = 17.2
     wind_release: float = 12.0
@@ -166,6 +174,9 @@ class ControllerConfig:
             raise HybridtrackError(f"unknown strategy {self.strategy!r}; choose from {', '.join(STRATEGIES)}")
         if self.sun_model not in ("plc", "spa"):
             raise HybridtrackError(f"unknown sun model {self.sun_model!r}; choose 'plc' or 'spa'")
+        for name in ("refraction", "lead"):  # "no" had been taken as True
+            if not isinstance(getattr(self, name), bool):
+                raise HybridtrackError(f"controller: {name} must be true or false, got {getattr(self, name)!r:.40}")
         if self.wind_missing not in ("stow", "track"):
             raise HybridtrackError(f"controller: wind_missing {self.wind_missing!r}; choose 'stow' or 'track'")
         if self.kalman not in ("fast", "filterpy"):

@@ -176,9 +176,10 @@ def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collecto
     sun_key = ("plan's sun", Same(clock), Content(minutes), site, config)
     clock, steps, alarms, altitude, azimuth, apparent, awake, slept = shared(
         sun_key, lambda: _plan_sun(clock, minutes, site, config))
+    aimed = apparent if config.refraction else altitude  # the sun as it appears, or the model's geometric sun
     vectors = shared(geometry_key(sun_key, "pointing", collector),
-                     lambda: pointing_vectors(altitude, azimuth, collector, night=True,
-                                              sun=heliostat_sun(sun_key, altitude, azimuth, collector, night=True)))
+                     lambda: pointing_vectors(aimed, azimuth, collector, night=True,
+                                              sun=heliostat_sun(sun_key, aimed, azimuth, collector, night=True)))
     model = (mount or MountEstimate()).vector_targets(vectors, collector)
     plan = ControllerPlan(np.asarray(minutes, float), model, awake, steps, alarms=alarms, apparent_altitude=apparent,
                           slept=slept)
