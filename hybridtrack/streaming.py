@@ -56,6 +56,7 @@ from .collectors import Collector, as_collector
 from .errors import HybridtrackError
 from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude, check_magnitude_by_day
 from .io.files import input_path
+from .io.stamps import has_offset
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
@@ -413,7 +414,12 @@ def _parsed_stamps(stamps: pd.Series, path: Path, first_row: int) -> pd.Datetime
     `hybridtrack.io.read_weather` keeps them."""
     try:
         parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=False)
-    except ValueError:  # offsets that differ from row to row
+    except ValueError:  # offsets that differ from row to row, or stamps with and without one
+        naive = np.flatnonzero((~has_offset(stamps.astype(str)) & stamps.notna()).to_numpy())
+        if len(naive):  # read as UTC by pandas: a record shifted by its zone's offset without a word
+            raise HybridtrackError(f"{path}: row {first_row + int(naive[0])}, column {stamps.name!r}: "
+                                   f"{stamps.iloc[naive[0]]!r} has no UTC offset, but other stamps in the column have "
+                                   f"one ({CONVERT_ONCE})") from None
         parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=True)
     bad = np.flatnonzero(parsed.isna().to_numpy())
     if len(bad):

@@ -813,3 +813,13 @@ def test_a_streamed_file_of_clear_and_overcast_days_in_watts_streams(tmp_path):
     frame.round(3).to_csv(tmp_path / "watts.csv", index_label="time")
     days = list(recorded_days(tmp_path / "watts.csv", SITE, chunk_rows=70))
     assert sum(len(day) for _, day in days) == len(frame)
+
+
+def test_a_naive_stamp_beside_stamps_with_an_offset_is_refused_not_read_as_utc(tmp_path):
+    """pandas reads a column of stamps with and without offsets as UTC: a Berlin record whose first
+    line carried its offset had streamed an hour late, without a word (helper-39)."""
+    path = tmp_path / "mixed.csv"
+    path.write_text("time,dni\n2021-01-10T00:00:00+01:00,0\n2021-01-10 00:10:00,0\n2021-01-10 00:20:00,0\n")
+    with pytest.raises(HybridtrackError, match=r"mixed\.csv: row 3, column 'time': '2021-01-10 00:10:00' has no UTC "
+                                               r"offset, but other stamps in the column have one"):
+        list(recorded_days(path, SITE, tz="Europe/Berlin"))

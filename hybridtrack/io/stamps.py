@@ -32,7 +32,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError, quoted_cut
 
-__all__ = ["parse_stamps", "fixed_zone", "offset_in_name", "CLOCK_ZONES"]
+__all__ = ["parse_stamps", "fixed_zone", "offset_in_name", "has_offset", "CLOCK_ZONES"]
 
 #: Zones named by a clock column's header: US standard times (no daylight saving), as MIDC writes.
 CLOCK_ZONES = {"mst": "-07:00", "pst": "-08:00", "cst": "-06:00", "est": "-05:00", "ast": "-04:00", "hst": "-10:00",
@@ -281,6 +281,12 @@ def _parse(column: _Column, text: pd.Series, utc: bool) -> pd.DatetimeIndex:
     return index
 
 
+def has_offset(stamps: pd.Series) -> pd.Series:
+    """Whether each ISO 8601 stamp (text) ends in a UTC offset (``+08:00``, ``-0500``, ``Z``) after
+    its time of day; a date alone (``2021-06-21``) has none."""
+    return stamps.str.contains(_OFFSET)
+
+
 def _epoch(column: _Column, report: dict, unit: str = "s") -> pd.DatetimeIndex:
     report["time"] = f"epoch {'milliseconds' if unit == 'ms' else 'seconds'} (since 1970-01-01 UTC)"
     values = column.text.astype("int64" if unit == "ms" else float)  # 13 digits: exact as integers
@@ -464,10 +470,10 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
         column.refuse(int(clock_only[0]), "has no date; stamps need the date (add a date column, or write "
                                           "'2021-06-21 12:00')")
     iso = _written_offsets(_to_iso(column, dayfirst, report), report)
-    has_offset = iso.str.contains(_OFFSET)
+    with_offset = has_offset(iso)
     iso, midnight = _end_of_day(iso)
-    index = _parse(column, iso, utc=bool(has_offset.any()))
-    if index.tz is not None and not has_offset.any():  # a zone pandas reads and hybridtrack does not
+    index = _parse(column, iso, utc=bool(with_offset.any()))
+    if index.tz is not None and not with_offset.any():  # a zone pandas reads and hybridtrack does not
         column.refuse(0, "ends in a time zone hybridtrack does not read; write its UTC offset (+08:00), or "
                          "remove it and give the zone (--tz)")
     if midnight.any():
@@ -477,8 +483,8 @@ def _read_stamps(column: _Column, tz, site_tz, clock_zone, dayfirst, report: dic
         report["end_of_day"] = (f"{len(at)} stamp{'s' if len(at) > 1 else ''} of 24:00 read as 00:00 of the next day "
                                 f"(line{'s' if len(at) > 1 else ''} {lines_at})")
     _refuse_twelve_hour_clock(column, index)
-    if has_offset.any():
-        return _with_offsets(column, index, iso, has_offset, tz, report), np.ones(len(index), bool)
+    if with_offset.any():
+        return _with_offsets(column, index, iso, with_offset, tz, report), np.ones(len(index), bool)
     if tz is not None:
         return _localise(column, index, tz, f"naive stamps localised to {tz}", report)
     if clock_zone is not None:
