@@ -165,3 +165,20 @@ def test_hours_of_a_dead_sensor_beside_a_day_in_watts_are_read(tmp_path):
     dead[morning] = noise.sample(int(morning.sum()), replace=True, random_state=1).to_numpy()
     frame = read_weather(write(tmp_path / "dead.csv", dead.round(4)), site="lanzhou")
     assert frame["ghi"].max() > 1000
+
+
+def test_an_afternoon_of_dni_in_kilowatts_beside_its_morning_in_watts_is_refused(tmp_path, capsys):
+    """DNI in kW/m² from noon, GHI and DHI in W/m², had been called clean and its clear afternoon
+    replayed as overcast: GHI − DHI shows a direct beam of hundreds of W/m² beside a DNI of 1 or
+    less (helper-39). The hours are refused naming their first line and a W/m² line of the day."""
+    sky = clear_sky("2021-06-21 00:00", "2021-06-21 23:50", "10min")
+    afternoon = sky.index.hour >= 12
+    sky["dni"] = sky["dni"].where(~afternoon, sky["dni"] / 1000.0)
+    path = tmp_path / "pm.csv"
+    sky[["ghi", "dni", "dhi"]].round(4).rename_axis("time").to_csv(path)
+    message = refused(path, capsys, "pm.csv: line ", "column 'dni': dni reads ", "hours of a direct beam (ghi - dhi "
+                      "reaches 100 W/m² or more), while the same day reads", "look like kW/m² (a unit changed within "
+                      "the day) or a pyrheliometer off the sun")
+    lines = path.read_text().splitlines()
+    named = lines[int(re.search(r"line (\d+),", message).group(1)) - 1].split(",")
+    assert pd.Timestamp(named[0]).hour >= 12 and float(named[2]) <= 1.5  # an afternoon line in kW/m²

@@ -282,12 +282,19 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
     a label per row) whose other readings under that sun are W/m² (above `KILOWATT_TOP`): a
     logger whose unit changed within the day. No sky is so dark for so long (`_refuse_too_dark`),
     and a dead sensor's noise reads below `DARKEST` / 1000 at times; such hours had passed as a
-    dark morning, the day's top in W/m² keeping the whole-day judgements quiet."""
+    dark morning, the day's top in W/m² keeping the whole-day judgements quiet. DNI is judged so
+    where GHI shows a direct beam (`horizontal_beam`, `BEAM_SEEN` W/m² or more): an afternoon's
+    DNI in kW/m² beside a morning's in W/m² had replayed a clear afternoon as overcast."""
     high = np.asarray(clear_ghi) >= SUN_WELL_UP
+    judged_where = {name: (high, "a high sun") for name in ("ghi", "dhi") if name in frame}
+    beam = horizontal_beam(frame, clear_ghi) if {"ghi", "dni"} <= set(frame.columns) else None
+    if beam is not None:
+        with np.errstate(invalid="ignore"):
+            judged_where["dni"] = (beam[0] >= BEAM_SEEN, f"a direct beam ({beam[1]} {BEAM_SEEN:g} W/m² or more)")
     hours = frame.index.as_unit("ns").asi8 // pd.Timedelta(hours=1).value  # the hour each stamp is in
-    for name in [name for name in ("ghi", "dhi") if name in frame]:
+    for name, (where, what) in judged_where.items():
         values = frame[name].to_numpy(float)
-        judged = high & np.isfinite(values)
+        judged = where & np.isfinite(values)
         kilowatt = judged & (values >= DARKEST / 1000.0) & (values <= KILOWATT_TOP)
         watts = judged & (values > KILOWATT_TOP)
         if not (kilowatt.any() and watts.any()):
@@ -301,21 +308,22 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
         if len(mixed):
             in_kilowatts = counts.index[counts["in_kilowatts"] & (counts["day"] == mixed[0])]
             _refuse_hours_in_kilowatts(path, frame, report, name, np.isin(hours, in_kilowatts) & kilowatt,
-                                       watts & (days == mixed[0]), len(in_kilowatts))
+                                       watts & (days == mixed[0]), f"{len(in_kilowatts)} hours of {what}")
 
 
 def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,
-                               watts: np.ndarray, hours: int) -> None:
+                               watts: np.ndarray, hours: str) -> None:
     """`_check_hours`' refusal of a day's `hours` in kW/m² (`stretch`) beside its readings in W/m²."""
     values = frame[name].to_numpy(float)
     lines, other = first_lines(frame, stretch), first_lines(frame, watts)
     header = report.get("columns", {}).get(name, name)
     where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    off_sun = " or a pyrheliometer off the sun" if name == "dni" else ""
     raise HybridtrackError(
-        f"{where}: {name} reads {np.min(values[stretch]):g} to {np.max(values[stretch]):g} through {hours} hours of "
-        f"a high sun, while the same day reads {np.max(values[watts]):g} W/m²{f' (line {other[0]})' if other else ''}: "
-        "those hours look like kW/m² (a unit changed within the day): convert them to W/m² (×1000), or make them "
-        "empty if the sensor failed")
+        f"{where}: {name} reads {np.min(values[stretch]):g} to {np.max(values[stretch]):g} through {hours}, "
+        f"while the same day reads {np.max(values[watts]):g} W/m²{f' (line {other[0]})' if other else ''}: "
+        f"those hours look like kW/m² (a unit changed within the day){off_sun}: convert them to W/m² (×1000), or "
+        "make them empty if the sensor failed")
 
 
 def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, clear_ghi: np.ndarray) -> None:
