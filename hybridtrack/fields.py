@@ -794,31 +794,31 @@ def _weighted(values: pd.Series, weights: pd.Series, *, squared: bool = False) -
     return round(float(np.sqrt(mean)) if squared else mean, 5)
 
 
-def _end_loss_weights(collector: Collector, dni: np.ndarray, altitude: np.ndarray, azimuth: np.ndarray,
-                      incidence: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """What every Fresnel row of one axis shares of its end loss (`_end_loss`), over the steps with
-    the true sun up and direct light: the direct light on a perfect aperture (`incidence`), the end
-    loss per metre of the row's distance to the receiver (``f = 1``: `fresnel_end_loss` is ``f``
-    times a term of the sun and the axis alone), their sum and the light's sum."""
-    dni = np.nan_to_num(dni)
-    up = (altitude > 0) & (dni > 0)
-    per_metre = np.abs(fresnel_end_loss(altitude[up], azimuth[up], 0.0, 1.0, collector.axis))
-    beam = (dni * incidence)[up]
-    return beam, per_metre, float(beam.sum()), float(np.sum(beam * per_metre))
+def _end_loss_terms(collector: Collector, dni: np.ndarray, altitude: np.ndarray,
+                    azimuth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What every Fresnel row of one axis shares of its end loss (`_end_loss`): the steps with the
+    true sun up and direct light, and at them the end loss per metre of the row's distance to the
+    receiver (``f = 1``: `fresnel_end_loss` is ``f`` times a term of the sun and the axis alone)."""
+    up = (altitude > 0) & (np.nan_to_num(dni) > 0)
+    return up, np.abs(fresnel_end_loss(altitude[up], azimuth[up], 0.0, 1.0, collector.axis))
 
 
-def _end_loss(collector: Collector, row_length: float, weights: tuple) -> dict[str, float]:
+def _end_loss(collector: Collector, row_length: float, terms: tuple, dni: np.ndarray,
+              incidence: np.ndarray) -> dict[str, float]:
     """A Fresnel row's mean end loss (metres) and the share of its light lost past the receiver's
-    end, weighted by the direct light on its aperture under the true sun: its distance ``f`` to
-    the receiver times the `_end_loss_weights` its field's rows share (a 20-row field-year's
-    took 0.5 s at the end, on one core, when every row's was computed together; 25 ms a row
-    when each row computed the sun's part again)."""
-    beam, per_metre, total, weighted = weights
+    end, weighted by the direct light on its mirror under the true sun (`incidence`, its own):
+    its distance ``f`` to the receiver times the `_end_loss_terms` its field's rows share (a
+    20-row field-year's took 0.5 s at the end, on one core, when every row's was computed
+    together; 25 ms a row when each row computed the sun's part again)."""
+    up, per_metre = terms
+    beam = (np.nan_to_num(dni) * incidence)[up]
+    total = float(beam.sum())
     if not total > 0:
         return {"end_loss_m": math.nan, "end_loss_share": math.nan}
     f = float(np.hypot(collector.row_distance, collector.receiver_height))
     share = np.minimum(f * per_metre, row_length) / row_length
-    return {"end_loss_m": f * weighted / total, "end_loss_share": float(np.sum(beam * share) / total)}
+    return {"end_loss_m": f * float(np.sum(beam * per_metre)) / total,
+            "end_loss_share": float(np.sum(beam * share) / total)}
 
 
 def simulate_field(frame: pd.DataFrame, site, field, *, strategy: str | None = None, config=None,
@@ -1038,13 +1038,13 @@ def run_collectors(frame: pd.DataFrame, runs: list, *, site, strategy, config, s
                 events = run.events()
                 scores, log = run.scores(events), None
             scoring, true_sun = run.scoring(), (Same(frame), run.site, run.config.truth)  # what the keys turn on
-            offered = shared(geometry_key(true_sun, "offered energy", collector), lambda: _energy(
+            offered = shared(geometry_key(true_sun, "offered energy", collector, aperture=True), lambda: _energy(
                 offered_light(run.world.frame_dni, scoring["sun_up"], scoring["incidence"]), frame.index))
             row = {**dataclasses.asdict(imperfect), **_metrics(scores), "offered": offered}
             if row_length is not None:
-                weights = shared(geometry_key(true_sun, "end loss weights", collector), lambda: _end_loss_weights(
-                    collector, run.world.frame_dni, run.world.altitude, run.world.azimuth, scoring["incidence"]))
-                row.update(_end_loss(collector, row_length, weights))
+                terms = shared(geometry_key(true_sun, "end loss terms", collector), lambda: _end_loss_terms(
+                    collector, run.world.frame_dni, run.world.altitude, run.world.azimuth))
+                row.update(_end_loss(collector, row_length, terms, run.world.frame_dni, scoring["incidence"]))
             done.append((i, row, events.assign(collector=name), log))
     return done
 

@@ -13,6 +13,8 @@ broadcasting functions of `hybridtrack.collectors` (`hybridtrack.fields`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import mountpass
@@ -145,26 +147,29 @@ def pointing_vectors(altitude, azimuth, collector: Collector, *, night: bool = F
     return heliostat_normal(np.abs(alt) if night else alt, az, collector.aim, sun=sun)
 
 
-def heliostat_sun(base: tuple, altitude, azimuth, collector: Collector, *, night: bool = False) -> np.ndarray | None:
+def heliostat_sun(base: tuple, altitude, azimuth, collector: Collector, *, night: bool = False,
+                  aperture: bool = False) -> np.ndarray | None:
     """The sun's unit vectors a heliostat's own geometry starts from (the `sun` of
     `pointing_vectors` and `incidence_cosine`), shared by a field's heliostats under the sun that
-    `base` keys; None for another collector, whose pointing vectors are the sun's own and are
-    shared whole (`geometry_key`)."""
-    if collector.kind != "heliostat":
+    `base` keys; with `aperture`, a Fresnel row's too, whose incidence turns on its own place
+    under the receiver (`incidence_cosine`). None for another collector, whose pointing vectors
+    are the sun's own and are shared whole (`geometry_key`)."""
+    if collector.kind != "heliostat" and not (aperture and collector.kind == "fresnel"):
         return None
     alt = np.asarray(altitude, float)
     return shared((*base, "sun vectors", night),
                   lambda: sun_vector(np.abs(alt) if night else alt, np.asarray(azimuth, float)))
 
 
-def geometry_key(base: tuple, what: str, collector: Collector) -> tuple | None:
+def geometry_key(base: tuple, what: str, collector: Collector, *, aperture: bool = False) -> tuple | None:
     """A `hybridtrack.reuse.shared` key for `what` of a collector's geometry under the sun that
-    `base` keys: what `pointing_vectors`, `incidence_cosine` and the mount fit's derivatives
+    `base` keys: what `pointing_vectors` and the mount fit's derivatives
     (`hybridtrack.control.mountfit.vector_jacobian`) read of a collector, its kind and axis, so
     that a field's rows or troughs on one axis line share them. None for a heliostat: its
     geometry turns on its own aim point, which no other heliostat of its field has, and keeping
-    what no other run asks for would only push out what they do."""
-    if collector.kind == "heliostat":
+    what no other run asks for would only push out what they do; so too for what a Fresnel row's
+    `aperture` reads (`incidence_cosine`), which turns on its own place under the receiver."""
+    if collector.kind == "heliostat" or (aperture and collector.kind == "fresnel"):
         return None
     return (*base, what, collector.kind, collector.axis)
 
@@ -251,10 +256,18 @@ def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np
     """Cosine of the sun's incidence on one collector's perfectly tracking aperture, (N,) for a
     sun path of N steps.
 
-    For a single-axis collector it is the part of the sun vector across the axis; a
-    heliostat's is the cosine of half the angle between sun and aim point. Zero at night.
-    `sun`: the sun's unit vectors (`sun_vector`), (N, 3), if computed already; another shape is
-    refused by name (it had raised numpy's errors).
+    For a trough it is the part of the sun vector across the axis. A Fresnel row's mirror turns
+    its normal halfway between the sun and the receiver in the plane across the axis, so its
+    cosine is that part times the cosine of half the angle, in that plane, between the sun and
+    the receiver as the row sees it (`row_distance`, `receiver_height`): rows far from the
+    receiver line catch less of the beam. A heliostat's is the cosine of half the angle between
+    sun and aim point. Zero at night. `sun`: the sun's unit vectors (`sun_vector`), (N, 3), if
+    computed already; another shape is refused by name (it had raised numpy's errors).
+
+    References
+    ----------
+    Duffie, J. A. & Beckman, W. A. (2013). *Solar Engineering of Thermal Processes*, 4th ed.,
+    Wiley, §1.9 (angle of incidence on tracking surfaces). doi:10.1002/9781118671603
     """
     alt, az = sun_path(altitude, azimuth, "incidence_cosine")
     collector = as_collector(collector)
@@ -266,4 +279,18 @@ def incidence_cosine(altitude, azimuth, collector: Collector, *, sun=None) -> np
         b = np.radians(collector.axis)
         along = s[:, 0] * np.sin(b) + s[:, 1] * np.cos(b)
         cos = np.sqrt(np.clip(1.0 - along**2, 0.0, 1.0))
+        if collector.kind == "fresnel":
+            cos = cos * _half_turn_to_receiver(s, b, cos, collector)
     return np.where(alt > 0, cos, 0.0)
+
+
+def _half_turn_to_receiver(s: np.ndarray, b: float, across_part: np.ndarray, collector: Collector) -> np.ndarray:
+    """cos(δ/2) for a Fresnel row, δ the angle in the plane across the axis (unit vectors
+    across, towards ``axis + 90°``, and up) between the sun's part there (of length
+    `across_part`) and the direction from the row to the receiver, ``(-d, h)``."""
+    across = s[:, 0] * np.cos(b) - s[:, 1] * np.sin(b)
+    reach = math.hypot(collector.row_distance, collector.receiver_height)
+    to_receiver = (-collector.row_distance * across + collector.receiver_height * s[:, 2]) / reach
+    with np.errstate(invalid="ignore", divide="ignore"):  # a sun along the axis has no part across it
+        cos_delta = np.where(across_part > 0, to_receiver / across_part, 1.0)
+    return np.sqrt(np.clip((1.0 + cos_delta) / 2.0, 0.0, 1.0))

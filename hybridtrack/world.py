@@ -327,8 +327,9 @@ class World:
         """Cosine of the true sun's incidence on a perfectly tracking aperture at each scan
         (`hybridtrack.mounting.incidence_cosine`), for the scoring; shared by a field's
         collectors of one geometry (`hybridtrack.mounting.geometry_key`)."""
-        return shared(geometry_key(self._sun_key, "incidence", self.collector),
-                      lambda: incidence_cosine(self.altitude, self.azimuth, self.collector, sun=self._heliostat_sun()))
+        return shared(geometry_key(self._sun_key, "incidence", self.collector, aperture=True),
+                      lambda: incidence_cosine(self.altitude, self.azimuth, self.collector, sun=heliostat_sun(
+                          self._sun_key, self.altitude, self.azimuth, self.collector, aperture=True)))
 
     def _heliostat_sun(self) -> np.ndarray | None:
         return heliostat_sun(self._sun_key, self.altitude, self.azimuth, self.collector)

@@ -293,17 +293,18 @@ def test_a_field_without_its_log_scores_each_collector_as_its_whole_result_does(
 
 
 @pytest.mark.parametrize("field, computed", [
-    (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (3, 1)),  # pointing (world, plan), incidence (which the
-    # rows' end losses take too); derivatives
+    (FresnelField(row_distances=[-4.0, 2.0, 6.0]), (3, 1)),  # pointing (world, plan), the sun's unit vectors
+    # each row's incidence on its own mirror starts from; derivatives
     (TroughLoop(count=3), (3, 1)),
     # the sun's unit vectors once for the world and once for the plan; each mirror's derivatives its own
     (HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0], [-30.0, -80.0]]), (2, 3)),
 ])
 def test_rows_on_one_axis_line_share_their_geometry_and_heliostats_keep_their_own(monkeypatch, field, computed):
     """Under one sun, the sun's direction (the world's and the plan's) and its incidence on the
-    aperture are computed once for a field's rows or troughs on one axis line, and so are the
-    mount fit's derivatives; a heliostat's pointing turns on its own aim point, so each of those
-    is its own, but the sun's unit vectors it starts from are shared. (The clear day before the
+    aperture are computed once for a field's troughs on one axis line, and so are the mount fit's
+    derivatives (and a Fresnel field's rows' pointing and derivatives); a heliostat's pointing and
+    a Fresnel row's incidence turn on its own aim point or place under the receiver, so each of
+    those is its own, but the sun's unit vectors they start from are shared. (The clear day before the
     run, a day's scans, is not counted here: `test_the_field_stood_under_one_sky_the_day_before`.)"""
     import hybridtrack.control.plan as plan
     import hybridtrack.mounting as mounting
@@ -705,13 +706,18 @@ def test_an_east_west_fresnel_field_reports_its_end_loss(day):
     result = simulate_field(day, "lanzhou", field, keep_log=False)
     assert list(result.collectors.columns) == collector_columns(field)
     # by hand: light-weighted |L_end| over the day, each step's L_end = f tan(θ) (docs/fields.md)
+    # weighted by the beam on each row's own mirror: pvlib's incidence on the plane fresnel_angle tilts
     sun = solar_position(day.index, "lanzhou")  # the true sun as it appears (refracted), the world's
     up = (sun["apparent_altitude"] > 0) & (day["dni"] > 0)
-    a, g = np.radians(sun["apparent_altitude"][up]), np.radians(sun["azimuth"][up] - 90.0)
+    altitude, azimuth = sun["apparent_altitude"][up], sun["azimuth"][up]
+    a, g = np.radians(altitude), np.radians(azimuth - 90.0)
     s_along = np.cos(a) * np.cos(g)
     loss = np.hypot(2.0, 10.0) * np.abs(s_along) / np.sqrt(1.0 - s_along**2)
-    beam = day["dni"][up] * np.sqrt(1.0 - s_along**2)
-    np.testing.assert_allclose(result.collectors["end_loss_m"], np.sum(beam * loss) / beam.sum(), rtol=1e-6)
+    for row, d in enumerate(field.row_distances):
+        rho = fresnel_angle(altitude.to_numpy(), azimuth.to_numpy(), d, 10.0, 90.0)
+        aoi = pvlib.irradiance.aoi(np.abs(90.0 - rho), np.where(rho < 90.0, 180.0, 0.0), 90.0 - altitude, azimuth)
+        beam = day["dni"][up] * np.cos(np.radians(aoi))
+        assert result.collectors["end_loss_m"].iloc[row] == pytest.approx(np.sum(beam * loss) / beam.sum(), rel=1e-6)
     assert 0 < result.summary["end_loss_share"] < 1
     assert isinstance(result.plot_map("end_loss_share"), Figure)
 
