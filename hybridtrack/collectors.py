@@ -340,7 +340,7 @@ def receiver_angle(d, h):
 
     A numpy.float64 for scalar `d` and `h`, else an array of their broadcast shape.
     """
-    d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
+    d, h = _distance(d, "row distance d"), _distance(h, "receiver height h")
     _broadcast("receiver_angle", d=d, h=h)
     if not np.all(h > 0):
         raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
@@ -353,6 +353,16 @@ def _finite(values, name: str) -> np.ndarray:
     array = finite_array(values, not_numbers=f"{name} must be numbers", infinite=f"{name} must be finite")
     if not np.all(np.isfinite(array)):
         raise HybridtrackError(f"{name} must be finite, got {array.tolist()!r}")
+    return array
+
+
+def _distance(values, name: str) -> np.ndarray:
+    """`_finite` metres no farther than `MAX_DISTANCE` (a row 1e308 m out had overflowed to an
+    infinite end loss with numpy's RuntimeWarning)."""
+    array = _finite(values, name)
+    if np.any(np.abs(array) > MAX_DISTANCE):
+        raise HybridtrackError(f"{name} must be within {MAX_DISTANCE:g} m, the farthest a row or receiver lies from "
+                               f"a collector; got {array.tolist()!r:.60}")
     return array
 
 
@@ -384,7 +394,7 @@ def fresnel_end_loss(altitude, azimuth, d, h, axis_azimuth=0.0):
         Metres; positive means the light is lost past the row's end at `axis_azimuth` (the
         north end of a north-south row), negative past the other end. NaN while the sun is down.
     """
-    d, h = _finite(d, "row distance d"), _finite(h, "receiver height h")
+    d, h = _distance(d, "row distance d"), _distance(h, "receiver height h")
     if not np.all(h > 0):  # the hypotenuse would hide the sign: -10 m gave +10 m's loss
         raise HybridtrackError(f"receiver height h must be positive, got {h.tolist()!r} m")
     axis = _finite(axis_azimuth, "axis azimuth")
@@ -395,7 +405,7 @@ def fresnel_end_loss(altitude, azimuth, d, h, axis_azimuth=0.0):
     f = np.hypot(d, h)
     with np.errstate(invalid="ignore", divide="ignore"):
         loss = -f * np.cos(a) * np.cos(g) / np.sqrt((np.cos(a) * np.sin(g)) ** 2 + np.sin(a) ** 2)
-    return _like(altitude, np.where(a > 0.0, loss, np.nan), "end_loss")
+    return _like(altitude, np.where(a >= 0.0, loss, np.nan), "end_loss")  # a sun on the horizon is up, as elsewhere
 
 
 def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:

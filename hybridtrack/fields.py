@@ -22,6 +22,7 @@ import dataclasses
 import math
 import numbers
 import sys
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -389,8 +390,8 @@ class TroughLoop:
 
     def targets(self, altitude, azimuth) -> np.ndarray:
         """Every collector's nominal rotation angle (T, N), degrees; NaN at night."""
-        alt, az = _sun_columns(altitude, azimuth)
-        return np.broadcast_to(trough_angle(alt, az, self.axis_azimuth), (alt.shape[0], self.count))
+        alt, az = _sun_columns(altitude, azimuth)  # a writable array of its own, as the other fields' targets
+        return np.repeat(trough_angle(alt, az, self.axis_azimuth), self.count, axis=1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -439,6 +440,7 @@ class HeliostatField:
         _refuse_far(np.abs(xyz) > MAX_DISTANCE)  # first: the overlap check squares them (1e200 m overflowed)
         _distinct(xyz, "heliostats", "m (east, north, up)")
         _refuse_overlapping(xyz)
+        xyz.setflags(write=False)  # a frozen field: a mirror moved in place had escaped every check above
         object.__setattr__(self, "positions", xyz)
         given = _aims_by_name(self.aims)
         if self.aim is not None and self.aims is not None and not _aim_of(self.aim, given):
@@ -467,6 +469,9 @@ class HeliostatField:
         _refuse_unreachable_aims(relative)
         object.__setattr__(self, "aim", tuple(aim.tolist()))
         # one shared point stays one: `dataclasses.replace` then moves it, or the mirrors, alone
+        if self.aims is not None:
+            aims = np.array(aims, float)  # its own, read-only as the positions are
+            aims.setflags(write=False)
         object.__setattr__(self, "aims", None if self.aims is None else aims)
 
     @classmethod
@@ -548,7 +553,7 @@ def _by_name(positions):
     Its aim columns (`AIM_COLUMNS`) are refused: they are given as ``aims``."""
     if not isinstance(positions, pd.DataFrame):
         return positions
-    names = {str(column).strip().lower(): column for column in positions.columns}
+    names = _named_columns(positions, "heliostat positions")
     wanted = [axis for axis in ("east", "north", "up") if axis in names]
     if wanted[:2] != ["east", "north"]:
         raise HybridtrackError(f"heliostat positions: a table needs columns 'east' and 'north' (and 'up'), m; it has "
@@ -559,9 +564,33 @@ def _by_name(positions):
                                f"positions does not read: give the table without them, and them as "
                                f"aims=table[{list(AIM_COLUMNS)}]")
     table = positions[[names[axis] for axis in wanted]]
+    _say_unread(positions, table, "heliostat positions", "east, north, up")
     if all(pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind) for kind in table.dtypes):
         return table.to_numpy(dtype=float, na_value=np.nan)  # pandas' nullable numbers too; NA is not finite
     return table
+
+
+def _named_columns(table: pd.DataFrame, what: str) -> dict:
+    """A table's columns by their names in lower case without spaces, a name given twice refused:
+    the last had been read, so ``east, East`` read the second as east and ``east, north, north``
+    the second north as up, without a word."""
+    names: dict = {}
+    for column in table.columns:
+        name = str(column).strip().lower()
+        if name in names:
+            raise HybridtrackError(f"{what}: the table has the column {name!r} more than once ({names[name]!r}, "
+                                   f"{column!r}); keep one")
+        names[name] = column
+    return names
+
+
+def _say_unread(table: pd.DataFrame, read: pd.DataFrame, what: str, reads: str) -> None:
+    """Warn of a table's columns that are not read (an ``elevation`` beside ``east, north`` put the
+    mirrors at 0 m up without a word; the command line names them as ``not read``)."""
+    unread = [str(column) for column in table.columns if column not in read.columns]
+    if unread:
+        warnings.warn(f"{what}: the table's {', '.join(unread)} {'is' if len(unread) == 1 else 'are'} not read "
+                      f"({what} reads {reads})", UserWarning, stacklevel=5)
 
 
 def _aims_by_name(aims):
@@ -571,10 +600,11 @@ def _aims_by_name(aims):
     aim point's east and north without a word. Any other aims as they are."""
     if not isinstance(aims, pd.DataFrame):
         return aims
-    names = {str(column).strip().lower(): column for column in aims.columns}
+    names = _named_columns(aims, "heliostat aim points")
     for wanted in (AIM_COLUMNS, ("east", "north", "up")):
         if all(column in names for column in wanted):
             table = aims[[names[column] for column in wanted]]
+            _say_unread(aims, table, "heliostat aim points", ", ".join(wanted))
             if all(pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind)
                    for kind in table.dtypes):
                 return table.to_numpy(dtype=float, na_value=np.nan)
@@ -586,12 +616,15 @@ def _aims_by_name(aims):
 def _refuse_unreachable_aims(relative: np.ndarray) -> None:
     """Refuse an aim point a heliostat cannot serve, naming the first such mirror: one not above it
     (a heliostat sends the sun up to its receiver; aimed down, it would catch nothing the field
-    counts), or farther along an axis than a collector's aim may lie (`MAX_DISTANCE`)."""
-    below = np.flatnonzero(relative[:, 2] <= 0)
+    counts), or farther along an axis than a collector's aim may lie (`MAX_DISTANCE`). An aim point
+    less than `MIN_RECEIVER_HEIGHT` above the mirror is refused as a Fresnel receiver so low is:
+    it lies on the mirror, or kilometres were typed for metres (1e-300 m up had run)."""
+    below = np.flatnonzero(~(relative[:, 2] >= MIN_RECEIVER_HEIGHT))
     if len(below):
         k = int(below[0])
         raise HybridtrackError(f"heliostat {k + 1}: its aim point is not above the mirror ({relative[k, 2]:g} m up "
-                               "from it): a heliostat reflects the sun up to its receiver")
+                               f"from it, at least {MIN_RECEIVER_HEIGHT:g} m): a heliostat reflects the sun up to "
+                               "its receiver")
     far = np.flatnonzero((np.abs(relative) > MAX_DISTANCE).any(axis=1))
     if len(far):
         raise HybridtrackError(f"heliostat {int(far[0]) + 1}: its aim point is more than {MAX_DISTANCE:g} m from "

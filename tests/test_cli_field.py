@@ -150,7 +150,7 @@ def test_bad_field_flags(capsys, flags, message):
      "--count, --collector-length: trough loop: 33 collectors of 160 m reach 5120 m along the axis, beyond 5000 m"),
     (["heliostat", "--count", "0"], "--count: heliostat count must be a whole number from 1 to 100000, got 0"),
     (["heliostat", "--count", "3", "--aim", "0", "0", "-5"], "--aim: heliostat 1: its aim point is not above the "
-                                                             "mirror (-5 m up from it): a heliostat reflects the sun "
+                                                             "mirror (-5 m up from it, at least 0.1 m): a heliostat reflects the sun "
                                                              "up to its receiver"),
     (["fresnel", "--spread", "encoder_offset=-1"], "--spread encoder_offset: imperfection spread: encoder_offset "
                                                    "must be a finite number >= 0, got -1.0"),
@@ -174,7 +174,7 @@ def test_a_positions_files_refusal_names_the_file_and_aim_only_when_it_came_from
     path.write_text("east,north\n0,-80\n")
     assert main([*base, "--aim", "0", "0", "-100"]) == 2
     assert capsys.readouterr().err == f"hybridtrack: error: {path}: --aim: heliostat 1: its aim point is not above " \
-                                      "the mirror (-100 m up from it): a heliostat reflects the sun up to its " \
+                                      "the mirror (-100 m up from it, at least 0.1 m): a heliostat reflects the sun up to its " \
                                       "receiver\n"
 
 

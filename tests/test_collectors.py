@@ -509,3 +509,13 @@ def test_a_fresnel_rows_incidence_is_the_beams_on_its_own_mirror(axis, d, h):
     aoi = pvlib.irradiance.aoi(tilt, facing, 90.0 - altitude, azimuth)
     collector = Collector("fresnel", axis_azimuth=axis, row_distance=d, receiver_height=h)
     np.testing.assert_allclose(incidence_cosine(altitude, azimuth, collector), np.cos(np.radians(aoi)), atol=1e-12)
+
+
+def test_the_fresnel_end_loss_of_a_sun_on_the_horizon_is_a_length_and_a_row_beyond_reach_is_refused():
+    """A sun at altitude 0 gave NaN where the angles give values; a row 1e308 m out overflowed to
+    an infinite loss with numpy's RuntimeWarning (helper-38)."""
+    f = np.hypot(2.0, 10.0)  # at 0° the ray runs f·|cos γ| / |sin γ| along the axis (γ from the axis)
+    assert fresnel_end_loss(0.0, 100.0, 2.0, 10.0) == pytest.approx(-f * np.cos(np.radians(100.0)) /
+                                                                     abs(np.sin(np.radians(100.0))))
+    with pytest.raises(HybridtrackError, match="row distance d must be within 5000 m"):
+        fresnel_end_loss(30.0, 180.0, 1e308, 1e308)

@@ -150,7 +150,7 @@ def test_replace_moves_a_shared_aim_point_or_the_mirrors():
     (lambda: HeliostatField.rings(3, spacing=1e-9), "spacing must be at least 1 m"),
     # aims a heliostat cannot serve had run (capture 0), or failed in the run without naming the mirror
     (lambda: HeliostatField(positions=[[0, -100], [0, -50]], aim=(0, 0, -50)),
-     r"heliostat 1: its aim point is not above the mirror \(-50 m up from it\)"),
+     r"heliostat 1: its aim point is not above the mirror \(-50 m up from it, at least 0\.1 m\)"),
     (lambda: HeliostatField(positions=[[0, -100, 0], [0, -50, 120]]), "heliostat 2: its aim point is not above"),
     (lambda: HeliostatField(positions=[[0, -100], [-4000, 0]], aim=(4500, 0, 100)),
      "heliostat 2: its aim point is more than 5000 m from the mirror"),
@@ -639,7 +639,9 @@ def test_far_heliostats_are_refused_before_their_overlap_is_checked(positions):
 def test_a_table_of_heliostat_positions_is_read_by_its_columns_names():
     """It was read by the columns' order: id, east, north put every mirror 100 m underground."""
     table = pd.DataFrame({"id": [1, 2], "North": [-100.0, -90.0], "east": [0.0, 50.0]})
-    np.testing.assert_array_equal(HeliostatField(positions=table).positions, [[0.0, -100.0, 0.0], [50.0, -90.0, 0.0]])
+    with pytest.warns(UserWarning, match="the table's id is not read"):
+        field = HeliostatField(positions=table)
+    np.testing.assert_array_equal(field.positions, [[0.0, -100.0, 0.0], [50.0, -90.0, 0.0]])
     with pytest.raises(HybridtrackError, match="a table needs columns 'east' and 'north' \\(and 'up'\\), m; it has x, y"):
         HeliostatField(positions=pd.DataFrame({"x": [1.0], "y": [2.0]}))
 
@@ -800,3 +802,40 @@ def test_a_field_starts_no_more_dask_workers_than_it_has_collectors(day, monkeyp
     with pytest.raises(HybridtrackError, match="stop here"):
         simulate_field(day, "lanzhou", FresnelField(row_distances=[-4.0, 0.0, 4.0]), workers=64)
     assert asked == [3]
+
+
+@pytest.mark.parametrize("table, what, name", [
+    (pd.DataFrame([[0, 500, -80], [20, 600, -80]], columns=["east", "East ", "north"]), "positions", "east"),
+    (pd.DataFrame([[0, -80, 5], [20, -80, 5]], columns=["east", "north", "north"]), "positions", "north"),
+    (pd.DataFrame([[0, 0, 100, 7], [0, 0, 90, 7]], columns=["aim_east", "aim_north", "aim_up", "AIM_UP"]), "aims",
+     "aim_up"),
+])
+def test_a_table_column_given_twice_is_refused_not_the_last_read(table, what, name):
+    """The last of two columns of one name had been read: ``east, East`` took the second as east,
+    ``east, north, north`` the second north as up, ``aim_up, AIM_UP`` the 7 m (helper-38)."""
+    given = {"positions": table} if what == "positions" else {"positions": [[0.0, -80.0], [20.0, -80.0]], "aims": table}
+    with pytest.raises(HybridtrackError, match=f"the table has the column '{name}' more than once"):
+        HeliostatField(**given)
+
+
+def test_a_tables_columns_not_read_are_named_in_a_warning():
+    """An ``elevation`` beside ``east, north`` had put the mirrors at 0 m up without a word."""
+    table = pd.DataFrame({"east": [0.0, 20.0], "north": [-80.0, -80.0], "elevation": [3.0, 3.0]})
+    with pytest.warns(UserWarning, match=r"heliostat positions: the table's elevation is not read \(heliostat "
+                                         r"positions reads east, north, up\)"):
+        field = HeliostatField(positions=table)
+    assert (field.positions[:, 2] == 0.0).all()
+
+
+def test_a_fields_mirrors_cannot_be_moved_in_place_and_an_aim_on_the_mirror_is_refused():
+    """A frozen field's positions had been writable (two mirrors put in one place ran), and an aim
+    point 1e-300 m above the mirror ran, scoring 0.97 (helper-38)."""
+    field = HeliostatField(positions=[[0.0, -60.0], [30.0, -80.0]], aims=[[0.0, 0.0, 80.0], [0.0, 0.0, 80.0]])
+    for array in (field.positions, field.aims):
+        with pytest.raises(ValueError, match="read-only"):
+            array[1] = array[0]
+    with pytest.raises(HybridtrackError, match=r"heliostat 1: its aim point is not above the mirror \(1e-300 m up "
+                                               r"from it, at least 0\.1 m\)"):
+        HeliostatField(positions=[[0.0, -60.0]], aim=(0.0, 0.0, 1e-300))
+    targets = TroughLoop(count=3).targets(np.array([30.0, 40.0]), np.array([120.0, 150.0]))
+    assert targets.shape == (2, 3) and targets.flags.writeable  # as the other fields' targets are
