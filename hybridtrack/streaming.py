@@ -292,8 +292,9 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     path = input_path(path, "weather file")
     if path.is_dir():
         raise HybridtrackError(f"{path}: is a folder, not a weather file")
-    if not path.is_file():
-        raise HybridtrackError(f"{path}: no such file")
+    if not path.is_file():  # /dev/null had been "no such file"
+        raise HybridtrackError(f"{path}: is not a regular file (a device or a pipe, which a streamed run, reading the "
+                               f"file twice, cannot take)" if path.exists() else f"{path}: no such file")
     chunk_rows = params.whole(chunk_rows, "chunk_rows", 1, 10**9)
     suffix = path.suffix.lower()
     if suffix not in (".parquet", ".pq", ".csv"):
@@ -315,6 +316,7 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
         return piece
 
     separator = csv_separator(path) if suffix == ".csv" else None
+    _refuse_repeated_columns(path, separator)
     measured = _measured(path, separator, ("dni", "wind_speed"))
     if "dni" not in measured:
         raise HybridtrackError(_without_dni(path, separator))
@@ -423,9 +425,9 @@ def _parsed_stamps(stamps: pd.Series, path: Path, first_row: int) -> pd.Datetime
         parsed = pd.to_datetime(stamps, format="ISO8601", errors="coerce", utc=True)
     bad = np.flatnonzero(parsed.isna().to_numpy())
     if len(bad):
-        row = first_row + int(bad[0])
-        raise HybridtrackError(f"{path}: row {row}, column {stamps.name!r}: {stamps.iloc[bad[0]]!r} is not an "
-                               f"ISO 8601 time stamp ({CONVERT_ONCE})")
+        row, cell = first_row + int(bad[0]), stamps.iloc[bad[0]]
+        what = "'' is an empty time stamp" if pd.isna(cell) else f"{str(cell)!r} is not an ISO 8601 time stamp"
+        raise HybridtrackError(f"{path}: row {row}, column {stamps.name!r}: {what} ({CONVERT_ONCE})")
     return pd.DatetimeIndex(parsed)
 
 
@@ -472,6 +474,25 @@ def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> set[
         return found if rows or separator is None else set(names)
     except (OSError, ValueError):  # pandas' and pyarrow's read errors
         return set(names)
+
+
+def _refuse_repeated_columns(path: Path, separator: str | None) -> None:
+    """Refuse a column name the file's header holds twice, as the record reader does: a CSV's second
+    ``dni`` had been read as ``dni.1`` and dropped without a word (the first, perhaps all zeros,
+    run), and a Parquet file's had ended in pandas' TypeError. A header that cannot be read is
+    left to the run's own read, which names what is wrong."""
+    try:
+        if separator is not None:
+            names = [str(name) for name in pd.read_csv(path, sep=separator, nrows=1, header=None, dtype=str).iloc[0]]
+        else:
+            import pyarrow.parquet as pq
+
+            names = list(pq.ParquetFile(path).schema_arrow.names)
+    except (OSError, ValueError, IndexError):  # pandas' and pyarrow's read errors; a file of no line
+        return
+    repeated = pd.Index(names)[pd.Index(names).duplicated()]
+    if len(repeated):
+        raise HybridtrackError(f"{path}: column {repeated[0]!r} appears more than once in the header; rename one")
 
 
 def _numeric(piece: pd.DataFrame, path: Path, first_row: int) -> None:
@@ -571,7 +592,8 @@ def _days_checked(path: Path, lines: pd.DataFrame, site: sites.Site, last: bool)
 
         judged = lines[whole]
         zenith = solar_position(judged.index, site, model="plc")["apparent_zenith"]  # as the reader's: PLC is ample
-        check_magnitude_by_day(path, judged, {}, pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float), site.tz)
+        check_magnitude_by_day(path, judged, {}, pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float), site.tz,
+                               part=True)  # the file's span passed whole: a day in kW/m² is among days in W/m²
     return lines[~whole]
 
 

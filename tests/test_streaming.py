@@ -823,3 +823,36 @@ def test_a_naive_stamp_beside_stamps_with_an_offset_is_refused_not_read_as_utc(t
     with pytest.raises(HybridtrackError, match=r"mixed\.csv: row 3, column 'time': '2021-01-10 00:10:00' has no UTC "
                                                r"offset, but other stamps in the column have one"):
         list(recorded_days(path, SITE, tz="Europe/Berlin"))
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_streamed_files_column_given_twice_is_refused_as_the_reader_refuses_it(tmp_path, suffix):
+    """A CSV's second ``dni`` had been read as ``dni.1`` and dropped without a word (an all-zero
+    first one ran), and a Parquet file's had ended in pandas' TypeError (helper-39)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = tmp_path / f"twice{suffix}"
+    stamps = ["2021-06-21T12:00:00+08:00", "2021-06-21T12:01:00+08:00"]
+    if suffix == ".csv":
+        path.write_text("time,dni,dhi,dni\n" + "".join(f"{t},0,100,800\n" for t in stamps))
+    else:
+        pq.write_table(pa.Table.from_arrays([pa.array(stamps), pa.array([0.0, 0.0]), pa.array([800.0, 800.0])],
+                                            names=["time", "dni", "dni"]), path)
+    with pytest.raises(HybridtrackError, match=rf"twice\{suffix}: column 'dni' appears more than once in the header"):
+        recorded_days(path, SITE)
+
+
+def test_a_streamed_day_in_kw_per_m2_among_days_in_watts_is_refused_by_its_line(tmp_path):
+    """Judged a day at a time, the day had passed the reader's check (it needs two days together)
+    and the run refused it naming only the frame's date (helper-39); it is named by line."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-19", "2021-06-21", weather="sunny", freq="10min", seed=1)[["ghi", "dni", "dhi"]]
+    frame.loc[frame.index.day == 20] /= 1000.0
+    frame.round(5).to_csv(tmp_path / "day.csv", index_label="time")
+    with pytest.raises(HybridtrackError, match=r"day\.csv: line (\d+), column 'ghi': ghi is at most [\d.]+ while the "
+                                               r"clear sky reaches \d+ W/m²; .* the file's other days are in W/m²") as e:
+        list(recorded_days(tmp_path / "day.csv", SITE, chunk_rows=100))
+    line = int(re.search(r"line (\d+),", str(e.value)).group(1))
+    assert (tmp_path / "day.csv").read_text().splitlines()[line - 1].startswith("2021-06-20")

@@ -251,25 +251,28 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             _refuse_too_dark(where, frame, name, top, clear_ghi)
 
 
-def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz) -> None:
+def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *,
+                           part: bool = False) -> None:
     """`_check_days` in the site's zone `tz` and, where the file's stamps are in another (a logger
     on UTC at a site eight hours east), in theirs: a logger changes its unit on its own day, whose
-    W/m² hours had kept each of the site's days above the limit."""
+    W/m² hours had kept each of the site's days above the limit. `frame` is `part` of a longer
+    file that passed as a whole (a streamed file's days): a day of it is judged alone too."""
     zones = [tz] + ([frame.index.tz] if str(frame.index.tz) != str(tz) else [])
     for zone in zones:
-        _check_days(path, frame, report, clear_ghi, zone)
+        _check_days(path, frame, report, clear_ghi, zone, part=part)
 
 
-def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz) -> None:
+def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *,
+                part: bool = False) -> None:
     """`check_magnitude`'s kW/m² judgement on each local day (in zone `tz`) of a file longer than
-    a day, as `hybridtrack.simulate` judges a frame: a file whose second day was in kW/m² had been
-    called clean (the first day's W/m² above the limit), and its replay then refused by the run
-    with no file or line named (a day of a dead sensor's noise, 1 W/m² at most, is refused so too,
-    by the reader as by the run); then hours of a day in kW/m² (`_check_hours`)."""
+    a day (or of `part` of one), as `hybridtrack.simulate` judges a frame: a file whose second day
+    was in kW/m² had been called clean (the first day's W/m² above the limit), and its replay then
+    refused by the run with no file or line named (a day of a dead sensor's noise, 1 W/m² at most,
+    is refused so too, by the reader as by the run); then hours of a day in kW/m² (`_check_hours`)."""
     days = clock_nanoseconds(frame.index.tz_convert(tz)) // DAY_NS  # the local calendar's day
     starts = np.concatenate([[0], np.flatnonzero(days[1:] != days[:-1]) + 1, [len(days)]])
     for start, stop in zip(starts[:-1], starts[1:]):
-        if stop - start >= 2 and len(starts) > 2:  # the whole file passed: some other day is in W/m²
+        if stop - start >= 2 and (len(starts) > 2 or part):  # the whole file passed: some other day is in W/m²
             check_magnitude(path, frame.iloc[start:stop], report, clear_ghi[start:stop], whole_file=False,
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
