@@ -54,6 +54,48 @@ def check_where(scheduler: str | None, workers: int | None, threads: int | None 
         _refuse_unreachable(scheduler)
 
 
+#: Seconds a scheduler has to answer: Dask's own connect timeout (10 s) bounds the connection, not
+#: the handshake after it, so a port that accepts and never answers (another service) had hung.
+ANSWER_SECONDS = 20.0
+
+
+def _connected(client_type, scheduler: str):
+    """A client of the scheduler at `scheduler`, or a refusal within `ANSWER_SECONDS`: the client
+    is made on a thread of its own, and left there if nothing answers. A port that speaks another
+    protocol (an HTTP proxy's 400) had been read as a message of 3 EiB (numpy's MemoryError)."""
+    made: dict = {}
+
+    def connect():
+        client = client_type.__new__(client_type)  # kept on failure, to be closed (`_abandoned`)
+        try:
+            client_type.__init__(client, scheduler, timeout="10s", set_as_default=False)
+            made["client"] = client
+        # TypeError: distributed's TLS and UCX connectors refuse to start without their setup
+        except (OSError, TimeoutError, ValueError, TypeError, MemoryError) as exc:
+            made["error"] = exc
+            _abandoned(client)
+
+    thread = threading.Thread(target=connect, name="hybridtrack-dask-connect", daemon=True)
+    thread.start()
+    thread.join(ANSWER_SECONDS)
+    if "client" in made:
+        return made["client"]
+    error = made.get("error")
+    why = (f"nothing answered as a scheduler in {ANSWER_SECONDS:g} s" if error is None else
+           "something answers there, but not as a Dask scheduler (its reply read as a message too large to hold)"
+           if isinstance(error, MemoryError) else f"{error}")
+    raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {why}")
+
+
+def _abandoned(client) -> None:
+    """Close a client whose connection failed, for a moment, and mark it closed: its finaliser had
+    waited 20 s for the scheduler that never answered, then printed a TimeoutError's traceback
+    as the process ended."""
+    with contextlib.suppress(Exception):
+        client.close(timeout=1)
+    client.status = "closed"
+
+
 def dask_client(scheduler: str | None, workers: int | None, *, what: str = "parallel runs"):
     """A Dask client and the local cluster it runs on (None on a given `scheduler`).
 
@@ -80,11 +122,7 @@ def dask_client(scheduler: str | None, workers: int | None, *, what: str = "para
         raise HybridtrackError(f"{what} need dask.distributed: pip install 'dask[distributed]'") from None
     check_where(scheduler, workers)
     if scheduler:
-        try:
-            client = Client(scheduler, timeout="10s", set_as_default=False)
-        # TypeError: distributed's TLS and UCX connectors refuse to start without their setup
-        except (OSError, TimeoutError, ValueError, TypeError) as exc:
-            raise HybridtrackError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+        client = _connected(Client, scheduler)
         _refuse_no_workers(client, scheduler)
         return client, None
     count = params.whole(workers, "workers", 1, MAX_WORKERS) if workers is not None else cores()

@@ -39,6 +39,7 @@ import contextlib
 import dataclasses
 import functools
 import itertools
+import numbers
 import signal
 import sys
 from dataclasses import dataclass
@@ -321,6 +322,7 @@ def _check_base(base: dict, config: dict, grid: dict, source: str) -> None:
     check it: each run key the grid does not set, then the collector and the weather when the grid
     sets none of their keys, and the config without the dotted keys the grid sets. A value checked
     with a key the grid sets is left to the runs (a grid value fails its own run only)."""
+    _refuse_set_by_both(base, config, grid, source)
     fixed = {key: value for key, value in base.items() if key not in grid}
     for key in RUN_KEYS.keys() & fixed.keys():
         _refuse_in_base([key], source, functools.partial(_key_checks()[key], fixed[key]))
@@ -330,6 +332,20 @@ def _check_base(base: dict, config: dict, grid: dict, source: str) -> None:
             _refuse_in_base([key for key in fixed if key in keys], source, functools.partial(make, spec))
     dotted = {k: v for k, v in fixed.items() if "." in k and not k.startswith("collector.")}
     _config_from(config, dotted, f"{source}: base")  # the base config must stand on its own
+
+
+def _refuse_set_by_both(base: dict, config: dict, grid: dict, source: str) -> None:
+    """Refuse a key the base sets that the grid sets too (``seed = 7`` beside ``seed = [0, 1]``, a
+    dotted ``drive.deadband`` or ``[base.config.drive] deadband`` beside a grid deadband): every run
+    takes the grid's value, and the base's had been dropped without a word."""
+    for key in grid:
+        node = config
+        for part in key.split("."):
+            node = node.get(part) if isinstance(node, dict) else None
+        where = f"base.{key}" if key in base else "[base.config]" if node is not None and "." in key else None
+        if where is not None:
+            raise HybridtrackError(f"{source}: {where} and grid.{key} both set {key}, and every run takes the grid's "
+                                   "value; give it once (in [grid] to vary it)")
 
 
 def _refuse_in_base(keys: list, source: str, check) -> None:
@@ -665,7 +681,12 @@ class SweepInterrupted(KeyboardInterrupt):
 
 def _table(rows: list[dict]) -> pd.DataFrame:
     """The runs' rows as one typed table, sorted by run, that Parquet can hold."""
-    table = pd.DataFrame(rows).sort_values("run", kind="stable").reset_index(drop=True)
+    table = pd.DataFrame(rows)
+    for column in table.columns.difference([*METRICS, "error"]):
+        given = [row.get(column) for row in rows]
+        if _whole_beside_fraction(given):  # pandas' float64 column: 9007199254740993 had become ...992.0
+            table[column] = pd.Series(given, dtype=object)
+    table = table.sort_values("run", kind="stable").reset_index(drop=True)
     for metric in METRICS:
         table[metric] = pd.to_numeric(table[metric], errors="coerce").astype("Int64" if metric in COUNTS else float)
     table["error"] = table["error"].astype("string")
@@ -674,6 +695,15 @@ def _table(rows: list[dict]) -> pd.DataFrame:
         if values.dtype == object and not all(isinstance(v, str) for v in values.dropna()):
             table[column] = _as_text(values)
     return table
+
+
+def _whole_beside_fraction(values: list) -> bool:
+    """Whether a key's values hold whole numbers beside floats (``[nan, 1]``, ``[1, 1.0]``), which one
+    column of numbers would hold as floats, each whole number as the float nearest it: the table
+    then names a run by a value it was not given (`_as_text` keeps each as given)."""
+    kinds = {type(value) for value in values if isinstance(value, numbers.Real) and not isinstance(value, bool)}
+    return any(issubclass(kind, numbers.Integral) for kind in kinds) and any(
+        not issubclass(kind, numbers.Integral) for kind in kinds)
 
 
 def _as_text(values: pd.Series) -> pd.Series:

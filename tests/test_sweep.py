@@ -210,10 +210,11 @@ def test_a_grid_key_that_is_a_typo_names_the_real_one(key, suggestion):
         Sweep.from_dict({"grid": {key: [0.1]}}, source="s.toml")
 
 
-def test_a_bad_base_value_the_grid_overrides_fails_no_run():
-    """days = 0 in [base] is never run when the grid sets days: only a value a run uses is judged."""
-    sweep = Sweep.from_dict({"base": {"days": 0, "site": "atlantis"}, "grid": {"days": [1], "site": ["lanzhou"]}})
-    assert [run["days"] for run in sweep.runs()] == [1]
+def test_a_base_value_the_grid_overrides_is_refused_as_given_twice_not_judged_as_a_run():
+    """days = 0 in [base] beside a grid of days had been taken and never used (no run reads it); it
+    is refused as set twice, before it is judged as a value a run would fail on."""
+    with pytest.raises(HybridtrackError, match="base.days and grid.days both set days"):
+        Sweep.from_dict({"base": {"days": 0, "site": "atlantis"}, "grid": {"days": [1], "site": ["lanzhou"]}})
 
 
 def test_a_runs_row_is_that_run_and_a_failure_is_a_row():
@@ -914,3 +915,70 @@ def test_dasks_advice_about_a_large_graph_is_not_printed_beside_the_bar():
         warnings.simplefilter("always")
         run_sweep(Sweep.from_dict({**TINY, "grid": {"seed": [0, 1]}}), workers=1, progress=False)
     assert not [w for w in caught if "large graph" in str(w.message)]
+
+
+@pytest.mark.parametrize("reply, message", [
+    (None, "nothing answered as a scheduler in 1 s"),  # accepts, never answers: had hung for ever
+    (b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n" * 4,  # another service: numpy's MemoryError
+     r"something answers there, but not as a Dask scheduler \(its reply read as a message too large to hold\)"),
+])
+def test_a_port_that_is_no_dask_scheduler_is_refused_in_time(monkeypatch, capfd, reply, message):
+    """A port that accepts and never answers had hung a sweep for ever (Dask's connect timeout does
+    not bound the handshake); an HTTP proxy's reply ended in a 3 EiB MemoryError's traceback, then
+    the half-made client's TimeoutError at exit (helper-39)."""
+    import socket
+
+    import hybridtrack.cluster as cluster_module
+
+    monkeypatch.setattr(cluster_module, "ANSWER_SECONDS", 1.0)
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+    held = []
+
+    def serve():
+        while True:
+            try:
+                connection, _ = server.accept()
+            except OSError:
+                return
+            held.append(connection)
+            if reply is not None:
+                connection.sendall(reply)
+
+    threading.Thread(target=serve, daemon=True).start()
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    try:
+        started = time.monotonic()
+        with pytest.raises(HybridtrackError, match=f"cannot reach the Dask scheduler at {address}: {message}"):
+            cluster_module.dask_client(address, None)
+        assert time.monotonic() - started < 15.0
+    finally:
+        server.close()
+        for connection in held:
+            connection.close()
+    assert "Traceback" not in capfd.readouterr().err
+
+
+@pytest.mark.parametrize("values, shown", [
+    ([float("nan"), 9007199254740993], ["nan", "9007199254740993"]),  # the float nearest had been ...992.0
+    ([1, 1.0], ["1", "1.0"]),
+])
+def test_whole_numbers_beside_floats_in_a_grid_column_keep_every_digit(values, shown):
+    """A grid key of whole numbers beside a float had been one float64 column: the table named a
+    run by a seed it was not given (helper-39). Such a column is the values as given, as text."""
+    rows = [{"run": k, "seed": value, **{m: None for m in METRICS}, "error": None} for k, value in enumerate(values)]
+    assert _table(rows)["seed"].tolist() == shown
+
+
+@pytest.mark.parametrize("data, where", [
+    ({"base": {"seed": 7}, "grid": {"seed": [0, 1]}}, "base.seed"),
+    ({"base": {"drive.deadband": 0.2}, "grid": {"drive.deadband": [0.1]}}, "base.drive.deadband"),
+    ({"base": {"config": {"drive": {"deadband": 0.3}}}, "grid": {"drive.deadband": [0.1, 0.2]}}, r"\[base.config\]"),
+])
+def test_a_key_set_by_the_base_and_the_grid_is_refused(data, where):
+    """Every run took the grid's value, and the base's was dropped without a word (helper-39)."""
+    key = next(iter(data["grid"]))
+    with pytest.raises(HybridtrackError, match=rf"s\.toml: {where} and grid\.{key} both set {key}, and every run takes "
+                                               r"the grid's value; give it once \(in \[grid\] to vary it\)"):
+        Sweep.from_dict(data, source="s.toml")
