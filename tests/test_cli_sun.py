@@ -80,3 +80,28 @@ def test_one_step_with_the_sun_up_has_no_rate_and_no_warning(capsys):
     assert "sun up in range 06:40-06:40" in captured.out
     assert "  fastest target rate: needs two steps with the sun up\n" in captured.out
     assert "nan" not in captured.out and captured.err == ""
+
+
+@pytest.mark.parametrize("geometric", [False, True])
+def test_the_sun_commands_targets_are_on_the_apparent_sun_unless_asked_for_the_geometric(tmp_path, geometric):
+    """Targets on the sun as it appears (where the light comes from, where the simulated world's sun
+    is and the controller aims), or with --geometric on the geometric sun: pvlib's SPA either way."""
+    import numpy as np
+    import pvlib
+
+    from hybridtrack.collectors import trough_angle
+
+    out = tmp_path / "sun.csv"
+    assert main(["sun", "--site", "lanzhou", "--date", "2021-06-21", "--start", "06:00", "--end", "09:00", "--freq",
+                 "10min", "--csv", str(out), *(["--geometric"] if geometric else [])]) == 0
+    table = pd.read_csv(out, index_col="time")
+    times = pd.DatetimeIndex(pd.to_datetime(table.index)).tz_convert("Asia/Shanghai")
+    from hybridtrack import sites
+
+    site = sites.get("lanzhou")
+    spa = pvlib.solarposition.spa_python(times, site.latitude, site.longitude, altitude=site.altitude, delta_t=67.0,
+                                         pressure=pvlib.atmosphere.alt2pres(site.altitude), temperature=12.0)
+    aimed = spa["elevation" if geometric else "apparent_elevation"].to_numpy()
+    expected = trough_angle(aimed, spa["azimuth"].to_numpy(), 0.0)
+    up = np.isfinite(expected)
+    np.testing.assert_allclose(table["angle"].to_numpy()[up], expected[up], atol=1e-5)  # the CSV's six places

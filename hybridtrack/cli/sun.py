@@ -31,6 +31,9 @@ def _sun_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--eot", choices=("wang-liu", "lamm"), default="wang-liu",
                         help="PLC model: equation of time (default wang-liu)")
     add_collector_arguments(parser)
+    parser.add_argument("--geometric", action="store_true",
+                        help="targets on the geometric sun (default: on the sun as it appears, refraction included, "
+                             "where the light comes from and the simulated controller aims)")
     parser.add_argument("--csv", metavar="OUT", help="write the table as CSV instead of printing it")
     parser.add_argument("--plot", metavar="PNG", help="also draw the sun path and targets")
     add_force_argument(parser)
@@ -59,7 +62,8 @@ def _sun(args: argparse.Namespace) -> int:
             parse(value)
     times = local_range(args.date, site.tz, start=args.start, end=args.end, freq=args.freq)
     position = solar_position(times, site, args.model, declination=args.declination, equation_of_time=args.eot)
-    angles = collector.angles(position["altitude"], position["azimuth"])
+    aimed = position["altitude" if args.geometric else "apparent_altitude"]
+    angles = collector.angles(aimed, position["azimuth"])
     table = pd.concat([position[["altitude", "apparent_altitude", "azimuth", "declination",
                                  "hour_angle", "equation_of_time"]], angles], axis=1)
     if args.csv:
@@ -69,9 +73,10 @@ def _sun(args: argparse.Namespace) -> int:
         shown = table.copy()
         shown.index = shown.index.strftime("%Y-%m-%d %H:%M:%S")
         print(shown.round(3).to_string(na_rep="-"))
-    up = position["altitude"] > 0
+    up = aimed > 0
     print(f"\n{site.name} ({site.latitude:.4f}°, {site.longitude:.4f}°) {args.date}, "
-          f"model {args.model}, collector {collector.kind}")
+          f"model {args.model}, collector {collector.kind}, targets on the "
+          f"{'geometric sun' if args.geometric else 'apparent (refracted) sun'}")
     if up.any():
         peak = position["altitude"].idxmax()
         print(f"  sun up in range {up.index[up.to_numpy()][0]:%H:%M}-{up.index[up.to_numpy()][-1]:%H:%M}; "
