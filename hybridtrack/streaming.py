@@ -300,6 +300,8 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     if suffix not in (".parquet", ".pq", ".csv"):
         raise HybridtrackError(f"{path}: a streamed run reads .parquet or .csv weather frames, not {suffix or 'this'}")
 
+    offsets: list = []  # whether the first piece's stamps carried their UTC offsets, and its zone
+
     def stamped(piece: pd.DataFrame, first_row: int) -> pd.DataFrame:
         name = "time"
         if not isinstance(piece.index, pd.DatetimeIndex):
@@ -307,10 +309,11 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
             piece = piece.set_index(_parsed_stamps(piece.pop(name), path, first_row))
         _numeric(piece, path, first_row)
         _physical(piece, path, first_row)
+        _same_kind_of_stamps(offsets, piece.index, path, first_row, name)
         if piece.index.tz is None and tz is not None:
             piece.index = _localised(piece.index, tz, path, first_row, name)
-        elif tz is not None:
-            piece.index = piece.index.tz_convert(tz)
+        elif piece.index.tz is not None:  # one zone for every piece, the first's: a daylight-saving change
+            piece.index = piece.index.tz_convert(tz or offsets[1])  # between two had joined +01:00 and +02:00 into none
         piece.index.name = None
         _in_order(piece, path, first_row)
         return piece
@@ -431,6 +434,19 @@ def _parsed_stamps(stamps: pd.Series, path: Path, first_row: int) -> pd.Datetime
     return pd.DatetimeIndex(parsed)
 
 
+def _same_kind_of_stamps(offsets: list, index: pd.DatetimeIndex, path: Path, first_row: int, name: str) -> None:
+    """Refuse a piece of stamps without UTC offsets after pieces with them, or the other way round,
+    by its first row, as stamps of both kinds in one piece are (`_parsed_stamps`): whether a file
+    was refused had turned on the size of the pieces it was read in."""
+    aware = index.tz is not None
+    if not offsets:
+        offsets.extend([aware, index.tz])
+    elif aware != offsets[0] and len(index):
+        kind = "has a UTC offset, but the stamps before it have none" if aware else \
+            "has no UTC offset, but the stamps before it have one"
+        raise HybridtrackError(f"{path}: row {first_row}, column {name!r}: {index[0]} {kind} ({CONVERT_ONCE})")
+
+
 def _localised(index: pd.DatetimeIndex, tz: str, path: Path, first_row: int, name: str) -> pd.DatetimeIndex:
     """Naive stamps put in `tz`, or refused by the first row that the zone's daylight-saving change
     skips or repeats (the reader drops or resolves those; a stream does not repair)."""
@@ -490,7 +506,8 @@ def _refuse_repeated_columns(path: Path, separator: str | None) -> None:
             names = list(pq.ParquetFile(path).schema_arrow.names)
     except (OSError, ValueError, IndexError):  # pandas' and pyarrow's read errors; a file of no line
         return
-    repeated = pd.Index(names)[pd.Index(names).duplicated()]
+    named = pd.Index([name for name in names if name not in ("", "nan")])  # a spreadsheet's empty padding columns
+    repeated = named[named.duplicated()]
     if len(repeated):
         raise HybridtrackError(f"{path}: column {repeated[0]!r} appears more than once in the header; rename one")
 

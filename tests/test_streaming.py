@@ -856,3 +856,36 @@ def test_a_streamed_day_in_kw_per_m2_among_days_in_watts_is_refused_by_its_line(
         list(recorded_days(tmp_path / "day.csv", SITE, chunk_rows=100))
     line = int(re.search(r"line (\d+),", str(e.value)).group(1))
     assert (tmp_path / "day.csv").read_text().splitlines()[line - 1].startswith("2021-06-20")
+
+
+@pytest.mark.parametrize("chunk_rows", [37, 200_000])
+def test_a_streamed_record_across_a_daylight_saving_change_reads_whatever_the_chunks(tmp_path, chunk_rows):
+    """pandas writes a Berlin frame's stamps with +01:00 and then +02:00: a piece of one offset
+    after a piece of both had joined into no zone, an AttributeError (helper-40)."""
+    from hybridtrack import sites
+    from hybridtrack.sky import synthetic
+
+    berlin = sites.custom(52.5, 13.4, "Europe/Berlin", name="berlin")
+    frame = synthetic(berlin, "2021-03-27", "2021-03-29", weather="sunny", freq="5min", seed=0)[["ghi", "dni", "dhi"]]
+    frame.to_csv(tmp_path / "dst.csv", index_label="time")
+    days = list(recorded_days(tmp_path / "dst.csv", berlin, chunk_rows=chunk_rows))
+    assert [str(day) for day, _ in days] == ["2021-03-27", "2021-03-28", "2021-03-29"]
+    read = pd.concat([piece for _, piece in days])
+    assert (read.index == frame.index).all() and len(read) == len(frame)
+
+
+def test_a_streamed_piece_without_offsets_after_pieces_with_them_is_refused_whatever_the_chunks(tmp_path):
+    """Stamps of both kinds in one piece are refused; in two pieces one had been localised without a
+    word, so the verdict turned on the pieces' size (helper-40)."""
+    path = tmp_path / "later.csv"
+    path.write_text("time,dni\n2021-01-10T00:00:00+01:00,0\n2021-01-10T00:10:00+01:00,0\n2021-01-10 00:20:00,0\n")
+    with pytest.raises(HybridtrackError, match=r"later\.csv: row 4, column 'time': 2021-01-10 00:20:00 has no UTC "
+                                               r"offset, but the stamps before it have one"):
+        list(recorded_days(path, SITE, tz="Europe/Berlin", chunk_rows=2))
+
+
+def test_empty_padding_columns_of_a_streamed_csv_are_not_a_column_given_twice(tmp_path):
+    """Two trailing separators (a spreadsheet's padding) had been refused as a column 'nan' given twice."""
+    path = tmp_path / "padded.csv"
+    path.write_text("time,dni,,\n2021-06-21T12:00:00+08:00,800,,\n2021-06-21T12:01:00+08:00,800,,\n")
+    assert sum(len(day) for _, day in recorded_days(path, SITE)) == 2
