@@ -625,9 +625,10 @@ class Collector:
         self._refuse_untruthful_axis()
         if self.kind == "heliostat":
             heliostat_normal(45.0, 180.0, self.aim)  # validates the aim point
-            if not self.aim[2] > 0:
-                raise HybridtrackError(f"collector: aim (m): the aim point must be above the mirror, got "
-                                       f"{self.aim[2]:g} m up: a heliostat reflects the sun up to its receiver")
+            if not self.aim[2] >= MIN_RECEIVER_HEIGHT:  # as a field's aim points and a Fresnel receiver
+                raise HybridtrackError(f"collector: aim (m): the aim point must be above the mirror, at least "
+                                       f"{MIN_RECEIVER_HEIGHT:g} m, got {self.aim[2]:g} m up: a heliostat reflects "
+                                       "the sun up to its receiver")
 
     def _refuse_other_kinds_geometry(self) -> None:
         """Refuse geometry this kind has no use for (a trough's row distance, a heliostat's axis),

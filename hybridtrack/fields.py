@@ -474,6 +474,11 @@ class HeliostatField:
             aims.setflags(write=False)
         object.__setattr__(self, "aims", None if self.aims is None else aims)
 
+    def __reduce__(self):
+        """Pickled (and copied) by its parameters, built again: its arrays come back read-only, and
+        checked, where numpy's own pickle had given them back writable."""
+        return type(self), (self.positions, self.aim, self.aims, self.spread)
+
     @classmethod
     def rings(cls, count: int = 12, *, first_radius: float = 60.0, spacing: float = 12.0,
               aim: tuple[float, float, float] = DEFAULT_AIM, spread: ImperfectionSpread | None = None

@@ -839,3 +839,10 @@ def test_a_fields_mirrors_cannot_be_moved_in_place_and_an_aim_on_the_mirror_is_r
         HeliostatField(positions=[[0.0, -60.0]], aim=(0.0, 0.0, 1e-300))
     targets = TroughLoop(count=3).targets(np.array([30.0, 40.0]), np.array([120.0, 150.0]))
     assert targets.shape == (2, 3) and targets.flags.writeable  # as the other fields' targets are
+    import copy
+    import pickle
+
+    for again in (pickle.loads(pickle.dumps(field)), copy.deepcopy(field)):  # numpy's pickle gives writable arrays
+        assert not again.positions.flags.writeable and not again.aims.flags.writeable
+        np.testing.assert_array_equal(again.positions, field.positions)
+        assert again.aim == field.aim

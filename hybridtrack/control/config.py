@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
@@ -174,9 +175,10 @@ class ControllerConfig:
             raise HybridtrackError(f"unknown strategy {self.strategy!r}; choose from {', '.join(STRATEGIES)}")
         if self.sun_model not in ("plc", "spa"):
             raise HybridtrackError(f"unknown sun model {self.sun_model!r}; choose 'plc' or 'spa'")
-        for name in ("refraction", "lead"):  # "no" had been taken as True
-            if not isinstance(getattr(self, name), bool):
+        for name in ("refraction", "lead"):  # "no" had been taken as True; numpy's booleans are taken, as bools
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise HybridtrackError(f"controller: {name} must be true or false, got {getattr(self, name)!r:.40}")
+            object.__setattr__(self, name, bool(getattr(self, name)))
         if self.wind_missing not in ("stow", "track"):
             raise HybridtrackError(f"controller: wind_missing {self.wind_missing!r}; choose 'stow' or 'track'")
         if self.kalman not in ("fast", "filterpy"):
