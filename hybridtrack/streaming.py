@@ -54,7 +54,7 @@ import pandas as pd
 from . import params, sites
 from .collectors import Collector, as_collector
 from .errors import HybridtrackError
-from .io.checks import CLIPPED_AT_ZERO, LIMITS, check_magnitude, check_magnitude_by_day
+from .io.checks import CLIPPED_AT_ZERO, KILOWATT_TOP, LIMITS, check_magnitude, check_magnitude_by_day
 from .io.files import input_path
 from .io.stamps import has_offset
 from .io.units import FRAME_UNITS
@@ -320,9 +320,10 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
 
     separator = csv_separator(path) if suffix == ".csv" else None
     _refuse_repeated_columns(path, separator)
-    measured = _measured(path, separator, ("dni", "wind_speed"))
+    measured, dni = _measured(path, separator, ("dni", "wind_speed"))
     if "dni" not in measured:
         raise HybridtrackError(_without_dni(path, separator))
+    _refuse_dni_in_kilowatts(path, dni)
     steps = None
     if suffix == ".csv":
 
@@ -464,32 +465,75 @@ def _localised(index: pd.DatetimeIndex, tz: str, path: Path, first_row: int, nam
 TEXT_COLUMNS = ("sky",)
 
 
-def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> set[str]:
-    """Which of the columns `names` hold at least one finite number, read alone a chunk at a time.
-    A file without rows, or one pandas or pyarrow cannot read, counts as holding them all: the
-    run's own read then says what is wrong, by row."""
+def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> tuple[set[str], tuple | None]:
+    """Which of the columns `names` hold at least one finite number, read alone a chunk at a time,
+    and, in a file of DNI without GHI or DHI, the DNI's top with its row and the file's first and
+    last stamps (`_refuse_dni_in_kilowatts`). A file without rows, or one pandas or pyarrow cannot
+    read, counts as holding them all: the run's own read then says what is wrong, by row."""
     try:
         if separator is not None:
             header = pd.read_csv(path, sep=separator, nrows=0).columns
-            chunks = pd.read_csv(path, sep=separator, usecols=[header[0], *(n for n in names if n in header)],
+            time, first_row = header[0], 2
+            chunks = pd.read_csv(path, sep=separator, usecols=[time, *(n for n in names if n in header)],
                                  chunksize=CHUNK_ROWS, low_memory=False)  # each chunk typed whole: no DtypeWarning
         else:
             import pyarrow.parquet as pq
 
             handle = pq.ParquetFile(path)
-            kept = [name for name in names if name in handle.schema_arrow.names]
-            chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=kept)) if kept else ()
+            header = handle.schema_arrow.names
+            time = next((n for n in header if n == "time" or n.startswith("__index_level_")), None)
+            kept = [name for name in names if name in header]
+            first_row = 1
+            chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=kept + [time] * (
+                time is not None))) if kept else ()
             if handle.metadata.num_rows == 0:
-                return set(names)
+                return set(names), None
+        dni_alone = "dni" in names and not {"ghi", "dhi"} & set(header)
         found: set[str] = set()
-        rows = 0
+        rows, top, stamps = 0, (-np.inf, 0), []
         for chunk in chunks:
-            rows += len(chunk)
             found |= {name for name in names if name in chunk.columns
                       and np.isfinite(pd.to_numeric(chunk[name], errors="coerce").to_numpy(float)).any()}
-        return found if rows or separator is None else set(names)
+            if dni_alone and "dni" in chunk.columns and len(chunk):
+                values = pd.to_numeric(chunk["dni"], errors="coerce").to_numpy(float)
+                if np.isfinite(values).any() and np.nanmax(values) > top[0]:
+                    top = (float(np.nanmax(values)), first_row + rows + int(np.nanargmax(values)))
+                stamps = [*stamps[:1], *_ends(chunk, time)]
+            rows += len(chunk)
+        if not rows and separator is not None:
+            return set(names), None
+        return found, (top, stamps[0], stamps[-1]) if dni_alone and np.isfinite(top[0]) and stamps else None
     except (OSError, ValueError):  # pandas' and pyarrow's read errors
-        return set(names)
+        return set(names), None
+
+
+def _ends(chunk: pd.DataFrame, time: str | None) -> list:
+    """A chunk's first and last stamps, read alone (an unreadable one is left to the run's read)."""
+    values = chunk.index if time is None or time not in chunk.columns else chunk[time]
+    try:
+        return [pd.Timestamp(values[0]), pd.Timestamp(values[-1])] if isinstance(values, pd.Index) else \
+            [pd.Timestamp(values.iloc[0]), pd.Timestamp(values.iloc[-1])]
+    except (ValueError, TypeError):
+        return []
+
+
+def _refuse_dni_in_kilowatts(path: Path, dni: tuple | None) -> None:
+    """The record reader's judgement of a file of DNI alone, on the whole file (`dni`: its top and
+    row, and its first and last stamps, from `_measured`), before the first day runs: DNI of at
+    most `KILOWATT_TOP` over six hours or more is kW/m². Judged on each span of the stream instead,
+    the verdict had turned on the pieces' size: a day in kW/m² streamed at one size and was refused
+    at another, and an overcast day's noise was refused at small sizes."""
+    if dni is None:
+        return
+    (top, row), first, last = dni
+    try:
+        hours = (last - first) / pd.Timedelta(hours=1)
+    except (TypeError, ValueError):  # stamps naive and aware: left to the run's read, which names them
+        return
+    if hours >= 6.0 and 0.0 < top <= KILOWATT_TOP:
+        raise HybridtrackError(f"{path}: row {row}, column 'dni': dni is at most {top:g} over {hours:.0f} hours; "
+                               "the values look like kW/m² read as W/m²: convert the file once with hybridtrack "
+                               "check FILE --units dni=kW/m2 --out clean.parquet")
 
 
 def _refuse_repeated_columns(path: Path, separator: str | None) -> None:
@@ -574,9 +618,10 @@ def _magnitude_checked(pieces: Iterator[pd.DataFrame], path: Path, first_rows: I
 
     def judge(last: bool):
         lines = pd.concat(window)
-        if len(lines) >= 2:
-            check_magnitude(path, lines, {}, None, remedy="convert the file once with hybridtrack check FILE "
-                                                          "--units {name}=kW/m2 --out clean.parquet")
+        if len(lines) >= 2:  # DNI alone is judged on the whole file (`_refuse_dni_in_kilowatts`), not a span
+            check_magnitude(path, lines, {}, None, whole_file=False,
+                            remedy="convert the file once with hybridtrack check FILE --units {name}=kW/m2 --out "
+                                   "clean.parquet")
         held[:] = [_days_checked(path, pd.concat([*held, lines]), site, last)]
 
     for piece, first_row in zip(pieces, first_rows):

@@ -889,3 +889,17 @@ def test_empty_padding_columns_of_a_streamed_csv_are_not_a_column_given_twice(tm
     path = tmp_path / "padded.csv"
     path.write_text("time,dni,,\n2021-06-21T12:00:00+08:00,800,,\n2021-06-21T12:01:00+08:00,800,,\n")
     assert sum(len(day) for _, day in recorded_days(path, SITE)) == 2
+
+
+@pytest.mark.parametrize("chunk_rows", [50, 289, 200_000])
+def test_a_dni_only_file_with_an_overcast_day_streams_whatever_the_chunks(tmp_path, chunk_rows):
+    """DNI alone is judged on the whole file, as the reader judges it, before the first day: judged
+    on each span, an overcast day's pyrheliometer noise (0-0.9 W/m²) had been refused at small
+    pieces and streamed at large ones (helper-40)."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-19", "2021-06-21", weather="sunny", freq="10min", seed=1)[["dni"]]
+    dull = frame.index.day == 20
+    frame.loc[dull, "dni"] = np.tile([0.0, 0.4, 0.9], int(dull.sum()) // 3 + 1)[:int(dull.sum())]
+    frame.round(3).to_csv(tmp_path / "dni.csv", index_label="time")
+    assert sum(len(day) for _, day in recorded_days(tmp_path / "dni.csv", SITE, chunk_rows=chunk_rows)) == len(frame)
