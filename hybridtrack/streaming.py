@@ -54,7 +54,8 @@ import pandas as pd
 from . import params, sites
 from .collectors import Collector, as_collector
 from .errors import HybridtrackError
-from .io.checks import CLIPPED_AT_ZERO, KILOWATT_TOP, LIMITS, check_magnitude, check_magnitude_by_day
+from .io.checks import (CLIPPED_AT_ZERO, KILOWATT_TOP, LIMITS, check_magnitude, check_magnitude_by_day,
+                        site_clear_sky)
 from .io.files import input_path
 from .io.stamps import has_offset
 from .io.units import FRAME_UNITS
@@ -648,13 +649,8 @@ def _days_checked(path: Path, lines: pd.DataFrame, site: sites.Site, last: bool)
     days = _local_days(lines.index, site.tz)
     whole = np.ones(len(lines), bool) if last else days < days[-1]
     if whole.any():
-        import pvlib
-
-        from .sun import solar_position
-
         judged = lines[whole]
-        zenith = solar_position(judged.index, site, model="plc")["apparent_zenith"]  # as the reader's: PLC is ample
-        check_magnitude_by_day(path, judged, {}, pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float), site.tz,
+        check_magnitude_by_day(path, judged, {}, site_clear_sky(judged.index, site)[1], site.tz,
                                part=True)  # the file's span passed whole: a day in kW/m² is among days in W/m²
     return lines[~whole]
 

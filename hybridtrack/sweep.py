@@ -310,11 +310,16 @@ def _refuse_given_twice(base: dict, config: dict, source: str) -> None:
     for key in base:
         if key in RUN_KEYS or key.startswith("collector."):
             continue
-        node = config
-        for part in key.split("."):
-            node = node.get(part) if isinstance(node, dict) else None
-        if node is not None:
+        if _config_value(config, key) is not None:
             raise HybridtrackError(f"{source}: base.{key} and [base.config] both set {key}; give it once")
+
+
+def _config_value(config: dict, key: str):
+    """The value a dotted `key` (``drive.deadband``) names in a ``[base.config]`` table, or None."""
+    node = config
+    for part in key.split("."):
+        node = node.get(part) if isinstance(node, dict) else None
+    return node
 
 
 def _check_base(base: dict, config: dict, grid: dict, source: str) -> None:
@@ -339,10 +344,8 @@ def _refuse_set_by_both(base: dict, config: dict, grid: dict, source: str) -> No
     dotted ``drive.deadband`` or ``[base.config.drive] deadband`` beside a grid deadband): every run
     takes the grid's value, and the base's had been dropped without a word."""
     for key in grid:
-        node = config
-        for part in key.split("."):
-            node = node.get(part) if isinstance(node, dict) else None
-        where = f"base.{key}" if key in base else "[base.config]" if node is not None and "." in key else None
+        in_config = "." in key and _config_value(config, key) is not None
+        where = f"base.{key}" if key in base else "[base.config]" if in_config else None
         if where is not None:
             raise HybridtrackError(f"{source}: {where} and grid.{key} both set {key}, and every run takes the grid's "
                                    "value; give it once (in [grid] to vary it)")

@@ -31,6 +31,7 @@ from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
 __all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude",
+           "site_clear_sky",
            "check_magnitude_by_day", "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
@@ -209,6 +210,17 @@ def _drop_empty(frame: pd.DataFrame, report: dict) -> pd.DataFrame:
 KILOWATT_TOP = 1.5
 #: W/m² of the site's clear-sky GHI (Haurwitz) the span must reach before its magnitude is judged.
 JUDGED_FROM = 300.0
+
+
+def site_clear_sky(index: pd.DatetimeIndex, site) -> tuple[pd.Series, np.ndarray]:
+    """The sun's apparent zenith at each stamp (the PLC model: ample for judging magnitudes) and the
+    site's clear-sky GHI there (Haurwitz 1945), W/m²: what the magnitude checks judge light by."""
+    import pvlib
+
+    from ..sun import solar_position
+
+    zenith = solar_position(index, site, model="plc")["apparent_zenith"]
+    return zenith, pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float)
 
 
 def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None, *,

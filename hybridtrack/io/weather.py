@@ -17,7 +17,8 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
-from .checks import check_frame, check_magnitude, check_magnitude_by_day, first_lines, refuse_repairs, span
+from .checks import (check_frame, check_magnitude, check_magnitude_by_day, first_lines, refuse_repairs,
+                     site_clear_sky, span)
 from .closure import closure_check
 from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, label_header,
                       name_shown, not_read, resolve_columns, split_header)
@@ -512,12 +513,8 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
     clear = None
     if site is not None:
         from .suncheck import sun_check
-        import pvlib
 
-        from ..sun import solar_position
-
-        zenith = solar_position(frame.index, site, model="plc")["apparent_zenith"]  # a magnitude check: PLC is ample
-        clear = pvlib.clearsky.haurwitz(zenith)["ghi"].to_numpy(float)
+        zenith, clear = site_clear_sky(frame.index, site)
         check_magnitude(path, frame, report, clear)
         check_magnitude_by_day(path, frame, report, clear, site.tz)
         sun_check(path, frame, site, report, lenient=lenient)
