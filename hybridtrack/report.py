@@ -478,13 +478,21 @@ def describe_html(result, *, events: int = 12) -> str:
             f"{f'<p>… {more} more in result.events</p>' if more > 0 else ''}</details></div>")
 
 
-def _true_sun(result, index=None):
-    """Sun-up flags and the incidence cosine on a perfect aperture at every step: the run's true
-    sun, as it appears (`hybridtrack.world.true_sun`), as the run scored it."""
+def true_sun_terms(result, index=None) -> tuple[np.ndarray, np.ndarray]:
+    """Sun-up flags and the incidence cosine on a perfect aperture at each stamp of `index` (the
+    run's log by default), as the run scored them: taken from its `Result.scoring` where it has
+    them, else computed from its true sun as it appears (`hybridtrack.world.true_sun`); a second
+    SPA over every stamp had been run for each daily table and trade-off."""
     from .mounting import incidence_cosine
     from .world import true_sun
 
-    altitude, azimuth = true_sun(result.log.index if index is None else index, result.site, result.config.truth)
+    index = result.log.index if index is None else index
+    scoring = getattr(result, "scoring", None)
+    if scoring is not None:
+        at = result.log.index.get_indexer(index)
+        if (at >= 0).all():
+            return np.asarray(scoring["sun_up"])[at], np.asarray(scoring["incidence"])[at]
+    altitude, azimuth = true_sun(index, result.site, result.config.truth)
     return altitude > 0, incidence_cosine(altitude, azimuth, result.collector)
 
 
@@ -499,7 +507,7 @@ def daily(result, log: pd.DataFrame | None = None) -> pd.DataFrame:
     if not isinstance(log, pd.DataFrame) or not isinstance(log.index, pd.DatetimeIndex):
         raise HybridtrackError(f"daily: log must be part of the run's log, a DataFrame on its time index; got "
                                f"{type(log).__name__}")
-    sun_up, incidence = _true_sun(result, log.index)
+    sun_up, incidence = true_sun_terms(result, log.index)
     return daily_table(log, collector=result.collector.kind, tz=result.site.tz, sun_up=sun_up, incidence=incidence)
 
 

@@ -143,12 +143,10 @@ def held_error(result) -> tuple[float, float]:
     next the collector holds its angle while the true target moves on (see the module's notes)."""
     from .collectors import direction_vectors
     from .metrics import TRACKING_MODES, weighted_quantile
-    from .mounting import incidence_cosine
-    from .world import true_sun
+    from .report import true_sun_terms
 
     log = result.log
-    altitude, azimuth = true_sun(log.index, result.site, result.config.truth)  # the sun the run scored against
-    beam = np.nan_to_num(log["dni"].to_numpy(float)) * incidence_cosine(altitude, azimuth, result.collector)
+    beam = np.nan_to_num(log["dni"].to_numpy(float)) * true_sun_terms(result)[1]  # as the run scored it
     single = result.collector.single_axis
     columns = ("",) if single else ("", "_azimuth")
     truth = [log[f"target_true{c}"].to_numpy(float) for c in columns]
