@@ -154,7 +154,7 @@ def heliostat_sun(base: tuple, altitude, azimuth, collector: Collector, *, night
     `base` keys; with `aperture`, a Fresnel row's too, whose incidence turns on its own place
     under the receiver (`incidence_cosine`). None for another collector, whose pointing vectors
     are the sun's own and are shared whole (`geometry_key`)."""
-    if collector.kind != "heliostat" and not (aperture and collector.kind == "fresnel"):
+    if not _its_own(collector, aperture):
         return None
     alt = np.asarray(altitude, float)
     return shared((*base, "sun vectors", night),
@@ -169,9 +169,15 @@ def geometry_key(base: tuple, what: str, collector: Collector, *, aperture: bool
     geometry turns on its own aim point, which no other heliostat of its field has, and keeping
     what no other run asks for would only push out what they do; so too for what a Fresnel row's
     `aperture` reads (`incidence_cosine`), which turns on its own place under the receiver."""
-    if collector.kind == "heliostat" or (aperture and collector.kind == "fresnel"):
+    if _its_own(collector, aperture):
         return None
     return (*base, what, collector.kind, collector.axis)
+
+
+def _its_own(collector: Collector, aperture: bool) -> bool:
+    """Whether a collector's geometry (its `aperture`'s, if asked) turns on what no other collector
+    of its field shares: a heliostat's aim point, a Fresnel row's place under the receiver."""
+    return collector.kind == "heliostat" or (aperture and collector.kind == "fresnel")
 
 
 def rotate(vectors, rotation) -> np.ndarray:
