@@ -54,7 +54,7 @@ import pandas as pd
 from . import params, sites
 from .collectors import Collector, as_collector
 from .errors import HybridtrackError
-from .io.checks import (CLIPPED_AT_ZERO, KILOWATT_TOP, LIMITS, check_magnitude, check_magnitude_by_day,
+from .io.checks import (CLIPPED_AT_ZERO, LIMITS, check_magnitude, check_magnitude_by_day, kilowatts_without_site,
                         site_clear_sky)
 from .io.files import input_path
 from .io.stamps import has_offset
@@ -521,7 +521,7 @@ def _ends(chunk: pd.DataFrame, time: str | None) -> list:
 def _refuse_dni_in_kilowatts(path: Path, dni: tuple | None) -> None:
     """The record reader's judgement of a file of DNI alone, on the whole file (`dni`: its top and
     row, and its first and last stamps, from `_measured`), before the first day runs: DNI of at
-    most `KILOWATT_TOP` over six hours or more is kW/m². Judged on each span of the stream instead,
+    most 1.5 over six hours or more is kW/m² (`kilowatts_without_site`). Judged on each span of the stream instead,
     the verdict had turned on the pieces' size: a day in kW/m² streamed at one size and was refused
     at another, and an overcast day's noise was refused at small sizes."""
     if dni is None:
@@ -531,7 +531,7 @@ def _refuse_dni_in_kilowatts(path: Path, dni: tuple | None) -> None:
         hours = (last - first) / pd.Timedelta(hours=1)
     except (TypeError, ValueError):  # stamps naive and aware: left to the run's read, which names them
         return
-    if hours >= 6.0 and 0.0 < top <= KILOWATT_TOP:
+    if kilowatts_without_site(top, hours):
         raise HybridtrackError(f"{path}: row {row}, column 'dni': dni is at most {top:g} over {hours:.0f} hours; "
                                "the values look like kW/m² read as W/m²: convert the file once with hybridtrack "
                                "check FILE --units dni=kW/m2 --out clean.parquet")

@@ -31,7 +31,7 @@ from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
 __all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude",
-           "site_clear_sky",
+           "site_clear_sky", "kilowatts_without_site",
            "check_magnitude_by_day", "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
@@ -212,6 +212,12 @@ KILOWATT_TOP = 1.5
 JUDGED_FROM = 300.0
 
 
+def kilowatts_without_site(top: float, hours: float) -> bool:
+    """`check_magnitude`'s judgement without a site: light whose largest value is above 0 and at
+    most `KILOWATT_TOP` over six hours or more (some of them daylight) is kW/m²."""
+    return hours >= 6.0 and 0.0 < top <= KILOWATT_TOP
+
+
 def site_clear_sky(index: pd.DatetimeIndex, site) -> tuple[pd.Series, np.ndarray]:
     """The sun's apparent zenith at each stamp (the PLC model: ample for judging magnitudes) and the
     site's clear-sky GHI there (Haurwitz 1945), W/m²: what the magnitude checks judge light by."""
@@ -251,7 +257,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             suspicious = reference >= JUDGED_FROM and 0.0 < top <= KILOWATT_TOP
             why = f"at most {top:g} while the clear sky reaches {reference:.0f} W/m²"
         else:
-            suspicious = hours >= 6.0 and 0.0 < top <= KILOWATT_TOP
+            suspicious = kilowatts_without_site(top, hours)
             why = f"at most {top:g} over {hours:.0f} hours"
         header = report.get("columns", {}).get(name, name)
         line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
