@@ -521,9 +521,9 @@ def _ends(chunk: pd.DataFrame, time: str | None) -> list:
 def _refuse_dni_in_kilowatts(path: Path, dni: tuple | None) -> None:
     """The record reader's judgement of a file of DNI alone, on the whole file (`dni`: its top and
     row, and its first and last stamps, from `_measured`), before the first day runs: DNI of at
-    most 1.5 over six hours or more is kW/m² (`kilowatts_without_site`). Judged on each span of the stream instead,
-    the verdict had turned on the pieces' size: a day in kW/m² streamed at one size and was refused
-    at another, and an overcast day's noise was refused at small sizes."""
+    most 1.5 over six hours or more is kW/m² (`kilowatts_without_site`). Judged on each span of
+    the stream instead, the verdict had turned on the pieces' size: a day in kW/m² streamed at one
+    size and was refused at another, and an overcast day's noise was refused at small sizes."""
     if dni is None:
         return
     (top, row), first, last = dni
