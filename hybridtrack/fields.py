@@ -512,9 +512,14 @@ class HeliostatField:
         return [f"H{i + 1}" for i in range(len(self.positions))]
 
     @property
+    def aim_points(self) -> np.ndarray:
+        """Each heliostat's aim point (N, 3), metres east, north and up from the tower's foot."""
+        return np.broadcast_to(np.asarray(self.aim), self.positions.shape) if self.aims is None else self.aims
+
+    @property
     def relative_aims(self) -> np.ndarray:
         """Each aim point from its mirror's centre (N, 3), metres."""
-        return (np.asarray(self.aim) if self.aims is None else self.aims) - self.positions
+        return self.aim_points - self.positions
 
     def collectors(self) -> list[Collector]:
         return [Collector("heliostat", aim=tuple(a)) for a in self.relative_aims.tolist()]
@@ -715,6 +720,7 @@ class FieldResult:
             points = ax.scatter(self.collectors["east"], self.collectors["north"], c=values, cmap="viridis",
                                 marker="^", s=max(12.0, 4000.0 / len(values) ** 0.8), edgecolors="0.3",
                                 linewidths=0.3)
+            ax.margins(0.08)  # the mirrors at the edge drawn whole
         else:  # rows and troughs: a line of their length along their axis
             from matplotlib.collections import LineCollection
 
@@ -723,8 +729,10 @@ class FieldResult:
             ax.autoscale_view()
         fig.colorbar(points, ax=ax, label=_METRIC_LABELS.get(metric, metric))
         if isinstance(self.field, HeliostatField):
-            ax.plot(*self.field.aim[:2], marker="*", color="tab:red", markersize=14, ls="", label="aim point")
-            ax.legend(loc="best")
+            _draw_aim_points(ax, self.field.aim_points)
+        if not np.isfinite(values).any():  # a night, or no light: the colours would mean nothing
+            ax.text(0.5, 0.5, f"no collector has a {metric}:\nnothing was scored", transform=ax.transAxes,
+                    ha="center", va="center", color="0.3")
         ax.set_xlabel("east (m)")
         ax.set_ylabel("north (m)")
         ax.set_aspect("equal", adjustable="datalim")
@@ -750,7 +758,7 @@ class FieldResult:
         claim(written.values(), earlier=earlier)
         with together():  # all of this field's files, or none
             write(written["collectors"],
-                  lambda path: self.collectors.to_csv(path, index_label="collector", float_format="%.6g"))
+                  lambda path: self.collectors.to_csv(path, index_label="collector"))
             write(written["events"], lambda path: self.events.to_csv(path, index=False))
             write(written["summary"], lambda path: path.write_text(strict_json(self.summary, indent=2) + "\n"))
             write(written["map"], lambda path: self.plot_map(metric).savefig(path, dpi=120))
@@ -811,11 +819,30 @@ COLLECTOR_METRICS = ("rms", "p95", "max", "mean", "within_0_5_deg", "energy_capt
 
 def collector_columns(field) -> list[str]:
     """The columns `simulate_field` gives `field`'s collector table (what a field map can show)."""
-    columns = ["east", "north", "up"] + (["row_distance"] if isinstance(field, FresnelField) else [])
+    columns = ["east", "north", "up"] + _placement_columns(field)
     columns += [f.name for f in dataclasses.fields(Imperfections)] + list(COLLECTOR_METRICS) + ["offered"]
     if isinstance(field, FresnelField):
         columns += ["end_loss_m", "end_loss_share"]
     return columns
+
+
+def _draw_aim_points(ax, aims: np.ndarray) -> None:
+    """Each distinct aim point of a heliostat field as a star (its east and north); their mean had
+    been drawn, which is no mirror's aim point when the field has several."""
+    distinct = np.unique(aims[:, :2], axis=0)
+    label = "aim point" if len(distinct) == 1 else f"aim points ({len(distinct)})"
+    ax.plot(distinct[:, 0], distinct[:, 1], marker="*", color="tab:red", markersize=14 if len(distinct) < 10 else 7,
+            ls="", label=label)
+    ax.legend(loc="best")
+
+
+def _placement_columns(field) -> list[str]:
+    """A collector table's columns after the positions that say where a collector looks: a Fresnel
+    row's distance from the receiver line, a heliostat's aim point (so that a saved field's
+    ``collectors.csv`` is a positions file that builds the same field again)."""
+    if isinstance(field, FresnelField):
+        return ["row_distance"]
+    return list(AIM_COLUMNS) if isinstance(field, HeliostatField) else []
 
 
 def _metrics(summary: dict) -> dict:
@@ -1102,6 +1129,9 @@ def _collector_table(rows: list[dict], field) -> pd.DataFrame:
         table.insert(i, axis, field.positions[:, i])
     if isinstance(field, FresnelField):
         table.insert(3, "row_distance", field.row_distances)
+    if isinstance(field, HeliostatField):
+        for i, column in enumerate(AIM_COLUMNS):
+            table.insert(3 + i, column, field.aim_points[:, i])
     return table
 
 
@@ -1164,8 +1194,9 @@ class _LogStore:
 
         variables = {c: (("collector", "time"), a, self.attrs.get(c, {}) | _units(c)) for c, a in self.arrays.items()}
         variables.update({c: (("time",), a, _units(c)) for c, a in self.shared.items()})
+        places = ["east", "north", "up"] + (list(AIM_COLUMNS) if isinstance(field, HeliostatField) else [])
         coords = {"collector": self.names, "time": self.time,
-                  **{axis: ("collector", table[axis].to_numpy()) for axis in ("east", "north", "up")}}
+                  **{place: ("collector", table[place].to_numpy(), {"units": "m"}) for place in places}}
         return xr.Dataset(variables, coords=coords,
                           attrs={"site": site.name, "timezone": site.tz, "field": type(field).__name__,
                                  "time_note": "UTC; the site's clock is in the timezone attribute"})

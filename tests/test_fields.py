@@ -429,6 +429,37 @@ def test_field_result_map_dataset_and_files(day, tmp_path):
     assert repr(result).startswith("<FieldResult: FresnelField of 3 at lanzhou, hybrid, 1,440 steps from 2021-06-21")
 
 
+def test_a_saved_heliostat_field_keeps_every_position_and_aim_point_to_the_last_digit(day, tmp_path):
+    """collectors.csv had rounded to six figures (a mirror 1234.5678 m east was written 1234.57) and
+    left the aim points out; it is now a positions file that builds the same field again."""
+    import xarray as xr
+
+    from hybridtrack.cli.field import read_positions
+
+    positions = [[1234.5678, -987.6543, 0.25], [50.123456789, 60.0, 1.5]]
+    aims = [[0.0, 0.0, 100.0], [0.0, 5.0, 90.0]]
+    field = HeliostatField(positions=positions, aims=aims)
+    result = simulate_field(day.iloc[600:660], "lanzhou", field, seed=0)
+    written = result.save(tmp_path / "field")
+    read, read_aims = read_positions(str(written["collectors"]))  # the metrics' columns are named as not read
+    np.testing.assert_array_equal(read, positions)
+    np.testing.assert_array_equal(read_aims, aims)
+    with xr.open_dataset(written["log"]) as log:
+        np.testing.assert_array_equal(log["aim_north"], [0.0, 5.0])
+        assert {place: log[place].attrs.get("units") for place in ("east", "north", "up", "aim_up")} \
+            == {"east": "m", "north": "m", "up": "m", "aim_up": "m"}
+
+
+def test_a_heliostat_map_stars_each_aim_point_and_says_when_nothing_was_scored(day):
+    """The map had starred the aims' mean, (0, 2.5) for aims at (0, 0) and (0, 5): neither mirror's."""
+    field = HeliostatField(positions=[[0.0, 60.0], [0.0, -60.0]], aims=[[0.0, 0.0, 100.0], [0.0, 5.0, 90.0]])
+    figure = simulate_field(day.iloc[600:660], "lanzhou", field, seed=0).plot_map("rms")
+    stars = [line for line in figure.axes[0].lines if line.get_marker() == "*"]
+    assert len(stars) == 1 and sorted(zip(stars[0].get_xdata(), stars[0].get_ydata())) == [(0.0, 0.0), (0.0, 5.0)]
+    night = simulate_field(day.iloc[:60], "lanzhou", FresnelField(row_distances=[-3.0, 3.0]), seed=0).plot_map("rms")
+    assert any("nothing was scored" in text.get_text() for text in night.axes[0].texts)
+
+
 def test_simulate_field_refuses_what_is_not_a_field(day):
     with pytest.raises(HybridtrackError, match="field must be"):
         simulate_field(day, "lanzhou", "fresnel")
