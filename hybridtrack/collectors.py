@@ -287,6 +287,8 @@ def tracking_rate(angle):
     """
     if not isinstance(angle, (pd.Series, pd.DataFrame)) or not isinstance(angle.index, pd.DatetimeIndex):
         raise HybridtrackError("tracking_rate needs a Series or DataFrame on a DatetimeIndex")
+    if angle.index.tz is None:  # a local clock's naive stamps across a change of summer time give wrong rates
+        raise HybridtrackError("tracking_rate needs a tz-aware time index; localise it (index.tz_localize(...))")
     if len(angle) < 2:
         raise HybridtrackError("tracking_rate needs at least two samples")
     if angle.index.hasnans or not angle.index.is_monotonic_increasing or not angle.index.is_unique:

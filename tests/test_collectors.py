@@ -519,3 +519,12 @@ def test_the_fresnel_end_loss_of_a_sun_on_the_horizon_is_a_length_and_a_row_beyo
                                                                      abs(np.sin(np.radians(100.0))))
     with pytest.raises(HybridtrackError, match="row distance d must be within 5000 m"):
         fresnel_end_loss(30.0, 180.0, 1e308, 1e308)
+
+
+def test_tracking_rate_refuses_naive_stamps_as_every_time_input_does():
+    """A naive local clock across a change of summer time reads an hour's step as two or none."""
+    naive = pd.Series([10.0, 20.0, 30.0], index=pd.date_range("2021-06-21", periods=3, freq="h"))
+    with pytest.raises(HybridtrackError, match="tz-aware"):
+        tracking_rate(naive)
+    aware = tracking_rate(naive.tz_localize("UTC"))
+    np.testing.assert_allclose(aware.to_numpy(), [10.0 / 60.0] * 3)  # 10° an hour, by hand
