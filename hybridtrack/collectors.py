@@ -474,7 +474,8 @@ def aim_unit(aim) -> np.ndarray:
         target = np.zeros(0)
     norm = np.linalg.norm(target, axis=-1, keepdims=True) if target.ndim else np.zeros(1)
     if target.ndim == 0 or target.shape[-1] != 3 or not np.all(np.isfinite(target)) or not np.all(norm > 0):
-        raise HybridtrackError(f"aim point must be three finite coordinates, not all zero; got {aim!r}")
+        raise HybridtrackError(f"aim point must be three finite coordinates (east, north, up), not all zero, shape "
+                               f"(3,) or (..., 3); got {_described(aim)}")
     return target / norm
 
 
@@ -694,6 +695,18 @@ class Collector:
         if self.kind == "fresnel":
             out["end_loss"] = fresnel_end_loss(altitude, azimuth, self.row_distance, self.receiver_height, self.axis)
         return out
+
+
+def _described(value) -> str:
+    """A value as one short line: an array by its shape (a thousand aim points had been printed),
+    anything else as its repr."""
+    shape = getattr(value, "shape", None)
+    if shape is not None and np.size(value) > 3:
+        return f"an array of shape {tuple(shape)}"
+    text = repr(value)
+    if len(text) <= 80 and "\n" not in text:
+        return text
+    return f"a {type(value).__name__}" + (f" of length {len(value)}" if hasattr(value, "__len__") else "")
 
 
 def as_collector(value) -> Collector:

@@ -528,3 +528,9 @@ def test_tracking_rate_refuses_naive_stamps_as_every_time_input_does():
         tracking_rate(naive)
     aware = tracking_rate(naive.tz_localize("UTC"))
     np.testing.assert_allclose(aware.to_numpy(), [10.0 / 60.0] * 3)  # 10° an hour, by hand
+
+
+def test_wrongly_shaped_aim_points_are_refused_in_one_line_naming_the_shape():
+    """A thousand (east, north) pairs had been printed whole in the refusal, over seven lines."""
+    with pytest.raises(HybridtrackError, match=r"shape \(3,\) or \(\.\.\., 3\); got an array of shape \(1000, 2\)$"):
+        heliostat_normal(50.0, 180.0, np.ones((1000, 2)))
