@@ -109,7 +109,7 @@ class Imperfections:
         for f in fields(self):  # numpy's numbers too, kept as floats (a float32 had been refused)
             value = getattr(self, f.name)
             if isinstance(value, bool) or not isinstance(value, numbers.Real) or not _finite(value):
-                raise HybridtrackError(f"imperfections: {f.name} must be a number, got {value!r:.60}")
+                raise HybridtrackError(f"imperfections: {f.name} must be a finite number, got {value!r:.60}")
             if abs(value) > limits[f.name]:
                 raise HybridtrackError(f"imperfections: {f.name} = {value} is beyond ±{limits[f.name]:g}")
             object.__setattr__(self, f.name, float(value))

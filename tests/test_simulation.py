@@ -307,7 +307,7 @@ def test_config_round_trips_and_refuses_unknown_keys(tmp_path):
     (lambda: SimulationConfig.from_dict(None), "a run config must be a table (a dict), got NoneType"),
     # an integer past any float raised OverflowError (or numpy's TypeError)
     (lambda: Drive(deadband=10**400), "drive: deadband (degrees) must be a finite number"),
-    (lambda: Imperfections(clock_error=10**400), "imperfections: clock_error must be a number"),
+    (lambda: Imperfections(clock_error=10**400), "imperfections: clock_error must be a finite number"),
 ])
 def test_a_config_part_a_run_would_not_read_or_could_not_use_is_refused(make, message):
     with pytest.raises(HybridtrackError, match=re.escape(message)):
