@@ -368,6 +368,13 @@ def _distance(values, name: str) -> np.ndarray:
     return array
 
 
+#: The sun vector's part across a Fresnel row's axis at or below which its ray runs along the row:
+#: sin 180° rounds to 1.2e-16, not 0, and a sun on the horizon straight down the row had been given
+#: a finite end loss of 8.5e16 m. Four units in the last place of 1, far below any sun that is not
+#: exactly on the axis's line at the horizon (1e-15 rad is 6e-14°).
+PARALLEL = 4.0 * np.finfo(float).eps
+
+
 def fresnel_end_loss(altitude, azimuth, d, h, axis_azimuth=0.0):
     """End loss of a Fresnel row: how far the reflected light runs past the receiver's end.
 
@@ -394,7 +401,9 @@ def fresnel_end_loss(altitude, azimuth, d, h, axis_azimuth=0.0):
     -------
     numpy.float64, ndarray or pandas.Series
         Metres; positive means the light is lost past the row's end at `axis_azimuth` (the
-        north end of a north-south row), negative past the other end. NaN while the sun is down.
+        north end of a north-south row), negative past the other end; infinite with the sun on
+        the horizon straight along the row (its ray never reaches the receiver). NaN while the
+        sun is down.
     """
     d, h = _distance(d, "row distance d"), _distance(h, "receiver height h")
     if not np.all(h > 0):  # the hypotenuse would hide the sign: -10 m gave +10 m's loss
@@ -405,8 +414,9 @@ def fresnel_end_loss(altitude, azimuth, d, h, axis_azimuth=0.0):
     a = np.radians(alt)
     g = np.radians(az - axis)  # the sun's azimuth from the axis
     f = np.hypot(d, h)
+    along, across = -f * np.cos(a) * np.cos(g), np.sqrt((np.cos(a) * np.sin(g)) ** 2 + np.sin(a) ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        loss = -f * np.cos(a) * np.cos(g) / np.sqrt((np.cos(a) * np.sin(g)) ** 2 + np.sin(a) ** 2)
+        loss = np.where(across > PARALLEL, along / across, np.copysign(np.inf, along))
     return _like(altitude, np.where(a >= 0.0, loss, np.nan), "end_loss")  # a sun on the horizon is up, as elsewhere
 
 

@@ -534,3 +534,11 @@ def test_wrongly_shaped_aim_points_are_refused_in_one_line_naming_the_shape():
     """A thousand (east, north) pairs had been printed whole in the refusal, over seven lines."""
     with pytest.raises(HybridtrackError, match=r"shape \(3,\) or \(\.\.\., 3\); got an array of shape \(1000, 2\)$"):
         heliostat_normal(50.0, 180.0, np.ones((1000, 2)))
+
+
+def test_end_loss_is_infinite_with_the_sun_on_the_horizon_straight_along_the_row():
+    """sin 180° rounds to 1.2e-16: the ray along the row had been given 8.5e16 m, a finite length."""
+    assert fresnel_end_loss(0.0, 180.0, 3.0, 10.0) == np.inf  # from the south: past the north end
+    assert fresnel_end_loss(0.0, 0.0, 3.0, 10.0) == -np.inf
+    low = 1e-9  # a sun just up along the axis: f cot(α), by hand
+    assert fresnel_end_loss(low, 180.0, 3.0, 10.0) == pytest.approx(np.hypot(3.0, 10.0) / np.tan(np.radians(low)))
