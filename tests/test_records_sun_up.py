@@ -1,0 +1,113 @@
+"""What the reader makes of light the site's sun says cannot be: negative GHI under a high sun,
+DNI in kW/m² beside DHI without GHI, and an air temperature that is no reading.
+
+The references are pvlib's Ineichen clear sky at Lanzhou on naive local stamps (written to the
+file as the site's clock), independent of the reader's own clear sky (Haurwitz on the PLC sun).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from hybridtrack import HybridtrackError, sites
+from hybridtrack.cli import main
+from hybridtrack.io import read_weather, validation_report
+
+SITE = sites.get("lanzhou")
+
+
+def clear_sky(start: str, end: str, freq: str) -> pd.DataFrame:
+    """pvlib's Ineichen clear sky at Lanzhou on naive local stamps."""
+    index = pd.date_range(start, end, freq=freq, tz=SITE.tz)
+    location = pvlib.location.Location(SITE.latitude, SITE.longitude, altitude=SITE.altitude)
+    return location.get_clearsky(index, model="ineichen").set_axis(index.tz_localize(None))
+
+
+def write(path, frame: pd.DataFrame):
+    frame.round(4).rename_axis("time").to_csv(path)
+    return path
+
+
+def line_of(frame: pd.DataFrame, stamp: str) -> int:
+    """The file line of `stamp`'s row: the header is line 1."""
+    return int(frame.index.get_loc(pd.Timestamp(stamp))) + 2
+
+
+def refused(path, capsys, *parts) -> str:
+    """The message of `read_weather` with the site, which `hybridtrack check` prints alike."""
+    with pytest.raises(HybridtrackError) as error:
+        read_weather(path, site="lanzhou")
+    message = str(error.value)
+    assert "\n" not in message and all(part in message for part in parts), message
+    assert main(["check", str(path), "--site", "lanzhou"]) == 2
+    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
+    return message
+
+
+# -- negative GHI under a high sun ----------------------------------------------------------------
+
+
+def three_clear_days() -> pd.DataFrame:
+    sky = clear_sky("2021-06-20 00:00", "2021-06-22 23:50", "10min")
+    return sky[["ghi", "dni", "dhi"]]
+
+
+def test_negative_ghi_at_noon_is_set_to_nan_and_counted_and_a_night_offset_still_clipped(tmp_path):
+    """A pyranometer covered for an hour at noon (-4 W/m²) had been clipped to 0 as a night offset,
+    a noon replayed without light; a night's -2 W/m² is an offset, clipped as before."""
+    frame = three_clear_days()
+    noon = pd.date_range("2021-06-21 12:00", "2021-06-21 12:50", freq="10min")  # the sun some 75° up
+    frame.loc[noon, "ghi"] = -4.0
+    frame.loc["2021-06-21 02:00", "ghi"] = -2.0  # the sun 30° below the horizon
+    path = write(tmp_path / "covered.csv", frame)
+    read = read_weather(path, site="lanzhou")
+    report = read.attrs["validation"]
+    assert report["negative_in_sun"] == {"ghi": {"count": 6, "lines": [line_of(frame, str(t)) for t in noon[:5]],
+                                                 "lowest": -4.0, "action": "set to NaN"}}
+    assert report["negative_clipped"]["ghi"] == {"count": 1, "lines": [line_of(frame, "2021-06-21 02:00")],
+                                                 "lowest": -2.0}
+    local = read.index.tz_convert(SITE.tz).tz_localize(None)
+    assert read["ghi"][local.isin(noon)].isna().all() and read["ghi"][local == "2021-06-21 02:00"].item() == 0.0
+    assert "set to NaN (negative irradiance with the sun well up: no night offset): ghi count 6" in \
+        validation_report(read)
+    with pytest.raises(HybridtrackError, match=f"line {line_of(frame, '2021-06-21 12:00')}, column 'ghi': a "
+                                               r"negative irradiance with the sun well up \(strict\)"):
+        read_weather(path, site="lanzhou", strict=True)
+
+
+def test_negative_ghi_through_most_of_the_high_sun_is_refused_by_its_first_line(tmp_path, capsys):
+    """Every day below 0 from 10:00 to 16:00, three quarters of the high sun's readings (the
+    reader's clear sky is 600 W/m² or more from 09:10 to 17:00): no offset, a sensor disconnected;
+    refused naming the first such line. (Half or less are set to NaN, as above.)"""
+    frame = three_clear_days()
+    frame.loc[(frame.index.hour >= 10) & (frame.index.hour < 16), "ghi"] = -5.0
+    path = write(tmp_path / "unplugged.csv", frame)
+    refused(path, capsys, f"unplugged.csv: line {line_of(frame, '2021-06-20 10:00')}, column 'ghi': ghi reads -5 W/m² "
+                          "with the sun well up", "a pyranometer reads below 0 only at night",
+            "covered, disconnected, or its sign reversed?")
+
+
+def test_a_constant_negative_ghi_is_refused_as_no_sky_and_said_to_be_below_zero(tmp_path, capsys):
+    """GHI of -5 W/m² in every row had been refused as "at most 0 W/m²" at a night's line, with a
+    hint to look for raw millivolts; it names the first line under a high sun and the sign."""
+    frame = three_clear_days().assign(ghi=-5.0)
+    first_high = frame.index[three_clear_days()["ghi"].to_numpy() > 550][0]
+    path = write(tmp_path / "minus5.csv", frame)
+    message = refused(path, capsys, "column 'ghi': ghi is at most -5 W/m² through", "no sky is that dark",
+                      "below 0 under that sun: no night offset")
+    line = int(message.split(": line ")[1].split(",")[0])
+    assert abs(line - line_of(frame, str(first_high))) <= 3  # Haurwitz's 600 W/m² against Ineichen's 550
+
+
+def test_negative_night_offsets_and_a_file_without_a_site_are_clipped_as_before(tmp_path):
+    frame = three_clear_days()
+    frame.loc[frame["ghi"] <= 0.0, "ghi"] = -3.0  # every night reading an offset
+    path = write(tmp_path / "nights.csv", frame)
+    nights = int((frame["ghi"] < 0).sum())
+    report = read_weather(path, site="lanzhou").attrs["validation"]
+    assert report["negative_clipped"]["ghi"]["count"] == nights and "negative_in_sun" not in report
+    report = read_weather(path, tz=SITE.tz).attrs["validation"]  # no sun to tell day from night by
+    assert report["negative_clipped"]["ghi"]["count"] == nights and "negative_in_sun" not in report
