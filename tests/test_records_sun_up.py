@@ -111,3 +111,51 @@ def test_negative_night_offsets_and_a_file_without_a_site_are_clipped_as_before(
     assert report["negative_clipped"]["ghi"]["count"] == nights and "negative_in_sun" not in report
     report = read_weather(path, tz=SITE.tz).attrs["validation"]  # no sun to tell day from night by
     assert report["negative_clipped"]["ghi"]["count"] == nights and "negative_in_sun" not in report
+
+
+# -- DNI in kW/m² beside DHI, without GHI ---------------------------------------------------------
+
+
+def test_dni_in_kilowatts_beside_dhi_without_ghi_is_refused_by_its_line(tmp_path, capsys):
+    """A clear day's DNI in kW/m² (0.9 at noon) beside DHI of 100-300 W/m² had been read as an
+    overcast day's: GHI derived as DHI, the day replayed overcast, the file called usable."""
+    sky = clear_sky("2021-06-21 00:00", "2021-06-21 23:59", "1min")
+    frame = pd.DataFrame({"DNI": sky["dni"] / 1000, "DHI": (sky["dhi"] + 0.2 * sky["ghi"]).clip(upper=300.0)})
+    assert 0.85 < frame["DNI"].max() < 1.1 and 250.0 < frame["DHI"].max() <= 300.0
+    path = write(tmp_path / "kw.csv", frame)
+    message = refused(path, capsys, "column 'DNI': dni reads", "in every reading of",
+                      "a beam in kW/m² read as W/m²", "--units dni=kW/m2")
+    row = int(message.split(": line ")[1].split(",")[0]) - 2
+    assert 0.02 <= frame["DNI"].iloc[row] <= 1.5 and sky["ghi"].iloc[row] > 550.0  # a high sun's kW/m² beam
+    read = read_weather(path, site="lanzhou", units={"dni": "kW/m2"})
+    assert read["dni"].max() == pytest.approx(1000 * frame["DNI"].max(), rel=1e-3)
+
+
+@pytest.mark.parametrize("dni", ["zero", "offset noise"])
+def test_an_overcast_days_dni_of_about_zero_beside_dhi_is_read(tmp_path, dni):
+    """An overcast day's DNI is 0, or a pyrheliometer's zero offset either side of it (-0.8 to 1.4
+    W/m² here), beside DHI of 100-300 W/m²: a real day, read as it is."""
+    sky = clear_sky("2021-06-21 00:00", "2021-06-21 23:59", "1min")
+    noise = np.random.default_rng(7).uniform(-0.8, 1.4, len(sky)).round(2)
+    frame = pd.DataFrame({"DNI": 0.0 if dni == "zero" else noise, "DHI": (0.3 * sky["ghi"]).clip(upper=300.0)},
+                         index=sky.index)
+    read = read_weather(write(tmp_path / "overcast.csv", frame), site="lanzhou")
+    assert read["dni"].max() == (0.0 if dni == "zero" else 1.4)
+    assert read["ghi"].max() == pytest.approx(300.0, abs=1.5)  # GHI = DHI + DNI cos z: the DHI's own top
+
+
+
+def test_a_streamed_file_of_dni_in_kilowatts_beside_dhi_is_refused_before_its_first_day(tmp_path):
+    """The streamed day checks judge a day as the reader does: refused before any day is handed on."""
+    from hybridtrack.streaming import recorded_days
+
+    sky = clear_sky("2021-06-21 00:00", "2021-06-22 23:50", "10min").set_axis(
+        pd.date_range("2021-06-21 00:00", "2021-06-22 23:50", freq="10min", tz=SITE.tz))
+    frame = pd.DataFrame({"dni": sky["dni"] / 1000, "dhi": (sky["dhi"] + 0.2 * sky["ghi"]).clip(upper=300.0)})
+    days = []
+    with pytest.raises(HybridtrackError, match=r"st\.csv: line \d+, column 'dni': dni reads .* a beam in kW/m²"):
+        for day, _ in recorded_days(write(tmp_path / "st.csv", frame), SITE):
+            days.append(day)
+    assert days == []
+    overcast = recorded_days(write(tmp_path / "ov.csv", frame.assign(dni=0.0)), SITE)
+    assert [len(day) for _, day in overcast] == [144, 144]

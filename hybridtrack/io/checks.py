@@ -353,6 +353,7 @@ def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nda
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
     _check_hours(path, frame, report, clear_ghi, days)
+    _refuse_dni_in_kw_beside_diffuse(path, frame, report, clear_ghi, days)
 
 
 def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, days: np.ndarray) -> None:
@@ -388,6 +389,44 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
             in_kilowatts = counts.index[counts["in_kilowatts"] & (counts["day"] == mixed[0])]
             _refuse_hours_in_kilowatts(path, frame, report, name, np.isin(hours, in_kilowatts) & kilowatt,
                                        watts & (days == mixed[0]), f"{len(in_kilowatts)} hours of {what}")
+
+
+def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray,
+                                     days: np.ndarray) -> None:
+    """Refuse, in a file of DNI and DHI without GHI, a day (`days`, a label per row) whose DNI
+    reads `DARKEST` / 1000 to `KILOWATT_TOP` (0.02 to 1.5) in every reading under a high sun (clear
+    sky `SUN_WELL_UP` W/m² or more, the DHI above `DARKEST` W/m²: daylight in the file too)
+    through `HOURS_WELL_UP` clock hours or more: a beam in kW/m² read as W/m².
+
+    Without GHI there is no beam on the horizontal to judge DNI by (`horizontal_beam`), and an
+    overcast day's DNI is legitimately about 0 beside a DHI of 100-300 W/m²: a clear day's DNI in
+    kW/m² (0.9 at noon) beside it had been read as such a day and replayed overcast. What tells
+    them apart is the pyrheliometer's zero: under cloud it reads 0, or its offset either side of 0,
+    so below 0.02 at times; a beam in kW/m² reads 0.02 or more in every reading under so high a sun.
+    """
+    if "ghi" in frame or not {"dni", "dhi"} <= set(frame.columns):
+        return
+    dni, dhi = frame["dni"].to_numpy(float), frame["dhi"].to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        judged = (np.asarray(clear_ghi) >= SUN_WELL_UP) & (dhi > DARKEST) & np.isfinite(dni)
+        in_band = judged & (dni >= DARKEST / 1000.0) & (dni <= KILOWATT_TOP)
+    if not in_band.any():
+        return
+    hours = frame.index.as_unit("ns").asi8 // pd.Timedelta(hours=1).value  # the hour each stamp is in
+    table = pd.DataFrame({"day": days, "hour": hours, "in_band": in_band})[judged]
+    by_day = table.groupby("day").agg(all_in=("in_band", "all"), hours=("hour", "nunique"))
+    found = by_day.index[by_day["all_in"] & (by_day["hours"] >= HOURS_WELL_UP)]
+    if not len(found):
+        return
+    stretch = in_band & (days == found[0])
+    lines = first_lines(frame, stretch)
+    header = report.get("columns", {}).get("dni", "dni")
+    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    raise HybridtrackError(
+        f"{where}: dni reads {np.min(dni[stretch]):g} to {np.max(dni[stretch]):g} in every reading of "
+        f"{by_day.loc[found[0], 'hours']} hours of a high sun (clear sky {SUN_WELL_UP:g} W/m² or more, dhi above "
+        f"{DARKEST:g} W/m²): a beam in kW/m² read as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below "
+        f"{DARKEST / 1000:g} at times): give its unit (--units dni=kW/m2), or convert the column to W/m² (×1000)")
 
 
 def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,
