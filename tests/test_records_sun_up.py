@@ -159,3 +159,34 @@ def test_a_streamed_file_of_dni_in_kilowatts_beside_dhi_is_refused_before_its_fi
     assert days == []
     overcast = recorded_days(write(tmp_path / "ov.csv", frame.assign(dni=0.0)), SITE)
     assert [len(day) for _, day in overcast] == [144, 144]
+
+# -- an air temperature that is no reading --------------------------------------------------------
+
+
+@pytest.mark.parametrize("cell, first", [("inf", "inf"), ("1e400", "inf"), ("-300", "-300.0")])
+def test_an_impossible_air_temperature_is_set_to_nan_and_counted_as_a_wind_speed_is(tmp_path, capsys, cell, first):
+    """The reader's rule for a value outside a column's limits, the same for temp_air as for
+    wind_speed: set to NaN, counted with its line; the replay runs on."""
+    text = "time,ghi,dni,dhi,wind_speed,temp_air\n" + "".join(
+        f"2021-06-21 12:{m:02d},900,800,100,{'200' if m == 3 else '2'},{cell if m == 2 else '25'}\n" for m in range(6))
+    path = tmp_path / "t.csv"
+    path.write_text(text)
+    report = read_weather(path, tz=SITE.tz).attrs["validation"]
+    assert report["impossible"]["temp_air"] == {"count": 1, "lines": [4], "first": float(first) if first != "inf"
+                                                else "inf", "action": "set to NaN"}
+    assert report["impossible"]["wind_speed"] == {"count": 1, "lines": [5], "first": 200.0, "action": "set to NaN"}
+    assert main(["check", str(path), "--tz", SITE.tz]) == 0
+    assert f"set to NaN (physically impossible): wind_speed count 1, lines 5, first 200.0, temp_air count 1, lines 4, " \
+           f"first {first}" in capsys.readouterr().out
+
+
+def test_air_temperature_as_text_is_counted_by_line_or_refused_when_most_of_it(tmp_path, capsys):
+    rows = [f"2021-06-21 12:{m:02d},900,800,100,2,{'warm' if m == 1 else '25'}\n" for m in range(6)]
+    path = tmp_path / "t.csv"
+    path.write_text("time,ghi,dni,dhi,wind_speed,temp_air\n" + "".join(rows))
+    report = read_weather(path, tz=SITE.tz).attrs["validation"]
+    assert report["unreadable"]["temp_air"] == {"count": 1, "lines": [3], "first": "'warm'", "action": "set to NaN"}
+    path.write_text("time,ghi,dni,dhi,wind_speed,temp_air\n" + "".join(r.replace(",25\n", ",warm\n") for r in rows))
+    assert main(["check", str(path), "--tz", SITE.tz]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {path}: line 2, column 'temp_air': 'warm' is not a number "
+                                       "(nor are 6 of its 6 values)\n")
