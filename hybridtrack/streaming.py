@@ -157,12 +157,13 @@ def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str
     -------
     DaySource
     """
-    from .sky import WEATHERS, synthetic
+    from .sky import WEATHERS, synthetic, weather_name
 
     site = sites.get(site)
     first, last = _dates(start, end)
-    if not isinstance(weather, str) or weather not in WEATHERS:
+    if not isinstance(weather, str) or weather_name(weather) not in WEATHERS:
         raise HybridtrackError(f"weather {weather!r}: a streamed run takes one of {', '.join(WEATHERS)} for every day")
+    weather = weather_name(weather)
     step = parse_freq(freq)
     params.seed(seed)
     days = (last - first).days + 1
