@@ -57,7 +57,7 @@ from .errors import HybridtrackError
 from .io.checks import (CLIPPED_AT_ZERO, LIMITS, check_magnitude, check_magnitude_by_day, kilowatts_without_site,
                         site_clear_sky)
 from .io.files import input_path
-from .io.stamps import has_offset
+from .io.stamps import has_offset, shown
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
@@ -507,7 +507,7 @@ def _parsed_stamps(stamps: pd.Series, path: Path, first_row: int) -> pd.Datetime
     bad = np.flatnonzero(parsed.isna().to_numpy())
     if len(bad):
         row, cell = first_row + int(bad[0]), stamps.iloc[bad[0]]
-        what = "'' is an empty time stamp" if pd.isna(cell) else f"{str(cell)!r} is not an ISO 8601 time stamp"
+        what = "'' is an empty time stamp" if pd.isna(cell) else f"{shown(cell)} is not an ISO 8601 time stamp"
         raise HybridtrackError(f"{path}: row {row}, column {stamps.name!r}: {what} ({CONVERT_ONCE})")
     return pd.DatetimeIndex(parsed)
 
