@@ -190,3 +190,16 @@ def test_air_temperature_as_text_is_counted_by_line_or_refused_when_most_of_it(t
     assert main(["check", str(path), "--tz", SITE.tz]) == 2
     assert capsys.readouterr().err == (f"hybridtrack: error: {path}: line 2, column 'temp_air': 'warm' is not a number "
                                        "(nor are 6 of its 6 values)\n")
+
+
+def test_a_column_of_infinities_is_damage_counted_not_a_unit_to_give(tmp_path, capsys):
+    """An air temperature of inf in every row had been refused as "100% of values are outside -90..65
+    (°C); wrong unit? give it, e.g. --units temp_air=K": no unit makes inf a temperature. It is a
+    sensor's damage, set to NaN and counted, as a logger's -9999 in every row is."""
+    path = tmp_path / "t.csv"
+    path.write_text("time,ghi,dni,dhi,temp_air\n" + "".join(f"2021-06-21 12:{m:02d},900,800,100,inf\n"
+                                                           for m in range(4)))
+    frame = read_weather(path, tz=SITE.tz)
+    assert frame.attrs["validation"]["impossible"]["temp_air"] == {"count": 4, "lines": [2, 3, 4, 5], "first": "inf",
+                                                                   "action": "set to NaN"}
+    assert frame["temp_air"].isna().all() and frame["ghi"].tolist() == [900.0] * 4

@@ -206,9 +206,13 @@ def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.nd
     An irradiance column is judged on its finite daylight values too (above `DARKEST` W/m², or
     beyond the limits): hourly kJ/m² sums (3.6 times W/m²) pass 1500 at every bright hour, but
     the nights' zeros had kept the share under half, so the noons were set to NaN and the rest
-    kept 3.6 times too high. A non-finite cell (``inf``) is damage, not a unit: not judged there.
+    kept 3.6 times too high. A non-finite cell (``inf``, ``1e400``) is damage, not a unit: not
+    judged in any column (set to NaN and counted, as a logger's missing-value marker is; a column
+    of them had been refused as a unit mistake, ``--units temp_air=K`` for an air temperature of
+    ``inf``).
     """
-    judged, what = ~np.isnan(values), "values"
+    judged, what = np.isfinite(values), "values"
+    bad = bad & judged
     if name in IRRADIANCE and bad.sum() <= 0.5 * judged.sum():
         judged, what = np.isfinite(values) & (bad | (values > DARKEST)), "daylight values"
         bad = bad & judged
