@@ -32,7 +32,7 @@ from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
 __all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "clip_offsets",
-           "check_magnitude", "site_clear_sky", "kilowatts_without_site",
+           "check_magnitude", "site_clear_sky", "kilowatts_without_site", "dni_kilowatt_day",
            "check_magnitude_by_day", "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
@@ -395,12 +395,12 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
                                        watts & (days == mixed[0]), f"{len(in_kilowatts)} hours of {what}")
 
 
-def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray,
-                                     days: np.ndarray) -> None:
-    """Refuse, in a file of DNI and DHI without GHI, a day (`days`, a label per row) whose DNI
-    reads `DARKEST` / 1000 to `KILOWATT_TOP` (0.02 to 1.5) in every reading under a high sun (clear
-    sky `SUN_WELL_UP` W/m² or more, the DHI above `DARKEST` W/m²: daylight in the file too)
-    through `HOURS_WELL_UP` clock hours or more: a beam in kW/m² read as W/m².
+def dni_kilowatt_day(frame: pd.DataFrame, clear_ghi: np.ndarray, days: np.ndarray) -> tuple[np.ndarray, int] | None:
+    """In a frame of DNI and DHI without GHI, the first day (`days`, a label per row) whose DNI
+    reads `DARKEST` / 1000 to `KILOWATT_TOP` (0.02 to 1.5) in every reading under a high sun (the
+    site's clear sky `clear_ghi` at `SUN_WELL_UP` W/m² or more, the DHI above `DARKEST` W/m²:
+    daylight in the frame too) through `HOURS_WELL_UP` clock hours or more: a beam in kW/m² read
+    as W/m². Returned as those readings (a mask) and their clock hours; None if no day is so.
 
     Without GHI there is no beam on the horizontal to judge DNI by (`horizontal_beam`), and an
     overcast day's DNI is legitimately about 0 beside a DHI of 100-300 W/m²: a clear day's DNI in
@@ -409,28 +409,36 @@ def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: di
     so below 0.02 at times; a beam in kW/m² reads 0.02 or more in every reading under so high a sun.
     """
     if "ghi" in frame or not {"dni", "dhi"} <= set(frame.columns):
-        return
+        return None
     dni, dhi = frame["dni"].to_numpy(float), frame["dhi"].to_numpy(float)
     with np.errstate(invalid="ignore"):
         judged = (np.asarray(clear_ghi) >= SUN_WELL_UP) & (dhi > DARKEST) & np.isfinite(dni)
         in_band = judged & (dni >= DARKEST / 1000.0) & (dni <= KILOWATT_TOP)
     if not in_band.any():
-        return
+        return None
     hours = frame.index.as_unit("ns").asi8 // pd.Timedelta(hours=1).value  # the hour each stamp is in
     table = pd.DataFrame({"day": days, "hour": hours, "in_band": in_band})[judged]
     by_day = table.groupby("day").agg(all_in=("in_band", "all"), hours=("hour", "nunique"))
     found = by_day.index[by_day["all_in"] & (by_day["hours"] >= HOURS_WELL_UP)]
-    if not len(found):
+    return (in_band & (days == found[0]), int(by_day.loc[found[0], "hours"])) if len(found) else None
+
+
+def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray,
+                                     days: np.ndarray) -> None:
+    """Refuse, naming its first line, a day `dni_kilowatt_day` finds in a file of DNI and DHI."""
+    found = dni_kilowatt_day(frame, clear_ghi, days)
+    if found is None:
         return
-    stretch = in_band & (days == found[0])
+    stretch, hours = found
+    dni = frame["dni"].to_numpy(float)
     lines = first_lines(frame, stretch)
     header = report.get("columns", {}).get("dni", "dni")
     where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
     raise HybridtrackError(
-        f"{where}: dni reads {np.min(dni[stretch]):g} to {np.max(dni[stretch]):g} in every reading of "
-        f"{by_day.loc[found[0], 'hours']} hours of a high sun (clear sky {SUN_WELL_UP:g} W/m² or more, dhi above "
-        f"{DARKEST:g} W/m²): a beam in kW/m² read as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below "
-        f"{DARKEST / 1000:g} at times): give its unit (--units dni=kW/m2), or convert the column to W/m² (×1000)")
+        f"{where}: dni reads {np.min(dni[stretch]):g} to {np.max(dni[stretch]):g} in every reading of {hours} hours "
+        f"of a high sun (clear sky {SUN_WELL_UP:g} W/m² or more, dhi above {DARKEST:g} W/m²): a beam in kW/m² read "
+        f"as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below {DARKEST / 1000:g} at times): give its "
+        "unit (--units dni=kW/m2), or convert the column to W/m² (×1000)")
 
 
 def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,
