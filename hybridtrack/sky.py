@@ -42,8 +42,8 @@ from .sites import Site, get
 from .smoothing import one_pole
 from .times import clock_hours, local_midnight, local_range, parse_freq, stamp_minutes
 
-__all__ = ["synthetic", "check_weather", "weather_name", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES",
-           "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
+__all__ = ["synthetic", "check_weather", "weather_name", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE",
+           "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
 #: W/m²: irradiance no sensor reads with the sun below the horizon (twilight gives a few W/m²):

@@ -176,8 +176,8 @@ def test_an_impossible_air_temperature_is_set_to_nan_and_counted_as_a_wind_speed
                                                 else "inf", "action": "set to NaN"}
     assert report["impossible"]["wind_speed"] == {"count": 1, "lines": [5], "first": 200.0, "action": "set to NaN"}
     assert main(["check", str(path), "--tz", SITE.tz]) == 0
-    assert f"set to NaN (physically impossible): wind_speed count 1, lines 5, first 200.0, temp_air count 1, lines 4, " \
-           f"first {first}" in capsys.readouterr().out
+    assert ("set to NaN (physically impossible): wind_speed count 1, lines 5, first 200.0, temp_air count 1, "
+            f"lines 4, first {first}") in capsys.readouterr().out
 
 
 def test_air_temperature_as_text_is_counted_by_line_or_refused_when_most_of_it(tmp_path, capsys):
