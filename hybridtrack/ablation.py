@@ -85,7 +85,7 @@ def checked_values(name: str, values, label: str) -> tuple:
     from . import params
     from . import sites as known_sites
     from .collectors import KINDS
-    from .sky import DAY_TYPES
+    from .sky import DAY_TYPES, weather_name
 
     # a text had been run a letter a value ("unknown site 'l'"); a number raised TypeError
     if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
@@ -104,9 +104,12 @@ def checked_values(name: str, values, label: str) -> tuple:
     else:
         what, known = {"seasons": ("season", tuple(SEASONS)), "weather": ("weather", (*DAY_TYPES, "mixed")),
                        "collectors": ("collector", KINDS), "policies": ("policy", STRATEGIES)}[name]
-        unknown = next((value for value in values if value not in known), None)
+        # a weather as synthetic reads it ('Sunny' is sunny), as a site by its own name
+        read = tuple(map(weather_name, values)) if name == "weather" else values
+        unknown = next((given for given, value in zip(values, read) if value not in known), None)
         if unknown is not None:
             raise HybridtrackError(f"{label}: unknown {what} {unknown!r}; choose from {', '.join(known)}")
+        values = read
     twice = next((value for k, value in enumerate(values) if value in values[:k]), None)
     if twice is not None:  # the same days run twice, and counted twice in the table's means
         raise HybridtrackError(f"{label}: {name} names {twice!r} twice")

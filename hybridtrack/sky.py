@@ -42,8 +42,8 @@ from .sites import Site, get
 from .smoothing import one_pole
 from .times import clock_hours, local_midnight, local_range, parse_freq, stamp_minutes
 
-__all__ = ["synthetic", "check_weather", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE", "DAY_TYPES",
-           "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
+__all__ = ["synthetic", "check_weather", "weather_name", "clear_sky", "smooth_noise", "MinuteGrid", "Climate", "CLIMATE",
+           "DAY_TYPES", "WEATHERS", "RegimeParameters", "REGIMES", "daily_summary"]
 
 DAY_TYPES = ("sunny", "cloudy", "overcast")
 #: W/m²: irradiance no sensor reads with the sun below the horizon (twilight gives a few W/m²):
@@ -192,23 +192,33 @@ def _gust_peak(peak) -> tuple[float, float]:
     return low, high
 
 
-def check_weather(weather, days: int) -> None:
-    """Refuse a weather `synthetic` cannot make for `days` days: an unknown name, or a per-day list
-    of another length or with a name that is not a day's weather (``climate`` draws them)."""
+def weather_name(name):
+    """A weather's name as `synthetic` reads it: in lower case, without the spaces around it
+    (``"Sunny"``, ``" SUNNY "`` -> ``"sunny"``), as a site's name and a file's sky labels are read;
+    anything but text is returned as it is, for `check_weather` to refuse."""
+    return name.strip().lower() if isinstance(name, str) else name
+
+
+def check_weather(weather, days: int) -> str | list[str]:
+    """The weather `synthetic` makes for `days` days, its names read by `weather_name`: one name, or
+    a per-day list of names. Refused: an unknown name (named as given, with the names known), or a
+    per-day list of another length or with a name that is not a day's weather (``climate`` draws
+    them)."""
     if isinstance(weather, str):
-        if weather not in WEATHERS:
+        if weather_name(weather) not in WEATHERS:
             raise HybridtrackError(f"unknown weather {weather!r}; choose from {', '.join(WEATHERS)} or a per-day list")
-        return
+        return weather_name(weather)
     weather = list(weather)
     if len(weather) != days:
         raise HybridtrackError(f"{len(weather)} weathers given for {days} days; give one per day")
     for value in weather:
-        if value not in WEATHERS or value == "climate":
+        if weather_name(value) not in WEATHERS or weather_name(value) == "climate":
             raise HybridtrackError(f"unknown day weather {value!r}; choose from sunny, cloudy, overcast, mixed")
+    return [weather_name(value) for value in weather]
 
 
 def _day_types(days: list, weather, climate: Climate, rng: np.random.Generator) -> list[str]:
-    check_weather(weather, len(days))
+    weather = check_weather(weather, len(days))
     if weather == "climate":
         out = []
         for day in days:

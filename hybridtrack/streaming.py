@@ -57,7 +57,7 @@ from .errors import HybridtrackError
 from .io.checks import (CLIPPED_AT_ZERO, LIMITS, check_magnitude, check_magnitude_by_day, kilowatts_without_site,
                         site_clear_sky)
 from .io.files import input_path
-from .io.stamps import has_offset
+from .io.stamps import has_offset, shown
 from .io.units import FRAME_UNITS
 from .metrics import HISTOGRAM_RESOLUTION, RunningSummary
 from .outputs import claim, held, output_folder, removing_empty_folders, strict_json, write, write_in_place
@@ -104,6 +104,9 @@ class DaySource:
 
     #: Whether `check_span` found a whole local day.
     _spans_a_day: bool = field(default=False, repr=False)
+    #: The check of the weather's true-sky labels (`check_true_sky`), a pass over them alone; None
+    #: where there is nothing to check before the run (synthetic days make their own labels).
+    _true_sky: Callable[[], None] | None = field(default=None, repr=False)
 
     def __iter__(self) -> Iterator[tuple[dt.date, pd.DataFrame]]:
         return self._days()
@@ -124,6 +127,15 @@ class DaySource:
         raise HybridtrackError(f"{self.describe}: holds no time steps" if days == 0 else
                                f"a streamed run needs at least one whole local day at {self.site.name}; this span "
                                "has none (run it without --stream; hybridtrack.simulate from Python)")
+
+    def check_true_sky(self) -> None:
+        """Refuse, before anything runs, a weather without the true-sky labels the hybrid-oracle
+        policy reads, or with one that names no sky (`stream` calls it for that policy, and the
+        command line before its progress bar). Each day's run refuses them too, but only when
+        that day comes: the days before a bad label had run and been written first."""
+        if self._true_sky is not None:
+            self._true_sky()
+            self._true_sky = None  # checked once per source
 
 
 def _dates(start, end) -> tuple[dt.date, dt.date]:
@@ -157,12 +169,13 @@ def synthetic_days(site, start, end=None, *, weather: str = "climate", freq: str
     -------
     DaySource
     """
-    from .sky import WEATHERS, synthetic
+    from .sky import WEATHERS, synthetic, weather_name
 
     site = sites.get(site)
     first, last = _dates(start, end)
-    if not isinstance(weather, str) or weather not in WEATHERS:
+    if not isinstance(weather, str) or weather_name(weather) not in WEATHERS:
         raise HybridtrackError(f"weather {weather!r}: a streamed run takes one of {', '.join(WEATHERS)} for every day")
+    weather = weather_name(weather)
     step = parse_freq(freq)
     params.seed(seed)
     days = (last - first).days + 1
@@ -267,7 +280,69 @@ def frame_days(frame: pd.DataFrame, site) -> DaySource:
     if covered is not None and covered < pd.Timedelta(hours=23):
         raise HybridtrackError(f"the frame spans {local[0]} to {local[-1]}: a streamed run needs at least one whole "
                                "local day (run a shorter span without --stream; hybridtrack.simulate from Python)")
-    return DaySource(site, "a weather frame", len(frame), days, lambda: _by_day(iter([frame]), site, "the frame"))
+    return DaySource(site, "a weather frame", len(frame), days, lambda: _by_day(iter([frame]), site, "the frame"),
+                     _true_sky=lambda: _refuse_unknown_sky_in_frame(frame))
+
+
+def _unknown_sky(labels: pd.Series) -> np.ndarray:
+    """Where `labels` (a ``sky`` column as read) name no sky of `SKY_CODES`; a missing one is
+    unknown, which the hybrid-oracle policy takes (`hybridtrack.simulate` reads them so)."""
+    from .control import SKY_CODES
+
+    return (labels.notna() & ~labels.isin(SKY_CODES)).to_numpy()
+
+
+def _oracle_reads() -> str:
+    from .control import SKY_CODES
+
+    return f"the hybrid-oracle policy reads {', '.join(map(repr, SKY_CODES))}"
+
+
+def _refuse_unknown_sky_in_frame(frame: pd.DataFrame) -> None:
+    """`DaySource.check_true_sky` of a frame in memory: its first bad label by its time stamp, as
+    `hybridtrack.simulate` names it."""
+    if "sky" not in frame.columns:
+        raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
+                               "have one)")
+    unknown = np.flatnonzero(_unknown_sky(frame["sky"]))
+    if len(unknown):
+        raise HybridtrackError(f"the frame's 'sky' column at {frame.index[unknown[0]]}: "
+                               f"{frame['sky'].iloc[unknown[0]]!r} is no sky label; {_oracle_reads()}")
+
+
+def _refuse_unknown_sky_in_file(path: Path, separator: str | None) -> None:
+    """`DaySource.check_true_sky` of a file on disk: its ``sky`` column alone read a chunk at a
+    time (as the run reads it, so that the verdict is the run's), the first label that names no
+    sky refused by its line (a CSV's; a Parquet file's row) and column, with their count. A file
+    pandas or pyarrow cannot read is left to the run's own read, which names what is wrong."""
+    try:
+        if separator is not None:
+            names = pd.read_csv(path, sep=separator, nrows=0).columns
+            chunks = pd.read_csv(path, sep=separator, usecols=["sky"], chunksize=CHUNK_ROWS,
+                                 low_memory=False) if "sky" in names else ()
+            first_row, where = 2, "line"
+        else:
+            import pyarrow.parquet as pq
+
+            handle = pq.ParquetFile(path)
+            names = handle.schema_arrow.names
+            chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=["sky"])) \
+                if "sky" in names else ()
+            first_row, where = 1, "row"
+        rows, count, first = 0, 0, None
+        for chunk in chunks:
+            unknown = np.flatnonzero(_unknown_sky(chunk["sky"]))
+            if len(unknown) and first is None:
+                first = (first_row + rows + int(unknown[0]), chunk["sky"].iloc[unknown[0]])
+            rows, count = rows + len(chunk), count + len(unknown)
+    except (OSError, ValueError):  # pandas' and pyarrow's read errors
+        return
+    if "sky" not in names:
+        raise HybridtrackError(f"{path}: no column 'sky': {_oracle_reads()} from a weather frame's true sky "
+                               "(hybridtrack check FILE --out clean.parquet keeps a record's sky column)")
+    if first is not None:
+        raise HybridtrackError(f"{path}: {where} {first[0]}, column 'sky': {first[1]!r:.40} is no sky label ({count} "
+                               f"such in the file); {_oracle_reads()} (a streamed file is read as written)")
 
 
 def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySource:
@@ -358,7 +433,8 @@ def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySo
     rows = lambda: itertools.count(first_row, chunk_rows)  # noqa: E731 - each piece's first row
     return DaySource(site, f"{path}", steps, None,
                      lambda: _by_day(_magnitude_checked(pieces(), path, rows(), site), site, str(path)),
-                     wind_measured="wind_speed" in measured)
+                     wind_measured="wind_speed" in measured,
+                     _true_sky=lambda: _refuse_unknown_sky_in_file(path, separator))
 
 
 #: The separators a streamed CSV may use: the one its header line holds most of is used.
@@ -431,7 +507,7 @@ def _parsed_stamps(stamps: pd.Series, path: Path, first_row: int) -> pd.Datetime
     bad = np.flatnonzero(parsed.isna().to_numpy())
     if len(bad):
         row, cell = first_row + int(bad[0]), stamps.iloc[bad[0]]
-        what = "'' is an empty time stamp" if pd.isna(cell) else f"{str(cell)!r} is not an ISO 8601 time stamp"
+        what = "'' is an empty time stamp" if pd.isna(cell) else f"{shown(cell)} is not an ISO 8601 time stamp"
         raise HybridtrackError(f"{path}: row {row}, column {stamps.name!r}: {what} ({CONVERT_ONCE})")
     return pd.DatetimeIndex(parsed)
 
@@ -990,6 +1066,8 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
         config = decided(config, source.steps)
     running = RunningSummary(site=site.name, collector=collector.kind, strategy=config.controller.strategy,
                              resolution=resolution)  # checks `resolution` before anything is written
+    if config.controller.strategy == "hybrid-oracle":
+        source.check_true_sky()
     source.check_span()
     files = stream_files(out)
     partial = partial_files(files)

@@ -115,6 +115,10 @@ class Sweep:
             if not isinstance(values, list) or not values:
                 raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
             _refuse_repeats(key, values, source)
+        if "weather" in grid:  # after the repeats are judged, by the names as given
+            grid["weather"] = [_canonical_weather(value) for value in grid["weather"]]
+        if "weather" in base:
+            base["weather"] = _canonical_weather(base["weather"])
         count = int(np.prod([len(v) for v in grid.values()], dtype=float))
         if count > MAX_RUNS:
             raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
@@ -374,16 +378,29 @@ def _strategy(name) -> str:
 
 
 def _weather_names(value) -> list[str]:
-    """The weather's names: one for every day, or one per day (a list, or text with commas)."""
-    from .sky import WEATHERS
+    """The weather's names as the runs read them (`hybridtrack.sky.weather_name`: ``Sunny`` is
+    ``sunny``): one for every day, or one per day (a list, or text with commas)."""
+    from .sky import WEATHERS, weather_name
 
     names = value if isinstance(value, list) else str(value).split(",")
     if not names:
         raise HybridtrackError("weather is an empty list; give a weather, or one per day")
     for name in names:
-        if name not in WEATHERS:
+        if weather_name(name) not in WEATHERS:
             raise HybridtrackError(f"unknown weather {name!r}; choose from {', '.join(WEATHERS)} or a per-day list")
-    return names
+    return [weather_name(name) for name in names]
+
+
+def _canonical_weather(value):
+    """A base or grid value of ``weather`` with its names as the runs read them (`_weather_names`),
+    in its own shape (text, or a list), so that the table, the plot and ``sweep.toml`` name the
+    weather the runs made: ``Sunny`` had been refused where ``Lanzhou`` was a site. A value the
+    runs refuse is kept as written, for them to refuse by its name."""
+    try:
+        names = _weather_names(value)
+    except HybridtrackError:
+        return value
+    return names if isinstance(value, list) else ",".join(names)
 
 
 def _step(freq) -> str:

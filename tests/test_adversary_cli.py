@@ -200,3 +200,60 @@ def test_an_unknown_site_is_refused_naming_the_flag(argv, capsys):
     assert main(argv) == 2
     assert capsys.readouterr().err == ("hybridtrack: error: --site: unknown site 'atlantis'; known sites: delingha, "
                                        "kunming, lanzhou, nanjing\n")
+
+
+def _packed(kind: str, text: str) -> bytes:
+    import gzip
+    import io
+    import zipfile
+
+    if kind == "gzip":
+        return gzip.compress(text.encode())
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("log.csv", text)
+    return buffer.getvalue()
+
+
+@pytest.mark.parametrize("kind, name, damage, message", [
+    # zlib's own error had escaped both readers: "zlib.error: Error -3 while decompressing data" and a traceback
+    ("gzip", "log.csv.gz", lambda raw: raw[:30] + b"\xff" * 20 + raw[50:],
+     "log.csv.gz: a damaged gzip file (Error -3 while decompressing data"),
+    ("zip", "log.zip", lambda raw: raw[:60] + b"\xff" * 20 + raw[80:],
+     "log.zip: a damaged or unsupported zip file (Error -3 while decompressing data"),
+    ("gzip", "log.csv", lambda raw: raw[:-30], "log.csv: a damaged gzip file (Compressed file ended before"),
+])
+def test_a_damaged_packed_file_is_one_line(tmp_path, capsys, kind, name, damage, message):
+    path = tmp_path / name
+    path.write_bytes(damage(_packed(kind, HEADER + ROWS * 20)))
+    assert refused(path, {"tz": "Asia/Shanghai"}, ["--tz", "Asia/Shanghai"], capsys).startswith(f"{tmp_path}/{message}")
+
+
+@pytest.mark.parametrize("kind", ["gzip", "zip"])
+def test_a_packed_file_that_unpacks_past_the_memory_budget_is_refused_not_unpacked(tmp_path, capsys, monkeypatch,
+                                                                                   kind):
+    """A few MB of packed zeros unpack a thousand times larger; they had been unpacked without a bound.
+    The budget is made 1 MiB here, the file 3 MiB unpacked (a little of it packed)."""
+    import hybridtrack.budget
+
+    monkeypatch.setattr(hybridtrack.budget, "memory_budget", lambda: 2**20)
+    text = HEADER + ROWS * (3 * 2**20 // len(ROWS))
+    path = tmp_path / ("log.csv.gz" if kind == "gzip" else "log.zip")
+    path.write_bytes(_packed(kind, text))
+    assert path.stat().st_size < 2**20
+    assert refused(path, {"tz": "Asia/Shanghai"}, ["--tz", "Asia/Shanghai"], capsys) == (
+        f"{path}: unpacks to more than 1 MiB, more than a file can be")
+
+
+def test_a_streamed_files_unwritten_tail_is_quoted_cut(tmp_path, capsys):
+    """A logger card's NUL padding after the last line (the record reader drops it) is the streamed
+    reader's last time cell: quoted whole, a megabyte of it had been one line of 4 MB."""
+    path = tmp_path / "card.csv"
+    path.write_bytes(("time,dni\n" + "".join(f"2021-06-21T{h:02d}:00:00+08:00,0\n" for h in range(24))).encode()
+                     + b"\x00" * 2**20)
+    assert main(["replay", str(path), "--site", "lanzhou", "--stream", "--out", str(tmp_path / "run")]) == 2
+    assert capsys.readouterr().err == (
+        f"hybridtrack: error: {path}: row 26, column 'time': '{chr(92)}x00{chr(92)}x00{chr(92)}x00{chr(92)}x00"
+        f"{(chr(92) + 'x00') * 16}'... (1,048,576 characters) is not an ISO 8601 time stamp (a streamed file is read "
+        "as written: convert a record once with hybridtrack check FILE --out clean.parquet "
+        "(hybridtrack.io.read_weather(...).to_parquet(...) from Python))\n")

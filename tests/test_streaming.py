@@ -903,3 +903,51 @@ def test_a_dni_only_file_with_an_overcast_day_streams_whatever_the_chunks(tmp_pa
     frame.loc[dull, "dni"] = np.tile([0.0, 0.4, 0.9], int(dull.sum()) // 3 + 1)[:int(dull.sum())]
     frame.round(3).to_csv(tmp_path / "dni.csv", index_label="time")
     assert sum(len(day) for _, day in recorded_days(tmp_path / "dni.csv", SITE, chunk_rows=chunk_rows)) == len(frame)
+
+
+def _oracle_frame() -> pd.DataFrame:
+    """Three mixed days at 30 min with their true sky as text, a day's label 'foggy' on the third."""
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-20", "2021-06-22", weather="mixed", freq="30min", seed=2)
+    frame = frame[["ghi", "dni", "dhi", "wind_speed", "sky"]].assign(sky=lambda f: f["sky"].astype(str))
+    frame.loc[frame.index[[110, 120]], "sky"] = "foggy"  # 2021-06-22 07:00 and 12:00
+    frame.loc[frame.index[5], "sky"] = np.nan  # a missing label is unknown, which the oracle takes
+    return frame
+
+
+def test_a_streamed_files_sky_label_the_oracle_cannot_read_is_refused_before_the_first_day(tmp_path, capsys):
+    """A streamed replay had run and written two days before the run of the third refused its label
+    by a time stamp; the non-streamed replay refuses it by the file's line and column before any
+    run. The sky column alone is read first, a chunk at a time."""
+    frame = _oracle_frame()
+    frame.to_csv(tmp_path / "w.csv", index_label="time")
+    lines = (tmp_path / "w.csv").read_text().splitlines()
+    first = next(n for n, line in enumerate(lines, 1) if line.endswith(",foggy"))
+    assert first == 110 + 2  # the header is line 1
+    assert main(["replay", str(tmp_path / "w.csv"), "--site", SITE, "--stream", "--strategy", "hybrid-oracle",
+                 "--out", str(tmp_path / "run")]) == 2
+    assert capsys.readouterr().err == (f"hybridtrack: error: {tmp_path / 'w.csv'}: line {first}, column 'sky': 'foggy' "
+                                       "is no sky label (2 such in the file); the hybrid-oracle policy reads 'sunny', "
+                                       "'cloudy', 'overcast', 'unknown' (a streamed file is read as written)\n")
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_streamed_parquet_files_or_frames_bad_sky_label_or_no_sky_is_refused_before_any_day(tmp_path):
+    frame = _oracle_frame()
+    frame.to_parquet(tmp_path / "w.parquet")
+    written = []
+    with pytest.raises(HybridtrackError, match=r"w\.parquet: row 111, column 'sky': 'foggy' is no sky label \(2 such"):
+        stream(recorded_days(tmp_path / "w.parquet", SITE, chunk_rows=7), tmp_path / "p", strategy="hybrid-oracle",
+               on_segment=written.append)
+    with pytest.raises(HybridtrackError, match=r"the frame's 'sky' column at 2021-06-22 07:00:00\+08:00: 'foggy' is no "
+                                               "sky label"):
+        stream(frame_days(frame, SITE), tmp_path / "f", strategy="hybrid-oracle", on_segment=written.append)
+    frame.drop(columns="sky").to_csv(tmp_path / "nosky.csv", index_label="time")
+    with pytest.raises(HybridtrackError, match=r"nosky\.csv: no column 'sky': the hybrid-oracle policy reads"):
+        stream(recorded_days(tmp_path / "nosky.csv", SITE), tmp_path / "n", strategy="hybrid-oracle",
+               on_segment=written.append)
+    assert written == [] and not any((tmp_path / name).exists() for name in "pfn")
+    good = frame.assign(sky=frame["sky"].replace("foggy", "cloudy"))
+    good.to_csv(tmp_path / "good.csv", index_label="time")
+    recorded_days(tmp_path / "good.csv", SITE).check_true_sky()  # a missing label is no refusal

@@ -321,7 +321,8 @@ def synthetic_span(args: argparse.Namespace):
     with flag_named("--freq"):
         run_step(args.freq)
     with flag_named("--weather"):
-        check_weather(args.weather.split(",") if "," in args.weather else args.weather, args.days)
+        weather = check_weather(args.weather.split(",") if "," in args.weather else args.weather, args.days)
+    args.weather = weather if isinstance(weather, str) else ",".join(weather)  # as read: headings name it so
     return first, first + dt.timedelta(days=args.days - 1)
 
 

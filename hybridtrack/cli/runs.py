@@ -127,6 +127,8 @@ def _stream(source, args, config, *, heading: str) -> int:
     if not args.out:
         raise HybridtrackError("--stream writes its log to disk: give --out FOLDER")
     claim(stream_files(args.out).values())  # a bad --out is refused before the bar
+    if (args.strategy or config.controller.strategy) == "hybrid-oracle":
+        source.check_true_sky()  # and a sky label the oracle cannot read, by its line
     source.check_span()  # and a span without a whole local day
     with leaving_out(args, [Result.files(args.out)["report"]], "--stream"), \
             progress_bar(source, label=config.controller.strategy) as bar:

@@ -8,7 +8,8 @@ mode. The limits and their reasons:
   measured at the Earth's surface: the solar constant is 1361 W/m² (Kopp & Lean 2011,
   doi:10.1029/2010GL045777) and the BSRN "physically possible" limits of Long & Shi (2008,
   doi:10.2174/1874282300802010023) are of this size. Small negative irradiance (down to
-  -50 W/m²) is a thermopile's night offset: clipped to 0.
+  -50 W/m²) is a thermopile's night offset: clipped to 0 (`clip_offsets`). GHI or DHI below 0
+  while the site's sun is well up is no offset (`_negative_under_high_sun`).
 * Wind below -0.5 m/s or above 75 m/s: a cup or sonic anemometer's zero offset gives small
   negative readings in calm air (a few tenths of m/s), which are calm, so clipped to 0; 75 m/s
   is above any recorded surface gust outside tornadoes.
@@ -30,8 +31,8 @@ from ..times import DAY_NS, clock_nanoseconds
 from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
-__all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "check_magnitude",
-           "site_clear_sky", "kilowatts_without_site",
+__all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "clip_offsets",
+           "check_magnitude", "site_clear_sky", "kilowatts_without_site", "dni_kilowatt_day",
            "check_magnitude_by_day", "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
@@ -64,7 +65,8 @@ REPAIRS = {
     "dst_dropped": "a time stamp that does not exist in the time zone",
     "sky_rewritten": "a sky label in capitals or with spaces", "sky_blank": "a blank sky label",
     "unsorted": "time stamps out of order", "duplicates": "a repeated time stamp",
-    "impossible": "a physically impossible value", "negative_clipped": "a negative irradiance",
+    "impossible": "a physically impossible value",
+    "negative_in_sun": "a negative irradiance with the sun well up", "negative_clipped": "a negative irradiance",
     "calm_clipped": "a negative wind reading", "empty_dropped": "an irradiance column without a readable value",
 }
 
@@ -118,7 +120,7 @@ def _gaps(frame: pd.DataFrame, report: dict) -> None:
 
 
 def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
-    clipped, calm, impossible = {}, {}, {}
+    impossible = {}
     for name, (low, high) in LIMITS.items():
         if name not in frame:
             continue
@@ -131,16 +133,71 @@ def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
             impossible[name] = {"count": int(bad.sum()), "lines": first_lines(frame, bad),
                                 "first": float(first) if np.isfinite(first) else str(first), "action": "set to NaN"}
             values = np.where(bad, np.nan, values)
-        negative = ~np.isnan(values) & (values < 0)
-        if negative.any() and name in CLIPPED_AT_ZERO:
+        frame[name] = values
+    if impossible:
+        report["impossible"] = impossible
+
+
+def clip_offsets(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray | None) -> None:
+    """Clip an instrument's zero offset to 0 in place, counted in `report`: irradiance between
+    -50 and 0 W/m² (a thermopile's night offset, ``negative_clipped``) and wind between -0.5 and
+    0 m/s (an anemometer's in calm air, ``calm_clipped``). With the site's clear sky on the
+    frame's stamps (`clear_ghi`, once the sun check has found the light on the site's clock),
+    GHI or DHI below 0 under a high sun is judged first (`_negative_under_high_sun`): no offset.
+    Without it the reader cannot tell night from day, and every such value is clipped."""
+    if clear_ghi is not None:
+        _negative_under_high_sun(path, frame, report, clear_ghi)
+    clipped, calm = {}, {}
+    for name in CLIPPED_AT_ZERO:
+        if name not in frame:
+            continue
+        values = frame[name].to_numpy(float)
+        with np.errstate(invalid="ignore"):
+            negative = values < 0
+        if negative.any():
             entry = {"count": int(negative.sum()), "lines": first_lines(frame, negative),
                      "lowest": float(values[negative].min())}
             (calm if name == "wind_speed" else clipped)[name] = entry
-            values = np.where(negative, 0.0, values)
-        frame[name] = values
-    for key, entry in (("negative_clipped", clipped), ("calm_clipped", calm), ("impossible", impossible)):
+            frame[name] = np.where(negative, 0.0, values)
+    for key, entry in (("negative_clipped", clipped), ("calm_clipped", calm)):
         if entry:
             report[key] = entry
+
+
+def _negative_under_high_sun(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray) -> None:
+    """Set to NaN, counted as ``negative_in_sun``, GHI or DHI below 0 W/m² while the site's clear
+    sky is `SUN_WELL_UP` or more; refuse the file, naming the first such line, when more than half
+    of the column's readings under such a sun are so.
+
+    Under a sun that high the thickest cloud still gives tens of W/m² (`_refuse_too_dark`), and a
+    thermopile's offset is a few W/m²: a working pyranometer reads well above 0. A reading below
+    it is a sensor covered, disconnected or wired with its sign reversed, not the night offset the
+    reader clips; clipped to 0 it had been replayed as a sky without light, and a file of GHI at
+    -5 W/m² in every row was refused as "at most 0 W/m²" or, beside a day of light, called usable.
+    DNI is not judged so: an overcast day's DNI is 0 and its offset below it.
+    """
+    high = np.asarray(clear_ghi) >= SUN_WELL_UP
+    for name in ("ghi", "dhi"):
+        if name not in frame:
+            continue
+        values = frame[name].to_numpy(float)
+        with np.errstate(invalid="ignore"):
+            below = high & (values < 0.0)
+        if not below.any():
+            continue
+        lines, judged = first_lines(frame, below), int((high & np.isfinite(values)).sum())
+        if below.sum() > 0.5 * judged:
+            header = report.get("columns", {}).get(name, name)
+            first = int(np.argmax(below))
+            where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+            raise HybridtrackError(
+                f"{where}: {name} reads {values[first]:g} W/m² with the sun well up (clear sky "
+                f"{clear_ghi[first]:.0f} W/m²), and {below.sum()} of its {judged} readings under such a sun are below "
+                "0: a pyranometer reads below 0 only at night (its offset); is it covered, disconnected, or its sign "
+                "reversed? make its cells empty if it failed")
+        report.setdefault("negative_in_sun", {})[name] = {
+            "count": int(below.sum()), "lines": lines, "lowest": float(values[below].min()), "action": "set to NaN"}
+        frame[name] = np.where(below, np.nan, values)
 
 
 def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.ndarray, bad: np.ndarray) -> None:
@@ -149,9 +206,13 @@ def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.nd
     An irradiance column is judged on its finite daylight values too (above `DARKEST` W/m², or
     beyond the limits): hourly kJ/m² sums (3.6 times W/m²) pass 1500 at every bright hour, but
     the nights' zeros had kept the share under half, so the noons were set to NaN and the rest
-    kept 3.6 times too high. A non-finite cell (``inf``) is damage, not a unit: not judged there.
+    kept 3.6 times too high. A non-finite cell (``inf``, ``1e400``) is damage, not a unit: not
+    judged in any column (set to NaN and counted, as a logger's missing-value marker is; a column
+    of them had been refused as a unit mistake, ``--units temp_air=K`` for an air temperature of
+    ``inf``).
     """
-    judged, what = ~np.isnan(values), "values"
+    judged, what = np.isfinite(values), "values"
+    bad = bad & judged
     if name in IRRADIANCE and bad.sum() <= 0.5 * judged.sum():
         judged, what = np.isfinite(values) & (bad | (values > DARKEST)), "daylight values"
         bad = bad & judged
@@ -172,7 +233,8 @@ def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.nd
 
 
 def check_frame(path: Path, frame: pd.DataFrame, report: dict) -> pd.DataFrame:
-    """`frame` sorted, without repeated stamps, with impossible values flagged and offsets clipped.
+    """`frame` sorted, without repeated stamps, with impossible values flagged (instruments'
+    offsets are clipped later, by `clip_offsets`, once the sun can tell night from day).
 
     Each repair is counted in `report`; gaps and NaN are reported, not changed.
     """
@@ -266,7 +328,7 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
                                    f"{remedy.format(name=name)}")
         if clear_ghi is not None and whole_file:
-            _refuse_too_dark(where, frame, name, top, clear_ghi)
+            _refuse_too_dark(path, header, frame, name, top, clear_ghi)
 
 
 def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *,
@@ -295,6 +357,7 @@ def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nda
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
     _check_hours(path, frame, report, clear_ghi, days)
+    _refuse_dni_in_kw_beside_diffuse(path, frame, report, clear_ghi, days)
 
 
 def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, days: np.ndarray) -> None:
@@ -332,6 +395,52 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
                                        watts & (days == mixed[0]), f"{len(in_kilowatts)} hours of {what}")
 
 
+def dni_kilowatt_day(frame: pd.DataFrame, clear_ghi: np.ndarray, days: np.ndarray) -> tuple[np.ndarray, int] | None:
+    """In a frame of DNI and DHI without GHI, the first day (`days`, a label per row) whose DNI
+    reads `DARKEST` / 1000 to `KILOWATT_TOP` (0.02 to 1.5) in every reading under a high sun (the
+    site's clear sky `clear_ghi` at `SUN_WELL_UP` W/m² or more, the DHI above `DARKEST` W/m²:
+    daylight in the frame too) through `HOURS_WELL_UP` clock hours or more: a beam in kW/m² read
+    as W/m². Returned as those readings (a mask) and their clock hours; None if no day is so.
+
+    Without GHI there is no beam on the horizontal to judge DNI by (`horizontal_beam`), and an
+    overcast day's DNI is legitimately about 0 beside a DHI of 100-300 W/m²: a clear day's DNI in
+    kW/m² (0.9 at noon) beside it had been read as such a day and replayed overcast. What tells
+    them apart is the pyrheliometer's zero: under cloud it reads 0, or its offset either side of 0,
+    so below 0.02 at times; a beam in kW/m² reads 0.02 or more in every reading under so high a sun.
+    """
+    if "ghi" in frame or not {"dni", "dhi"} <= set(frame.columns):
+        return None
+    dni, dhi = frame["dni"].to_numpy(float), frame["dhi"].to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        judged = (np.asarray(clear_ghi) >= SUN_WELL_UP) & (dhi > DARKEST) & np.isfinite(dni)
+        in_band = judged & (dni >= DARKEST / 1000.0) & (dni <= KILOWATT_TOP)
+    if not in_band.any():
+        return None
+    hours = frame.index.as_unit("ns").asi8 // pd.Timedelta(hours=1).value  # the hour each stamp is in
+    table = pd.DataFrame({"day": days, "hour": hours, "in_band": in_band})[judged]
+    by_day = table.groupby("day").agg(all_in=("in_band", "all"), hours=("hour", "nunique"))
+    found = by_day.index[by_day["all_in"] & (by_day["hours"] >= HOURS_WELL_UP)]
+    return (in_band & (days == found[0]), int(by_day.loc[found[0], "hours"])) if len(found) else None
+
+
+def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray,
+                                     days: np.ndarray) -> None:
+    """Refuse, naming its first line, a day `dni_kilowatt_day` finds in a file of DNI and DHI."""
+    found = dni_kilowatt_day(frame, clear_ghi, days)
+    if found is None:
+        return
+    stretch, hours = found
+    dni = frame["dni"].to_numpy(float)
+    lines = first_lines(frame, stretch)
+    header = report.get("columns", {}).get("dni", "dni")
+    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    raise HybridtrackError(
+        f"{where}: dni reads {np.min(dni[stretch]):g} to {np.max(dni[stretch]):g} in every reading of {hours} hours "
+        f"of a high sun (clear sky {SUN_WELL_UP:g} W/m² or more, dhi above {DARKEST:g} W/m²): a beam in kW/m² read "
+        f"as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below {DARKEST / 1000:g} at times): give its "
+        "unit (--units dni=kW/m2), or convert the column to W/m² (×1000)")
+
+
 def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,
                                watts: np.ndarray, hours: str) -> None:
     """`_check_hours`' refusal of a day's `hours` in kW/m² (`stretch`) beside its readings in W/m²."""
@@ -347,9 +456,11 @@ def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, na
         "make them empty if the sensor failed")
 
 
-def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, clear_ghi: np.ndarray) -> None:
+def _refuse_too_dark(path: Path, header: str, frame: pd.DataFrame, name: str, top: float,
+                     clear_ghi: np.ndarray) -> None:
     """Refuse GHI or DHI whose largest value is at most `DARKEST` W/m² through `HOURS_WELL_UP` clock
-    hours of a clear sky of `SUN_WELL_UP` W/m² or more: no sky is so dark.
+    hours of a clear sky of `SUN_WELL_UP` W/m² or more: no sky is so dark. The first line under
+    such a sun is named (the line of the top had been a night's, for a column of one value).
 
     The thickest clouds (optical depth about 100) still pass some 8 % of the light, by the
     two-stream transmittance of a thick scattering cloud, 1 / (1 + 0.75 (1 - g) tau) with g = 0.85:
@@ -358,13 +469,20 @@ def _refuse_too_dark(where: str, frame: pd.DataFrame, name: str, top: float, cle
     of energy (hourly MJ/m², one-minute Wh/m²). It had been read as a day without light, the sun
     check skipped and the file called clean.
     """
-    well_up = frame.index[np.asarray(clear_ghi) >= SUN_WELL_UP].floor("h").nunique()
+    high = np.asarray(clear_ghi) >= SUN_WELL_UP
+    well_up = frame.index[high].floor("h").nunique()
     if well_up < HOURS_WELL_UP or top > DARKEST:
         return
+    values = frame[name].to_numpy(float)
+    lines = first_lines(frame, high & np.isfinite(values))
+    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    with np.errstate(invalid="ignore"):
+        negative = bool((values[high] < 0).any()) and not (values[high] > 0).any()
+    cause = ("below 0 under that sun: no night offset; is the pyranometer covered, disconnected, or its sign reversed?"
+             if negative else "a wrong unit? raw mV, MJ/m² or Wh/m² sums? convert the column to W/m²")
     raise HybridtrackError(f"{where}: {name} is at most {top:g} W/m² through {well_up} hours in which the clear sky "
                            f"is above {SUN_WELL_UP:g} W/m²; no sky is that dark with the sun so high (the thickest "
-                           "cloud still gives tens of W/m²): a wrong unit? raw mV, MJ/m² or Wh/m² sums? convert the "
-                           "column to W/m²")
+                           f"cloud still gives tens of W/m²): {cause}")
 
 
 #: W/m² of direct light on the horizontal (GHI - DHI) that only a direct beam of as much again or

@@ -11,6 +11,7 @@ from __future__ import annotations
 import gzip
 import io
 import zipfile
+import zlib
 from pathlib import Path
 
 from .. import params
@@ -101,12 +102,26 @@ def _read_up_to(stream, limit: int) -> bytes | None:
     return None
 
 
+def _unpacked(path: Path, stream) -> bytes:
+    """All of a packed file's `stream`, refused past the memory budget (a file of zeros packs a
+    thousand to one: a few MB had unpacked without a bound)."""
+    from ..budget import memory_budget
+
+    limit = memory_budget()
+    content = stream.read(limit + 1)
+    if len(content) > limit:
+        raise HybridtrackError(f"{path}: unpacks to more than {limit / 2**20:,.0f} MiB, more than a file can be")
+    return content
+
+
 def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
-    """The content of a gzip or zip file (by its magic bytes), and how it was packed."""
+    """The content of a gzip or zip file (by its magic bytes), and how it was packed. A damaged
+    one (zlib's own error among them, which had ended in a traceback) is refused in one line."""
     if raw[:2] == b"\x1f\x8b":
         try:
-            return gzip.decompress(raw), "gzip"
-        except (OSError, EOFError, gzip.BadGzipFile) as exc:
+            with gzip.GzipFile(fileobj=io.BytesIO(raw)) as stream:
+                return _unpacked(path, stream), "gzip"
+        except (OSError, EOFError, gzip.BadGzipFile, zlib.error) as exc:
             raise HybridtrackError(f"{path}: a damaged gzip file ({exc})") from None
     if raw[:4] == b"PK\x03\x04":
         try:
@@ -119,8 +134,9 @@ def unpack(path: Path, raw: bytes) -> tuple[bytes, str | None]:
                 if len(members) != 1:
                     names = ", ".join(m.filename for m in members) or "nothing"
                     raise HybridtrackError(f"{path}: a zip archive must hold exactly one file; it holds {names}")
-                return archive.read(members[0]), f"zip member {members[0].filename}"
-        except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, NotImplementedError) as exc:
+                with archive.open(members[0]) as stream:
+                    return _unpacked(path, stream), f"zip member {members[0].filename}"
+        except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, NotImplementedError, zlib.error) as exc:
             raise HybridtrackError(f"{path}: a damaged or unsupported zip file ({exc})") from None
     return raw, None
 

@@ -17,7 +17,7 @@ from .resample import native_step
 __all__ = ["validation_report", "ISSUES"]
 
 #: Report keys that make the verdict "usable, with issues" rather than "clean".
-ISSUES = ("unreadable", "missing_markers", "truncated", "short_rows", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_clipped", "calm_clipped",
+ISSUES = ("unreadable", "missing_markers", "truncated", "short_rows", "dst_dropped", "unsorted", "duplicates", "gaps", "nan", "negative_in_sun", "negative_clipped", "calm_clipped",
           "impossible", "light_at_night", "wind_missing", "empty_dropped", "sky_unknown")
 
 _FINDINGS = {"gaps": "gaps (kept as gaps)", "nan": "NaN kept", "dst_repeated": "DST: repeated hour",
@@ -33,6 +33,7 @@ _CHANGES = {
     "dst_dropped": "dropped (DST: stamps that do not exist, or repeated ones their order could not place)",
     "unsorted": "sorted (stamps out of order)",
     "duplicates": "dropped (repeated stamps, the first kept)", "impossible": "set to NaN (physically impossible)",
+    "negative_in_sun": "set to NaN (negative irradiance with the sun well up: no night offset)",
     "negative_clipped": "clipped to 0 (negative irradiance)", "calm_clipped": "clipped to 0 (anemometer zero offset)",
     "empty_dropped": "dropped (irradiance column without a readable value)", "filled": "filled",
     "nights_filled": "put back (the nights the logger left out, --fill-nights)",

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import HybridtrackError
-from .checks import (check_frame, check_magnitude, check_magnitude_by_day, first_lines, refuse_repairs,
+from .checks import (check_frame, check_magnitude, check_magnitude_by_day, clip_offsets, first_lines, refuse_repairs,
                      site_clear_sky, span)
 from .closure import closure_check
 from .columns import (IRRADIANCE, LABEL_COLUMN, LONGEST_NAME, STAMP_PARTS, WEATHER_COLUMNS, check_names, label_header,
@@ -417,6 +417,16 @@ def _wind(frame: pd.DataFrame, attrs: dict, report: dict) -> pd.DataFrame:
     return frame
 
 
+def _clip_offsets(path: Path, frame: pd.DataFrame, report: dict, clear: np.ndarray | None, strict: bool) -> None:
+    """`checks.clip_offsets` after the sun check, on the site's clear sky `clear` unless the sun
+    check found the light off the site's clock (a warning, with ``lenient``): the sun's height at a
+    stamp then says nothing of the light there. In `strict` mode a clipped offset is refused."""
+    trusted = clear is not None and not str(report.get("sun_check", "")).startswith("WARNING")
+    clip_offsets(path, frame, report, clear if trusted else None)
+    if strict:
+        refuse_repairs(path, report)
+
+
 def _check_switches(*, dayfirst, **switches) -> None:
     """Refuse a switch of `read_weather` that is not True or False (`dayfirst` may be None): ``strict="no"``
     had been read as True, ``lenient="no"`` and ``dayfirst="no"`` taken as they came."""
@@ -518,9 +528,11 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
         check_magnitude(path, frame, report, clear)
         check_magnitude_by_day(path, frame, report, clear, site.tz)
         sun_check(path, frame, site, report, lenient=lenient)
-        closure_check(path, frame, zenith.to_numpy(float), report, strict=strict)
     else:
         check_magnitude(path, frame, report, None)
+    _clip_offsets(path, frame, report, clear, strict)
+    if site is not None:
+        closure_check(path, frame, zenith.to_numpy(float), report, strict=strict)
     attrs: dict = {}
     frame = fill_components(path, frame, site, decomposition, attrs, report)
     if strict and freq is None:
