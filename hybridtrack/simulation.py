@@ -393,7 +393,7 @@ def _check_frame(frame: pd.DataFrame) -> pd.DataFrame:
     repeated = frame.columns[frame.columns.duplicated()]
     if len(repeated):  # which of the two would be the weather?
         raise HybridtrackError(f"the weather frame has the column {repeated[0]!r} more than once; keep one")
-    for column in ("dni", "dhi", "ghi", "wind_speed", "photocurrent", *RECORDED_POINTING):
+    for column in ("dni", "dhi", "ghi", "wind_speed", "temp_air", "photocurrent", *RECORDED_POINTING):
         if column in frame.columns:
             _physical_column(frame, column)
     first, last = frame.index[0], frame.index[-1]
@@ -456,6 +456,24 @@ def _refuse_kilowatts(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarra
             raise HybridtrackError(f"the weather frame on {day}: column {name!r}: {name} is at most {top[name]:g} while "
                                    f"{why}; the values look like kW/m², where W/m² belong: multiply the frame's "
                                    f"{name} by 1000")
+    _refuse_dni_kilowatts_beside_diffuse(frame, clear, 90.0 - altitude, days)
+
+
+def _refuse_dni_kilowatts_beside_diffuse(frame: pd.DataFrame, clear: np.ndarray, zenith: np.ndarray,
+                                         days: pd.DatetimeIndex) -> None:
+    """Refuse a frame of DNI and DHI without GHI whose DNI reads as kW/m² through hours of high sun,
+    as a file's reader does (`hybridtrack.io.checks.dni_kilowatt_day`): it had been replayed as an
+    overcast day."""
+    from .io.checks import dni_kilowatt_day
+
+    found = dni_kilowatt_day(frame, clear, zenith, days.asi8)
+    if found is not None:
+        readings, hours = found
+        first = int(np.flatnonzero(readings)[0])
+        raise HybridtrackError(f"the weather frame on {frame.index[first].tz_convert(days.tz).date()}: column 'dni': "
+                               f"dni reads {frame['dni'].iloc[first]:g} at {frame.index[first]} and stays within "
+                               f"kW/m²'s range through {hours} hours of high sun beside a DHI of daylight; the values "
+                               "look like kW/m², where W/m² belong: multiply the frame's dni by 1000")
 
 
 def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:
@@ -499,6 +517,8 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
         raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
     if column in RECORDED_POINTING:
         _pointing_column(frame, column)
+    if column == "temp_air":
+        _air_temperature(frame)
     if column not in NOT_LIGHT:
         return
     array = values.to_numpy(float, na_value=np.nan)
@@ -511,6 +531,24 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
         raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {value:g} "
                                f"{_UNITS[column]} is {why}; read files with hybridtrack.io.read_weather, which flags "
                                "and counts such values")
+
+
+def _air_temperature(frame: pd.DataFrame) -> None:
+    """Refuse an air temperature no air has (`hybridtrack.io.checks.LIMITS`, -90 to 65 °C, the
+    records on earth either side), or none (infinite), naming the first such row. No run reads it
+    yet, but a frame's kelvins or a logger's -9999 beside its light says the frame was made wrong,
+    and its inf and text had run without a word; a file's reader counts such cells instead."""
+    from .io.checks import LIMITS
+
+    low, high = LIMITS["temp_air"]
+    array = frame["temp_air"].to_numpy(float, na_value=np.nan)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(np.isinf(array) | (array < low) | (array > high))
+    if len(bad):
+        value = array[bad[0]]
+        why = "no reading (infinite)" if np.isinf(value) else f"no air's (outside [{low:g}, {high:g}] °C: kelvins?)"
+        raise HybridtrackError(f"the weather frame's column 'temp_air' at {frame.index[bad[0]]}: {value:g} °C is {why}; "
+                               "read files with hybridtrack.io.read_weather, which flags and counts such values")
 
 
 #: Degrees: the largest offset a recorded pointing signal can give, the sun at the horizon of a

@@ -717,3 +717,30 @@ def test_a_drive_slower_than_the_sun_is_refused_with_the_suns_rate(name):
     with pytest.raises(HybridtrackError, match=rf"drive: {name} \(degrees per minute; the sun turns 0.25.*= 0.2 is "
                                                r"outside \[0.25, 360\]"):
         Drive(**{name: 0.2})
+
+
+def test_dni_in_kilowatts_beside_diffuse_light_is_refused_but_a_thin_overcast_runs():
+    """A frame of DNI and DHI without GHI had no beam to judge DNI by: a sunny day's DNI in kW/m²
+    ran as overcast. An overcast day whose DNI lets 1.07-1.35 W/m² through all day (the package's
+    own Nanjing sky, seed 3) reads in kW/m²'s band too, but as kW/m² it would make, with its DHI,
+    1.35-1.7 times the clear sky's GHI: no sky's, so it runs."""
+    sunny = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    in_kilowatts = sunny[["dni", "dhi", "wind_speed"]].assign(dni=sunny["dni"] / 1000.0)
+    with pytest.raises(HybridtrackError, match="on 2021-06-21: column 'dni': .* look like kW/m²"):
+        simulate(in_kilowatts, "lanzhou")
+    overcast = synthetic("nanjing", "2013-06-21", weather="overcast", freq="10min", seed=3)
+    assert 1.0 < overcast["dni"].max() <= 1.5
+    assert simulate(overcast[["dni", "dhi", "wind_speed"]], "nanjing").summary["steps"] == 144
+
+
+@pytest.mark.parametrize("value, said", [(np.inf, "no reading .infinite."), (300.0, "no air's .* kelvins"),
+                                         (-100.0, "no air's")])
+def test_an_air_temperature_no_air_has_is_refused_from_a_frame(value, said):
+    """No run reads temp_air, but kelvins, a logger's marker or inf beside the light say the frame
+    was made wrong; text and inf had run without a word. 25 °C runs."""
+    day = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=1)
+    with pytest.raises(HybridtrackError, match=f"column 'temp_air' at 2021-06-21 00:00:00\\+08:00: .* °C is {said}"):
+        simulate(day.assign(temp_air=value), "lanzhou")
+    with pytest.raises(HybridtrackError, match="'temp_air' must hold numbers"):
+        simulate(day.assign(temp_air="warm"), "lanzhou")
+    assert simulate(day.assign(temp_air=25.0), "lanzhou").summary["steps"] == 144
