@@ -84,6 +84,22 @@ class Sweep:
     y: str = "rms"
     source: str = "sweep"
 
+    def __post_init__(self) -> None:
+        """A sweep built directly is checked as a file's is (`from_dict`), and its values made what
+        its file holds: built so, a numpy seed had ended in a TypeError writing ``sweep.toml``, a
+        misspelt key had run (every row failed), and x = y had been written and then refused."""
+        if not isinstance(self.source, str):
+            raise HybridtrackError(f"sweep: source must be text, got {self.source!r:.60}")
+        for name in ("base", "grid"):
+            _table_of_text_keys(getattr(self, name), self.source, f"[{name}]")
+        for axis in ("x", "y"):
+            if not isinstance(getattr(self, axis), str):
+                raise HybridtrackError(f"{self.source}: plot.{axis}: must be a metric's name, "
+                                       f"got {getattr(self, axis)!r:.60}")
+        base, grid, x, y = _checked(self.to_dict(), self.source)
+        for name, value in (("base", base), ("grid", grid), ("x", x), ("y", y)):
+            object.__setattr__(self, name, value)
+
     @classmethod
     def from_toml(cls, path) -> Sweep:
         from .io import read_toml
@@ -92,48 +108,8 @@ class Sweep:
 
     @classmethod
     def from_dict(cls, data: dict, *, source: str = "sweep") -> Sweep:
-        _table_of_text_keys(data, source, "the sweep")
-        unknown = [key for key in data if key not in ("base", "grid", "plot")]
-        if unknown:
-            raise HybridtrackError(f"{source}: {unknown[0]}: unknown table; a sweep has [base], [grid] and [plot]")
-        base = dict(_table_of_text_keys(data.get("base", {}), source, "[base]"))
-        config = _table_of_text_keys(base.pop("config", {}), source, "[base.config]")
-        base = {k: _written(v, f"base.{k}", source) for k, v in _dotted(base, source, "base").items()}
-        config = _written(config, "base.config", source)
-        grid = {k: _written(v, f"grid.{k}", source)
-                for k, v in _dotted(_table_of_text_keys(data.get("grid", {}), source, "[grid]"), source, "grid").items()}
-        plot = _table_of_text_keys(data.get("plot", {}), source, "[plot]")
-        for key in base:
-            _check_key(key, source, "base")
-        _refuse_given_twice(base, config, source)
-        _check_base(base, config, grid, source)
-        if not grid:
-            said = "is empty" if "grid" in data else "is missing"
-            raise HybridtrackError(f"{source}: [grid] {said}; give at least one key with a list of values")
-        for key, values in grid.items():
-            _check_key(key, source, "grid")
-            if not isinstance(values, list) or not values:
-                raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
-            _refuse_repeats(key, values, source)
-        if "weather" in grid:  # after the repeats are judged, by the names as given
-            grid["weather"] = [_canonical_weather(value) for value in grid["weather"]]
-        if "weather" in base:
-            base["weather"] = _canonical_weather(base["weather"])
-        count = int(np.prod([len(v) for v in grid.values()], dtype=float))
-        if count > MAX_RUNS:
-            raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
-        for axis in ("x", "y"):
-            if axis in plot and plot[axis] not in METRICS:
-                raise HybridtrackError(f"{source}: plot.{axis}: {plot[axis]!r} is not a metric; "
-                                       f"choose from {', '.join(METRICS)}")
-        unknown = sorted(set(plot) - {"x", "y"})
-        if unknown:
-            raise HybridtrackError(f"{source}: plot.{unknown[0]}: unknown key; known: x, y")
-        x, y = plot.get("x", "moves"), plot.get("y", "rms")
-        if x == y:  # one metric against itself: a diagonal, its "front" one point
-            unsaid = "".join(f" ({axis} by default)" for axis in ("x", "y") if axis not in plot)
-            raise HybridtrackError(f"{source}: plot.x and plot.y are both {x!r}{unsaid}; a trade-off needs two metrics")
-        return cls({**base, "config": config}, dict(grid), x, y, source)
+        """A sweep from its TOML layout (``base``, ``grid``, ``plot`` tables), checked."""
+        return cls(*_checked(data, source), source)
 
     def to_dict(self) -> dict:
         """The sweep in its TOML layout; `from_dict` reads it back equal."""
@@ -153,6 +129,53 @@ class Sweep:
         keys = list(self.grid)
         return [{"run": i, **dict(zip(keys, values))}
                 for i, values in enumerate(itertools.product(*(self.grid[k] for k in keys)))]
+
+
+def _checked(data: dict, source: str) -> tuple[dict, dict, str, str]:
+    """A sweep in its TOML layout (`Sweep.to_dict`), checked: its base (with its ``config``), its
+    grid and its plot's axes, each value as its file holds it (`_written`)."""
+    _table_of_text_keys(data, source, "the sweep")
+    unknown = [key for key in data if key not in ("base", "grid", "plot")]
+    if unknown:
+        raise HybridtrackError(f"{source}: {unknown[0]}: unknown table; a sweep has [base], [grid] and [plot]")
+    base = dict(_table_of_text_keys(data.get("base", {}), source, "[base]"))
+    config = _table_of_text_keys(base.pop("config", {}), source, "[base.config]")
+    base = {k: _written(v, f"base.{k}", source) for k, v in _dotted(base, source, "base").items()}
+    config = _written(config, "base.config", source)
+    grid = {k: _written(v, f"grid.{k}", source)
+            for k, v in _dotted(_table_of_text_keys(data.get("grid", {}), source, "[grid]"), source, "grid").items()}
+    plot = _table_of_text_keys(data.get("plot", {}), source, "[plot]")
+    for key in base:
+        _check_key(key, source, "base")
+    _refuse_given_twice(base, config, source)
+    _check_base(base, config, grid, source)
+    if not grid:
+        said = "is empty" if "grid" in data else "is missing"
+        raise HybridtrackError(f"{source}: [grid] {said}; give at least one key with a list of values")
+    for key, values in grid.items():
+        _check_key(key, source, "grid")
+        if not isinstance(values, list) or not values:
+            raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
+        _refuse_repeats(key, values, source)
+    if "weather" in grid:  # after the repeats are judged, by the names as given
+        grid["weather"] = [_canonical_weather(value) for value in grid["weather"]]
+    if "weather" in base:
+        base["weather"] = _canonical_weather(base["weather"])
+    count = int(np.prod([len(v) for v in grid.values()], dtype=float))
+    if count > MAX_RUNS:
+        raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
+    for axis in ("x", "y"):
+        if axis in plot and plot[axis] not in METRICS:
+            raise HybridtrackError(f"{source}: plot.{axis}: {plot[axis]!r} is not a metric; "
+                                   f"choose from {', '.join(METRICS)}")
+    unknown = sorted(set(plot) - {"x", "y"})
+    if unknown:
+        raise HybridtrackError(f"{source}: plot.{unknown[0]}: unknown key; known: x, y")
+    x, y = plot.get("x", "moves"), plot.get("y", "rms")
+    if x == y:  # one metric against itself: a diagonal, its "front" one point
+        unsaid = "".join(f" ({axis} by default)" for axis in ("x", "y") if axis not in plot)
+        raise HybridtrackError(f"{source}: plot.x and plot.y are both {x!r}{unsaid}; a trade-off needs two metrics")
+    return {**base, "config": config}, dict(grid), x, y
 
 
 def _table_of_text_keys(table, source: str, name: str) -> dict:

@@ -982,3 +982,17 @@ def test_a_key_set_by_the_base_and_the_grid_is_refused(data, where):
     with pytest.raises(HybridtrackError, match=rf"s\.toml: {where} and grid\.{key} both set {key}, and every run takes "
                                                r"the grid's value; give it once \(in \[grid\] to vary it\)"):
         Sweep.from_dict(data, source="s.toml")
+
+
+def test_a_sweep_built_directly_is_checked_as_its_file_would_be(tmp_path):
+    """Sweep(...) had skipped from_dict's checks: a numpy seed ended in a TypeError writing
+    sweep.toml, a misspelt key ran every row to a failure, x = y was written and then refused."""
+    built = Sweep(base={"site": "lanzhou"}, grid={"seed": [np.int64(0), np.int64(1)]})
+    assert built.grid == {"seed": [0, 1]} and type(built.grid["seed"][0]) is int
+    assert Sweep.from_toml(built.to_toml(tmp_path / "s.toml")).grid == built.grid
+    with pytest.raises(HybridtrackError, match="grid.drive.deadbnd: unknown key; did you mean drive.deadband"):
+        Sweep(base={}, grid={"drive.deadbnd": [0.1]})
+    with pytest.raises(HybridtrackError, match="plot.x and plot.y are both 'rms'"):
+        Sweep(base={}, grid={"seed": [1]}, x="rms", y="rms")
+    with pytest.raises(HybridtrackError, match=r"\[base\] must be a table, got None"):
+        Sweep(base=None, grid={"seed": [1]})
