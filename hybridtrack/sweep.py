@@ -157,10 +157,11 @@ def _checked(data: dict, source: str) -> tuple[dict, dict, str, str]:
         if not isinstance(values, list) or not values:
             raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
         _refuse_repeats(key, values, source)
-    if "weather" in grid:  # after the repeats are judged, by the names as given
-        grid["weather"] = [_canonical_weather(value) for value in grid["weather"]]
-    if "weather" in base:
-        base["weather"] = _canonical_weather(base["weather"])
+    for key, canonical in (("weather", _canonical_weather), ("site", _canonical_site)):
+        if key in grid:  # after the repeats are judged, by the names as given
+            grid[key] = [canonical(value) for value in grid[key]]
+        if key in base:
+            base[key] = canonical(base[key])
     count = int(np.prod([len(v) for v in grid.values()], dtype=float))
     if count > MAX_RUNS:
         raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
@@ -424,6 +425,18 @@ def _canonical_weather(value):
     except HybridtrackError:
         return value
     return names if isinstance(value, list) else ",".join(names)
+
+
+def _canonical_site(value):
+    """A base or grid value of ``site`` by the name the runs give it (``Lanzhou`` is ``lanzhou``),
+    so that the table and its plot name one site one way, as the ablation's table does; a value
+    the runs refuse is kept as written, for them to refuse by its name."""
+    from . import sites
+
+    try:
+        return sites.get(value).name if isinstance(value, str) else value
+    except HybridtrackError:
+        return value
 
 
 def _step(freq) -> str:

@@ -996,3 +996,10 @@ def test_a_sweep_built_directly_is_checked_as_its_file_would_be(tmp_path):
         Sweep(base={}, grid={"seed": [1]}, x="rms", y="rms")
     with pytest.raises(HybridtrackError, match=r"\[base\] must be a table, got None"):
         Sweep(base=None, grid={"seed": [1]})
+
+
+def test_a_sweeps_sites_are_named_as_the_runs_name_them():
+    """'Lanzhou' had been kept as written in the table, beside the ablation's 'lanzhou'; a name no
+    site has is kept, for its runs to refuse by it."""
+    assert Sweep(base={"site": "NANJING"}, grid={"seed": [1]}).base["site"] == "nanjing"
+    assert Sweep(base={}, grid={"site": ["Lanzhou", "atlantis"]}).grid["site"] == ["lanzhou", "atlantis"]
