@@ -163,7 +163,8 @@ def test_a_streamed_file_of_dni_in_kilowatts_beside_dhi_is_refused_before_its_fi
         pd.date_range("2021-06-21 00:00", "2021-06-22 23:50", freq="10min", tz=SITE.tz))
     frame = pd.DataFrame({"dni": sky["dni"] / 1000, "dhi": (sky["dhi"] + 0.1 * sky["ghi"]).clip(upper=300.0)})
     days = []
-    with pytest.raises(HybridtrackError, match=r"st\.csv: line \d+, column 'dni': dni reads .* a beam in kW/m²"):
+    with pytest.raises(HybridtrackError, match=r"st\.csv: line \d+, column 'dni': dni reads .* a beam in kW/m².*"
+                                               r"convert the file once with hybridtrack check FILE --units dni=kW/m2"):
         for day, _ in recorded_days(write(tmp_path / "st.csv", frame), SITE):
             days.append(day)
     assert days == []

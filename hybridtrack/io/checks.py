@@ -365,7 +365,7 @@ def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nda
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
     _check_hours(path, frame, report, clear_ghi, days)
-    _refuse_dni_in_kw_beside_diffuse(path, frame, report, clear_ghi, zenith, days)
+    _refuse_dni_in_kw_beside_diffuse(path, frame, report, clear_ghi, zenith, days, streamed=part)
 
 
 def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, days: np.ndarray) -> None:
@@ -440,8 +440,9 @@ def dni_kilowatt_day(frame: pd.DataFrame, clear_ghi: np.ndarray, zenith,
 
 
 def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, zenith,
-                                     days: np.ndarray) -> None:
-    """Refuse, naming its first line, a day `dni_kilowatt_day` finds in a file of DNI and DHI."""
+                                     days: np.ndarray, *, streamed: bool = False) -> None:
+    """Refuse, naming its first line, a day `dni_kilowatt_day` finds in a file of DNI and DHI; a
+    `streamed` file (which takes no ``--units``) is told to convert the file once."""
     found = dni_kilowatt_day(frame, clear_ghi, zenith, days)
     if found is None:
         return
@@ -453,8 +454,9 @@ def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: di
     raise HybridtrackError(
         f"{where}: dni reads {np.min(dni[stretch]):g} to {np.max(dni[stretch]):g} in every reading of {hours} hours "
         f"of a high sun (clear sky {SUN_WELL_UP:g} W/m² or more, dhi above {DARKEST:g} W/m²): a beam in kW/m² read "
-        f"as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below {DARKEST / 1000:g} at times): give its "
-        "unit (--units dni=kW/m2), or convert the column to W/m² (×1000)")
+        f"as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below {DARKEST / 1000:g} at times): "
+        + ("convert the file once with hybridtrack check FILE --units dni=kW/m2 --out clean.parquet" if streamed else
+           "give its unit (--units dni=kW/m2), or convert the column to W/m² (×1000)"))
 
 
 def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,
