@@ -9,21 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-import pvlib
 import pytest
 
-from hybridtrack import HybridtrackError, sites
+from hybridtrack import HybridtrackError
 from hybridtrack.cli import main
 from hybridtrack.io import read_weather, validation_report
-
-SITE = sites.get("lanzhou")
-
-
-def clear_sky(start: str, end: str, freq: str) -> pd.DataFrame:
-    """pvlib's Ineichen clear sky at Lanzhou on naive local stamps."""
-    index = pd.date_range(start, end, freq=freq, tz=SITE.tz)
-    location = pvlib.location.Location(SITE.latitude, SITE.longitude, altitude=SITE.altitude)
-    return location.get_clearsky(index, model="ineichen").set_axis(index.tz_localize(None))
+from test_records_magnitude import SITE, clear_sky, refused
 
 
 def write(path, frame: pd.DataFrame):
@@ -34,17 +25,6 @@ def write(path, frame: pd.DataFrame):
 def line_of(frame: pd.DataFrame, stamp: str) -> int:
     """The file line of `stamp`'s row: the header is line 1."""
     return int(frame.index.get_loc(pd.Timestamp(stamp))) + 2
-
-
-def refused(path, capsys, *parts) -> str:
-    """The message of `read_weather` with the site, which `hybridtrack check` prints alike."""
-    with pytest.raises(HybridtrackError) as error:
-        read_weather(path, site="lanzhou")
-    message = str(error.value)
-    assert "\n" not in message and all(part in message for part in parts), message
-    assert main(["check", str(path), "--site", "lanzhou"]) == 2
-    assert capsys.readouterr().err == f"hybridtrack: error: {message}\n"
-    return message
 
 
 # -- negative GHI under a high sun ----------------------------------------------------------------
