@@ -456,24 +456,6 @@ def _refuse_kilowatts(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarra
             raise HybridtrackError(f"the weather frame on {day}: column {name!r}: {name} is at most {top[name]:g} while "
                                    f"{why}; the values look like kW/m², where W/m² belong: multiply the frame's "
                                    f"{name} by 1000")
-    _refuse_dni_kilowatts_beside_diffuse(frame, clear, 90.0 - altitude, days)
-
-
-def _refuse_dni_kilowatts_beside_diffuse(frame: pd.DataFrame, clear: np.ndarray, zenith: np.ndarray,
-                                         days: pd.DatetimeIndex) -> None:
-    """Refuse a frame of DNI and DHI without GHI whose DNI reads as kW/m² through hours of high sun,
-    as a file's reader does (`hybridtrack.io.checks.dni_kilowatt_day`): it had been replayed as an
-    overcast day."""
-    from .io.checks import dni_kilowatt_day
-
-    found = dni_kilowatt_day(frame, clear, zenith, days.asi8)
-    if found is not None:
-        readings, hours = found
-        first = int(np.flatnonzero(readings)[0])
-        raise HybridtrackError(f"the weather frame on {frame.index[first].tz_convert(days.tz).date()}: column 'dni': "
-                               f"dni reads {frame['dni'].iloc[first]:g} at {frame.index[first]} and stays within "
-                               f"kW/m²'s range through {hours} hours of high sun beside a DHI of daylight; the values "
-                               "look like kW/m², where W/m² belong: multiply the frame's dni by 1000")
 
 
 def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.ndarray) -> None:

@@ -726,8 +726,7 @@ def _days_checked(path: Path, lines: pd.DataFrame, site: sites.Site, last: bool)
     whole = np.ones(len(lines), bool) if last else days < days[-1]
     if whole.any():
         judged = lines[whole]
-        zenith, clear = site_clear_sky(judged.index, site)
-        check_magnitude_by_day(path, judged, {}, clear, site.tz, zenith=zenith.to_numpy(float),
+        check_magnitude_by_day(path, judged, {}, site_clear_sky(judged.index, site)[1], site.tz,
                                part=True)  # the file's span passed whole: a day in kW/m² is among days in W/m²
     return lines[~whole]
 

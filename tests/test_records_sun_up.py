@@ -1,5 +1,5 @@
 """What the reader makes of light the site's sun says cannot be: negative GHI under a high sun,
-DNI in kW/m² beside DHI without GHI, and an air temperature that is no reading.
+an overcast day's DNI beside DHI without GHI, and an air temperature that is no reading.
 
 The references are pvlib's Ineichen clear sky at Lanzhou on naive local stamps (written to the
 file as the site's clock), independent of the reader's own clear sky (Haurwitz on the PLC sun).
@@ -93,32 +93,7 @@ def test_negative_night_offsets_and_a_file_without_a_site_are_clipped_as_before(
     assert report["negative_clipped"]["ghi"]["count"] == nights and "negative_in_sun" not in report
 
 
-# -- DNI in kW/m² beside DHI, without GHI ---------------------------------------------------------
-
-
-def test_dni_in_kilowatts_beside_dhi_without_ghi_is_refused_by_its_line(tmp_path, capsys):
-    """A clear day's DNI in kW/m² (0.9 at noon) beside a hazy day's DHI (up to 200 W/m²) had been
-    read as an overcast day's: GHI derived as DHI, the day replayed overcast, the file called
-    usable. (As kW/m² it makes, with its DHI, 1.17-1.20 times Haurwitz's clear sky: a sky's.)"""
-    sky = clear_sky("2021-06-21 00:00", "2021-06-21 23:59", "1min")
-    frame = pd.DataFrame({"DNI": sky["dni"] / 1000, "DHI": (sky["dhi"] + 0.1 * sky["ghi"]).clip(upper=300.0)})
-    assert 0.85 < frame["DNI"].max() < 1.1 and 150.0 < frame["DHI"].max() <= 300.0
-    path = write(tmp_path / "kw.csv", frame)
-    message = refused(path, capsys, "column 'DNI': dni reads", "in every reading of",
-                      "a beam in kW/m² read as W/m²", "--units dni=kW/m2")
-    row = int(message.split(": line ")[1].split(",")[0]) - 2
-    assert 0.02 <= frame["DNI"].iloc[row] <= 1.5 and sky["ghi"].iloc[row] > 550.0  # a high sun's kW/m² beam
-    read = read_weather(path, site="lanzhou", units={"dni": "kW/m2"})
-    assert read["dni"].max() == pytest.approx(1000 * frame["DNI"].max(), rel=1e-3)
-
-
-def test_a_clear_beam_with_more_light_than_a_clear_sky_is_not_called_kilowatts(tmp_path):
-    """DNI of 0.9 beside a DHI of 500 W/m² would, in kW/m², make 1.49-1.53 times Haurwitz's clear
-    sky all day (Ineichen's own is 1.06-1.09 of it here): no sky's, so the readings are not called
-    kW/m²; an overcast sky that lets 1-1.4 W/m² through all day reads so (the package's own)."""
-    sky = clear_sky("2021-06-21 00:00", "2021-06-21 23:59", "1min")
-    frame = pd.DataFrame({"DNI": sky["dni"] / 1000, "DHI": (sky["dhi"] + 0.4 * sky["ghi"]).clip(upper=500.0)})
-    assert read_weather(write(tmp_path / "bright.csv", frame), site="lanzhou")["dni"].max() < 1.1
+# -- DNI beside DHI, without GHI -------------------------------------------------------------------
 
 
 @pytest.mark.parametrize("dni", ["zero", "offset noise"])
@@ -133,23 +108,6 @@ def test_an_overcast_days_dni_of_about_zero_beside_dhi_is_read(tmp_path, dni):
     assert read["dni"].max() == (0.0 if dni == "zero" else 1.4)
     assert read["ghi"].max() == pytest.approx(300.0, abs=1.5)  # GHI = DHI + DNI cos z: the DHI's own top
 
-
-
-def test_a_streamed_file_of_dni_in_kilowatts_beside_dhi_is_refused_before_its_first_day(tmp_path):
-    """The streamed day checks judge a day as the reader does: refused before any day is handed on."""
-    from hybridtrack.streaming import recorded_days
-
-    sky = clear_sky("2021-06-21 00:00", "2021-06-22 23:50", "10min").set_axis(
-        pd.date_range("2021-06-21 00:00", "2021-06-22 23:50", freq="10min", tz=SITE.tz))
-    frame = pd.DataFrame({"dni": sky["dni"] / 1000, "dhi": (sky["dhi"] + 0.1 * sky["ghi"]).clip(upper=300.0)})
-    days = []
-    with pytest.raises(HybridtrackError, match=r"st\.csv: line \d+, column 'dni': dni reads .* a beam in kW/m².*"
-                                               r"convert the file once with hybridtrack check FILE --units dni=kW/m2"):
-        for day, _ in recorded_days(write(tmp_path / "st.csv", frame), SITE):
-            days.append(day)
-    assert days == []
-    overcast = recorded_days(write(tmp_path / "ov.csv", frame.assign(dni=0.0)), SITE)
-    assert [len(day) for _, day in overcast] == [144, 144]
 
 # -- an air temperature that is no reading --------------------------------------------------------
 

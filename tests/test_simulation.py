@@ -719,18 +719,14 @@ def test_a_drive_slower_than_the_sun_is_refused_with_the_suns_rate(name):
         Drive(**{name: 0.2})
 
 
-def test_dni_in_kilowatts_beside_diffuse_light_is_refused_but_a_thin_overcast_runs():
-    """A frame of DNI and DHI without GHI had no beam to judge DNI by: a sunny day's DNI in kW/m²
-    ran as overcast. An overcast day whose DNI lets 1.07-1.35 W/m² through all day (the package's
-    own Nanjing sky, seed 3) reads in kW/m²'s band too, but as kW/m² it would make, with its DHI,
-    1.35-1.7 times the clear sky's GHI: no sky's, so it runs."""
-    sunny = synthetic("lanzhou", "2021-06-21", weather="sunny", freq="10min", seed=1)
-    in_kilowatts = sunny[["dni", "dhi", "wind_speed"]].assign(dni=sunny["dni"] / 1000.0)
-    with pytest.raises(HybridtrackError, match="on 2021-06-21: column 'dni': .* look like kW/m²"):
-        simulate(in_kilowatts, "lanzhou")
-    overcast = synthetic("nanjing", "2013-06-21", weather="overcast", freq="10min", seed=3)
-    assert 1.0 < overcast["dni"].max() <= 1.5
-    assert simulate(overcast[["dni", "dhi", "wind_speed"]], "nanjing").summary["steps"] == 144
+def test_the_packages_own_overcast_days_run_beside_their_diffuse_light_without_ghi():
+    """An overcast sky that lets 0.05-1.4 W/m² of DNI through all day (seeds 3, 29, 34) is real
+    light in W/m²; a rule that took such DNI beside DHI for a beam in kW/m² had refused them, so
+    a frame of DNI and DHI is not judged for kW/m² (docs/robustness.md says why)."""
+    for site, date, seed in (("nanjing", "2013-06-21", 3), ("nanjing", "2013-06-21", 29), ("lanzhou", "2021-06-21", 34)):
+        overcast = synthetic(site, date, weather="overcast", freq="10min", seed=seed)
+        assert 0.0 < overcast["dni"].max() <= 1.5
+        assert simulate(overcast[["dni", "dhi", "wind_speed"]], site).summary["steps"] == 144
 
 
 @pytest.mark.parametrize("value, said", [(np.inf, "no reading .infinite."), (300.0, "no air's .* kelvins"),

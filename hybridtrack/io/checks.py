@@ -32,7 +32,7 @@ from .columns import IRRADIANCE, WEATHER_COLUMNS
 from .units import FRAME_UNITS
 
 __all__ = ["LIMITS", "CLIPPED_AT_ZERO", "CALM_OFFSET", "first_lines", "span", "check_frame", "clip_offsets",
-           "check_magnitude", "site_clear_sky", "kilowatts_without_site", "dni_kilowatt_day",
+           "check_magnitude", "site_clear_sky", "kilowatts_without_site",
            "check_magnitude_by_day", "check_derived", "refuse_repairs"]
 
 #: Physically possible range of each column; outside it a value is flagged (NaN).
@@ -53,13 +53,6 @@ HOURS_WELL_UP = 2
 #: W/m²: the largest value no sky keeps below for `HOURS_WELL_UP` hours of a high sun (see
 #: `_refuse_too_dark`); it is also the light the sun check counts (`hybridtrack.sky.LIGHT_AT_NIGHT`).
 DARKEST = LIGHT_AT_NIGHT
-#: The most GHI a reading of DNI in kW/m² may make, with its DHI, over the clear sky, for the
-#: reading to be taken as kW/m²: DNI × 1000 × cos z + DHI. pvlib's Ineichen clear sky at Lanzhou
-#: (1,520 m) is 1.06-1.09 of Haurwitz's, which runs low at high, dry sites; 1.3 leaves room for a
-#: higher site and hazier diffuse light. A flat overcast DNI of 1-1.4 W/m² read as kW/m² would
-#: make 1.35-1.8 (the package's own overcast Nanjing days), no sky's, so such a day is not called
-#: kW/m².
-KILOWATT_POSSIBLE = 1.3
 
 _HINT = {"ghi": "kW/m2", "dni": "kW/m2", "dhi": "kW/m2", "wind_speed": "km/h", "temp_air": "K", "photocurrent": "A",
          "pointing": "rad", "pointing_2": "rad"}
@@ -338,19 +331,18 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
             _refuse_too_dark(path, header, frame, name, top, clear_ghi)
 
 
-def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *, zenith,
+def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *,
                            part: bool = False) -> None:
     """`_check_days` in the site's zone `tz` and, where the file's stamps are in another (a logger
     on UTC at a site eight hours east), in theirs: a logger changes its unit on its own day, whose
     W/m² hours had kept each of the site's days above the limit. `frame` is `part` of a longer
-    file that passed as a whole (a streamed file's days): a day of it is judged alone too.
-    `zenith` (degrees, on the frame's stamps, `site_clear_sky`'s) judges DNI beside DHI."""
+    file that passed as a whole (a streamed file's days): a day of it is judged alone too."""
     zones = [tz] + ([frame.index.tz] if str(frame.index.tz) != str(tz) else [])
     for zone in zones:
-        _check_days(path, frame, report, clear_ghi, zone, zenith=zenith, part=part)
+        _check_days(path, frame, report, clear_ghi, zone, part=part)
 
 
-def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *, zenith,
+def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *,
                 part: bool = False) -> None:
     """`check_magnitude`'s kW/m² judgement on each local day (in zone `tz`) of a file longer than
     a day (or of `part` of one), as `hybridtrack.simulate` judges a frame: a file whose second day
@@ -365,7 +357,6 @@ def _check_days(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nda
                             remedy="the file's other days are in W/m²: convert this day's {name} to W/m² (×1000) "
                                    "if its unit changes within the file, or make it empty if the sensor was dead")
     _check_hours(path, frame, report, clear_ghi, days)
-    _refuse_dni_in_kw_beside_diffuse(path, frame, report, clear_ghi, zenith, days, streamed=part)
 
 
 def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, days: np.ndarray) -> None:
@@ -401,62 +392,6 @@ def _check_hours(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.nd
             in_kilowatts = counts.index[counts["in_kilowatts"] & (counts["day"] == mixed[0])]
             _refuse_hours_in_kilowatts(path, frame, report, name, np.isin(hours, in_kilowatts) & kilowatt,
                                        watts & (days == mixed[0]), f"{len(in_kilowatts)} hours of {what}")
-
-
-def dni_kilowatt_day(frame: pd.DataFrame, clear_ghi: np.ndarray, zenith,
-                     days: np.ndarray) -> tuple[np.ndarray, int] | None:
-    """In a frame of DNI and DHI without GHI, the first day (`days`, a label per row) whose DNI
-    reads `DARKEST` / 1000 to `KILOWATT_TOP` (0.02 to 1.5) in every reading under a high sun (the
-    site's clear sky `clear_ghi` at `SUN_WELL_UP` W/m² or more, the DHI above `DARKEST` W/m²:
-    daylight in the frame too) through `HOURS_WELL_UP` clock hours or more, each a reading a sky
-    can give in kW/m² (with the DHI, a GHI of at most `KILOWATT_POSSIBLE` times the clear sky's,
-    the sun's `zenith` in degrees): a beam in kW/m² read as W/m². Returned as those readings (a
-    mask) and their clock hours; None if no day is so.
-
-    Without GHI there is no beam on the horizontal to judge DNI by (`horizontal_beam`), and an
-    overcast day's DNI is legitimately about 0 beside a DHI of 100-300 W/m²: a clear day's DNI in
-    kW/m² (0.9 at noon) beside it had been read as such a day and replayed overcast. What tells
-    them apart is the pyrheliometer's zero: under cloud it reads 0, or its offset either side of 0,
-    so below 0.02 at times; a beam in kW/m² reads 0.02 or more in every reading under so high a sun.
-    An overcast sky that lets 1-1.4 W/m² through all day (the package's own Nanjing days) reads so
-    too, but as kW/m² it would make more light than a clear sky: it is no such day.
-    """
-    if "ghi" in frame or not {"dni", "dhi"} <= set(frame.columns):
-        return None
-    dni, dhi = frame["dni"].to_numpy(float), frame["dhi"].to_numpy(float)
-    clear_ghi = np.asarray(clear_ghi, float)
-    with np.errstate(invalid="ignore"):
-        judged = (clear_ghi >= SUN_WELL_UP) & (dhi > DARKEST) & np.isfinite(dni)
-        as_kilowatts = dni * 1000.0 * np.cos(np.radians(np.asarray(zenith, float))) + dhi
-        in_band = (judged & (dni >= DARKEST / 1000.0) & (dni <= KILOWATT_TOP)
-                   & (as_kilowatts <= KILOWATT_POSSIBLE * clear_ghi))
-    if not in_band.any():
-        return None
-    hours = frame.index.as_unit("ns").asi8 // pd.Timedelta(hours=1).value  # the hour each stamp is in
-    table = pd.DataFrame({"day": days, "hour": hours, "in_band": in_band})[judged]
-    by_day = table.groupby("day").agg(all_in=("in_band", "all"), hours=("hour", "nunique"))
-    found = by_day.index[by_day["all_in"] & (by_day["hours"] >= HOURS_WELL_UP)]
-    return (in_band & (days == found[0]), int(by_day.loc[found[0], "hours"])) if len(found) else None
-
-
-def _refuse_dni_in_kw_beside_diffuse(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, zenith,
-                                     days: np.ndarray, *, streamed: bool = False) -> None:
-    """Refuse, naming its first line, a day `dni_kilowatt_day` finds in a file of DNI and DHI; a
-    `streamed` file (which takes no ``--units``) is told to convert the file once."""
-    found = dni_kilowatt_day(frame, clear_ghi, zenith, days)
-    if found is None:
-        return
-    stretch, hours = found
-    dni = frame["dni"].to_numpy(float)
-    lines = first_lines(frame, stretch)
-    header = report.get("columns", {}).get("dni", "dni")
-    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
-    raise HybridtrackError(
-        f"{where}: dni reads {np.min(dni[stretch]):g} to {np.max(dni[stretch]):g} in every reading of {hours} hours "
-        f"of a high sun (clear sky {SUN_WELL_UP:g} W/m² or more, dhi above {DARKEST:g} W/m²): a beam in kW/m² read "
-        f"as W/m² (an overcast day's DNI, a pyrheliometer's zero, reads below {DARKEST / 1000:g} at times): "
-        + ("convert the file once with hybridtrack check FILE --units dni=kW/m2 --out clean.parquet" if streamed else
-           "give its unit (--units dni=kW/m2), or convert the column to W/m² (×1000)"))
 
 
 def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, name: str, stretch: np.ndarray,

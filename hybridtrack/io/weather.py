@@ -526,7 +526,7 @@ def read_weather(path, *, columns: Mapping[str, str] | None = None, tz: str | No
 
         zenith, clear = site_clear_sky(frame.index, site)
         check_magnitude(path, frame, report, clear)
-        check_magnitude_by_day(path, frame, report, clear, site.tz, zenith=zenith.to_numpy(float))
+        check_magnitude_by_day(path, frame, report, clear, site.tz)
         sun_check(path, frame, site, report, lenient=lenient)
     else:
         check_magnitude(path, frame, report, None)
