@@ -82,7 +82,7 @@ class Sweep:
     grid: dict
     x: str = "moves"
     y: str = "rms"
-    source: str = "sweep"
+    source: str = dataclasses.field(default="sweep", compare=False)  # where it was read, not what it runs
 
     def __post_init__(self) -> None:
         """A sweep built directly is checked as a file's is (`from_dict`), and its values made what

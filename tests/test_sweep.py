@@ -989,7 +989,7 @@ def test_a_sweep_built_directly_is_checked_as_its_file_would_be(tmp_path):
     sweep.toml, a misspelt key ran every row to a failure, x = y was written and then refused."""
     built = Sweep(base={"site": "lanzhou"}, grid={"seed": [np.int64(0), np.int64(1)]})
     assert built.grid == {"seed": [0, 1]} and type(built.grid["seed"][0]) is int
-    assert Sweep.from_toml(built.to_toml(tmp_path / "s.toml")).grid == built.grid
+    assert Sweep.from_toml(built.to_toml(tmp_path / "s.toml")) == built  # where it was read is not compared
     with pytest.raises(HybridtrackError, match="grid.drive.deadbnd: unknown key; did you mean drive.deadband"):
         Sweep(base={}, grid={"drive.deadbnd": [0.1]})
     with pytest.raises(HybridtrackError, match="plot.x and plot.y are both 'rms'"):
