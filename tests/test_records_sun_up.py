@@ -152,3 +152,12 @@ def test_a_column_of_infinities_is_damage_counted_not_a_unit_to_give(tmp_path, c
     assert frame.attrs["validation"]["impossible"]["temp_air"] == {"count": 4, "lines": [2, 3, 4, 5], "first": "inf",
                                                                    "action": "set to NaN"}
     assert frame["temp_air"].isna().all() and frame["ghi"].tolist() == [900.0] * 4
+
+
+def test_a_diffuse_column_with_its_sign_reversed_is_told_so_not_to_give_a_unit(tmp_path, capsys):
+    """Daylight below -50 W/m² in most readings had been refused as a unit mistake, 'give --units
+    dhi=kW/m2': no unit turns daylight negative; a pyranometer wired the wrong way round does."""
+    sky = clear_sky("2021-06-21 00:00", "2021-06-21 23:50", "10min")
+    frame = pd.DataFrame({"ghi": sky["ghi"], "dni": sky["dni"], "dhi": -sky["dhi"]})
+    refused(write(tmp_path / "sign.csv", frame), capsys, "column 'dhi':", "below -50 W/m²: its sign reversed?",
+            "convert the column (×−1)")

@@ -219,15 +219,19 @@ def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.nd
     if not judged.sum() or bad.sum() <= 0.5 * judged.sum():
         return
     low, high = LIMITS[name]
+    header = report.get("columns", {}).get(name, name)
     given, converted, _ = report.get("units_converted", {}).get(name, "").partition(" -> ")
     if converted:  # the unit the file or --units gave is the one to doubt, not another to give
         hint = f"it was read in {given} and converted; if {given} is not its unit, give it, e.g. --units " \
                f"{name}={FRAME_UNITS[name]}"
+    elif name in IRRADIANCE and (values[bad] < low).all():  # no unit turns daylight negative
+        raise HybridtrackError(f"{path}: column {header!r}: {bad.sum() / judged.sum():.0%} of {what} are below "
+                               f"{low:g} {FRAME_UNITS[name]}: its sign reversed? (a pyranometer wired the wrong way "
+                               "round reads below 0 in daylight) convert the column (×−1)")
     elif name not in IRRADIANCE or not (values[bad] > high).all():
         hint = f"give it, e.g. --units {name}={_HINT[name]}"
     else:
         hint = "kJ/m² or J/m² sums? convert the column to W/m²"
-    header = report.get("columns", {}).get(name, name)
     raise HybridtrackError(f"{path}: column {header!r}: {bad.sum() / judged.sum():.0%} of {what} are outside "
                            f"{low:g}..{high:g} ({FRAME_UNITS[name]}); wrong unit? {hint}")
 
