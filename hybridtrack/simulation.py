@@ -797,7 +797,7 @@ def track(frame: pd.DataFrame, site, *, collector: str | Collector = "trough-ns"
     faults = _check_faults(faults or {}, len(frame), 2 if collector.kind == "heliostat" else 1)
     drives = _drives(collector, config)
     if config.controller.strategy == "hybrid-oracle":
-        _check_true_sky(frame)
+        check_true_sky(frame)
 
     def build_world():
         world = World(frame, site, collector, config.imperfections, config.sensor, drives, config.seed, faults,
@@ -851,17 +851,26 @@ def _scored(run: Tracked) -> Result:
 
 
 
-def _check_true_sky(frame: pd.DataFrame) -> None:
+#: What the hybrid-oracle policy reads from a weather's ``sky`` column, for its refusals.
+ORACLE_READS = f"the hybrid-oracle policy reads {', '.join(map(repr, SKY_CODES))}"
+
+
+def unknown_sky(labels: pd.Series) -> np.ndarray:
+    """Where `labels` (a ``sky`` column as read) name no sky of `SKY_CODES`; a missing one is
+    unknown, which the hybrid-oracle policy takes."""
+    return (labels.notna() & ~labels.isin(SKY_CODES)).to_numpy()
+
+
+def check_true_sky(frame: pd.DataFrame) -> None:
     """The hybrid-oracle policy's true sky: a ``sky`` column of `SKY_CODES` labels (or missing). Any
     other label ('Sunny', 'clear', 1) had been read as not sunny, and the day run open loop."""
     if "sky" not in frame.columns:
         raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
                                "have one)")
-    labels = frame["sky"].dropna()
-    unknown = labels[~labels.isin(SKY_CODES)]
+    unknown = np.flatnonzero(unknown_sky(frame["sky"]))
     if len(unknown):
-        raise HybridtrackError(f"the frame's 'sky' column at {unknown.index[0]}: {unknown.iloc[0]!r} is no sky label; "
-                               f"the hybrid-oracle policy reads {', '.join(map(repr, SKY_CODES))}")
+        raise HybridtrackError(f"the frame's 'sky' column at {frame.index[unknown[0]]}: "
+                               f"{frame['sky'].iloc[unknown[0]]!r} is no sky label; {ORACLE_READS}")
 
 
 def _check_run_options(classifier, bulk_nights, warm_start) -> None:

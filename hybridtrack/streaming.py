@@ -281,68 +281,61 @@ def frame_days(frame: pd.DataFrame, site) -> DaySource:
         raise HybridtrackError(f"the frame spans {local[0]} to {local[-1]}: a streamed run needs at least one whole "
                                "local day (run a shorter span without --stream; hybridtrack.simulate from Python)")
     return DaySource(site, "a weather frame", len(frame), days, lambda: _by_day(iter([frame]), site, "the frame"),
-                     _true_sky=lambda: _refuse_unknown_sky_in_frame(frame))
+                     _true_sky=lambda: _check_true_sky(frame))
 
 
-def _unknown_sky(labels: pd.Series) -> np.ndarray:
-    """Where `labels` (a ``sky`` column as read) name no sky of `SKY_CODES`; a missing one is
-    unknown, which the hybrid-oracle policy takes (`hybridtrack.simulate` reads them so)."""
-    from .control import SKY_CODES
+def _check_true_sky(frame: pd.DataFrame) -> None:
+    """`DaySource.check_true_sky` of a frame in memory: `hybridtrack.simulate`'s own check."""
+    from .simulation import check_true_sky
 
-    return (labels.notna() & ~labels.isin(SKY_CODES)).to_numpy()
-
-
-def _oracle_reads() -> str:
-    from .control import SKY_CODES
-
-    return f"the hybrid-oracle policy reads {', '.join(map(repr, SKY_CODES))}"
-
-
-def _refuse_unknown_sky_in_frame(frame: pd.DataFrame) -> None:
-    """`DaySource.check_true_sky` of a frame in memory: its first bad label by its time stamp, as
-    `hybridtrack.simulate` names it."""
-    if "sky" not in frame.columns:
-        raise HybridtrackError("the hybrid-oracle policy needs the frame's true 'sky' column (synthetic frames "
-                               "have one)")
-    unknown = np.flatnonzero(_unknown_sky(frame["sky"]))
-    if len(unknown):
-        raise HybridtrackError(f"the frame's 'sky' column at {frame.index[unknown[0]]}: "
-                               f"{frame['sky'].iloc[unknown[0]]!r} is no sky label; {_oracle_reads()}")
+    check_true_sky(frame)
 
 
 def _refuse_unknown_sky_in_file(path: Path, separator: str | None) -> None:
     """`DaySource.check_true_sky` of a file on disk: its ``sky`` column alone read a chunk at a
-    time (as the run reads it, so that the verdict is the run's), the first label that names no
-    sky refused by its line (a CSV's; a Parquet file's row) and column, with their count. A file
-    pandas or pyarrow cannot read is left to the run's own read, which names what is wrong."""
-    try:
-        if separator is not None:
-            names = pd.read_csv(path, sep=separator, nrows=0).columns
-            chunks = pd.read_csv(path, sep=separator, usecols=["sky"], chunksize=CHUNK_ROWS,
-                                 low_memory=False) if "sky" in names else ()
-            first_row, where = 2, "line"
-        else:
-            import pyarrow.parquet as pq
+    time (`_column_chunks`, as the run reads it, so that the verdict is the run's), the first label
+    that names no sky refused by its line (a CSV's; a Parquet file's row) and column, with their
+    count. A file pandas or pyarrow cannot read is left to the run's own read, which names what is
+    wrong."""
+    from .simulation import ORACLE_READS, unknown_sky
 
-            handle = pq.ParquetFile(path)
-            names = handle.schema_arrow.names
-            chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=["sky"])) \
-                if "sky" in names else ()
-            first_row, where = 1, "row"
+    try:
+        names, chunks, first_row, _ = _column_chunks(path, separator, lambda header: ["sky"] if "sky" in header else [])
         rows, count, first = 0, 0, None
-        for chunk in chunks:
-            unknown = np.flatnonzero(_unknown_sky(chunk["sky"]))
+        for chunk in chunks if "sky" in names else ():
+            unknown = np.flatnonzero(unknown_sky(chunk["sky"]))
             if len(unknown) and first is None:
                 first = (first_row + rows + int(unknown[0]), chunk["sky"].iloc[unknown[0]])
             rows, count = rows + len(chunk), count + len(unknown)
     except (OSError, ValueError):  # pandas' and pyarrow's read errors
         return
     if "sky" not in names:
-        raise HybridtrackError(f"{path}: no column 'sky': {_oracle_reads()} from a weather frame's true sky "
+        raise HybridtrackError(f"{path}: no column 'sky': {ORACLE_READS} from a weather frame's true sky "
                                "(hybridtrack check FILE --out clean.parquet keeps a record's sky column)")
     if first is not None:
+        where = "line" if separator is not None else "row"
         raise HybridtrackError(f"{path}: {where} {first[0]}, column 'sky': {first[1]!r:.40} is no sky label ({count} "
-                               f"such in the file); {_oracle_reads()} (a streamed file is read as written)")
+                               f"such in the file); {ORACLE_READS} (a streamed file is read as written)")
+
+
+def _column_chunks(path: Path, separator: str | None, pick: Callable[[list], list]
+                   ) -> tuple[list, Iterator[pd.DataFrame], int, int | None]:
+    """A CSV (`separator`) or Parquet file's column names; the columns `pick` chooses from them,
+    read alone a chunk at a time (none if it chooses none); the file row of a chunk's first row (a
+    CSV's line: 2); and the file's row count where its metadata gives it (Parquet), else None."""
+    if separator is not None:
+        names = list(pd.read_csv(path, sep=separator, nrows=0).columns)
+        kept = pick(names)
+        chunks = pd.read_csv(path, sep=separator, usecols=kept, chunksize=CHUNK_ROWS,
+                             low_memory=False) if kept else iter(())  # each chunk typed whole: no DtypeWarning
+        return names, chunks, 2, None
+    import pyarrow.parquet as pq
+
+    handle = pq.ParquetFile(path)
+    names = list(handle.schema_arrow.names)
+    kept = pick(names)
+    chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=kept)) if kept else iter(())
+    return names, chunks, 1, handle.metadata.num_rows
 
 
 def recorded_days(path, site, *, tz=None, chunk_rows: int = CHUNK_ROWS) -> DaySource:
@@ -547,24 +540,17 @@ def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> tupl
     and, in a file of DNI without GHI or DHI, the DNI's top with its row and the file's first and
     last stamps (`_refuse_dni_in_kilowatts`). A file without rows, or one pandas or pyarrow cannot
     read, counts as holding them all: the run's own read then says what is wrong, by row."""
-    try:
+    def pick(header: list) -> list:  # a CSV's first column is its stamps; a Parquet file's, its index
+        kept = [name for name in names if name in header]
         if separator is not None:
-            header = pd.read_csv(path, sep=separator, nrows=0).columns
-            time, first_row = header[0], 2
-            chunks = pd.read_csv(path, sep=separator, usecols=[time, *(n for n in names if n in header)],
-                                 chunksize=CHUNK_ROWS, low_memory=False)  # each chunk typed whole: no DtypeWarning
-        else:
-            import pyarrow.parquet as pq
+            return [header[0], *kept]
+        time = next((n for n in header if n == "time" or n.startswith("__index_level_")), None)
+        return kept + [time] * (time is not None) if kept else []
 
-            handle = pq.ParquetFile(path)
-            header = handle.schema_arrow.names
-            time = next((n for n in header if n == "time" or n.startswith("__index_level_")), None)
-            kept = [name for name in names if name in header]
-            first_row = 1
-            chunks = (batch.to_pandas() for batch in handle.iter_batches(CHUNK_ROWS, columns=kept + [time] * (
-                time is not None))) if kept else ()
-            if handle.metadata.num_rows == 0:
-                return set(names), None
+    try:
+        header, chunks, first_row, total = _column_chunks(path, separator, pick)
+        if total == 0:
+            return set(names), None
         dni_alone = "dni" in names and not {"ghi", "dhi"} & set(header)
         found: set[str] = set()
         rows, top, stamps = 0, (-np.inf, 0), []
@@ -575,7 +561,7 @@ def _measured(path: Path, separator: str | None, names: tuple[str, ...]) -> tupl
                 values = pd.to_numeric(chunk["dni"], errors="coerce").to_numpy(float)
                 if np.isfinite(values).any() and np.nanmax(values) > top[0]:
                     top = (float(np.nanmax(values)), first_row + rows + int(np.nanargmax(values)))
-                stamps = [*stamps[:1], *_ends(chunk, time)]
+                stamps = [*stamps[:1], *_ends(chunk, next((c for c in chunk.columns if c not in names), None))]
             rows += len(chunk)
         if not rows and separator is not None:
             return set(names), None
