@@ -149,22 +149,40 @@ def _checked(data: dict, source: str) -> tuple[dict, dict, str, str]:
         _check_key(key, source, "base")
     _refuse_given_twice(base, config, source)
     _check_base(base, config, grid, source)
+    _check_grid(grid, source, given="grid" in data)
+    _canonical_names(base, grid)
+    x, y = _plot_axes(plot, source)
+    return {**base, "config": config}, dict(grid), x, y
+
+
+def _check_grid(grid: dict, source: str, *, given: bool) -> None:
+    """Refuse a grid that is empty (or not `given`), a key no run reads, a value that is no
+    non-empty list, a value given twice, or more runs than `MAX_RUNS`."""
     if not grid:
-        said = "is empty" if "grid" in data else "is missing"
-        raise HybridtrackError(f"{source}: [grid] {said}; give at least one key with a list of values")
+        raise HybridtrackError(f"{source}: [grid] {'is empty' if given else 'is missing'}; give at least one key with "
+                               "a list of values")
     for key, values in grid.items():
         _check_key(key, source, "grid")
         if not isinstance(values, list) or not values:
             raise HybridtrackError(f"{source}: grid.{key}: must be a non-empty list of values, got {values!r}")
         _refuse_repeats(key, values, source)
-    for key, canonical in (("weather", _canonical_weather), ("site", _canonical_site)):
-        if key in grid:  # after the repeats are judged, by the names as given
-            grid[key] = [canonical(value) for value in grid[key]]
-        if key in base:
-            base[key] = canonical(base[key])
     count = int(np.prod([len(v) for v in grid.values()], dtype=float))
     if count > MAX_RUNS:
         raise HybridtrackError(f"{source}: the grid makes {count:,} runs; at most {MAX_RUNS:,} in one sweep")
+
+
+def _canonical_names(base: dict, grid: dict) -> None:
+    """The base's and the grid's weathers and sites, in place, by the names the runs give them
+    (after the grid's repeats are judged, by the names as given)."""
+    for key, canonical in (("weather", _canonical_weather), ("site", _canonical_site)):
+        if key in grid:
+            grid[key] = [canonical(value) for value in grid[key]]
+        if key in base:
+            base[key] = canonical(base[key])
+
+
+def _plot_axes(plot: dict, source: str) -> tuple[str, str]:
+    """The plot's two metrics (``moves`` and ``rms`` by default), refused unless metrics, and two."""
     for axis in ("x", "y"):
         if axis in plot and plot[axis] not in METRICS:
             raise HybridtrackError(f"{source}: plot.{axis}: {plot[axis]!r} is not a metric; "
@@ -176,7 +194,7 @@ def _checked(data: dict, source: str) -> tuple[dict, dict, str, str]:
     if x == y:  # one metric against itself: a diagonal, its "front" one point
         unsaid = "".join(f" ({axis} by default)" for axis in ("x", "y") if axis not in plot)
         raise HybridtrackError(f"{source}: plot.x and plot.y are both {x!r}{unsaid}; a trade-off needs two metrics")
-    return {**base, "config": config}, dict(grid), x, y
+    return x, y
 
 
 def _table_of_text_keys(table, source: str, name: str) -> dict:
