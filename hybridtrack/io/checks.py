@@ -77,6 +77,13 @@ def first_lines(frame: pd.DataFrame, mask) -> list[int]:
     return [int(v) for v in lines[np.isfinite(lines)][:5]]
 
 
+def place(path: Path, report: dict, name: str, lines: list[int]) -> str:
+    """Where a refusal points in a file: the first of `lines` (none for a resampled frame's rows) and
+    the column of frame name `name` by its header in the file."""
+    header = report.get("columns", {}).get(name, name)
+    return f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+
+
 def span(delta) -> str:
     """A duration in its largest whole unit: ``5min``, ``1h``, ``30s``, ``2d``."""
     delta = pd.Timedelta(delta)
@@ -127,7 +134,7 @@ def _limits(path: Path, frame: pd.DataFrame, report: dict) -> None:
         values = frame[name].to_numpy(float)
         present = ~np.isnan(values)
         bad = present & ~((values >= low) & (values <= high))  # inf and 1e400 included
-        _refuse_mostly_impossible(path, report, name, values, bad)
+        _refuse_mostly_impossible(path, report, frame, name, bad)
         if bad.any():
             first = values[bad][0]
             impossible[name] = {"count": int(bad.sum()), "lines": first_lines(frame, bad),
@@ -187,9 +194,8 @@ def _negative_under_high_sun(path: Path, frame: pd.DataFrame, report: dict, clea
             continue
         lines, judged = first_lines(frame, below), int((high & np.isfinite(values)).sum())
         if below.sum() > 0.5 * judged:
-            header = report.get("columns", {}).get(name, name)
             first = int(np.argmax(below))
-            where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+            where = place(path, report, name, lines)
             raise HybridtrackError(
                 f"{where}: {name} reads {values[first]:g} W/m² with the sun well up (clear sky "
                 f"{clear_ghi[first]:.0f} W/m²), and {below.sum()} of its {judged} readings under such a sun are below "
@@ -200,8 +206,9 @@ def _negative_under_high_sun(path: Path, frame: pd.DataFrame, report: dict, clea
         frame[name] = np.where(below, np.nan, values)
 
 
-def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.ndarray, bad: np.ndarray) -> None:
-    """Refuse a column most of whose values are outside `LIMITS`: a unit mistake, not spikes.
+def _refuse_mostly_impossible(path: Path, report: dict, frame: pd.DataFrame, name: str, bad: np.ndarray) -> None:
+    """Refuse a column most of whose values are outside `LIMITS`: a unit mistake, not spikes. The
+    refusal names the file's line of the first value judged outside (`where`).
 
     An irradiance column is judged on its finite daylight values too (above `DARKEST` W/m², or
     beyond the limits): hourly kJ/m² sums (3.6 times W/m²) pass 1500 at every bright hour, but
@@ -211,6 +218,7 @@ def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.nd
     of them had been refused as a unit mistake, ``--units temp_air=K`` for an air temperature of
     ``inf``).
     """
+    values = frame[name].to_numpy(float)
     judged, what = np.isfinite(values), "values"
     bad = bad & judged
     if name in IRRADIANCE and bad.sum() <= 0.5 * judged.sum():
@@ -219,20 +227,20 @@ def _refuse_mostly_impossible(path: Path, report: dict, name: str, values: np.nd
     if not judged.sum() or bad.sum() <= 0.5 * judged.sum():
         return
     low, high = LIMITS[name]
-    header = report.get("columns", {}).get(name, name)
+    where = place(path, report, name, first_lines(frame, bad))
     given, converted, _ = report.get("units_converted", {}).get(name, "").partition(" -> ")
     if converted:  # the unit the file or --units gave is the one to doubt, not another to give
         hint = f"it was read in {given} and converted; if {given} is not its unit, give it, e.g. --units " \
                f"{name}={FRAME_UNITS[name]}"
     elif name in IRRADIANCE and (values[bad] < low).all():  # no unit turns daylight negative
-        raise HybridtrackError(f"{path}: column {header!r}: {bad.sum() / judged.sum():.0%} of {what} are below "
+        raise HybridtrackError(f"{where}: {bad.sum() / judged.sum():.0%} of {what} are below "
                                f"{low:g} {FRAME_UNITS[name]}: its sign reversed? (a pyranometer wired the wrong way "
                                "round reads below 0 in daylight) convert the column (×−1)")
     elif name not in IRRADIANCE or not (values[bad] > high).all():
         hint = f"give it, e.g. --units {name}={_HINT[name]}"
     else:
         hint = "kJ/m² or J/m² sums? convert the column to W/m²"
-    raise HybridtrackError(f"{path}: column {header!r}: {bad.sum() / judged.sum():.0%} of {what} are outside "
+    raise HybridtrackError(f"{where}: {bad.sum() / judged.sum():.0%} of {what} are outside "
                            f"{low:g}..{high:g} ({FRAME_UNITS[name]}); wrong unit? {hint}")
 
 
@@ -325,14 +333,12 @@ def check_magnitude(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np
         else:
             suspicious = kilowatts_without_site(top, hours)
             why = f"at most {top:g} over {hours:.0f} hours"
-        header = report.get("columns", {}).get(name, name)
-        line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values)))
-        where = f"{path}: line {line[0]}, column {header!r}" if line else f"{path}: column {header!r}"
+        where = place(path, report, name, first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(values))))
         if suspicious:
             raise HybridtrackError(f"{where}: {name} is {why}; the values look like kW/m² read as W/m²: "
                                    f"{remedy.format(name=name)}")
         if clear_ghi is not None and whole_file:
-            _refuse_too_dark(path, header, frame, name, top, clear_ghi)
+            _refuse_too_dark(path, report, frame, name, top, clear_ghi)
 
 
 def check_magnitude_by_day(path: Path, frame: pd.DataFrame, report: dict, clear_ghi: np.ndarray, tz, *,
@@ -403,8 +409,7 @@ def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, na
     """`_check_hours`' refusal of a day's `hours` in kW/m² (`stretch`) beside its readings in W/m²."""
     values = frame[name].to_numpy(float)
     lines, other = first_lines(frame, stretch), first_lines(frame, watts)
-    header = report.get("columns", {}).get(name, name)
-    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    where = place(path, report, name, lines)
     off_sun = " or a pyrheliometer off the sun" if name == "dni" else ""
     raise HybridtrackError(
         f"{where}: {name} reads {np.min(values[stretch]):g} to {np.max(values[stretch]):g} through {hours}, "
@@ -413,7 +418,7 @@ def _refuse_hours_in_kilowatts(path: Path, frame: pd.DataFrame, report: dict, na
         "make them empty if the sensor failed")
 
 
-def _refuse_too_dark(path: Path, header: str, frame: pd.DataFrame, name: str, top: float,
+def _refuse_too_dark(path: Path, report: dict, frame: pd.DataFrame, name: str, top: float,
                      clear_ghi: np.ndarray) -> None:
     """Refuse GHI or DHI whose largest value is at most `DARKEST` W/m² through `HOURS_WELL_UP` clock
     hours of a clear sky of `SUN_WELL_UP` W/m² or more: no sky is so dark. The first line under
@@ -431,8 +436,7 @@ def _refuse_too_dark(path: Path, header: str, frame: pd.DataFrame, name: str, to
     if well_up < HOURS_WELL_UP or top > DARKEST:
         return
     values = frame[name].to_numpy(float)
-    lines = first_lines(frame, high & np.isfinite(values))
-    where = f"{path}: line {lines[0]}, column {header!r}" if lines else f"{path}: column {header!r}"
+    where = place(path, report, name, first_lines(frame, high & np.isfinite(values)))
     with np.errstate(invalid="ignore"):
         negative = bool((values[high] < 0).any()) and not (values[high] > 0).any()
     cause = ("below 0 under that sun: no night offset; is the pyranometer covered, disconnected, or its sign reversed?"
@@ -478,11 +482,10 @@ def _refuse_dni_in_kw_beside_beam(path: Path, frame: pd.DataFrame, report: dict,
     top, seen = float(np.nanmax(dni)), float(np.nanmax(beam[0]))
     lowest = 0.0 if "dhi" in frame or not whole_file else -np.inf
     if lowest < top <= KILOWATT_TOP and seen >= BEAM_SEEN:
-        header = report.get("columns", {}).get("dni", "dni")
         why = ("is the pyrheliometer dead or off the sun? remove the column from the file to derive DNI from GHI"
                if top <= 0.0 else f"the values look like kW/m² read as W/m²: {remedy.format(name='dni')}")
         line = first_lines(frame, np.arange(len(frame)) == int(np.nanargmax(beam[0]))) if "_line" in frame else []
-        where = f"{path}: line {line[0]}, column {header!r}" if line else f"{path}: column {header!r}"
+        where = place(path, report, "dni", line)
         raise HybridtrackError(f"{where}: dni is at most {top:g} while {beam[1]} {seen:.0f} W/m² (a direct beam); "
                                f"{why}")
 
