@@ -481,6 +481,16 @@ def _refuse_light_at_night(frame: pd.DataFrame, site: sites.Site, altitude: np.n
                                "zone? (hybridtrack.io.read_weather with the site finds the offset that fits)")
 
 
+def _first_not_number(values: pd.Series) -> str:
+    """Where a column of text first holds a value that is no number (``; the first that is none, at
+    <stamp>: 'warm'``); nothing for another dtype (dates, booleans), or text of numbers alone."""
+    if values.dtype != object and not pd.api.types.is_string_dtype(values.dtype):
+        return ""
+    numbers = pd.to_numeric(values, errors="coerce")
+    text = np.flatnonzero(numbers.isna().to_numpy() & values.notna().to_numpy())
+    return f"; the first that is none, at {values.index[text[0]]}: {values.iloc[text[0]]!r:.40}" if len(text) else ""
+
+
 #: Light no sky gives, by column: ten times the most there is (the solar constant, 1361 W/m², at
 #: perihelion: 1408 W/m²; a photocurrent of 10 A where the reader's limit is 10,000 mA). A reading
 #: past it is a unit mixed up (kW/m² read as W/m², ×1000) or garbage (1e200 W/m² failed deep in the
@@ -496,7 +506,8 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
     repairs files."""
     values = frame[column]
     if not params.real_numbers(values.dtype):
-        raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}")
+        raise HybridtrackError(f"the weather frame's column {column!r} must hold numbers, got dtype {values.dtype}"
+                               f"{_first_not_number(values)}")
     if column in RECORDED_POINTING:
         _pointing_column(frame, column)
     if column == "temp_air":

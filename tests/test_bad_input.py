@@ -481,6 +481,10 @@ def _small_day():
     (lambda f: f.assign(photocurrent=math.inf), "inf mA is not light"),
     (lambda f: f.assign(ghi=f["ghi"].astype(str)), "column 'ghi' must hold numbers"),  # TypeError in the kW check
     (lambda f: f.assign(ghi=f["ghi"].astype(object).where(f["ghi"] < 500, "abc")), "column 'ghi' must hold numbers"),
+    (lambda f: f.assign(ghi=f["ghi"].astype(object).where(f.index.hour != 11, "abc")),  # named the dtype, not the row
+     "column 'ghi' must hold numbers, got dtype object; the first that is none, at 2021-06-21 11:00:00\\+08:00: 'abc'"),
+    (lambda f: f.assign(temp_air=f["temp_air"].astype(str).where(f.index.hour != 12, "warm")),
+     "column 'temp_air' must hold numbers, got dtype (str|object); the first that is none, at 2021-06-21 12:00:00"),
     (lambda f: f.assign(ghi=math.inf), "column 'ghi' at .*: inf W/m² is not light"),  # blamed dni as kW/m²
     (lambda f: f.assign(ghi=-math.inf), r"column 'ghi' at .*: -inf W/m² is no reading \(infinite\)"),  # "over 14,080"
 ])
