@@ -195,7 +195,7 @@ def across_angle(vectors: np.ndarray, axis_azimuth) -> np.ndarray:
     """
     vectors = _vectors("across_angle", vectors, "vectors")
     b = np.radians(_finite(axis_azimuth, "axis azimuth"))
-    _broadcast("across_angle", vectors=vectors[..., 0], axis_azimuth=b)
+    _broadcast("across_angle", **{"vectors without their x, y, z axis": vectors[..., 0]}, axis_azimuth=b)
     across = vectors[..., 0] * np.cos(b) - vectors[..., 1] * np.sin(b)  # horizontal, at azimuth b + 90°
     angle = np.degrees(np.arctan2(vectors[..., 2], across))
     angle = np.where(angle < -90.0, angle + 360.0, angle)  # [-90, 270): continuous through both horizons
@@ -450,7 +450,7 @@ def heliostat_normal(altitude, azimuth, aim, *, sun=None) -> np.ndarray:
     """
     unit = aim_unit(aim)
     alt, az = checked_sun(altitude, azimuth, "heliostat_normal")
-    _broadcast("heliostat_normal", altitude=alt, azimuth=az, aim_points=unit[..., 0])
+    _broadcast("heliostat_normal", altitude=alt, azimuth=az, **{"aim_points without their x, y, z axis": unit[..., 0]})
     if sun is None:
         s = direction_vectors(alt, az)
     else:

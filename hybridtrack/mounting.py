@@ -211,7 +211,8 @@ def rotate(vectors, rotation) -> np.ndarray:
         got = f"shape {matrices.shape}" if matrices.dtype.kind in "fiu" else f"{rotation!r:.60}"
         raise HybridtrackError(f"rotate: rotation must be 3 x 3 matrices of numbers (mounting_rotation), shape "
                                f"(..., 3, 3); got {got}")
-    _broadcast("rotate", vectors=vectors[..., 0], rotation=matrices[..., 0, 0])
+    _broadcast("rotate", **{"vectors without their x, y, z axis": vectors[..., 0],
+                            "rotations without their 3 x 3": matrices[..., 0, 0]})
     x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
     out = np.empty(np.broadcast_shapes(x.shape, matrices.shape[:-2]) + (3,))
     for d in range(3):
