@@ -75,8 +75,9 @@ class ControllerConfig:
         file that has no wind at all (``hybridtrack replay`` chooses it then, and says so). In
         both cases the run reports the wind as missing, never as calm.
     working_hours : tuple of str
-        Local clock times the controller may work between: an optional limit on a day that the
-        computed sun sets (the default spans the whole day).
+        Local clock times the controller may work between, the end included: an optional limit
+        on a day that the computed sun sets. The default spans the whole day, to ``24:00`` (the
+        day's end).
     min_altitude : float
         Degrees: the computed sun must be above this to track.
     calibration_tau : str
@@ -148,7 +149,7 @@ class ControllerConfig:
     wind_release: float = 12.0
     wind_hold: str = "10min"
     wind_missing: str = "stow"
-    working_hours: tuple[str, str] = ("00:00", "23:59")
+    working_hours: tuple[str, str] = ("00:00", "24:00")
     min_altitude: float = 0.0
     calibration_tau: str = "30min"
     sensor_loss: str = "3min"

@@ -24,6 +24,7 @@ own per-scan computation would:
 
 from __future__ import annotations
 
+import datetime as dt
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -151,9 +152,16 @@ def _rebased(clock: pd.DatetimeIndex, minutes: np.ndarray) -> tuple[pd.DatetimeI
 
 
 def _working(local: pd.DatetimeIndex, hours: tuple[str, str]) -> np.ndarray:
+    """Scans whose local clock reads within `hours`, both ends included; an end of ``24:00`` is
+    the day's end, every reading before the next midnight (its seconds had been dropped, so the
+    clock's last minute of each day was outside)."""
     start, end = (parse_clock(h) for h in hours)
     clock = clock_hours(local)
-    return (clock >= start.hour + start.minute / 60.0) & (clock <= end.hour + end.minute / 60.0)
+    return (clock >= _hours_of(start)) & (clock <= (24.0 if end == dt.time.max else _hours_of(end)))
+
+
+def _hours_of(time: dt.time) -> float:
+    return time.hour + time.minute / 60.0 + (time.second + time.microsecond / 1e6) / 3600.0
 
 
 def make_plan(clock: pd.DatetimeIndex, minutes: np.ndarray, site: Site, collector: Collector,
