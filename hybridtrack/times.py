@@ -244,6 +244,8 @@ def local_range(start_date, tz: str, *, end_date=None, start: str = "00:00", end
     first_day = parse_date(start_date)
     last_day = parse_date(end_date) if end_date is not None else first_day
     step = parse_freq(freq)
+    if last_day < first_day:  # had been told its last day did not exist on the zone's clock (Apia's case below)
+        raise HybridtrackError(f"the range ends on {last_day}, before it starts on {first_day}")
     t0 = _localise(first_day, parse_clock(start), tz)
     if end is None:
         t1 = _localise(last_day + dt.timedelta(days=1), dt.time(0), tz) - pd.Timedelta(1, "ns")

@@ -127,3 +127,10 @@ def test_a_day_its_zone_skipped_is_named():
         local_range("2011-12-30", "Pacific/Apia")
     both = local_range("2011-12-29", "Pacific/Apia", end_date="2011-12-30", freq="1h")
     assert len(both) == 24 and both[-1] == pd.Timestamp("2011-12-29 23:00", tz="Pacific/Apia")
+
+
+def test_a_range_that_ends_the_day_before_it_starts_says_so():
+    """It had been told its last day did not exist on the zone's clock, the skipped day's message
+    (helper-44)."""
+    with pytest.raises(HybridtrackError, match="^the range ends on 2024-06-20, before it starts on 2024-06-21$"):
+        local_range("2024-06-21", "UTC", end_date="2024-06-20")
