@@ -44,6 +44,7 @@ import datetime as dt
 import itertools
 import os
 import shutil
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -64,7 +65,16 @@ from .outputs import claim, held, output_folder, removing_empty_folders, strict_
 from .times import check_tz, local_midnight, local_steps, parse_date, parse_freq
 
 __all__ = ["stream", "StreamResult", "DaySource", "synthetic_days", "recorded_days", "frame_days", "day_seed",
-           "read_log", "stream_files", "partial_files"]
+           "read_log", "stream_files", "partial_files", "AwakeAtMidnightWarning"]
+
+
+class AwakeAtMidnightWarning(UserWarning):
+    """A streamed run cut its span at a midnight with the tracker awake (the sun up at midnight: a
+    polar summer): each such segment restarts the tracker from stow, as no real night did."""
+
+
+#: Modes a tracker rests in at a streamed run's cut, as it should: asleep at night, or stowed.
+RESTING = ("stow_night", "stow_wind")
 
 #: Rows read from a recorded file at a time (a day at 1 s is 86,400).
 CHUNK_ROWS = 200_000
@@ -1059,8 +1069,13 @@ def stream(source: DaySource, out, *, collector: str | Collector = "trough-ns", 
     partial = partial_files(files)
     claim([*files.values(), partial["events"]], folders=[partial["log"]])  # the log's segments: a folder
     with held(files["log"].parent), progress_updates(progress, lambda: progress_bar(source)) as update:
-        return _stream_segments(source, files, site, collector, config, classifier, warm_start, update,
-                                on_segment, running)  # no other run may append to this folder's log meanwhile
+        result = _stream_segments(source, files, site, collector, config, classifier, warm_start, update,
+                                  on_segment, running)  # no other run may append to this folder's log meanwhile
+    if "awake_at_midnight" in result.summary["streamed"]:
+        awake = result.summary["streamed"]["awake_at_midnight"]
+        warnings.warn(f"{awake['count']} streamed day(s) began with the tracker awake at midnight (the first "
+                      f"{awake['first']}): {awake['why']}", AwakeAtMidnightWarning, stacklevel=2)
+    return result
 
 
 def _stream_segments(source: DaySource, files: dict, site, collector: Collector, config, classifier,
@@ -1071,7 +1086,7 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
     run = _PartialRun(files)
     memory: bool | dict = warm_start
     start = None
-    wind, cycle, last = set(), [], None
+    wind, cycle, last, awake_at_cut = set(), [], None, []
     kept = KeptAsRead()
     try:
         for day, frame in source:
@@ -1084,6 +1099,8 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
                 seed=config.seed if run.segments == 0 else day_seed(config.seed, day))
             result = simulate(frame, site, collector=collector, config=setup, classifier=classifier,
                               progress=progress, warm_start=memory)
+            if run.segments and result.log["mode"].iloc[0] not in RESTING:
+                awake_at_cut.append(day)
             run.append(result)
             running.add(result.log, events=result.events, **result.scoring)
             wind.add(result.summary["wind_data"])
@@ -1105,8 +1122,19 @@ def _stream_segments(source: DaySource, files: dict, site, collector: Collector,
     summary["streamed"] = {"segments": run.segments, "segment": "one local day, cut at midnight",
                            "p95_resolution_deg": running.resolution, "weather": source.describe,
                            "kept_as_read": kept.report()}
+    if awake_at_cut:
+        summary["streamed"]["awake_at_midnight"] = _awake_at_cut(awake_at_cut)
     write(files["summary"], lambda path: path.write_text(strict_json(summary, indent=2) + "\n"))
     return StreamResult(summary, files, site, collector, config, memory, kept)
+
+
+def _awake_at_cut(days: list[dt.date]) -> dict:
+    """The summary's note of the days a streamed run began with the tracker awake (`stream` warns of
+    them: `AwakeAtMidnightWarning`): the controller's state and the collector restart at each cut,
+    which a midnight at night stow hides and a midnight sun does not (the collector slews from stow)."""
+    return {"count": len(days), "first": str(days[0]),
+            "why": "the tracker was awake at midnight (the sun up): each such day restarted it from stow; "
+                   "run these days in memory (simulate) for an unbroken run"}
 
 
 #: The columns whose missing readings a streamed run counts (`KeptAsRead`).

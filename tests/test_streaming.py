@@ -951,3 +951,32 @@ def test_a_streamed_parquet_files_or_frames_bad_sky_label_or_no_sky_is_refused_b
     good = frame.assign(sky=frame["sky"].replace("foggy", "cloudy"))
     good.to_csv(tmp_path / "good.csv", index_label="time")
     recorded_days(tmp_path / "good.csv", SITE).check_true_sky()  # a missing label is no refusal
+
+
+def test_a_streamed_run_says_which_days_began_with_the_tracker_awake(tmp_path, capsys):
+    """Cut at midnight, a streamed run restarts the controller and the collector from stow: hidden
+    at a midnight at night stow, not under a midnight sun (Longyearbyen, June: a slew of 48° from
+    stow at each cut, with nothing said; helper-44)."""
+    from hybridtrack import sites
+    from hybridtrack.streaming import AwakeAtMidnightWarning
+
+    polar = sites.custom(78.2, 15.6, "Arctic/Longyearbyen")
+    with pytest.warns(AwakeAtMidnightWarning, match="2 streamed day"):
+        result = stream(synthetic_days(polar, "2024-06-20", "2024-06-22", weather="sunny", freq="10min", seed=1),
+                        tmp_path / "polar")
+    assert result.summary["streamed"]["awake_at_midnight"]["count"] == 2
+    assert result.summary["streamed"]["awake_at_midnight"]["first"] == "2024-06-21"
+    at_cuts = result.log(columns=["mode"]).loc[lambda log: log.index.strftime("%H:%M") == "00:00", "mode"]
+    assert (at_cuts.iloc[1:] != "stow_night").all()  # awake: the restart is what the note says, not a night
+
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", AwakeAtMidnightWarning)  # a night at each cut: nothing to say
+        quiet = stream(synthetic_days(SITE, "2021-06-20", "2021-06-21", weather="sunny", freq="10min", seed=1),
+                       tmp_path / "lanzhou")
+    assert "awake_at_midnight" not in quiet.summary["streamed"]
+    assert main(["simulate", "--lat", "78.2", "--lon", "15.6", "--tz", "Arctic/Longyearbyen", "--date", "2024-06-20",
+                 "--days", "2", "--weather", "sunny", "--freq", "10min", "--stream", "--out", str(tmp_path / "cli")]) == 0
+    out, err = capsys.readouterr()
+    assert "awake at midnight: 1 day(s), the first 2024-06-21: the tracker was awake at midnight" in out
+    assert "Warning" not in err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -122,7 +123,7 @@ def _add_stream_argument(parser: argparse.ArgumentParser, what: str) -> None:
 def _stream(source, args, config, *, heading: str) -> int:
     """A streamed run (`hybridtrack.streaming`): a progress bar on stderr, the summary, the files."""
     from ..simulation import Result
-    from ..streaming import progress_bar, stream, stream_files
+    from ..streaming import AwakeAtMidnightWarning, progress_bar, stream, stream_files
 
     if not args.out:
         raise HybridtrackError("--stream writes its log to disk: give --out FOLDER")
@@ -132,11 +133,16 @@ def _stream(source, args, config, *, heading: str) -> int:
     source.check_span()  # and a span without a whole local day
     with leaving_out(args, [Result.files(args.out)["report"]], "--stream"), \
             progress_bar(source, label=config.controller.strategy) as bar:
-        result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
-                        config=config, progress=bar.update)
+        with warnings.catch_warnings():  # said below, in a line of its own
+            warnings.simplefilter("ignore", AwakeAtMidnightWarning)
+            result = stream(source, args.out, collector=collector_from_arguments(args), strategy=args.strategy,
+                            config=config, progress=bar.update)
     print(heading + f" (streamed in {result.summary['streamed']['segments']} day-long segments)")
     for line in result.kept_as_read.lines():
         print(line)
+    if "awake_at_midnight" in result.summary["streamed"]:
+        awake = result.summary["streamed"]["awake_at_midnight"]
+        print(f"awake at midnight: {awake['count']} day(s), the first {awake['first']}: {awake['why']}")
     print(summary_table({result.summary["strategy"]: result.summary}))
     print("wrote " + ", ".join(str(p) for p in result.files.values()))
     return 0
