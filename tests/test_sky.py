@@ -171,3 +171,42 @@ def test_a_start_the_clocks_skip_or_repeat_is_refused_in_one_line(start, end):
     berlin = sites.Site("berlin", 52.52, 13.40, 34.0, "Europe/Berlin")
     with pytest.raises(HybridtrackError, match="is not one time on Europe/Berlin's clock"):
         synthetic(berlin, start, end)
+
+
+@pytest.mark.parametrize("altitude, lat, lon, tz", [(4500, 32.5, 80.1, "Asia/Shanghai"), (9000, 28.0, 86.9, "Asia/Kathmandu")])
+@pytest.mark.parametrize("date", ["2024-01-03", "2024-06-21"])
+def test_no_clear_sky_brings_more_light_than_the_top_of_the_atmosphere(altitude, lat, lon, tz, date):
+    """Ineichen's altitude terms pass both bounds above some 4,000 m: GHI 1,371 W/m² at 4,500 m
+    under a top-of-atmosphere 1,305 on the horizontal, DNI 1,501 at 9,000 m (helper-44)."""
+    import pvlib
+
+    from hybridtrack.sky import clear_sky
+
+    site = sites.custom(lat, lon, tz, altitude=altitude)
+    index = pd.date_range(date, periods=24 * 60, freq="1min", tz=tz)
+    zenith = pvlib.solarposition.get_solarposition(index, lat, lon, altitude)["apparent_zenith"].to_numpy()
+    ghi, dni, dhi = clear_sky(index, site, zenith)
+    top = pvlib.irradiance.get_extra_radiation(index).to_numpy()
+    cos_zenith = np.clip(np.cos(np.radians(zenith)), 0, None)
+    assert (dni <= top + 1e-9).all() and (ghi <= top * cos_zenith + 1e-9).all()
+    assert (dhi >= 0).all() and np.allclose(ghi, dni * cos_zenith + dhi, atol=1e-9)
+    if date.endswith("06-21"):  # where Ineichen passes the top, held at it, not cut below it
+        assert ghi.max() == pytest.approx((top * cos_zenith).max(), rel=1e-6)
+
+
+def test_a_clear_sky_below_the_top_of_the_atmosphere_is_ineichens_to_the_bit():
+    import pvlib
+
+    from hybridtrack.sky import clear_sky
+
+    site = sites.get("delingha")  # 2,980 m, the highest built-in site
+    index = pd.date_range("2021-06-21", periods=24 * 60, freq="1min", tz=site.tz)
+    zenith = pvlib.solarposition.get_solarposition(index, site.latitude, site.longitude)["apparent_zenith"].to_numpy()
+    up = zenith < 90
+    airmass = pvlib.atmosphere.get_absolute_airmass(pvlib.atmosphere.get_relative_airmass(zenith[up]),
+                                                    pvlib.atmosphere.alt2pres(site.altitude))
+    linke = pvlib.clearsky.lookup_linke_turbidity(index[up], site.latitude, site.longitude).to_numpy()
+    expected = pvlib.clearsky.ineichen(zenith[up], airmass, linke, altitude=site.altitude)
+    ghi, dni, dhi = clear_sky(index, site, zenith)
+    for ours, theirs in zip((ghi, dni, dhi), (expected["ghi"], expected["dni"], expected["dhi"])):
+        assert np.array_equal(ours[up], np.nan_to_num(np.asarray(theirs, float)))
