@@ -13,6 +13,11 @@ daylight at night. Two tests, on the measured light before any gap is filled:
   of the day are found on overcast days too. With DNI alone only the light-at-night side
   counts, and the smallest shift that explains it is named.
 
+A file read in a zone whose clock changes within it (summer time) is judged on each side of the
+change too, where a side holds a day of readings: a logger kept on standard time all year fits
+the sun on one side and is an hour off on the other, which one shift for the whole file had
+averaged to within the tolerance (`_clock_change_check`).
+
 A shift beyond `max(45 min, step)`, or light at night in more than 2 % of the lit rows (and
 more than 3 rows), refuses the file, naming the first such row, the shift that fits and the
 UTC offset the stamps would then have. With ``lenient=True`` it is a warning in the report.
@@ -162,6 +167,10 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
     night = _night_light(site, frame, name, tolerance)
     header = report.get("columns", {}).get(name, name)
     offset_wrong = abs(shift) > tolerance
+    if not offset_wrong:
+        _clock_change_check(path, frame, site, curve, header, tolerance, lenient, report)
+        if "sun_check" in report:
+            return
     if offset_wrong or night.sum() > max(3, 0.02 * (frame[name].to_numpy(float) > LIGHT).sum()):
         message = _mismatch(path, frame, site, name, header, night, shift if offset_wrong else None, lenient)
         if not lenient:
@@ -173,6 +182,63 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
                                     "column": header, "action": "kept"}
     report["sun_check"] = (f"light follows the sun at {site.name} (best shift {_signed(shift)}, {disagree:.1%} of "
                            "bins disagree)")
+
+
+#: Ten-minute bins of readings a side of a clock change needs to be judged on its own: a day.
+SIDE_BINS = 144
+
+
+def _clock_change_check(path: Path, frame: pd.DataFrame, site, curve: str, header: str, tolerance: pd.Timedelta,
+                        lenient: bool, report: dict) -> None:
+    """Refuse (or, `lenient`, warn about in ``report["sun_check"]``) a file whose stamps change
+    their UTC offset (the zone's summer time) where one side fits the sun and another is off by
+    more than `tolerance`: a logger that kept one offset through the change."""
+    if frame.index.tz is None:
+        return
+    sides = _offset_sides(frame.index)
+    if len(sides) < 2:
+        return
+    judged = []
+    for side in sides:
+        grid, light = _binned(frame.iloc[side], curve)
+        if np.isfinite(light).sum() >= SIDE_BINS:
+            judged.append((side, _best_shift(site, grid, light, symmetric=curve != "dni")[0]))
+    off = [(side, shift) for side, shift in judged if abs(shift) > tolerance]
+    if not off or len(off) == len(judged):
+        return
+    side, shift = off[0]
+    fitting = next(s for s, shifted in judged if abs(shifted) <= tolerance)
+    first = int(side[0])
+    line = first_lines(frame, np.arange(len(frame)) == first)
+    where = f"line {line[0]}, " if line else ""
+    fixed = _offset_text(frame.iloc[side], shift)
+    message = (f"{path}: {where}column {header!r}: the light fits the sun at {site.name} in the rows stamped "
+               f"UTC{_offset_of(frame.index[int(fitting[0])])} and is {_signed(shift)} off in those stamped "
+               f"UTC{_offset_of(frame.index[first])} (from {frame.index[first]}): the logger kept one clock through "
+               f"the zone's change? Give its fixed zone ({_fixed_zone(fixed)}), or --lenient to read it anyway")
+    if not lenient:
+        raise HybridtrackError(message)
+    report["sun_check"] = "WARNING: " + message.split(": ", 1)[1].removesuffix(", or --lenient to read it anyway")
+
+
+def _offset_sides(index: pd.DatetimeIndex) -> list[np.ndarray]:
+    """The row positions of each run of stamps with one UTC offset."""
+    offsets = index.tz_localize(None).as_unit("ns").asi8 - index.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8
+    return np.split(np.arange(len(index)), np.flatnonzero(np.diff(offsets)) + 1)
+
+
+def _offset_of(stamp: pd.Timestamp) -> str:
+    minutes = int(round(stamp.utcoffset() / pd.Timedelta(minutes=1)))
+    return f"{'+' if minutes >= 0 else '-'}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"
+
+
+def _fixed_zone(offset_text: str) -> str:
+    """An IANA zone of the fixed offset `offset_text` (``UTC+01:00`` -> ``--tz Etc/GMT-1``: the
+    Etc zones' signs are POSIX's, reversed), or the offset itself where no Etc zone has it."""
+    sign, hours, minutes = offset_text[3], int(offset_text[4:6]), int(offset_text[7:9])
+    if minutes:
+        return f"stamps in {offset_text}"
+    return "--tz Etc/GMT" + ("" if not hours else f"{'-' if sign == '+' else '+'}{hours}")
 
 
 def _distance(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
