@@ -145,7 +145,8 @@ class Controller:
         self.jacobian, self.weight = plan.jacobian, plan.weight
         self.fit = MountEstimator(self.axes, config.sensor_noise, parameters=plan.jacobian.shape[2]) \
             if plan.jacobian is not None else None
-        self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise) if self.fit is not None else None
+        self.clock = ClockWatch(plan.jacobian.shape[2], config.sensor_noise, constant_seen=self.axes == 2) \
+            if self.fit is not None else None
         self.theta = np.zeros(self.fit.n if self.fit is not None else 2 + self.axes)
         self.fit_since = 0.0
         self.fitted_at = [-math.inf] * self.axes

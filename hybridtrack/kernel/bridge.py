@@ -95,7 +95,7 @@ def _settings(controller: Controller) -> kc.ControllerSettings:
         float(fit.memory) if fit else 1.0, float(fit.clip) if fit else 1.0, int(fit.check_every) if fit else 1,
         float(config.pull_gain), float(controller.responsivity or 0.0), float(controller.sun_threshold),
         float(clock.r) if clock else 1.0,
-        np.array(np.diag(clock.prior_information) if clock else [], float),
+        np.array(np.diag(clock.prior_information) if clock else [], float), bool(clock and clock.constant_seen),
         inputs.mode == "relative", float(sky.mean.window) if sky.mean is not None else 0.0, float(sky.window_minutes),
         float(inputs.min_altitude), inputs.low_sun == "absolute", float(inputs.relative_floor),
         float(inputs.full_variation), float(sky.dark),

@@ -59,7 +59,7 @@ ControllerSettings = namedtuple("ControllerSettings", [
     "wind_stow", "wind_release", "wind_hold", "stow_when_missing", "encoder_confirm",
     "q", "r", "stuck_scans", "stuck_spread", "gate2", "reacquire", "tau", "max_rate",
     "has_fit", "fit_r", "prior", "fit_memory", "clip", "check_every", "pull_gain", "responsivity", "sun_threshold",
-    "clock_r", "clock_prior",
+    "clock_r", "clock_prior", "clock_constant_seen",
     "sky_relative", "smoothing", "window", "min_altitude", "low_sun_absolute", "relative_floor", "full_variation",
     "dark", "table", "table_step", "table_last", "ranges", "edges", "codes",
     "deadband", "speed", "stow_speed", "low", "high", "stow", "resolution", "circular"])
@@ -1006,7 +1006,8 @@ def clock_verdict(cfg, state, log, i):
     estimate, std = clock_solve(state.clock_moments, state.clock_sums, count, span, cfg.clock_prior, cfg.clock_r)
     clock, drift = estimate[n - 2], estimate[n - 1]
     clock_std, drift_std = std[n - 2], std[n - 1]
-    if not k[CLOCK_RAISED] and abs(clock) >= max(ALARM_SIGMAS * clock_std, CLOCK_TOLERANCE):
+    seen = cfg.clock_constant_seen  # a heliostat's: not a single axis's (`ClockWatch`)
+    if seen and not k[CLOCK_RAISED] and abs(clock) >= max(ALARM_SIGMAS * clock_std, CLOCK_TOLERANCE):
         k[CLOCK_RAISED] = 1
         _alarm3(i, ev.CLOCK_OFF, clock, clock_std, float(count), state, log)
     if not k[DRIFT_RAISED] and span >= DRIFT_DAYS and abs(drift) >= max(ALARM_SIGMAS * drift_std, DRIFT_TOLERANCE):
