@@ -1136,7 +1136,7 @@ def _run(world: World, controller: Controller, progress, bulk_nights: bool) -> N
         if progress is not None and i - reported >= 8192:
             progress(i - reported)
             reported = i
-        if bulk_nights and controller.resting and not controller.awake[i]:
+        if bulk_nights and controller.resting and not guard.stuck and not controller.awake[i]:
             j = controller.sleeps_until(i)
             if j > i + 1 and wind_ok[j] == wind_ok[i]:
                 controller.rest(i, j, world.minutes[j - 1])

@@ -376,3 +376,43 @@ def test_a_healthy_year_under_clouds_raises_no_held_off_alarm(site):
     frame = synthetic(site, "2021-01-01", "2021-12-31", weather="climate", seed=2)
     result = simulate(frame, site, strategy="hybrid-always")
     assert not result.events["reason"].str.contains("held beyond").any()
+
+
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_a_stuck_anemometer_stays_stuck_through_the_night(engine):
+    """Stuck at 3.00 m/s from 08:00 on the first of two sunny days: alarmed at 11:00, and at dusk
+    the guard had forgotten it, so the next morning the same 3.00 m/s was 'moving again' and taken
+    for calm for three more hours of daylight (helper-45). It stays stuck until a reading moves,
+    and the night is stepped (not passed over in bulk) while it is, alike on either setting."""
+    import dataclasses
+
+    frame = synthetic("lanzhou", "2021-06-21", "2021-06-22", weather="sunny", seed=1)
+    wind = np.clip(frame["wind_speed"].to_numpy(), 0.0, 11.0)
+    wind[8 * 60:] = 3.0
+    config = dataclasses.replace(SimulationConfig(), engine=engine)
+    result = simulate(frame.assign(wind_speed=wind), "lanzhou", config=config)
+    reasons = result.events["reason"]
+    assert reasons.str.contains("anemometer stuck at 3.00 m/s").sum() == 1
+    assert not reasons.str.contains("anemometer moving again").any()
+    day_two = result.log.loc["2021-06-22 05:00":"2021-06-22 23:59", "mode"]
+    assert (day_two == "stow_wind").all()  # missing wind: stowed all day, as from 11:00 on the first
+    stepped = simulate(frame.assign(wind_speed=wind), "lanzhou", config=config, bulk_nights=False)
+    pd.testing.assert_frame_equal(result.log, stepped.log)
+    pd.testing.assert_frame_equal(result.events, stepped.events)
+
+
+def test_a_stuck_anemometer_is_judged_through_missing_readings_and_cleared_when_it_moves():
+    """A reading missing every two hours had restarted the three-hour count, so an anemometer stuck
+    at 3.00 m/s with a dropout now and then was never judged (helper-45); a reading off the value
+    clears it, by night as by day."""
+    frame = synthetic("lanzhou", "2021-06-21", weather="sunny", seed=1)
+    wind = np.clip(frame["wind_speed"].to_numpy(), 0.0, 11.0)
+    wind[8 * 60:] = 3.0
+    wind[np.arange(9 * 60, 24 * 60, 120)] = np.nan  # a dropout every two hours from 09:00
+    wind[22 * 60:] = 0.4  # a calm night after ten: the anemometer moves
+    result = simulate(frame.assign(wind_speed=wind), "lanzhou")
+    events = result.events.set_index(result.events["time"].dt.tz_convert("Asia/Shanghai").dt.strftime("%H:%M"))
+    stuck = events["reason"].str.contains("anemometer stuck at 3.00 m/s")
+    assert list(events.index[stuck]) == ["11:01"]  # three hours from 08:00; 11:00 itself is a dropout
+    moving = events["reason"].str.contains("anemometer moving again")
+    assert list(events.index[moving]) == ["22:00"]

@@ -64,25 +64,37 @@ class WindGuard:
         return not wind <= self.stow_above
 
     def watch(self, t: float, wind: float, daylight: bool) -> str | None:
-        """Watch for a stuck anemometer; return an alarm text when it sticks or comes back."""
-        if math.isnan(wind) or unreadable(wind) or not daylight:
-            self.flat_value = math.nan  # the flat spell must be daylight without a break
+        """Watch for a stuck anemometer; return an alarm text when it sticks or comes back.
+
+        A flat spell is counted over daylight only (a calm night may read 0 for hours), and a
+        missing reading neither breaks it nor counts as a move. Once stuck, the anemometer stays
+        stuck, through the night too, until a reading moves off its value: at each dusk the guard
+        had forgotten the value, so every morning the same stuck reading passed as wind for the
+        three hours it takes to judge it again."""
+        if math.isnan(wind) or unreadable(wind):
+            return None
+        if self.stuck:
+            if abs(wind - self.flat_value) <= STUCK_SPREAD:
+                return None
+            self.stuck = False
+            self.flat_value, self.flat_since = (wind, t) if daylight else (math.nan, math.nan)
+            return f"anemometer moving again ({wind:.1f} m/s)"
+        if not daylight:
+            self.flat_value = math.nan
             return None
         if math.isnan(self.flat_value) or abs(wind - self.flat_value) > STUCK_SPREAD:
             self.flat_value, self.flat_since = wind, t
-            if self.stuck:
-                self.stuck = False
-                return f"anemometer moving again ({wind:.1f} m/s)"
             return None
-        if not self.stuck and t - self.flat_since >= 60.0 * STUCK_HOURS:
+        if t - self.flat_since >= 60.0 * STUCK_HOURS:
             self.stuck = True
             return (f"anemometer stuck at {self.flat_value:.2f} m/s for {STUCK_HOURS:g} h of daylight; "
                     "its readings count as missing")
         return None
 
     def gusts(self, readings: np.ndarray) -> np.ndarray:
-        """Per reading, whether `update` takes it for a gust once `heard`, a stuck spell aside
-        (which needs daylight): the scans a night asleep in bulk must not pass over."""
+        """Per reading, whether `update` takes it for a gust once `heard`, a stuck anemometer aside:
+        the scans a night asleep in bulk must not pass over (no night is passed over in bulk while
+        the guard holds the anemometer stuck, `Controller`)."""
         readings = np.asarray(readings, float)
         with np.errstate(invalid="ignore"):
             missing = np.isnan(readings) | (readings < READABLE[0]) | (readings > READABLE[1])

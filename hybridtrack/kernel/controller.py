@@ -262,17 +262,23 @@ def _gusty(cfg, wind):
 def wind_watch(state, t, wind, daylight):
     """WindGuard.watch: (event code or 0, value)."""
     s, k = state.s, state.k
-    if math.isnan(wind) or _unreadable(wind) or not daylight:
+    if math.isnan(wind) or _unreadable(wind):
+        return 0, 0.0
+    if k[WIND_STUCK]:
+        if abs(wind - s[FLAT_VALUE]) <= STUCK_SPREAD:
+            return 0, 0.0
+        k[WIND_STUCK] = 0
+        s[FLAT_VALUE] = wind if daylight else math.nan
+        s[FLAT_SINCE] = t if daylight else math.nan
+        return ev.ANEMOMETER_MOVING, wind
+    if not daylight:
         s[FLAT_VALUE] = math.nan
         return 0, 0.0
     if math.isnan(s[FLAT_VALUE]) or abs(wind - s[FLAT_VALUE]) > STUCK_SPREAD:
         s[FLAT_VALUE] = wind
         s[FLAT_SINCE] = t
-        if k[WIND_STUCK]:
-            k[WIND_STUCK] = 0
-            return ev.ANEMOMETER_MOVING, wind
         return 0, 0.0
-    if not k[WIND_STUCK] and t - s[FLAT_SINCE] >= 60.0 * STUCK_HOURS:
+    if t - s[FLAT_SINCE] >= 60.0 * STUCK_HOURS:
         k[WIND_STUCK] = 1
         return ev.ANEMOMETER_STUCK, s[FLAT_VALUE]
     return 0, 0.0

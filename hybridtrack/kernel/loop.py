@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .controller import CLOCK_ROWS, EVENTS, RESTING, clock_recount, controller_rest, controller_step, sleeps_until
+from .controller import (CLOCK_ROWS, EVENTS, RESTING, WIND_STUCK, clock_recount, controller_rest, controller_step,
+                         sleeps_until)
 from .jit import kernel
 from .world import world_move, world_observe, world_rest
 
@@ -46,7 +47,7 @@ def _scans(start, stop, bulk_nights, wind_ok, world, world_state, cfg, plan, sta
     while i < stop:
         if state.k[EVENTS] + EVENTS_PER_SCAN > capacity:
             return i
-        if bulk_nights and state.k[RESTING] and not plan.awake[i]:
+        if bulk_nights and state.k[RESTING] and not state.k[WIND_STUCK] and not plan.awake[i]:
             j = sleeps_until(plan, i)
             if j > i + 1 and wind_ok[j] == wind_ok[i]:
                 controller_rest(cfg, plan, state, out, i, j, world.minutes[j - 1])
