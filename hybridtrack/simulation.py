@@ -1014,12 +1014,12 @@ def _history(site, collector, config, start, classifier, warm_start, sky_seed=No
 #: What an earlier run's memory (`Result.memory`) holds: the mount fit's state, its calibration
 #: offsets, the light level, the clock watch's readings and a commissioned mount.
 MEMORY_KEYS = ("offsets", "theta", "p", "information", "evidence", "frozen", "updates", "light_level", "clock",
-               "commissioned", "origin")
+               "commissioned", "origin", "anemometer_stuck_at")
 #: Where and when a memory was left (`Tracked.memory`): the kind of collector and its geometry
 #: (`collector_geometry`), the site and the run's last step.
 _ORIGIN_KEYS = ("collector", "geometry", "site", "latitude", "longitude", "end")
 #: The numbers a memory holds, each an array or a number.
-_MEMORY_NUMBERS = ("offsets", "theta", "p", "information", "evidence", "light_level")
+_MEMORY_NUMBERS = ("offsets", "theta", "p", "information", "evidence", "light_level", "anemometer_stuck_at")
 #: The clock watch's readings (`ClockWatch.save`).
 _CLOCK_KEYS = ("start", "counted", "t", "axis", "x", "y", "spell_start", "spell_last", "raised")
 

@@ -980,3 +980,27 @@ def test_a_streamed_run_says_which_days_began_with_the_tracker_awake(tmp_path, c
     out, err = capsys.readouterr()
     assert "awake at midnight: 1 day(s), the first 2024-06-21: the tracker was awake at midnight" in out
     assert "Warning" not in err
+
+
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_a_stuck_anemometer_stays_stuck_across_a_streamed_runs_midnights(tmp_path, engine):
+    """The wind guard's judgement is carried (`Result.memory`'s ``anemometer_stuck_at``): each
+    streamed day had judged the same frozen reading again, tracking three hours of daylight on it."""
+    source = frame_days(_stuck_wind_days(), SITE)
+    config = dataclasses.replace(SimulationConfig(), engine=engine)
+    result = stream(source, tmp_path / engine, config=config)
+    events = pd.read_csv(result.files["events"])
+    assert events["reason"].str.contains("anemometer stuck at 3.00 m/s").sum() == 1
+    assert not events["reason"].str.contains("anemometer moving again").any()
+    day_two = result.log(columns=["mode"], day="2021-06-22")["mode"]
+    assert (day_two.between_time("05:00", "20:00") == "stow_wind").all()
+
+
+def _stuck_wind_days():
+    from hybridtrack.sky import synthetic
+
+    frame = synthetic(SITE, "2021-06-21", "2021-06-22", weather="sunny", seed=1, freq="5min")
+    wind = np.clip(frame["wind_speed"].to_numpy(), 0.0, 11.0)
+    wind[frame.index.hour >= 8] = 3.0
+    wind[frame.index >= pd.Timestamp("2021-06-22", tz=frame.index.tz)] = 3.0
+    return frame.assign(wind_speed=wind)

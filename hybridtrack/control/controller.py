@@ -165,6 +165,8 @@ class Controller:
                 self.fit.level = memory.get("light_level", self.fit.level)
             if self.clock is not None and "clock" in memory:  # a run carried on (`carry`), timers rebased
                 self.clock.restore(memory["clock"])
+            if "anemometer_stuck_at" in memory:  # the anemometer an earlier run judged stuck (`carry`)
+                self.wind.stuck, self.wind.flat_value = True, float(memory["anemometer_stuck_at"])
         self.dwell, self.loss = config.minutes("dwell"), config.minutes("sensor_loss")
         self.coast_for = config.minutes("coast")
         self.mode, self.mode_since = STOW_NIGHT, -math.inf
@@ -634,6 +636,8 @@ class Controller:
         state = self.memory()
         if self.clock is not None:
             state["clock"] = self.clock.save(start)
+        if self.wind.stuck:  # judged over three hours of daylight: not again each morning of a long run
+            state["anemometer_stuck_at"] = self.wind.flat_value
         return state
 
     def _recall(self, memory: dict) -> None:

@@ -227,7 +227,8 @@ def _worded(controller: Controller, events: kc.EventLog, count: int) -> list:
 
 
 def _write_back(controller: Controller, state: kc.ControllerState) -> None:
-    """What `Controller.memory` and `Controller.fitted_mount` read after the run."""
+    """What `Controller.memory`, `Controller.carry` and `Controller.fitted_mount` read after the run."""
+    controller.wind.stuck, controller.wind.flat_value = bool(state.k[kc.WIND_STUCK]), float(state.s[kc.FLAT_VALUE])
     for calibrator, (offset, learned) in zip(controller.calibrators, state.calibration.tolist()):
         calibrator.offset, calibrator.learned = offset, learned
     fit = controller.fit
