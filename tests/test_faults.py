@@ -416,3 +416,22 @@ def test_a_stuck_anemometer_is_judged_through_missing_readings_and_cleared_when_
     assert list(events.index[stuck]) == ["11:01"]  # three hours from 08:00; 11:00 itself is a dropout
     moving = events["reason"].str.contains("anemometer moving again")
     assert list(events.index[moving]) == ["22:00"]
+
+
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_the_sensor_only_tracker_says_when_its_sensor_sticks_and_searches_with_its_cells(engine):
+    """It has no sun model to fall back on; with its fine sensor stuck it had coasted, then held
+    while the sun moved on (37.4° off on a north-south trough) and said nothing (helper-45). Stuck
+    for `sensor_loss` (3 min), it says so and follows the sun on its acquisition cells."""
+    import dataclasses
+
+    from hybridtrack.faults import SCENARIOS
+
+    scenario = SCENARIOS["sensor-stuck"]
+    frame, faults, _, _ = scenario.build(scenario.site)
+    config = dataclasses.replace(SimulationConfig(), engine=engine)
+    result = simulate(frame, scenario.site, collector="trough-ns", strategy="sensor", faults=faults, config=config)
+    lost = result.events[result.events["reason"] == "sensor lost (stuck)"]
+    assert len(lost) >= 1 and (lost["to"] == "search").all()
+    midday = result.log.between_time("11:00", "14:30")
+    assert midday["error"].abs().max() < 10.0  # the cells' coarse aim, where holding had reached 37°

@@ -24,7 +24,7 @@ from .disagreement import DisagreementMonitor
 from .encoder import AXIS_NAMES, EncoderMonitor
 from .mountfit import MountEstimator, ordered_dot, pull_spread
 from .modes import (ASTRONOMICAL, FAULT, FAULTY, IMPLAUSIBLE, INVALID, MODES, NOT_READ, OK, OUT_OF_VIEW, OUTLIER,
-                    SEARCH, SENSOR, SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, SUNNY, UNKNOWN)
+                    SEARCH, SENSOR, SENSOR_STATUS, SKY_CODES, STOW_NIGHT, STOW_WIND, STUCK, SUNNY, UNKNOWN)
 from .observation import Observation
 from .plan import ControllerPlan
 from .sensing import SensorGate, axis_offset, reading_scale
@@ -662,14 +662,16 @@ class Controller:
         if mode not in (ASTRONOMICAL, SENSOR, SEARCH):
             return
         sensor_ok = self.config.uses_sensor and all(valid)
-        if self.config.sensor_only:
+        lost_for = t - self.invalid_since
+        if self.config.sensor_only:  # no sun model: a sensor faulty for `sensor_loss` hands over to the acquisition cells
             if mode == SEARCH and sensor_ok:
                 self._switch(i, SENSOR, "sun back in the sensor's view", t)
+            elif mode == SENSOR and status in (STUCK, IMPLAUSIBLE) and lost_for >= self.loss:
+                self._switch(i, SEARCH, f"sensor lost ({SENSOR_STATUS[status]})", t)
             elif mode == SENSOR and status == OUT_OF_VIEW:
                 self._switch(i, SEARCH, "the acquisition cells see the sun outside the fine view", t)
             return
         want = self.config.uses_sensor and self._trusts_sensor(sky, obs)
-        lost_for = t - self.invalid_since
         if mode == SENSOR and not sensor_ok and (status in FAULTY or lost_for >= self.loss):
             self._switch(i, ASTRONOMICAL, f"sensor lost ({SENSOR_STATUS[status]})", t)
         elif mode == SENSOR and not want and t - self.mode_since >= self.dwell:

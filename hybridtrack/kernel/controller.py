@@ -1133,16 +1133,18 @@ def _choose_mode(cfg, state, log, i, t, status, valid, sky, true_sky):
     if mode != ASTRONOMICAL and mode != SENSOR and mode != SEARCH:
         return
     sensor_ok = cfg.uses_sensor and valid.all()
-    if cfg.sensor_only:
+    faulty = status == STUCK or status == IMPLAUSIBLE or status == INVALID
+    lost_for = t - state.s[INVALID_SINCE]
+    if cfg.sensor_only:  # no sun model: a sensor faulty for `sensor_loss` hands over to the acquisition cells
         if mode == SEARCH and sensor_ok:
             _switch(i, SENSOR, ev.SUN_BACK, 0.0, t, state, log)
+        elif mode == SENSOR and (status == STUCK or status == IMPLAUSIBLE) and lost_for >= cfg.loss:
+            _switch(i, SEARCH, ev.SENSOR_LOST, float(status), t, state, log)
         elif mode == SENSOR and status == OUT_OF_VIEW:
             _switch(i, SEARCH, ev.OUT_OF_FINE_VIEW, 0.0, t, state, log)
         return
     want = cfg.uses_sensor and _trusts_sensor(cfg, sky, true_sky)
-    lost_for = t - state.s[INVALID_SINCE]
     since = t - state.s[MODE_SINCE]
-    faulty = status == STUCK or status == IMPLAUSIBLE or status == INVALID
     if mode == SENSOR and not sensor_ok and (faulty or lost_for >= cfg.loss):
         _switch(i, ASTRONOMICAL, ev.SENSOR_LOST, float(status), t, state, log)
     elif mode == SENSOR and not want and since >= cfg.dwell:
