@@ -1041,6 +1041,9 @@ def _check_memory_form(memory: dict) -> None:
                 refuse(f"{key} must be numbers, got {memory[key]!r:.40}")
     if "theta" in memory and not {"p", "information", "frozen", "updates"} <= set(memory):
         refuse("the mount fit's theta comes with its p, information, frozen and updates")
+    stuck = memory.get("anemometer_stuck_at")
+    if stuck is not None and not (np.ndim(stuck) == 0 and np.isfinite(np.asarray(stuck, float))):
+        refuse(f"anemometer_stuck_at must be one finite reading (m/s), got {stuck!r:.40}")
     clock = memory.get("clock")
     if clock is not None and (not isinstance(clock, dict) or set(clock) != set(_CLOCK_KEYS)):
         refuse("clock must be the clock watch's readings, as a run leaves them")

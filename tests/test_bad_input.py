@@ -116,8 +116,8 @@ MATRIX = [
     ("GHI 5000 W/m2 throughout", weather_file(HEADER + "2021-06-21 12:00,5000,800,100,3\n2021-06-21 12:01,5100,8,1,3\n"),
      lambda p: read_weather(p, tz="UTC"), lambda p: ["check", str(p), "--tz", "UTC"],
      "line 2, column 'ghi': 100% of values are outside -50..1500 (W/m²); wrong unit?"),
-    ("GHI in kJ/m2 from the second hour", weather_file(HEADER + "2021-06-21 11:00,0,0,0,3\n2021-06-21 12:00,3000,8,1,3\n"
-                                                       "2021-06-21 13:00,3100,8,1,3\n"),
+    ("GHI in kJ/m2 from the second hour",
+     weather_file(HEADER + "2021-06-21 11:00,0,0,0,3\n2021-06-21 12:00,3000,8,1,3\n2021-06-21 13:00,3100,8,1,3\n"),
      lambda p: read_weather(p, tz="UTC"), lambda p: ["check", str(p), "--tz", "UTC"],
      "line 3, column 'ghi': 67% of values are outside -50..1500 (W/m²); wrong unit? kJ/m² or J/m² sums?"),
     ("naive stamps without a time zone", weather_file(HEADER + GOOD_ROWS), lambda p: read_weather(p),

@@ -395,7 +395,8 @@ THREE_UP = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
      r"angles_on_mount: vectors must be .* shape \(\.\.\., 3\); got shape \(3, 2\)"),
     (lambda m: m.angles_on_mount([[0, 1, 1], [0, 1]], Collector()), "angles_on_mount: vectors must be .* of numbers"),
     (lambda m: m.rotate(np.ones((4, 3)), np.ones((2, 3, 3))),
-     r"rotate: the shapes vectors without their x, y, z axis \(4,\), rotations without their 3 x 3 \(2,\) do not broadcast"),  # einsum's ValueError
+     r"rotate: the shapes vectors without their x, y, z axis \(4,\), rotations without their 3 x 3 \(2,\) do not "
+     "broadcast"),  # einsum's ValueError
     (lambda m: m.rotate(np.ones(3), np.eye(2)), r"rotate: rotation must be 3 x 3 .* got shape \(2, 2\)"),
     (lambda m: m.rotate(np.ones(2), np.eye(3)), r"rotate: vectors must be .* got shape \(2,\)"),
     (lambda m: m.rotate(5.0, np.eye(3)), r"rotate: vectors must be .* got shape \(\)"),

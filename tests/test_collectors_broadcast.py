@@ -165,7 +165,8 @@ THREE_SUNS = np.array([30.0, 45.0, 60.0]), np.array([120.0, 180.0, 240.0])
      r"\(a sun position of shape \(T, 1\) against"),
     (lambda: fresnel_angle(*THREE_SUNS, [-4.0, 4.0], 8.0), r"fresnel_angle: the shapes .* d \(2,\), h \(\)"),
     (lambda: fresnel_end_loss(*THREE_SUNS, [-4.0, 4.0], 8.0), r"fresnel_end_loss: the shapes .* d \(2,\)"),
-    (lambda: heliostat_normal(*THREE_SUNS, [[0, 100, 100], [50, 90, 100]]), r"aim_points without their x, y, z axis \(2,\) do not broadcast"),
+    (lambda: heliostat_normal(*THREE_SUNS, [[0, 100, 100], [50, 90, 100]]),
+     r"aim_points without their x, y, z axis \(2,\) do not broadcast"),
     (lambda: receiver_angle([1.0, 2.0], [1.0, 2.0, 3.0]), r"receiver_angle: the shapes d \(2,\), h \(3,\) do not "
                                                            r"broadcast together$"),
     (lambda: normal_angles(np.ones((3, 2))), r"normals must be \(east, north, up\) vectors.*got shape \(3, 2\)"),
@@ -299,7 +300,8 @@ def test_collector_parameters_and_sun_positions_that_are_no_numbers_are_refused_
     (lambda: jack_heights([np.inf, 0.0, 1.0]), "jack_heights: normals must be finite"),  # gave nan, inf, -inf
     (lambda: across_angle([np.inf, 0.0, 1.0], 0.0), "across_angle: vectors must be finite"),  # gave 0°
     (lambda: across_angle(np.eye(3), [0.0, 90.0]),
-     r"across_angle: the shapes vectors without their x, y, z axis \(3,\), axis_azimuth \(2,\) do not broadcast together"),  # numpy's
+     r"across_angle: the shapes vectors without their x, y, z axis \(3,\), axis_azimuth \(2,\) do not broadcast "
+     "together"),  # numpy's
     (lambda: jack_heights([0.0, 0.0, 1.0], "ab"), "supports must be numbers"),  # numpy's ValueError
     (lambda: jack_heights([0.0, 0.0, 1.0], [[np.nan, 1.0]]), "supports must be finite"),  # gave NaN heights
     (lambda: across_angle([0.0, 0.0, 0.0], 0.0), "across_angle: a zero vector has no direction"),  # gave 0°

@@ -61,7 +61,8 @@ def test_hourly_kilojoules_are_refused_as_a_unit_not_their_noons_set_to_nan(tmp_
     share = round(100 * (lit > 1500).sum() / len(lit))
     assert (ghi > 1500).sum() < 0.5 * len(ghi)  # under half of all rows: the nights hid it
     refused(write(tmp_path / "kj.csv", ghi), capsys,
-            f"line 11, column 'GHI': {share}% of daylight values are outside -50..1500 (W/m²)", "kJ/m² or J/m² sums?")
+            f"line 11, column 'GHI': {share}% of daylight values are outside -50..1500 (W/m²)",
+            "kJ/m² or J/m² sums?")
 
 
 def test_an_overcast_day_and_a_few_bright_spikes_are_still_read(tmp_path):

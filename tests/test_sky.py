@@ -173,7 +173,8 @@ def test_a_start_the_clocks_skip_or_repeat_is_refused_in_one_line(start, end):
         synthetic(berlin, start, end)
 
 
-@pytest.mark.parametrize("altitude, lat, lon, tz", [(4500, 32.5, 80.1, "Asia/Shanghai"), (9000, 28.0, 86.9, "Asia/Kathmandu")])
+@pytest.mark.parametrize("altitude, lat, lon, tz", [(4500, 32.5, 80.1, "Asia/Shanghai"),
+                                                   (9000, 28.0, 86.9, "Asia/Kathmandu")])
 @pytest.mark.parametrize("date", ["2024-01-03", "2024-06-21"])
 def test_no_clear_sky_brings_more_light_than_the_top_of_the_atmosphere(altitude, lat, lon, tz, date):
     """Ineichen's altitude terms pass both bounds above some 4,000 m: GHI 1,371 W/m² at 4,500 m

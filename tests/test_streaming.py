@@ -976,7 +976,8 @@ def test_a_streamed_run_says_which_days_began_with_the_tracker_awake(tmp_path, c
                        tmp_path / "lanzhou")
     assert "awake_at_midnight" not in quiet.summary["streamed"]
     assert main(["simulate", "--lat", "78.2", "--lon", "15.6", "--tz", "Arctic/Longyearbyen", "--date", "2024-06-20",
-                 "--days", "2", "--weather", "sunny", "--freq", "10min", "--stream", "--out", str(tmp_path / "cli")]) == 0
+                 "--days", "2", "--weather", "sunny", "--freq", "10min", "--stream",
+                 "--out", str(tmp_path / "cli")]) == 0
     out, err = capsys.readouterr()
     assert "awake at midnight: 1 day(s), the first 2024-06-21: the tracker was awake at midnight" in out
     assert "Warning" not in err
@@ -1004,3 +1005,13 @@ def _stuck_wind_days():
     wind[frame.index.hour >= 8] = 3.0
     wind[frame.index >= pd.Timestamp("2021-06-22", tz=frame.index.tz)] = 3.0
     return frame.assign(wind_speed=wind)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), [3.0, 3.0]])
+def test_a_carried_anemometer_judgement_must_be_one_finite_reading(value):
+    from hybridtrack.sky import synthetic
+
+    day = synthetic(SITE, "2021-06-21", weather="sunny", seed=1, freq="30min")
+    memory = {**simulate(day, SITE).memory, "anemometer_stuck_at": value}
+    with pytest.raises(HybridtrackError, match="anemometer_stuck_at must be one finite reading"):
+        simulate(synthetic(SITE, "2021-06-22", weather="sunny", seed=1, freq="30min"), SITE, warm_start=memory)

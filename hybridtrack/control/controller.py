@@ -663,7 +663,7 @@ class Controller:
             return
         sensor_ok = self.config.uses_sensor and all(valid)
         lost_for = t - self.invalid_since
-        if self.config.sensor_only:  # no sun model: a sensor faulty for `sensor_loss` hands over to the acquisition cells
+        if self.config.sensor_only:  # no sun model: a sensor faulty for `sensor_loss` hands over to the cells
             if mode == SEARCH and sensor_ok:
                 self._switch(i, SENSOR, "sun back in the sensor's view", t)
             elif mode == SENSOR and status in (STUCK, IMPLAUSIBLE) and lost_for >= self.loss:

@@ -1135,7 +1135,7 @@ def _choose_mode(cfg, state, log, i, t, status, valid, sky, true_sky):
     sensor_ok = cfg.uses_sensor and valid.all()
     faulty = status == STUCK or status == IMPLAUSIBLE or status == INVALID
     lost_for = t - state.s[INVALID_SINCE]
-    if cfg.sensor_only:  # no sun model: a sensor faulty for `sensor_loss` hands over to the acquisition cells
+    if cfg.sensor_only:  # no sun model: a sensor faulty for `sensor_loss` hands over to the cells
         if mode == SEARCH and sensor_ok:
             _switch(i, SENSOR, ev.SUN_BACK, 0.0, t, state, log)
         elif mode == SENSOR and (status == STUCK or status == IMPLAUSIBLE) and lost_for >= cfg.loss:
