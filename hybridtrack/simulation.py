@@ -684,17 +684,13 @@ class AnotherSiteWarning(UserWarning):
     """A weather frame made for one site (its ``attrs["site"]``) is run at another."""
 
 
-#: Degrees: a frame's site and the run's are one place when both coordinates agree within this
-#: (a built-in site passed as a `Site` of another name): 0.1° is some 10 km.
-SAME_PLACE = 0.1
-
 
 def warn_of_another_site(frame: pd.DataFrame, site) -> None:
     """Warn (`AnotherSiteWarning`) when `frame` says it was made for another site than `site`:
     its ``attrs["site"]`` (set by `hybridtrack.sky.synthetic` and `hybridtrack.io.read_weather`)
     names another place. Lanzhou's weather run at Nanjing had run without a word: its sun, light
     and wind are Lanzhou's, and only another time zone's index is refused (light at night). A
-    built-in site's name beside a `Site` at the same coordinates (within `SAME_PLACE`) is the same
+    built-in site's name beside a `Site` at the same coordinates (`sites.builtin_here`) is the same
     place; a site the run refuses is left to the run to refuse."""
     import warnings
 
@@ -705,9 +701,7 @@ def warn_of_another_site(frame: pd.DataFrame, site) -> None:
         return
     if not isinstance(made_for, str) or made_for.strip().lower() == runs_at.name.strip().lower():
         return
-    known = sites.BUILTIN.get(made_for.strip().lower())
-    if known is not None and abs(known.latitude - runs_at.latitude) <= SAME_PLACE \
-            and abs((known.longitude - runs_at.longitude + 180.0) % 360.0 - 180.0) <= SAME_PLACE:
+    if sites.builtin_here(made_for, runs_at) is not None:
         return
     warnings.warn(f"the weather frame was made for {made_for} (its attrs['site']) and runs at {runs_at.name}: "
                   f"its sun, light and wind are {made_for}'s; make or read the weather for {runs_at.name}",

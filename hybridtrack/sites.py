@@ -15,7 +15,7 @@ import numpy as np
 from .errors import HybridtrackError
 from .times import check_tz
 
-__all__ = ["Site", "get", "names", "custom", "check_place", "BUILTIN"]
+__all__ = ["Site", "get", "names", "custom", "check_place", "BUILTIN", "SAME_PLACE", "builtin_here"]
 
 
 @dataclass(frozen=True)
@@ -90,6 +90,22 @@ BUILTIN: dict[str, Site] = {
         Site("delingha", 37.352317, 97.803267, 2980.0, "Asia/Shanghai"),
     )
 }
+
+
+#: Degrees: two sites are one place when both coordinates agree within this (a built-in site
+#: passed as a `Site` of another name): 0.1° is some 10 km.
+SAME_PLACE = 0.1
+
+
+def builtin_here(name: str, site: Site) -> Site | None:
+    """The built-in site named `name` (any case, spaces trimmed) if `site` stands where it does
+    (within `SAME_PLACE`), else None: a custom site that borrows a built-in's name elsewhere is
+    not that place."""
+    known = BUILTIN.get(name.strip().lower())
+    if known is not None and abs(known.latitude - site.latitude) <= SAME_PLACE \
+            and abs((known.longitude - site.longitude + 180.0) % 360.0 - 180.0) <= SAME_PLACE:
+        return known
+    return None
 
 
 def names() -> list[str]:

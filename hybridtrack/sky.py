@@ -38,7 +38,7 @@ import pandas as pd
 from . import params
 from .budget import check_steps
 from .errors import HybridtrackError
-from .sites import Site, get
+from .sites import Site, builtin_here, get
 from .smoothing import one_pole
 from .times import clock_hours, local_midnight, local_range, parse_freq, stamp_minutes
 
@@ -139,8 +139,12 @@ CLIMATE = {
 
 
 def _climate_for(site: Site) -> Climate:
-    if site.name in CLIMATE:
-        return CLIMATE[site.name]
+    """The site's monthly normals where it is a built-in site with them (by name and place: a
+    custom site that borrows 'lanzhou' at Cape Town had been given Lanzhou's winter in a Cape Town
+    summer), else a generic mid-latitude default."""
+    known = builtin_here(site.name, site)
+    if known is not None and known.name in CLIMATE:
+        return CLIMATE[known.name]
     # a site without normals: a mid-latitude default, flagged in the frame's attrs
     return Climate((0.5,) * 12, tuple(15.0 - 10.0 * np.cos(2 * np.pi * (m - 0.5) / 12.0) *
                                       np.sign(site.latitude or 1.0) for m in range(1, 13)),

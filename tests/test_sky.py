@@ -211,3 +211,15 @@ def test_a_clear_sky_below_the_top_of_the_atmosphere_is_ineichens_to_the_bit():
     ghi, dni, dhi = clear_sky(index, site, zenith)
     for ours, theirs in zip((ghi, dni, dhi), (expected["ghi"], expected["dni"], expected["dhi"])):
         assert np.array_equal(ours[up], np.nan_to_num(np.asarray(theirs, float)))
+
+
+def test_a_custom_site_borrowing_a_built_in_name_elsewhere_gets_no_borrowed_climate():
+    """A Site named 'lanzhou' at Cape Town had been given Lanzhou's January (-10 to 3 °C) in a Cape
+    Town summer (helper-44); the built-in's name at its own place, in any case, keeps its normals."""
+    cape_town = sites.Site("lanzhou", -33.9, 18.4, 0, "Africa/Johannesburg")
+    borrowed = synthetic(cape_town, "2024-01-15", weather="climate", seed=1)
+    assert borrowed.attrs["climate_source"].startswith("generic")
+    assert borrowed["temp_air"].mean() > 15.0  # the generic southern summer
+    for same in (sites.get("lanzhou"), sites.Site("Lanzhou", 36.1, 103.7, 1520.0, "Asia/Shanghai")):
+        frame = synthetic(same, "2024-01-15", weather="climate", seed=1)
+        assert frame.attrs["climate_source"] == CLIMATE["lanzhou"].source
