@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextvars
 import dataclasses
 import functools
+import numbers
 import threading
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
@@ -1035,9 +1036,9 @@ def _check_memory_form(memory: dict) -> None:
                 refuse(f"{key} must be numbers, got {memory[key]!r:.40}")
     if "theta" in memory and not {"p", "information", "frozen", "updates"} <= set(memory):
         refuse("the mount fit's theta comes with its p, information, frozen and updates")
-    stuck = memory.get("anemometer_stuck_at")
-    if stuck is not None and not (np.ndim(stuck) == 0 and np.isfinite(np.asarray(stuck, float))):
-        refuse(f"anemometer_stuck_at must be one finite reading (m/s), got {stuck!r:.40}")
+    if "anemometer_stuck_at" in memory and not _anemometer_reading(memory["anemometer_stuck_at"]):
+        refuse(f"anemometer_stuck_at must be one anemometer reading ({READABLE[0]:g} to {READABLE[1]:g} m/s), got "
+               f"{memory['anemometer_stuck_at']!r:.40}")
     clock = memory.get("clock")
     if clock is not None and (not isinstance(clock, dict) or set(clock) != set(_CLOCK_KEYS)):
         refuse("clock must be the clock watch's readings, as a run leaves them")
@@ -1048,6 +1049,13 @@ def _check_memory_form(memory: dict) -> None:
                                or not isinstance(origin["geometry"], dict)
                                or not isinstance(origin["end"], pd.Timestamp) or origin["end"].tz is None):
         refuse("origin must say where and when the memory was left, as a run leaves it")
+
+
+def _anemometer_reading(value) -> bool:
+    """Whether `value` is one reading an anemometer can give (`hybridtrack.control.wind.READABLE`):
+    not a flag, text or None (None had raised a TypeError in the controller)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) \
+        and READABLE[0] <= value <= READABLE[1]
 
 
 def _check_origin(origin: dict | None, collector: Collector, site: sites.Site, start: pd.Timestamp) -> None:

@@ -45,3 +45,21 @@ def test_a_logger_on_standard_time_through_the_clock_change_is_refused_by_its_si
 def test_a_logger_on_the_zones_own_clock_through_the_change_follows_the_sun(tmp_path, start, end):
     frame = read_weather(_week(tmp_path, start, end, "local"), tz="Europe/Madrid", site=MADRID)
     assert frame.attrs["validation"]["sun_check"].startswith("light follows the sun at madrid (best shift 0")
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_correct_file_with_its_nights_left_out_is_not_taken_for_one_clock(tmp_path, seed):
+    """Without dark bins each side's shift is loose (the whole file sits near ±40 min): two sides
+    10 minutes apart across the tolerance had refused correct London files as a logger kept on
+    one clock, and told them to read as Etc/GMT (helper-46). A refusal needs the sides to differ
+    by the zone's own step."""
+    london = sites.custom(51.5, -0.12, "Europe/London", 100.0, "london")
+    frame = synthetic(london, "2021-10-24", "2021-11-06", weather="mixed", freq="10min", seed=seed)
+    frame = frame.loc[frame["ghi"] > 0, ["ghi", "dni", "dhi"]]  # a logger that records by day only
+    table = frame.copy()
+    table.index = [stamp.isoformat() for stamp in frame.index]
+    table.index.name = "time"
+    path = tmp_path / "london.csv"
+    table.to_csv(path, float_format="%.1f")
+    read = read_weather(path, site=london, tz="Europe/London")
+    assert read.attrs["validation"]["sun_check"].startswith("light follows the sun at london")

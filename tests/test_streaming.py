@@ -1007,11 +1007,11 @@ def _stuck_wind_days():
     return frame.assign(wind_speed=wind)
 
 
-@pytest.mark.parametrize("value", [float("nan"), float("inf"), [3.0, 3.0]])
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), [3.0, 3.0], None, True, "3.0", -5.0, 1e300])
 def test_a_carried_anemometer_judgement_must_be_one_finite_reading(value):
     from hybridtrack.sky import synthetic
 
     day = synthetic(SITE, "2021-06-21", weather="sunny", seed=1, freq="30min")
     memory = {**simulate(day, SITE).memory, "anemometer_stuck_at": value}
-    with pytest.raises(HybridtrackError, match="anemometer_stuck_at must be one finite reading"):
+    with pytest.raises(HybridtrackError, match="anemometer_stuck_at must be one anemometer reading"):
         simulate(synthetic(SITE, "2021-06-22", weather="sunny", seed=1, freq="30min"), SITE, warm_start=memory)

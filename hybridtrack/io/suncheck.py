@@ -191,8 +191,11 @@ SIDE_BINS = 144
 def _clock_change_check(path: Path, frame: pd.DataFrame, site, curve: str, header: str, tolerance: pd.Timedelta,
                         lenient: bool, report: dict) -> None:
     """Refuse (or, `lenient`, warn about in ``report["sun_check"]``) a file whose stamps change
-    their UTC offset (the zone's summer time) where one side fits the sun and another is off by
-    more than `tolerance`: a logger that kept one offset through the change."""
+    their UTC offset (the zone's summer time) where one side fits the sun, another is off by more
+    than `tolerance`, and the two sides' shifts differ by the change itself (`_kept_one_clock`): a
+    logger that kept one offset through the change. A file with its nights left out fits each
+    side loosely (no dark bin holds an edge of the day): its sides' shifts had differed by ten
+    minutes across the tolerance, and correct London files were refused."""
     if frame.index.tz is None:
         return
     sides = _offset_sides(frame.index)
@@ -203,15 +206,14 @@ def _clock_change_check(path: Path, frame: pd.DataFrame, site, curve: str, heade
         grid, light = _binned(frame.iloc[side], curve)
         if np.isfinite(light).sum() >= SIDE_BINS:
             judged.append((side, _best_shift(site, grid, light, symmetric=curve != "dni")[0]))
-    off = [(side, shift) for side, shift in judged if abs(shift) > tolerance]
-    if not off or len(off) == len(judged):
+    pair = _kept_one_clock(frame.index, judged, tolerance)
+    if pair is None:
         return
-    side, shift = off[0]
-    fitting = next(s for s, shifted in judged if abs(shifted) <= tolerance)
+    (side, shift), (fitting, _) = pair
     first = int(side[0])
     line = first_lines(frame, np.arange(len(frame)) == first)
     where = f"line {line[0]}, " if line else ""
-    fixed = _offset_text(frame.iloc[side], shift)
+    fixed = "UTC" + _offset_of(frame.index[int(fitting[0])])  # the clock the logger kept: the side that fits
     message = (f"{path}: {where}column {header!r}: the light fits the sun at {site.name} in the rows stamped "
                f"UTC{_offset_of(frame.index[int(fitting[0])])} and is {_signed(shift)} off in those stamped "
                f"UTC{_offset_of(frame.index[first])} (from {frame.index[first]}): the logger kept one clock through "
@@ -219,6 +221,21 @@ def _clock_change_check(path: Path, frame: pd.DataFrame, site, curve: str, heade
     if not lenient:
         raise HybridtrackError(message)
     report["sun_check"] = "WARNING: " + message.split(": ", 1)[1].removesuffix(", or --lenient to read it anyway")
+
+
+def _kept_one_clock(index: pd.DatetimeIndex, judged: list, tolerance: pd.Timedelta):
+    """Of the `judged` sides (positions, best shift), the first pair, (off, fitting), where one is
+    off by more than `tolerance`, the other within it, and their shifts differ by their offsets'
+    difference within two bins: the signature of stamps kept on one offset through the change.
+    None where no pair has it."""
+    for side, shift in judged:
+        if abs(shift) <= tolerance:
+            continue
+        for fitting, fit_shift in judged:
+            step = index[int(side[0])].utcoffset() - index[int(fitting[0])].utcoffset()
+            if abs(fit_shift) <= tolerance and abs(abs(shift - fit_shift) - abs(step)) <= 2 * BIN:
+                return (side, shift), (fitting, fit_shift)
+    return None
 
 
 def _offset_sides(index: pd.DatetimeIndex) -> list[np.ndarray]:
