@@ -1133,8 +1133,8 @@ def _awake_at_cut(days: list[dt.date]) -> dict:
     them: `AwakeAtMidnightWarning`): the controller's state and the collector restart at each cut,
     which a midnight at night stow hides and a midnight sun does not (the collector slews from stow)."""
     return {"count": len(days), "first": str(days[0]),
-            "why": "the tracker was awake at midnight (its computed sun up, or about to be): each such day restarted it from stow; "
-                   "run these days in memory (simulate) for an unbroken run"}
+            "why": "the tracker was awake at midnight (its computed sun up, or about to be): each such day "
+                   "restarted it from stow; run these days in memory (simulate) for an unbroken run"}
 
 
 #: The columns whose missing readings a streamed run counts (`KeptAsRead`).
