@@ -515,16 +515,22 @@ def _physical_column(frame: pd.DataFrame, column: str) -> None:
         _air_temperature(frame)
     if column not in NOT_LIGHT:
         return
-    array = values.to_numpy(float, na_value=np.nan)
-    with np.errstate(invalid="ignore"):
-        bad = np.flatnonzero(np.isinf(array) | (array > NOT_LIGHT[column]))
-    if len(bad):
-        value = array[bad[0]]
+    first = _first_wrong(frame, column, lambda light: np.isinf(light) | (light > NOT_LIGHT[column]))
+    if first is not None:
+        stamp, value = first
         why = "no reading (infinite)" if value == -np.inf else \
             f"not light (over {NOT_LIGHT[column]:,.0f}: a unit mixed up?)"  # -inf had been called "over 14,080"
-        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {value:g} "
-                               f"{_UNITS[column]} is {why}; read files with hybridtrack.io.read_weather, which flags "
-                               "and counts such values")
+        raise HybridtrackError(f"the weather frame's column {column!r} at {stamp}: {value:g} {_UNITS[column]} is "
+                               f"{why}; read files with hybridtrack.io.read_weather, which flags and counts such values")
+
+
+def _first_wrong(frame: pd.DataFrame, column: str, wrong) -> tuple[pd.Timestamp, float] | None:
+    """The stamp and value of `column`'s first row where `wrong` (of the column's values as floats,
+    NaN for a missing one) holds, or None."""
+    array = frame[column].to_numpy(float, na_value=np.nan)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(wrong(array))
+    return (frame.index[bad[0]], array[bad[0]]) if len(bad) else None
 
 
 def _air_temperature(frame: pd.DataFrame) -> None:
@@ -535,13 +541,11 @@ def _air_temperature(frame: pd.DataFrame) -> None:
     from .io.checks import LIMITS
 
     low, high = LIMITS["temp_air"]
-    array = frame["temp_air"].to_numpy(float, na_value=np.nan)
-    with np.errstate(invalid="ignore"):
-        bad = np.flatnonzero(np.isinf(array) | (array < low) | (array > high))
-    if len(bad):
-        value = array[bad[0]]
+    first = _first_wrong(frame, "temp_air", lambda air: np.isinf(air) | (air < low) | (air > high))
+    if first is not None:
+        stamp, value = first
         why = "no reading (infinite)" if np.isinf(value) else f"no air's (outside [{low:g}, {high:g}] °C: kelvins?)"
-        raise HybridtrackError(f"the weather frame's column 'temp_air' at {frame.index[bad[0]]}: {value:g} °C is {why}; "
+        raise HybridtrackError(f"the weather frame's column 'temp_air' at {stamp}: {value:g} °C is {why}; "
                                "read files with hybridtrack.io.read_weather, which flags and counts such values")
 
 
@@ -553,12 +557,10 @@ POINTING_LIMIT = 90.0
 def _pointing_column(frame: pd.DataFrame, column: str) -> None:
     """Refuse a recorded pointing signal (degrees off the sun) that is infinite or past
     `POINTING_LIMIT`: inf and 500° had been taken as readings."""
-    array = frame[column].to_numpy(float, na_value=np.nan)
-    with np.errstate(invalid="ignore"):
-        bad = np.flatnonzero(np.isinf(array) | (np.abs(array) > POINTING_LIMIT))
-    if len(bad):
-        raise HybridtrackError(f"the weather frame's column {column!r} at {frame.index[bad[0]]}: {array[bad[0]]:g}° "
-                               f"is no sun sensor's offset (beyond ±{POINTING_LIMIT:g}°: milliradians, or arcminutes?)")
+    first = _first_wrong(frame, column, lambda offset: np.isinf(offset) | (np.abs(offset) > POINTING_LIMIT))
+    if first is not None:
+        raise HybridtrackError(f"the weather frame's column {column!r} at {first[0]}: {first[1]:g}° is no sun "
+                               f"sensor's offset (beyond ±{POINTING_LIMIT:g}°: milliradians, or arcminutes?)")
 
 
 def checked_config(config) -> SimulationConfig:
