@@ -521,6 +521,4 @@ def refuse_repairs(path: Path, report: dict) -> None:
         if "lines" in entry:
             raise HybridtrackError(f"{path}: line {entry['lines'][0]}: {what} (strict)")
         column, detail = next(iter(entry.items()))
-        header = report.get("columns", {}).get(column, column)
-        where = f"line {detail['lines'][0]}, " if "lines" in detail else ""
-        raise HybridtrackError(f"{path}: {where}column {header!r}: {what} (strict)")
+        raise HybridtrackError(f"{place(path, report, column, detail.get('lines', []))}: {what} (strict)")

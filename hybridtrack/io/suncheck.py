@@ -36,7 +36,7 @@ import pandas as pd
 
 from ..errors import HybridtrackError
 from ..sky import LIGHT_AT_NIGHT
-from .checks import first_lines, span
+from .checks import first_lines, place, span
 
 __all__ = ["sun_check", "place_check", "meta_name", "LIGHT", "BIN", "FAR"]
 
@@ -103,10 +103,13 @@ def _night_light(site, frame: pd.DataFrame, name: str, window: pd.Timedelta) -> 
 
 def _offset_text(frame: pd.DataFrame, shift: pd.Timedelta) -> str:
     """The UTC offset the stamps would have if the light is right: theirs minus the shift."""
-    offset = frame.index[len(frame) // 2].utcoffset() - shift
+    return _utc(frame.index[len(frame) // 2].utcoffset() - shift)
+
+
+def _utc(offset: pd.Timedelta) -> str:
+    """A UTC offset as ``UTC+01:00``, to the minute."""
     minutes = int(round(offset / pd.Timedelta(minutes=1)))
-    sign = "+" if minutes >= 0 else "-"
-    return f"UTC{sign}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"
+    return f"UTC{'+' if minutes >= 0 else '-'}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"
 
 
 def _fits(frame: pd.DataFrame, site, shift: pd.Timedelta) -> str:
@@ -121,13 +124,12 @@ def _signed(shift: pd.Timedelta) -> str:
     return ("+" if shift >= pd.Timedelta(0) else "-") + span(abs(shift)) if shift != pd.Timedelta(0) else "0"
 
 
-def _mismatch(path: Path, frame: pd.DataFrame, site, name: str, header: str, night: np.ndarray,
+def _mismatch(path: Path, frame: pd.DataFrame, site, name: str, report: dict, night: np.ndarray,
               shift: pd.Timedelta | None, lenient: bool) -> str:
     """The one-line message: the first row of light at night (or the brightest), and the shift that fits."""
     values = frame[name].to_numpy(float)
     row = int(np.flatnonzero(night)[0]) if night.any() else int(np.nanargmax(values))
-    line = first_lines(frame, np.arange(len(frame)) == row)
-    where = f"line {line[0]}, " if line else ""
+    where = place(path, report, name, first_lines(frame, np.arange(len(frame)) == row))
     lit = int((values > LIGHT).sum())
     if night.any():
         what = (f"{night.sum()} of {lit} lit rows have {name} while the sun is down, the first {values[row]:g} W/m² "
@@ -136,7 +138,7 @@ def _mismatch(path: Path, frame: pd.DataFrame, site, name: str, header: str, nig
         what = f"the daily light curve is offset from the sun, e.g. {values[row]:g} W/m² at {frame.index[row]}"
     fits = _fits(frame, site, shift) if shift is not None else "no shift of the sun explains it"
     ask = "" if lenient else ", or --lenient to read it anyway"
-    return (f"{path}: {where}column {header!r}: {what}; {fits}{'' if fits.endswith('?') else '.'} Give the file's "
+    return (f"{where}: {what}; {fits}{'' if fits.endswith('?') else '.'} Give the file's "
             f"time zone (--tz) or the right site{ask}")
 
 
@@ -165,21 +167,20 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
     tolerance = max(pd.Timedelta(minutes=45), pd.Timedelta(report.get("step", "1min")))
     shift, disagree = _best_shift(site, *_binned(frame, curve), symmetric=curve != "dni")
     night = _night_light(site, frame, name, tolerance)
-    header = report.get("columns", {}).get(name, name)
     offset_wrong = abs(shift) > tolerance
     if not offset_wrong:
-        _clock_change_check(path, frame, site, curve, header, tolerance, lenient, report)
+        _clock_change_check(path, frame, site, name, curve, tolerance, lenient, report)
         if "sun_check" in report:
             return
     if offset_wrong or night.sum() > max(3, 0.02 * (frame[name].to_numpy(float) > LIGHT).sum()):
-        message = _mismatch(path, frame, site, name, header, night, shift if offset_wrong else None, lenient)
+        message = _mismatch(path, frame, site, name, report, night, shift if offset_wrong else None, lenient)
         if not lenient:
             raise HybridtrackError(message)
         report["sun_check"] = "WARNING: " + message.split(": ", 1)[1]
         return
     if night.any():
         report["light_at_night"] = {"count": int(night.sum()), "lines": first_lines(frame, night),
-                                    "column": header, "action": "kept"}
+                                    "column": report.get("columns", {}).get(name, name), "action": "kept"}
     report["sun_check"] = (f"light follows the sun at {site.name} (best shift {_signed(shift)}, {disagree:.1%} of "
                            "bins disagree)")
 
@@ -188,7 +189,7 @@ def sun_check(path: Path, frame: pd.DataFrame, site, report: dict, *, lenient: b
 SIDE_BINS = 144
 
 
-def _clock_change_check(path: Path, frame: pd.DataFrame, site, curve: str, header: str, tolerance: pd.Timedelta,
+def _clock_change_check(path: Path, frame: pd.DataFrame, site, name: str, curve: str, tolerance: pd.Timedelta,
                         lenient: bool, report: dict) -> None:
     """Refuse (or, `lenient`, warn about in ``report["sun_check"]``) a file whose stamps change
     their UTC offset (the zone's summer time) where one side fits the sun, another is off by more
@@ -211,13 +212,12 @@ def _clock_change_check(path: Path, frame: pd.DataFrame, site, curve: str, heade
         return
     (side, shift), (fitting, _) = pair
     first = int(side[0])
-    line = first_lines(frame, np.arange(len(frame)) == first)
-    where = f"line {line[0]}, " if line else ""
-    fixed = "UTC" + _offset_of(frame.index[int(fitting[0])])  # the clock the logger kept: the side that fits
-    message = (f"{path}: {where}column {header!r}: the light fits the sun at {site.name} in the rows stamped "
-               f"UTC{_offset_of(frame.index[int(fitting[0])])} and is {_signed(shift)} off in those stamped "
-               f"UTC{_offset_of(frame.index[first])} (from {frame.index[first]}): the logger kept one clock through "
-               f"the zone's change? Give its fixed zone ({_fixed_zone(fixed)}), or --lenient to read it anyway")
+    kept = frame.index[int(fitting[0])].utcoffset()  # the clock the logger kept: the side that fits
+    where = place(path, report, name, first_lines(frame, np.arange(len(frame)) == first))
+    message = (f"{where}: the light fits the sun at {site.name} in the rows stamped {_utc(kept)} and is "
+               f"{_signed(shift)} off in those stamped {_utc(frame.index[first].utcoffset())} (from "
+               f"{frame.index[first]}): the logger kept one clock through the zone's change? Give its fixed zone "
+               f"({_fixed_zone(kept)}), or --lenient to read it anyway")
     if not lenient:
         raise HybridtrackError(message)
     report["sun_check"] = "WARNING: " + message.split(": ", 1)[1].removesuffix(", or --lenient to read it anyway")
@@ -244,18 +244,13 @@ def _offset_sides(index: pd.DatetimeIndex) -> list[np.ndarray]:
     return np.split(np.arange(len(index)), np.flatnonzero(np.diff(offsets)) + 1)
 
 
-def _offset_of(stamp: pd.Timestamp) -> str:
-    minutes = int(round(stamp.utcoffset() / pd.Timedelta(minutes=1)))
-    return f"{'+' if minutes >= 0 else '-'}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"
-
-
-def _fixed_zone(offset_text: str) -> str:
-    """An IANA zone of the fixed offset `offset_text` (``UTC+01:00`` -> ``--tz Etc/GMT-1``: the
-    Etc zones' signs are POSIX's, reversed), or the offset itself where no Etc zone has it."""
-    sign, hours, minutes = offset_text[3], int(offset_text[4:6]), int(offset_text[7:9])
-    if minutes:
-        return f"stamps in {offset_text}"
-    return "--tz Etc/GMT" + ("" if not hours else f"{'-' if sign == '+' else '+'}{hours}")
+def _fixed_zone(offset: pd.Timedelta) -> str:
+    """An IANA zone of the fixed UTC `offset` (+1 h -> ``--tz Etc/GMT-1``: the Etc zones' signs are
+    POSIX's, reversed), or the offset itself where no Etc zone has it (a half hour)."""
+    minutes = int(round(offset / pd.Timedelta(minutes=1)))
+    if minutes % 60:
+        return f"stamps in {_utc(offset)}"
+    return "--tz Etc/GMT" + (f"{-minutes // 60:+d}" if minutes else "")
 
 
 def _distance(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
